@@ -1,0 +1,222 @@
+"""Reading and writing topographies.
+
+Native formats: ``.npz`` (fem_twin format with pitch, origin, mask and metadata), ``.npy``
+(heights only), ASCII matrices (``.txt``, ``.asc``, ``.csv``) and XYZ point lists
+(``.xyz``).  Instrument formats (FRT ``.frt``, Sensofar ``.plu``, Gwyddion ``.gwy``,
+ISO 25178 ``.x3p``, Digital Surf ``.sur``, Zygo, Wyko, Alicona, ...) are read through the
+maintained SurfaceTopography library (optional extra ``fem-twin[instruments]``).
+Everything is converted to metres on reading.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import re
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from ..topography.core import Topography
+from .atomic import atomic_path
+
+FORMAT = "fem_twin.topography/1"
+ASCII_SUFFIXES = {".txt", ".asc", ".csv", ".xyz"}
+#: Length units as they appear in instrument files, in metres.
+UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9,
+         "Å": 1e-10, "A": 1e-10, "pm": 1e-12}
+#: Fixed zip timestamp so that writing the same topography twice gives identical bytes.
+_ZIP_DATE = (1980, 1, 1, 0, 0, 0)
+
+
+class TopographyFileError(ValueError):
+    """A file that cannot be read as a topography (unknown format, corrupt, no data)."""
+
+
+def read_topography(path, *, spacing=None, unit: str = "m") -> Topography:
+    """Read a topography from ``path`` and return it in SI units.
+
+    Parameters
+    ----------
+    path : str or Path
+    spacing : float or (dx1, dx2), optional
+        Pixel pitch [m] for formats that do not store it (``.npy``, plain matrices).
+    unit : str
+        Unit of heights and coordinates in plain ASCII/``.npy`` files (``m``, ``mm``,
+        ``um``, ``nm``); instrument files carry their own units.
+
+    Raises
+    ------
+    TopographyFileError
+        Unknown or corrupt file, or one without valid data.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such topography file: {path}")
+    if unit not in UNITS:
+        raise ValueError(f"unknown unit {unit!r}; use one of {sorted(UNITS)}")
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".npz":
+            return _read_npz(path, spacing, UNITS[unit])
+        if suffix == ".npy":
+            return _read_npy(path, spacing, UNITS[unit])
+        if suffix in ASCII_SUFFIXES:
+            return _read_ascii(path, spacing, UNITS[unit])
+        return _read_instrument(path, spacing)
+    except TopographyFileError:
+        raise
+    except (ValueError, OSError, KeyError, EOFError, zipfile.BadZipFile) as err:
+        raise TopographyFileError(f"cannot read topography from {path}: {err}") from err
+
+
+def write_topography(path, topo: Topography, *, height_scale: float | None = None) -> Path:
+    """Write ``topo`` atomically; the format follows the suffix (.npz, .npy, .txt, .xyz).
+
+    For ``.npz``, ``height_scale`` [m] stores heights as int32 multiples of that quantum
+    (as instruments do), which makes files smaller; rounding error <= height_scale / 2.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    with atomic_path(path) as tmp:
+        if suffix == ".npz":
+            _write_npz(tmp, topo, height_scale)
+        elif suffix == ".npy":
+            np.save(tmp, topo.heights)
+        elif suffix in {".txt", ".asc", ".csv"}:
+            np.savetxt(tmp, topo.heights, header=_ascii_header(topo),
+                       delimiter="," if suffix == ".csv" else " ")
+        elif suffix == ".xyz":
+            x1, x2 = topo.coordinates()
+            np.savetxt(tmp, np.column_stack([x1.ravel(), x2.ravel(), topo.heights.ravel()]),
+                       header=_ascii_header(topo))
+        else:
+            raise ValueError(f"cannot write {suffix!r}; use .npz, .npy, .txt, .csv or .xyz")
+    return path
+
+
+# -- native formats ----------------------------------------------------------------------
+def _write_npz(path: Path, topo: Topography, height_scale):
+    arrays = {"format": np.array(FORMAT), "spacing": np.array(topo.spacing),
+              "origin": np.array(topo.origin), "meta": np.array(json.dumps(topo.meta))}
+    if height_scale is None:
+        arrays["heights"] = topo.heights
+    else:
+        q = np.round(np.nan_to_num(topo.heights) / height_scale)
+        if np.abs(q).max() >= 2 ** 31:
+            raise ValueError("height_scale too small for int32 storage")
+        arrays["heights"] = q.astype(np.int32)
+        arrays["height_scale"] = np.array(float(height_scale))
+    if topo.mask is not None:
+        arrays["mask"] = topo.mask
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+        for name, arr in arrays.items():
+            buf = io.BytesIO()
+            np.lib.format.write_array(buf, np.asarray(arr), allow_pickle=False)
+            info = zipfile.ZipInfo(f"{name}.npy", date_time=_ZIP_DATE)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            zf.writestr(info, buf.getvalue())
+
+
+def _read_npz(path: Path, spacing, scale) -> Topography:
+    with np.load(path, allow_pickle=False) as data:
+        if "heights" not in data:
+            raise TopographyFileError(f"{path}: .npz has no 'heights' array "
+                                      f"(found {sorted(data.files)})")
+        if "format" in data and str(data["format"]) == FORMAT:
+            h = data["heights"].astype(float)
+            if "height_scale" in data:
+                h = h * float(data["height_scale"])
+            mask = data["mask"] if "mask" in data else None
+            return Topography(h, tuple(data["spacing"]), mask=mask,
+                              origin=tuple(data["origin"]), meta=json.loads(str(data["meta"])))
+        # a plain .npz with heights (and possibly spacing) in ``unit``
+        sp = data["spacing"] * scale if "spacing" in data else _need_spacing(path, spacing)
+        return Topography(data["heights"] * scale, sp, meta={"source": str(path)})
+
+
+def _read_npy(path: Path, spacing, scale) -> Topography:
+    h = np.load(path, allow_pickle=False)
+    if not np.issubdtype(h.dtype, np.number):
+        raise TopographyFileError(f"{path}: .npy holds {h.dtype}, not numbers")
+    return Topography(h * scale, _need_spacing(path, spacing), meta={"source": str(path)})
+
+
+def _ascii_header(topo: Topography) -> str:
+    return (f"fem_twin topography; unit = m; spacing = {topo.spacing[0]!r} {topo.spacing[1]!r};"
+            f" origin = {topo.origin[0]!r} {topo.origin[1]!r}")
+
+
+def _read_ascii(path: Path, spacing, scale) -> Topography:
+    text = path.read_text(errors="strict")
+    header = re.search(r"spacing = (\S+) (\S+); origin = (\S+) (\S+)", text)
+    data = np.loadtxt(io.StringIO(text), delimiter="," if path.suffix.lower() == ".csv" else None,
+                      ndmin=2)
+    if data.size == 0:
+        raise TopographyFileError(f"{path}: no numbers in file")
+    if path.suffix.lower() == ".xyz":
+        return _grid_from_xyz(path, data, scale)
+    if header:
+        sp, origin = (float(header[1]), float(header[2])), (float(header[3]), float(header[4]))
+        return Topography(data, sp, origin=origin, meta={"source": str(path)})
+    return Topography(data * scale, _need_spacing(path, spacing), meta={"source": str(path)})
+
+
+def _grid_from_xyz(path: Path, data: np.ndarray, scale) -> Topography:
+    if data.shape[1] != 3:
+        raise TopographyFileError(f"{path}: XYZ needs 3 columns, found {data.shape[1]}")
+    x, y, z = (data * scale).T
+    ux, uy = np.unique(x), np.unique(y)
+    if ux.size * uy.size != z.size or ux.size < 2 or uy.size < 2:
+        raise TopographyFileError(f"{path}: XYZ points do not form a full regular grid "
+                                  f"({ux.size} x {uy.size} coordinates for {z.size} points)")
+    dx, dy = np.diff(ux), np.diff(uy)
+    if np.ptp(dx) > 1e-6 * dx.mean() or np.ptp(dy) > 1e-6 * dy.mean():
+        raise TopographyFileError(f"{path}: XYZ grid is not evenly spaced")
+    heights = np.full((uy.size, ux.size), np.nan)
+    heights[np.searchsorted(uy, y), np.searchsorted(ux, x)] = z
+    return Topography(heights, (dx.mean(), dy.mean()), origin=(ux[0], uy[0]),
+                      meta={"source": str(path)})
+
+
+def _need_spacing(path: Path, spacing):
+    if spacing is None:
+        raise TopographyFileError(f"{path}: this format does not store the pixel pitch; "
+                                  "pass spacing=(dx1, dx2) in metres")
+    return spacing
+
+
+# -- instrument formats via SurfaceTopography ----------------------------------------------
+def _read_instrument(path: Path, spacing) -> Topography:
+    try:
+        from SurfaceTopography import open_topography
+        from SurfaceTopography.Exceptions import CannotDetectFileFormat, CorruptFile, ReadFileError
+    except ImportError as err:  # pragma: no cover - depends on the installation
+        raise TopographyFileError(
+            f"{path}: reading instrument files needs SurfaceTopography; "
+            "install it with  pip install 'fem-twin[instruments]'") from err
+    try:
+        reader = open_topography(str(path))
+        kwargs = {}
+        if reader.default_channel.physical_sizes is None:
+            sp = np.broadcast_to(np.asarray(_need_spacing(path, spacing), float), (2,))
+            kwargs["physical_sizes"] = tuple(sp * reader.default_channel.nb_grid_pts)
+        t = reader.topography(**kwargs)
+    except CannotDetectFileFormat as err:
+        raise TopographyFileError(f"{path}: not a topography file in any known format "
+                                  "(unknown or corrupt)") from err
+    except (CorruptFile, ReadFileError) as err:
+        raise TopographyFileError(f"{path}: corrupt instrument file: {err}") from err
+    if t.dim != 2:
+        raise TopographyFileError(f"{path}: holds a {t.dim}D line scan, not a 2D map")
+    unit = t.unit
+    if unit not in UNITS:
+        raise TopographyFileError(f"{path}: unsupported length unit {unit!r} in file")
+    s = UNITS[unit]
+    h = t.heights()
+    h = np.ma.filled(np.ma.asarray(h, dtype=float), np.nan).T   # (nx, ny) -> (ny, nx)
+    nx, ny = t.nb_grid_pts
+    sx, sy = t.physical_sizes
+    meta = {"source": str(path), "reader": type(reader).__name__, "file_unit": unit}
+    return Topography(h * s, (sx * s / nx, sy * s / ny), meta=meta)

@@ -1,0 +1,46 @@
+"""Resampling of a topography to a new resolution (paper 2.2.1 and section 3.2)."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.ndimage as ndi
+
+from .core import Topography
+
+_ORDER = {"nearest": 0, "linear": 1, "cubic": 3}
+
+
+def resample(topo: Topography, shape: tuple[int, int], method: str = "linear") -> Topography:
+    """Interpolate onto a ``shape = (ny, nx)`` grid spanning the same first and last pixels.
+
+    The new pitch is ``(n - 1) / (m - 1)`` times the old one, so a refinement with
+    ``m - 1 = k (n - 1)`` (e.g. 500 -> 999 or 1997 pixels) contains every original point
+    unchanged and adds ``k - 1`` points in between.  ``method`` is ``"linear"`` (default,
+    like MATLAB's interp2), ``"cubic"`` (interpolating spline) or ``"nearest"``.
+    """
+    if method not in _ORDER:
+        raise ValueError(f"method must be one of {sorted(_ORDER)}, got {method!r}")
+    if topo.mask is not None:
+        raise ValueError("resample needs a fully valid topography: call fill_defects first")
+    ny, nx = (int(v) for v in shape)
+    if ny < 2 or nx < 2:
+        raise ValueError(f"target shape must be at least 2 x 2, got {shape}")
+    oy, ox = topo.shape
+    # exact rational positions: i (n-1) / (m-1) is an integer whenever the refinement is exact
+    pos2 = np.arange(ny) * (oy - 1) / (ny - 1)
+    pos1 = np.arange(nx) * (ox - 1) / (nx - 1)
+    p2, p1 = np.meshgrid(pos2, pos1, indexing="ij")
+    order = _ORDER[method]
+    new = ndi.map_coordinates(topo.heights, [p2, p1], order=order, mode="nearest",
+                              prefilter=order > 1)
+    spacing = (topo.spacing[0] * (ox - 1) / (nx - 1), topo.spacing[1] * (oy - 1) / (ny - 1))
+    return topo.with_heights(new, spacing=spacing,
+                             meta=topo.with_history(f"resample({ny}x{nx}, {method})"))
+
+
+def refine(topo: Topography, factor: int, method: str = "linear") -> Topography:
+    """Insert ``factor - 1`` points between neighbours: ``n -> factor (n - 1) + 1`` pixels."""
+    if int(factor) != factor or factor < 1:
+        raise ValueError(f"refinement factor must be a positive integer, got {factor}")
+    ny, nx = topo.shape
+    return resample(topo, (factor * (ny - 1) + 1, factor * (nx - 1) + 1), method)
