@@ -115,8 +115,8 @@ def worn_disk(seed: int, k: int) -> Topography:
     depth = rng.uniform(0.15e-6, 0.3e-6)
     track = -depth * 0.5 * (1 - np.tanh((dist - 3.6e-3) / 0.15e-3))
     lam = rng.uniform(20e-3, 40e-3, size=2)
-    wave = 0.35e-6 * np.sin(2 * np.pi * X1 / lam[0] + rng.uniform(0, 2 * np.pi)) \
-        + 0.25e-6 * np.sin(2 * np.pi * X2 / lam[1] + rng.uniform(0, 2 * np.pi))
+    wave = 0.2e-6 * np.sin(2 * np.pi * X1 / lam[0] + rng.uniform(0, 2 * np.pi)) \
+        + 0.1e-6 * np.sin(2 * np.pi * X2 / lam[1] + rng.uniform(0, 2 * np.pi))
     rough = self_affine(MACRO_SHAPE, dx, 0.8, 0.08e-6, rolloff_wavelength=0.2e-3, rng=rng).heights
     tilt = rng.uniform(-3e-4, 3e-4, size=2)
     z = track + wave + rough + 10e-9 * rng.standard_normal(MACRO_SHAPE)

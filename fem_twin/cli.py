@@ -1,0 +1,204 @@
+"""Command line: ``fem-twin STAGE ...``, one subcommand per pipeline stage."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import sys
+from pathlib import Path
+
+DEFAULT_CASE = Path("examples/pin_on_disk.toml")
+
+#: topography steps: name -> (help, function building the step from parsed arguments)
+_STEPS = {
+    "info": "print grid, pitch, Sq and invalid pixels",
+    "convert": "rewrite in another format (by suffix: .npz .npy .txt .csv .xyz)",
+    "fill": "fill invalid pixels by the Laplace equation",
+    "level": "subtract the mean plane (optionally within --radius of --centre)",
+    "clip": "limit heights to [--lower, --upper] m",
+    "filter": "Gaussian filter with FWHM --fwhm pixels",
+    "resample": "interpolate to --shape NY NX pixels",
+    "refine": "insert points between originals (500 -> 999 with --factor 2)",
+    "patch": "cut a --shape NY NX patch at --start ROW COL (no interpolation)",
+    "align": "rotate so that --direction becomes x1 (sliding velocity)",
+    "flip": "flip a disk over the pin (about x1)",
+    "mount": "pin in its holder: below --truncation becomes the holder at --holder m",
+    "prepare-pin": "whole pin chain: fill, level, clip, filter, resample, centre, mount",
+    "prepare-disk": "whole disk chain: fill, level, clip, filter, resample, centre, flip",
+    "prepare-patch": "whole roughness-patch chain: fill, level, patch (, flip with --upper)",
+}
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
+                        format="%(levelname)s %(name)s: %(message)s")
+    try:
+        return args.func(args) or 0
+    except (ValueError, FileNotFoundError) as err:
+        print(f"fem-twin {args.command}: error: {err}", file=sys.stderr)
+        return 2
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+    p = argparse.ArgumentParser(
+        prog="fem-twin",
+        description="Digital twin of a pin-on-disk tribometer in mixed lubrication. "
+                    "Stages: topography -> (contact -> homogenise -> macro -> stribeck); "
+                    "'run' executes the whole pipeline of a case file.")
+    p.add_argument("--version", action="version", version=f"fem-twin {__version__}")
+    p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    sub = p.add_subparsers(dest="command", required=True, metavar="STAGE")
+
+    r = sub.add_parser("run", help="run the pipeline of a case file (TOML) into an output folder")
+    r.add_argument("case", nargs="?", type=Path, default=DEFAULT_CASE,
+                   help=f"case file (default: {DEFAULT_CASE})")
+    r.add_argument("-o", "--output", type=Path, default=Path("out"), help="output folder")
+    r.add_argument("--no-progress", action="store_true", help="no progress bars")
+    r.set_defaults(func=_run)
+
+    t = sub.add_parser("topography", help="read and pre-process measured topographies")
+    steps = t.add_subparsers(dest="step", required=True, metavar="STEP")
+    for name, text in _STEPS.items():
+        s = steps.add_parser(name, help=text, description=text)
+        s.add_argument("input", type=Path)
+        if name != "info":
+            s.add_argument("output", type=Path)
+        s.add_argument("--spacing", type=float, nargs="+", metavar="M",
+                       help="pixel pitch [m] for files that do not store it")
+        s.add_argument("--unit", default="m", help="unit of plain ASCII/.npy files")
+        _step_options(name, s)
+        s.set_defaults(func=_topography)
+
+    m = sub.add_parser("mesh", help="topography -> structured FE mesh written as VTU for ParaView")
+    m.add_argument("input", type=Path)
+    m.add_argument("output", type=Path, help="VTU file")
+    m.add_argument("--periodic", action="store_true", help="periodic mesh (roughness patch)")
+    m.add_argument("--kind", choices=("quad", "tri"), default="quad")
+    m.add_argument("--spacing", type=float, nargs="+", metavar="M")
+    m.set_defaults(func=_mesh)
+
+    g = sub.add_parser("sample", help="regenerate the bundled sample twin (seeded)")
+    g.add_argument("-o", "--output", type=Path, default=Path("meshes/sample"))
+    g.set_defaults(func=_sample)
+    return p
+
+
+def _step_options(name, s):
+    if name == "level":
+        s.add_argument("--radius", type=float, help="fit only within this radius [m]")
+        s.add_argument("--centre", type=float, nargs=2, default=(0.0, 0.0), metavar=("X1", "X2"))
+    elif name == "clip":
+        s.add_argument("--lower", type=float, default=-20e-6)
+        s.add_argument("--upper", type=float, default=20e-6)
+    elif name == "filter":
+        s.add_argument("--fwhm", type=float, required=True, help="FWHM in pixels")
+    elif name in ("resample", "patch", "prepare-patch"):
+        s.add_argument("--shape", type=int, nargs=2, metavar=("NY", "NX"),
+                       required=name == "resample", default=(256, 256))
+        if name != "resample":
+            s.add_argument("--start", type=int, nargs=2, default=(0, 0), metavar=("ROW", "COL"))
+        s.add_argument("--method", choices=("linear", "cubic", "nearest"), default="linear")
+        if name == "prepare-patch":
+            s.add_argument("--upper", action="store_true", help="disk patch: flip above the pin")
+    elif name == "refine":
+        s.add_argument("--factor", type=int, required=True)
+        s.add_argument("--method", choices=("linear", "cubic"), default="linear")
+    elif name == "align":
+        s.add_argument("--direction", choices=("+x1", "-x1", "+x2", "-x2"), required=True)
+    elif name == "mount":
+        s.add_argument("--truncation", type=float, default=-20e-6)
+        s.add_argument("--holder", type=float, default=-1e-3)
+    elif name in ("prepare-pin", "prepare-disk"):
+        s.add_argument("--fwhm", type=float, default=9.0)
+        s.add_argument("--resolution", type=int, nargs=2, default=(256, 256))
+        s.add_argument("--clip", type=float, default=20e-6)
+
+
+def _read(args):
+    from .io.files import read_topography
+    return read_topography(args.input, spacing=args.spacing, unit=args.unit)
+
+
+def _topography(args):
+    from . import topography as tp
+    from .io.files import write_topography
+    from .topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
+    topo = _read(args)
+    step = args.step
+    if step == "info":
+        ny, nx = topo.shape
+        inval = 0 if topo.mask is None else int((~topo.mask).sum())
+        print(json.dumps({"file": str(args.input), "grid": [ny, nx], "spacing_m": topo.spacing,
+                          "size_m": topo.size, "sq_m": topo.rms_height(),
+                          "invalid_pixels": inval, "meta": topo.meta}, indent=2, default=str))
+        return 0
+    if step == "convert":
+        out = topo
+    elif step == "fill":
+        out = tp.fill_defects(topo)
+    elif step == "level":
+        mask = None if args.radius is None else tp.radial_mask(topo, args.radius, args.centre)
+        out = tp.level(topo, mask)
+    elif step == "clip":
+        out = tp.clip_heights(topo, args.lower, args.upper)
+    elif step == "filter":
+        out = tp.gaussian_filter(topo, args.fwhm)
+    elif step == "resample":
+        out = tp.resample(topo, args.shape, args.method)
+    elif step == "refine":
+        out = tp.refine(topo, args.factor, args.method)
+    elif step == "patch":
+        out = tp.extract_patch(topo, args.shape, args.start)
+    elif step == "align":
+        out = tp.align_sliding(topo, args.direction)
+    elif step == "flip":
+        out = tp.flip_disk(topo)
+    elif step == "mount":
+        out = tp.mount_pin(topo, args.truncation, args.holder)
+    elif step in ("prepare-pin", "prepare-disk"):
+        opts = MacroOptions(fwhm_px=args.fwhm, resolution=tuple(args.resolution), clip=args.clip)
+        out = (prepare_pin if step == "prepare-pin" else prepare_disk)(topo, opts)
+    else:  # prepare-patch
+        out = prepare_patch(topo, args.shape, args.start, upper=args.upper)
+    write_topography(args.output, out)
+    print(f"{args.output}: {out!r}")
+    return 0
+
+
+def _mesh(args):
+    from .io.files import read_topography
+    from .io.mesh import grid_mesh, write_vtu
+    topo = read_topography(args.input, spacing=args.spacing)
+    gm = grid_mesh(topo.shape, topo.spacing, topo.origin, periodic=args.periodic, kind=args.kind)
+    fields = {"height": topo.heights, "valid": topo.valid.astype(float)}
+    write_vtu(args.output, gm, fields)
+    print(f"{args.output}: {gm.mesh.nvertices} nodes, {gm.mesh.nelements} {args.kind} elements")
+    return 0
+
+
+def _sample(args):
+    from . import samples
+    for path in samples.generate(args.output):
+        print(path)
+    return 0
+
+
+def _run(args):
+    from .case import load_case
+    from .pipeline import run
+    if not args.case.is_file():
+        raise FileNotFoundError(f"case file not found: {args.case} (give the case file as "
+                                "the first argument)")
+    case = load_case(args.case)
+    summary = run(case, args.output, progress=not args.no_progress)
+    print(json.dumps(summary, indent=2))
+    print(f"results in {args.output}/")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

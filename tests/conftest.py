@@ -1,0 +1,17 @@
+"""Shared fixtures: paths to the repository's sample twin and the shared instrument files."""
+
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLE = ROOT / "meshes" / "sample"
+SHARED_TOPOGRAPHIES = ROOT.parent / "shared" / "topographies"
+
+
+@pytest.fixture
+def shared_topographies():
+    """The measured instrument files beside the project (absent in a user's fresh clone)."""
+    if not SHARED_TOPOGRAPHIES.is_dir():
+        pytest.skip(f"shared instrument files not found at {SHARED_TOPOGRAPHIES}")
+    return SHARED_TOPOGRAPHIES
