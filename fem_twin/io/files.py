@@ -212,7 +212,9 @@ def _read_instrument(path: Path, spacing) -> Topography:
         raise TopographyFileError(f"{path}: holds a {t.dim}D line scan, not a 2D map")
     unit = t.unit
     if unit not in UNITS:
-        raise TopographyFileError(f"{path}: unsupported length unit {unit!r} in file")
+        raise TopographyFileError(
+            f"{path}: {type(reader).__name__} found no usable length unit ({unit!r}); the file "
+            "is corrupt or not a topography, or its units must be converted first")
     s = UNITS[unit]
     h = t.heights()
     h = np.ma.filled(np.ma.asarray(h, dtype=float), np.nan).T   # (nx, ny) -> (ny, nx)

@@ -1,0 +1,84 @@
+"""Command line and the main job on the bundled case."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from fem_twin import Topography, read_topography, write_topography
+from fem_twin.case import CaseError, load_case
+from fem_twin.cli import main
+
+from conftest import ROOT
+
+
+def test_help_lists_pipeline_stages(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["--help"])
+    assert exit_.value.code == 0
+    out = capsys.readouterr().out
+    for stage in ("run", "topography", "mesh", "sample"):
+        assert stage in out
+
+
+def test_console_script_runs():
+    out = subprocess.run([sys.executable, "-m", "fem_twin.cli", "topography", "--help"],
+                         capture_output=True, text=True, check=True).stdout
+    for step in ("fill", "level", "clip", "filter", "resample", "patch", "flip", "mount"):
+        assert step in out
+
+
+def test_topography_steps_write_files(tmp_path):
+    z = np.random.default_rng(0).normal(size=(40, 50)) * 1e-7
+    z[5, 5] = np.nan
+    write_topography(tmp_path / "raw.npz", Topography(z, 1e-6))
+    assert main(["topography", "fill", str(tmp_path / "raw.npz"), str(tmp_path / "f.npz")]) == 0
+    assert main(["topography", "filter", str(tmp_path / "f.npz"), str(tmp_path / "g.txt"),
+                 "--fwhm", "3"]) == 0
+    assert main(["topography", "refine", str(tmp_path / "g.txt"), str(tmp_path / "r.npz"),
+                 "--factor", "2"]) == 0
+    r = read_topography(tmp_path / "r.npz")
+    assert r.shape == (79, 99) and r.mask is None
+    assert main(["mesh", str(tmp_path / "r.npz"), str(tmp_path / "r.vtu"), "--periodic"]) == 0
+    assert (tmp_path / "r.vtu").stat().st_size > 0
+
+
+def test_cli_reports_bad_input_clearly(tmp_path, capsys):
+    (tmp_path / "bad.npy").write_bytes(b"nonsense")
+    assert main(["topography", "info", str(tmp_path / "bad.npy"), "--spacing", "1e-6"]) == 2
+    assert "cannot read topography" in capsys.readouterr().err
+    assert main(["run", str(tmp_path / "none.toml")]) == 2
+
+
+def test_case_validation(tmp_path):
+    pin = tmp_path / "pin.npz"
+    write_topography(pin, Topography(np.zeros((8, 8)), 1e-3 / 8))
+    (tmp_path / "ok.toml").write_text('[geometry]\npins = ["pin.npz"]\n')
+    assert load_case(tmp_path / "ok.toml").geometry.pins == (pin.resolve(),)
+    bad = {
+        "typo.toml": ('[geometry]\npins = ["pin.npz"]\n[preprocessing]\nfwhm = 9\n', "unknown key"),
+        "missing.toml": ('[geometry]\npins = ["nope.npz"]\n', "file not found"),
+        "units.toml": ('[geometry]\npins = ["pin.npz"]\n[preprocessing]\nclip = 20\n', "metres"),
+        "toml.toml": ("[geometry\n", "not valid TOML"),
+        "nopin.toml": ("[geometry]\npins = []\n", "at least one pin"),
+    }
+    for name, (text, match) in bad.items():
+        (tmp_path / name).write_text(text)
+        with pytest.raises(CaseError, match=match):
+            load_case(tmp_path / name)
+
+
+def test_run_bundled_case_and_resume(tmp_path):
+    case = ROOT / "examples" / "pin_on_disk.toml"
+    out = tmp_path / "out"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    pins = summary["stages"]["geometry"]["pins"]
+    assert len(pins) == 3 and all(abs(p["face_fraction"] - np.pi / 4) < 0.05 for p in pins)
+    assert len(summary["stages"]["geometry"]["patches"]) == 6
+    files = sorted((out / "geometry").iterdir())
+    stamps = {f.name: f.stat().st_mtime_ns for f in files}
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0   # resumes
+    assert {f.name: f.stat().st_mtime_ns for f in (out / "geometry").iterdir()} == stamps
