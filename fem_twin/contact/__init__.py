@@ -1,0 +1,7 @@
+"""Contact stage: elastic half-space operators and CG-FFT dry contact (paper 2.2.1)."""
+
+from .elastic import ElasticOperator, elastic_operator, love_rectangle, reduced_modulus
+from .solver import ContactNotConverged, ContactResult, solve
+
+__all__ = ["ElasticOperator", "elastic_operator", "love_rectangle", "reduced_modulus",
+           "ContactNotConverged", "ContactResult", "solve"]
