@@ -2,7 +2,7 @@
 
 Non-periodic: linear convolution with the Love (1929) influence of uniform pressure on a
 rectangular pixel (Johnson eq 3.25), by zero padding to 2N and real FFTs.
-Periodic: the exact periodic half-space response ``u(q) = 2 p(q) / (E' |q|)`` with zero
+Periodic: the exact periodic half-space response ``u(q) = 2 p(q) / (E* |q|)`` with zero
 mean deformation (the mean compression of a roughness cell belongs to the macro scale, whose
 h_el is computed from the mean contact pressure, paper eqs 19-21).
 Kernel FFTs are computed once per grid and reused (``functools.lru_cache``).
@@ -81,7 +81,7 @@ def _operator(shape, spacing, e_reduced, periodic):
         q2 = 2 * np.pi * fft.fftfreq(ny, dx2)
         q = np.hypot(q1[None, :], q2[:, None])
         q[0, 0] = np.inf                       # zero mean deformation
-        k_hat = 2.0 / (e_reduced * q)
+        k_hat = 4.0 / (e_reduced * q)           # 2 / (E* q), E* = E'/2
     else:
         i1 = np.r_[np.arange(nx), np.arange(-nx, 0)] * dx1
         i2 = np.r_[np.arange(ny), np.arange(-ny, 0)] * dx2

@@ -1,0 +1,105 @@
+"""Dry contact against closed forms (../shared/REFERENCES.md): Love, Hertz, Westergaard, KKT."""
+
+import numpy as np
+import pytest
+
+from fem_twin import contact
+
+E_REDUCED = contact.reduced_modulus(210e9, 0.3, 210e9, 0.3)     # eq 22, steel/steel
+E_STAR = E_REDUCED / 2
+
+
+def test_reduced_modulus_steel():
+    assert np.isclose(E_STAR, 115.38e9, rtol=1e-4)
+
+
+def test_love_kernel_closed_form_values():
+    a = 1e-6
+    w = lambda x, y: contact.love_rectangle(x, y, a, a, E_REDUCED) * E_STAR / a  # noqa: E731
+    assert np.isclose(w(0, 0), 8 / np.pi * np.log(1 + np.sqrt(2)), rtol=1e-14)
+    assert np.isclose(w(0, 0), 2.244399, rtol=1e-6)
+    assert np.isclose(w(a, a), 1.122200, rtol=1e-6)
+    r = 1000 * a                                              # far field 4 p a^2 / (pi E* r)
+    assert np.isclose(w(r, 0.3 * r) * np.pi * np.hypot(r, 0.3 * r) / (4 * a), 1, rtol=1e-6)
+    # symmetric, and cancellation-free far on the negative side
+    assert np.isclose(w(-r, 0), w(r, 0), rtol=1e-12)
+
+
+def _hertz_grid(n=256, R=10e-3, N=150.0):
+    a = (3 * N * R / (4 * E_STAR)) ** (1 / 3)
+    L = 4 * a
+    dx = L / n
+    x = (np.arange(n) - n / 2) * dx
+    X, Y = np.meshgrid(x, x)
+    return (X ** 2 + Y ** 2) / (2 * R), dx, a
+
+
+def test_hertz_sphere_on_flat():
+    R, N = 10e-3, 150.0
+    shape, dx, a = _hertz_grid(256, R, N)
+    res = contact.solve(shape, (dx, dx), E_REDUCED, load=N)
+    assert np.isclose(a, 213.63e-6, rtol=1e-4)                 # REFERENCES values
+    p0, delta = 3 * N / (2 * np.pi * a ** 2), a ** 2 / R
+    assert np.isclose(p0, 1.569e9, rtol=1e-3) and np.isclose(delta, 4.564e-6, rtol=1e-3)
+    a_num = np.sqrt(res.contact_fraction * shape.size * dx * dx / np.pi)
+    # 1 % bar of the issue; contact radius resolved to about one pixel in 64
+    assert abs(res.pressure.max() / p0 - 1) < 0.01
+    assert abs(a_num / a - 1) < 0.01
+    assert abs(-res.separation / delta - 1) < 0.01
+    assert abs(res.load / N - 1) < 1e-12
+    # the same state is found with the separation imposed
+    sep = contact.solve(shape, (dx, dx), E_REDUCED, separation=res.separation)
+    assert abs(sep.load / N - 1) < 1e-6
+
+
+def test_westergaard_periodic_sinusoid():
+    lam, nx, ny, h = 100e-6, 1024, 2, 0.1e-6
+    dx = lam / nx
+    x = (np.arange(nx) - nx / 2) * dx
+    shape = np.tile(2 * h * np.sin(np.pi * x / lam) ** 2, (ny, 1))
+    p_star = np.pi * E_STAR * h / lam
+    p_mean = 0.3 * p_star
+    res = contact.solve(shape, (dx, dx), E_REDUCED, load=p_mean * lam * ny * dx, periodic=True)
+    s2 = p_mean / p_star
+    a = lam / np.pi * np.arcsin(np.sqrt(s2))
+    inside = np.sin(np.pi * x / lam) ** 2 < s2
+    p_exact = np.where(inside, 2 * p_mean * np.cos(np.pi * x / lam) / s2
+                       * np.sqrt(np.clip(s2 - np.sin(np.pi * x / lam) ** 2, 0, None)), 0)
+    half_width = 0.5 * (res.pressure[0] > 0).sum() * dx
+    assert abs(half_width / a - 1) < 0.01
+    assert np.max(np.abs(res.pressure[0] - p_exact)) < 0.01 * p_exact.max()
+    assert abs(res.pressure.mean() / p_mean - 1) < 1e-12
+
+
+@pytest.mark.parametrize("control", ["load", "separation"])
+def test_hardness_cap_and_kkt_pointwise(control):
+    H = 1.2e9                                    # below Hertz p0 = 1.57 GPa: plastic core
+    shape, dx, _ = _hertz_grid(128)
+    kw = {"load": 150.0} if control == "load" else {"separation": -5e-6}
+    res = contact.solve(shape, (dx, dx), E_REDUCED, hardness=H, **kw)
+    p, g = res.pressure, res.raw_gap
+    assert p.max() <= H and p.min() >= 0 and res.plastic_fraction > 0
+    scale = np.ptp(shape)
+    elastic = (p > 0) & (p < H)
+    assert np.max(np.abs(g[elastic])) < 1e-9 * scale          # closed where 0 < p < H
+    assert g[p == 0].min() > -1e-9 * scale                      # open where p = 0
+    assert g[p == H].max() < 1e-9 * scale                       # overlap where p = H
+    assert np.all(res.gap >= 1e-9) and np.allclose(res.gap, np.maximum(g, 1e-9))
+    assert np.allclose(g, res.separation + shape + res.deformation, rtol=0, atol=1e-18)
+    if control == "load":
+        assert abs(res.load / 150.0 - 1) < 1e-8
+
+
+def test_bad_input_and_non_convergence_raise():
+    shape, dx, _ = _hertz_grid(32)
+    with pytest.raises(ValueError, match="exactly one"):
+        contact.solve(shape, dx, E_REDUCED)
+    with pytest.raises(ValueError, match="exactly one"):
+        contact.solve(shape, dx, E_REDUCED, load=1.0, separation=0.0)
+    with pytest.raises(ValueError, match="finite"):
+        contact.solve(np.full((4, 4), np.nan), dx, E_REDUCED, load=1.0)
+    with pytest.raises(ValueError, match="modulus"):
+        contact.solve(shape, dx, -1.0, load=1.0)
+    with pytest.raises(contact.ContactNotConverged) as err:
+        contact.solve(shape, dx, E_REDUCED, load=150.0, max_iter=3)
+    assert len(err.value.history) == 3
