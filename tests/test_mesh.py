@@ -92,6 +92,5 @@ def test_vtu_opens_in_vtk_like_paraview(tmp_path):
     assert out.GetNumberOfPoints() == 7 * 9 and out.GetNumberOfCells() == 6 * 8
     data = np.array([out.GetPointData().GetArray("gap").GetValue(i) for i in range(63)])
     assert np.array_equal(data, gm.to_nodes(f))
-    collection = vtk.vtkXMLGenericDataObjectReader()  # noqa: F841 - the PVD is plain XML
     text = (tmp_path / "series.pvd").read_text()
     assert 'file="p.vtu"' in text and 'type="Collection"' in text

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import brentq
 
 from .elastic import elastic_operator
 
@@ -109,7 +110,6 @@ def _solve_load_by_separation(shape, spacing, e_reduced, load, initial_pressure,
         step *= 2
         if len(history) > 60:
             raise ContactNotConverged("could not bracket the separation for the load", history)
-    from scipy.optimize import brentq
     h0 = brentq(excess, lo, hi, xtol=1e-16 * max(abs(lo), abs(hi), 1e-9), rtol=1e-15, maxiter=100)
     r = state["result"]
     if r is None or r.separation != h0:
