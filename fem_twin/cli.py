@@ -47,7 +47,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="fem-twin",
         description="Digital twin of a pin-on-disk tribometer in mixed lubrication. "
-                    "Stages: topography -> (contact -> homogenise -> macro -> stribeck); "
+                    "Stages: topography -> contact -> (homogenise -> macro -> stribeck); "
                     "'run' executes the whole pipeline of a case file.")
     p.add_argument("--version", action="version", version=f"fem-twin {__version__}")
     p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
@@ -72,6 +72,20 @@ def build_parser() -> argparse.ArgumentParser:
         s.add_argument("--unit", default="m", help="unit of plain ASCII/.npy files")
         _step_options(name, s)
         s.set_defaults(func=_topography)
+
+    c = sub.add_parser("contact", help="dry contact: pin levelling by torque balance, set averaging")
+    cs = c.add_subparsers(dest="step", required=True, metavar="STEP")
+    lv = cs.add_parser("level", help="tilt a mounted pin until the 50 N contact torques vanish")
+    lv.add_argument("pin", type=Path, help="mounted pin (fem-twin topography prepare-pin)")
+    lv.add_argument("output", type=Path)
+    lv.add_argument("--disk", type=Path, help="flipped disk on the same grid (default: flat)")
+    lv.add_argument("--load", type=float, default=50.0, help="imposed load [N]")
+    lv.add_argument("--method", choices=("broyden", "pid"), default="broyden")
+    lv.set_defaults(func=_contact_level)
+    av = cs.add_parser("average", help="set average of levelled pins, then level it again")
+    av.add_argument("pins", type=Path, nargs="+")
+    av.add_argument("-o", "--output", type=Path, required=True)
+    av.set_defaults(func=_contact_average)
 
     m = sub.add_parser("mesh", help="topography -> structured FE mesh written as VTU for ParaView")
     m.add_argument("input", type=Path)
@@ -166,6 +180,29 @@ def _topography(args):
         out = prepare_patch(topo, args.shape, args.start, upper=args.upper)
     write_topography(args.output, out)
     print(f"{args.output}: {out!r}")
+    return 0
+
+
+def _contact_level(args):
+    from .contact.levelling import level_pin
+    from .io.files import read_topography, write_topography
+    pin = read_topography(args.pin)
+    disk = read_topography(args.disk) if args.disk else None
+    res = level_pin(pin, disk, load=args.load, method=args.method)
+    write_topography(args.output, res.pin)
+    print(json.dumps({"tilt_rad": res.tilt, "residuals": res.residuals,
+                      "contact_solves": len(res.history),
+                      "contact_fraction": res.contact.contact_fraction}, indent=2))
+    return 0
+
+
+def _contact_average(args):
+    from .contact.levelling import average_pins, level_pin
+    from .io.files import read_topography, write_topography
+    res = level_pin(average_pins([read_topography(p) for p in args.pins]))
+    write_topography(args.output, res.pin)
+    print(json.dumps({"pins": len(args.pins), "tilt_rad": res.tilt,
+                      "residuals": res.residuals}, indent=2))
     return 0
 
 

@@ -19,7 +19,7 @@ def test_help_lists_pipeline_stages(capsys):
         main(["--help"])
     assert exit_.value.code == 0
     out = capsys.readouterr().out
-    for stage in ("run", "topography", "mesh", "sample"):
+    for stage in ("run", "topography", "contact", "mesh", "sample"):
         assert stage in out
 
 
@@ -43,6 +43,21 @@ def test_topography_steps_write_files(tmp_path):
     assert r.shape == (79, 99) and r.mask is None
     assert main(["mesh", str(tmp_path / "r.npz"), str(tmp_path / "r.vtu"), "--periodic"]) == 0
     assert (tmp_path / "r.vtu").stat().st_size > 0
+
+
+def test_contact_level_and_average_steps(tmp_path, capsys):
+    pins = []
+    for k in (1, 2):
+        out = tmp_path / f"pin{k}.npz"
+        assert main(["topography", "prepare-pin", str(ROOT / "meshes" / "sample" / f"pin_{k}.npz"),
+                     str(out), "--resolution", "48", "48"]) == 0
+        pins.append(str(out))
+    capsys.readouterr()
+    assert main(["contact", "level", pins[0], str(tmp_path / "lev.npz")]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert max(abs(r) for r in report["residuals"]) < 1e-6
+    assert main(["contact", "average", *pins, "-o", str(tmp_path / "avg.npz")]) == 0
+    assert read_topography(tmp_path / "avg.npz").shape == (48, 48)
 
 
 def test_cli_reports_bad_input_clearly(tmp_path, capsys):
