@@ -19,6 +19,7 @@ from fem_twin import topography as tp  # noqa: E402
 from fem_twin.topography.prepare import prepare_pin  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
 SAMPLE = os.path.join(HERE, "..", "meshes", "sample")
 
 
@@ -49,7 +50,46 @@ def bench_topography():
     return base, rows
 
 
-GROUPS = {"topography": bench_topography}
+def bench_contact(sizes=(256, 512, 1024)):
+    """Periodic rough contact (Hurst 0.8, Sq 150 nm, 85 um patch) vs textbook numpy PK."""
+    from contact_reference import polonsky_keer
+
+    from fem_twin import contact
+    from fem_twin.topography.synthetic import self_affine
+
+    e_red = contact.reduced_modulus(210e9, 0.3, 210e9, 0.3)
+    rows, base = [], None
+    for n in sizes:
+        dx = 85e-6 / n
+        shape = -self_affine((n, n), dx, 0.8, 150e-9, rng=1).heights
+        z = np.random.default_rng(0).random((n, n))
+        t_fft, _ = best_of(lambda: np.fft.irfft2(np.fft.rfft2(z), s=z.shape), 5)
+        load = 100e6 * 85e-6 ** 2
+        t_ref, (p_ref, it_ref) = best_of(lambda: polonsky_keer(shape, dx, e_red, 100e6), 1)
+        t_el, el = best_of(lambda: contact.solve(shape, dx, e_red, load=load, periodic=True), 1)
+        near = contact.solve(shape, dx, e_red, load=0.9 * load, periodic=True)
+        t_w, warm = best_of(lambda: contact.solve(shape, dx, e_red, load=load, periodic=True,
+                                                  initial_pressure=near.pressure), 1)
+        h0 = el.separation
+        t_s, sep = best_of(lambda: contact.solve(shape, dx, e_red, separation=h0, periodic=True,
+                                                 hardness=6.99e9), 1)
+        t_sw, sepw = best_of(lambda: contact.solve(shape, dx, e_red, separation=h0, periodic=True,
+                                                   hardness=6.99e9, initial_pressure=el.pressure), 1)
+        base = base or t_fft
+        per = lambda t, it: f"{it} it, {t / it / t_fft:.2f} x (rfft2+irfft2) per it"  # noqa: E731
+        assert np.abs(el.pressure - p_ref).max() < 1e-6 * p_ref.max()
+        rows += [
+            (f"{n}^2 baseline rfft2+irfft2", t_fft, ""),
+            (f"{n}^2 textbook numpy PK, 100 MPa (ref)", t_ref, per(t_ref, it_ref)),
+            (f"{n}^2 fem_twin PK, 100 MPa, cold", t_el, per(t_el, el.iterations)),
+            (f"{n}^2 fem_twin PK, warm from 90 MPa", t_w, per(t_w, warm.iterations)),
+            (f"{n}^2 fixed h0 + H, cold", t_s, per(t_s, sep.iterations)),
+            (f"{n}^2 fixed h0 + H, warm", t_sw, per(t_sw, sepw.iterations)),
+        ]
+    return base, rows
+
+
+GROUPS = {"topography": bench_topography, "contact": bench_contact}
 
 
 def main(argv):

@@ -103,3 +103,24 @@ def test_bad_input_and_non_convergence_raise():
     with pytest.raises(contact.ContactNotConverged) as err:
         contact.solve(shape, dx, E_REDUCED, load=150.0, max_iter=3)
     assert len(err.value.history) == 3
+
+
+def test_hertz_mesh_convergence_orders():
+    """Refining the grid: approach error falls at second order, pressure RMS error at first
+    order (the square-root edge of the Hertz pressure limits the field's rate)."""
+    R, N = 10e-3, 150.0
+    a = (3 * N * R / (4 * E_STAR)) ** (1 / 3)
+    delta, p0 = a ** 2 / R, 3 * N / (2 * np.pi * a ** 2)
+    e_delta, e_p = [], []
+    for n in (32, 64, 128):
+        dx = 4 * a / n
+        x = (np.arange(n) - n / 2 + 0.5) * dx
+        X, Y = np.meshgrid(x, x)
+        res = contact.solve((X ** 2 + Y ** 2) / (2 * R), dx, E_REDUCED, load=N)
+        exact = p0 * np.sqrt(np.clip(1 - (X ** 2 + Y ** 2) / a ** 2, 0, None))
+        e_delta.append(abs(-res.separation / delta - 1))
+        e_p.append(np.sqrt(np.mean((res.pressure - exact) ** 2)) / p0)
+    order_delta = np.log2(np.array(e_delta[:-1]) / e_delta[1:])
+    order_p = np.log2(np.array(e_p[:-1]) / e_p[1:])
+    assert np.all(order_delta > 1.8), order_delta      # measured 2.2, 2.2
+    assert np.all(order_p > 0.9), order_p              # measured 1.2, 1.0
