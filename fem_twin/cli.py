@@ -10,7 +10,7 @@ from pathlib import Path
 
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
-#: topography steps: name -> (help, function building the step from parsed arguments)
+#: topography steps: name -> help text
 _STEPS = {
     "info": "print grid, pitch, Sq and invalid pixels",
     "convert": "rewrite in another format (by suffix: .npz .npy .txt .csv .xyz)",

@@ -104,7 +104,7 @@ def level_pin(pin: Topography, disk: Topography | None = None, *, load: float = 
             r_prev = r
             tilted, res, r = evaluate(tilt)
     else:
-        jac = _initial_jacobian(evaluate, tilt, r, pin)
+        jac = _initial_jacobian(evaluate, tilt, r, pin, holder_height)
         for _ in range(max_iter):
             if np.max(np.abs(r)) < tol:
                 break
@@ -133,9 +133,9 @@ def mean_plane_tilt(pin: Topography, upper: np.ndarray, holder_height: float = -
     return np.array([np.arctan(b2), np.arctan(-b1)])
 
 
-def _initial_jacobian(evaluate, tilt, r, pin):
+def _initial_jacobian(evaluate, tilt, r, pin, holder_height):
     """Finite-difference d r / d tilt with a step of 1e-3 of the face's slope scale."""
-    face = pin_face(pin)
+    face = pin_face(pin, holder_height)
     x1, x2 = pin.coordinates()
     radius = np.sqrt(np.max(x1[face] ** 2 + x2[face] ** 2))
     h = 1e-3 * max(np.ptp(pin.heights[face]), 1e-7) / radius

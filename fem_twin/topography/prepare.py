@@ -95,11 +95,10 @@ def prepare_patch(raw: Topography, shape=(256, 256), start=(0, 0), *, upper: boo
                   sliding_direction: str = "+x1") -> Topography:
     """Measured roughness patch -> periodic cell surface (no filter, no interpolation).
 
-    Laplace fill, mean plane, zero at the plane, ``shape`` pixels cut at ``start``; the
-    disk patch (``upper=True``) is flipped above the pin.
+    Laplace fill, ``shape`` pixels cut at ``start``, mean plane of the patch with zero at
+    that plane (a plane removed from the whole map first would be absorbed by this fit),
+    origin at the patch corner; the disk patch (``upper=True``) is flipped above the pin.
     """
-    topo = level(align_sliding(fill_defects(raw), sliding_direction))
-    topo = extract_patch(topo, shape, start)
-    topo = level(topo)
-    topo = centre_on(topo, (topo.origin[0], topo.origin[1]))
+    topo = extract_patch(align_sliding(fill_defects(raw), sliding_direction), shape, start)
+    topo = centre_on(level(topo), topo.origin)
     return flip_disk(topo) if upper else topo
