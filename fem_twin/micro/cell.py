@@ -1,0 +1,275 @@
+"""FE cell problems of the roughness scale (paper eqs 8-10) on a periodic pixel mesh.
+
+Bilinear quadrilaterals, one per pixel square, nodes = pixels, 2 x 2 Gauss quadrature.  With
+``a = h^3`` at the quadrature points the weak forms are, for all periodic test functions v,
+
+    (a grad chi_1, grad v) = (h, dv/dx1) - (tau, v)        eq 8, tau = (1/u_m) dh/dt
+    (a grad chi_2, grad v) = -(a, dv/dx1)                  eq 9
+    (a grad chi_3, grad v) = -(a, dv/dx2)                  eq 10
+
+(the derivatives of h and h^3 moved onto v by parts, which is exact on a periodic cell).
+All pixel squares are the same rectangle, so the element matrix of the flow form is a sum
+over quadrature points ``q`` of ``a_q k_q`` with four 4 x 4 tensors ``k_q`` computed once by
+scikit-fem on one element.  Re-assembling the operator for a new gap is then one small dense
+product and one ``bincount`` onto a sparsity pattern fixed in advance (about 10 x faster
+than ``BilinearForm.assemble``).  One node is pinned (chi = 0) to remove the constant.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+import skfem
+from skfem.helpers import dot, grad
+
+from ..io.mesh import GridMesh, grid_mesh
+
+
+@skfem.BilinearForm
+def flow_form(u, v, w):
+    """Poiseuille operator of eqs 8-10: ``a grad u . grad v`` with ``a = h^3`` [m^3]."""
+    return w.a * dot(grad(u), grad(v))
+
+
+@skfem.LinearForm
+def couette_form(v, w):
+    """Right-hand side of eq 8 without the time term: ``h dv/dx1``."""
+    return w.h * v.grad[0]
+
+
+@skfem.LinearForm
+def pressure_form_1(v, w):
+    """Right-hand side of eq 9: ``-h^3 dv/dx1``."""
+    return -w.a * v.grad[0]
+
+
+@skfem.LinearForm
+def pressure_form_2(v, w):
+    """Right-hand side of eq 10: ``-h^3 dv/dx2``."""
+    return -w.a * v.grad[1]
+
+
+@skfem.LinearForm
+def squeeze_form(v, w):
+    """Time term of eq 8 moved to the right: ``-tau v``, ``tau = (1/u_m) dh/dt`` [-]."""
+    return -w.tau * v
+
+
+@dataclass(frozen=True, eq=False)
+class CellSolution:
+    """The three cell solutions at one time step, as grid fields ``(ny, nx)``.
+
+    chi : (3, ny, nx); chi_1 [1/m], chi_2 and chi_3 [m]; zero at the pinned pixel
+    moments : dict of the cell averages that eqs 11-16 need at this step (see
+        :meth:`CellSolver.moments`)
+    """
+
+    chi: np.ndarray
+    moments: dict
+
+
+class CellSolver:
+    """Periodic Q1 cell problems on a ``(ny, nx)`` grid of pitch ``spacing`` [m].
+
+    Everything that does not depend on the gap is built once: the mesh, the per-quadrature-
+    point element tensors, the sparsity pattern with the pinned node removed, and the scatter
+    maps of the right-hand sides.
+    """
+
+    def __init__(self, shape, spacing, *, pinned: int = 0):
+        self.shape = (int(shape[0]), int(shape[1]))
+        self.spacing = tuple(float(s) for s in np.broadcast_to(np.asarray(spacing, float), (2,)))
+        self.grid: GridMesh = grid_mesh(self.shape, self.spacing, periodic=True)
+        n = self.shape[0] * self.shape[1]
+        if not 0 <= pinned < n:
+            raise ValueError(f"pinned pixel {pinned} outside the {self.shape} grid")
+        self.pinned = int(pinned)
+        self.basis = skfem.Basis(self.grid.mesh, skfem.ElementQuad1(), intorder=2)
+        ref = self._reference_element()
+        self._k = ref["k"]                       # (nq, 16) flow tensors per quadrature point
+        self._g = ref["g"]                       # (2, nq, 4) w_q dphi_i/dx_d
+        self._m = ref["m"]                       # (nq, 4) w_q phi_i
+        self._phi = ref["phi"]                   # (4, nq) phi_i at the quadrature points
+        self._dphi = ref["dphi"]                 # (2, 4, nq) dphi_i/dx_d
+        pix = self.grid.node_pixel[self.grid.mesh.t]          # (4, nelems) pixel of each dof
+        self._pix = pix
+        rows = np.repeat(pix, 4, axis=0).T.ravel()             # element-major, (i, j) inner
+        cols = np.tile(pix, (4, 1)).T.ravel()
+        keep = (rows != self.pinned) & (cols != self.pinned)
+        # unknowns are numbered in a nested-dissection order of the torus (fill-reducing,
+        # 1.6 x faster to factorise than SuperLU's own MMD ordering at 256^2)
+        order = nested_dissection_torus(self.shape)
+        free = order[order != self.pinned]
+        renum = np.full(n, -1)
+        renum[free] = np.arange(n - 1)
+        r, c = renum[rows[keep]], renum[cols[keep]]
+        key = r.astype(np.int64) * (n - 1) + c
+        uniq, slot = np.unique(key, return_inverse=True)
+        self._keep = keep
+        self._slot = slot
+        self._nnz = uniq.size
+        pattern = sp.csr_matrix((np.ones(uniq.size), (uniq // (n - 1), uniq % (n - 1))),
+                                shape=(n - 1, n - 1))
+        pattern.sort_indices()
+        # csr data order equals the sorted keys, which np.unique returned
+        self._indptr, self._indices = pattern.indptr, pattern.indices
+        self._free = free                       # pixel of each unknown
+
+    # -- reference element --------------------------------------------------------------
+    def _reference_element(self) -> dict:
+        """Element tensors of the forms per quadrature point, computed by scikit-fem."""
+        dx1, dx2 = self.spacing
+        one = skfem.MeshQuad1(np.array([[0, dx1, dx1, 0], [0, 0, dx2, dx2]], float),
+                              np.array([[0], [1], [2], [3]]))
+        b = skfem.Basis(one, skfem.ElementQuad1(), intorder=2)
+        nq = b.X.shape[1]
+        k, g, m = [], [], []
+        for q in range(nq):
+            unit = np.zeros((1, nq))
+            unit[0, q] = 1.0
+            k.append(flow_form.assemble(b, a=unit).toarray().ravel())
+            g.append([-pressure_form_1.assemble(b, a=unit), -pressure_form_2.assemble(b, a=unit)])
+            m.append(-squeeze_form.assemble(b, tau=unit))
+        phi = np.array([np.asarray(b.basis[i][0])[0] for i in range(4)])
+        dphi = np.array([[b.basis[i][0].grad[d][0] for i in range(4)] for d in range(2)])
+        return {"k": np.array(k), "g": np.transpose(np.array(g), (1, 0, 2)), "m": np.array(m),
+                "phi": phi, "dphi": dphi}
+
+    @property
+    def nq(self) -> int:
+        return self._k.shape[0]
+
+    # -- fields at quadrature points -----------------------------------------------------
+    def at_quadrature(self, field: np.ndarray) -> np.ndarray:
+        """Grid field ``(ny, nx)`` -> values at the quadrature points ``(nelems, nq)``."""
+        return np.asarray(field, float).ravel()[self._pix].T @ self._phi
+
+    def gradient(self, field: np.ndarray) -> np.ndarray:
+        """Gradient of a grid field at the quadrature points, ``(2, nelems, nq)``."""
+        f = np.asarray(field, float).ravel()[self._pix].T
+        return np.stack([f @ self._dphi[0], f @ self._dphi[1]])
+
+    # -- assembly ------------------------------------------------------------------------
+    def operator(self, a_q: np.ndarray) -> sp.csc_matrix:
+        """Reduced flow operator for ``a = h^3`` at the quadrature points.
+
+        Pinned node removed, unknowns in the order of ``self.unknowns`` (pixel indices).
+        The matrix is symmetric, so its CSR arrays are also its CSC arrays.
+        """
+        data = (a_q @ self._k).ravel()[self._keep]
+        values = np.bincount(self._slot, weights=data, minlength=self._nnz)
+        n = self._free.size
+        return sp.csc_matrix((values, self._indices, self._indptr), shape=(n, n))
+
+    @property
+    def unknowns(self) -> np.ndarray:
+        """Pixel index of each unknown of the reduced system."""
+        return self._free
+
+    def _scatter(self, local: np.ndarray) -> np.ndarray:
+        """Element vectors ``(nelems, 4)`` -> reduced global vector."""
+        n = self.shape[0] * self.shape[1]
+        return np.bincount(self._pix.T.ravel(), weights=local.ravel(), minlength=n)[self._free]
+
+    def right_hand_sides(self, h_q: np.ndarray, a_q: np.ndarray, tau_q=None) -> np.ndarray:
+        """Load vectors of eqs 8, 9, 10 as columns ``(n - 1, 3)``."""
+        f1 = h_q @ self._g[0]
+        if tau_q is not None:
+            f1 = f1 - tau_q @ self._m
+        f2 = -(a_q @ self._g[0])
+        f3 = -(a_q @ self._g[1])
+        return np.column_stack([self._scatter(f1), self._scatter(f2), self._scatter(f3)])
+
+    # -- solve ---------------------------------------------------------------------------
+    def solve(self, gap: np.ndarray, squeeze: np.ndarray | None = None) -> CellSolution:
+        """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady).
+
+        ``squeeze`` is ``(1/u_m) dh/dt`` on the grid, already discretised in time; its cell
+        mean (non-zero only where the truncation at the gap floor changes the mean gap) is
+        removed, as the periodic problem requires.
+        """
+        h = np.asarray(gap, float)
+        if h.shape != self.shape:
+            raise ValueError(f"gap shape {h.shape} does not match the cell {self.shape}")
+        if not np.all(np.isfinite(h)) or h.min() <= 0:
+            raise ValueError("the gap must be finite and positive (truncate it first) [m]")
+        h_q = self.at_quadrature(h)
+        a_q = h_q ** 3
+        tau_q = None
+        if squeeze is not None:
+            # the mean squeeze of the cell is macro-scale (d h_m / dt); the periodic problem
+            # is solvable only without it, and keeping it would make chi depend on the pin
+            tau_q = self.at_quadrature(squeeze)
+            tau_q = tau_q - tau_q.mean()
+        K = self.operator(a_q)
+        F = self.right_hand_sides(h_q, a_q, tau_q)
+        scale = a_q.mean()
+        lu = spla.splu(K / scale, permc_spec="NATURAL", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+        X = lu.solve(F / scale)
+        n = self.shape[0] * self.shape[1]
+        chi = np.zeros((3, n))
+        chi[:, self._free] = X.T
+        chi = chi.reshape(3, *self.shape)
+        return CellSolution(chi, self.moments(h_q, chi))
+
+    def moments(self, h_q: np.ndarray, chi: np.ndarray) -> dict:
+        """Cell averages of one time step, unnormalised (eqs 12-16 divide by h_m later).
+
+        h : <h> [m];  h3_grad : <h^3 (I + G)> [m^3], G[i, j] = d chi_{j+2} / dx_i;
+        h3_g1 : <h^3 grad chi_1> [m];  h_grad : <h (I + G)> [m];  h_g1 : <h grad chi_1> [1/m]
+        """
+        g1 = self.gradient(chi[0])
+        G = np.stack([self.gradient(chi[1]), self.gradient(chi[2])], axis=1)   # (i, j, e, q)
+        a_q = h_q ** 3
+        eye = np.eye(2)[:, :, None, None]
+        return {"h": float(h_q.mean()),
+                "h3_grad": (a_q * (eye + G)).mean(axis=(2, 3)),
+                "h3_g1": (a_q * g1).mean(axis=(1, 2)),
+                "h_grad": (h_q * (eye + G)).mean(axis=(2, 3)),
+                "h_g1": (h_q * g1).mean(axis=(1, 2))}
+
+    @cached_property
+    def area(self) -> float:
+        return self.shape[0] * self.shape[1] * self.spacing[0] * self.spacing[1]
+
+
+def nested_dissection_torus(shape, leaf: int = 4) -> np.ndarray:
+    """Fill-reducing order of the pixels of a periodic grid (geometric nested dissection).
+
+    Columns 0 and nx/2 and then rows 0 and ny/2 cut the torus into four open rectangles,
+    which are bisected recursively along their longer side; separators come last.
+    """
+    ny, nx = shape
+    out = []
+
+    def dissect(rows, cols):
+        if len(rows) * len(cols) <= leaf * leaf or min(len(rows), len(cols)) < 3:
+            out.append((rows[:, None] * nx + cols[None, :]).ravel())
+        elif len(cols) >= len(rows):
+            m = len(cols) // 2
+            dissect(rows, cols[:m])
+            dissect(rows, cols[m + 1:])
+            out.append(rows * nx + cols[m])
+        else:
+            m = len(rows) // 2
+            dissect(rows[:m], cols)
+            dissect(rows[m + 1:], cols)
+            out.append(rows[m] * nx + cols)
+
+    cy, cx = ny // 2, nx // 2
+    for cols in (np.arange(1, cx), np.arange(cx + 1, nx)):
+        for rows in (np.arange(1, cy), np.arange(cy + 1, ny)):
+            if len(rows) and len(cols):
+                dissect(rows, cols)
+        out.append(cols)                          # row 0
+        out.append(cy * nx + cols)                # row ny/2
+    out.append(np.unique(np.r_[np.arange(ny) * nx, np.arange(ny) * nx + cx]))
+    order = np.concatenate(out)
+    if np.unique(order).size != ny * nx:          # guard against a wrong partition
+        raise AssertionError("nested dissection lost or repeated pixels")
+    return order

@@ -1,0 +1,179 @@
+"""Homogenised flow factors versus the roughness-scale separation h0 (paper eqs 11-16).
+
+A :class:`FlowFactors` value is what the micro scale hands to the macro scale: for each
+rigid-body separation ``h0`` the mean gap ``h_m``, the mean asperity contact pressure
+``p_con`` and the factors ``A``, ``b`` (Poiseuille and Couette flow, eq 17) and ``C``, ``d``
+(shear stress, eq 31).  It saves to and loads from ``.npz`` with its metadata, averages over
+patches, and interpolates in ``h0`` with the paper's rules beyond the computed range.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import PchipInterpolator
+
+from ..io.atomic import atomic_path
+
+_ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "contact_fraction")
+
+
+@dataclass(frozen=True, eq=False)
+class FlowFactors:
+    """Flow factors of one roughness patch pair (or an average of several), SI units.
+
+    h0 : (n,) rigid-body separations [m], increasing
+    h_m : (n,) mean gap, eq 12 [m]
+    p_con : (n,) mean asperity contact pressure, eq 11 [Pa]
+    A : (n, 2, 2) pressure flow factor, eq 13 [-]
+    b : (n, 2) Couette flow factor, eq 14 [-]
+    C : (n, 2, 2) pressure-driven shear factor, eq 15 [-]
+    d : (n, 2) shear-driven shear factor, eq 16 [-]
+    contact_fraction : (n,) space-time mean fraction of pixels in contact [-]
+    meta : JSON-able description (patch ids, grid, materials, method, version, ...)
+    """
+
+    h0: np.ndarray
+    h_m: np.ndarray
+    p_con: np.ndarray
+    A: np.ndarray
+    b: np.ndarray
+    C: np.ndarray
+    d: np.ndarray
+    contact_fraction: np.ndarray
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        n = np.asarray(self.h0).shape
+        expect = {"h0": n, "h_m": n, "p_con": n, "A": n + (2, 2), "b": n + (2,),
+                  "C": n + (2, 2), "d": n + (2,), "contact_fraction": n}
+        for name, shape in expect.items():
+            v = np.asarray(getattr(self, name), dtype=float)
+            if v.shape != shape:
+                raise ValueError(f"FlowFactors.{name} has shape {v.shape}, expected {shape}")
+            if not np.all(np.isfinite(v)):
+                raise ValueError(f"FlowFactors.{name} contains NaN or inf")
+            object.__setattr__(self, name, v)
+        if len(n) != 1 or n[0] < 1 or np.any(np.diff(self.h0) <= 0) or self.h0[0] <= 0:
+            raise ValueError("h0 must be a positive, strictly increasing 1D array [m]")
+
+    def __len__(self) -> int:
+        return self.h0.size
+
+    # -- files ---------------------------------------------------------------------------
+    def save(self, path) -> Path:
+        """Write ``.npz`` (arrays + ``meta`` as JSON) atomically."""
+        path = Path(path)
+        with atomic_path(path) as tmp:
+            with open(tmp, "wb") as f:
+                np.savez(f, **{k: getattr(self, k) for k in _ARRAYS},
+                         meta=np.array(json.dumps(self.meta, sort_keys=True)))
+        return path
+
+    @classmethod
+    def load(cls, path) -> "FlowFactors":
+        """Read a file written by :meth:`save`."""
+        path = Path(path)
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                missing = [k for k in _ARRAYS if k not in z]
+                if missing:
+                    raise KeyError(f"missing {missing}")
+                return cls(**{k: z[k] for k in _ARRAYS}, meta=json.loads(str(z["meta"])))
+        except (OSError, EOFError, ValueError, KeyError) as err:
+            raise ValueError(f"{path}: cannot read flow factors ({err})") from err
+
+    def write_csv(self, path) -> Path:
+        """Table with one row per h0 (h0 and h_m in um, p_con in MPa as in Figures 4-5)."""
+        cols = {"h0_um": self.h0 * 1e6, "h_m_um": self.h_m * 1e6, "p_con_MPa": self.p_con * 1e-6,
+                "A11": self.A[:, 0, 0], "A12": self.A[:, 0, 1], "A21": self.A[:, 1, 0],
+                "A22": self.A[:, 1, 1], "b1": self.b[:, 0], "b2": self.b[:, 1],
+                "C11": self.C[:, 0, 0], "C12": self.C[:, 0, 1], "C21": self.C[:, 1, 0],
+                "C22": self.C[:, 1, 1], "d1": self.d[:, 0], "d2": self.d[:, 1],
+                "contact_fraction": self.contact_fraction}
+        path = Path(path)
+        with atomic_path(path) as tmp:
+            np.savetxt(tmp, np.column_stack(list(cols.values())), delimiter=",",
+                       header=",".join(cols), comments="", fmt="%.10g")
+        return path
+
+    # -- interpolation -------------------------------------------------------------------
+    def at(self, h0) -> "LocalFactors":
+        """Factors at any separations ``h0`` [m] (e.g. a macro gap field), paper 2.2.2 rules.
+
+        Inside the computed range: monotone cubic (PCHIP) interpolation in ``log h0``.
+        Above ``h0_max``: ``h_m = h0``, ``p_con = 0`` and the factors at ``h0_max``.
+        Below ``h0_min`` (not covered by the paper): ``h_m`` and ``p_con`` continue linearly
+        with their end slopes, ``h_m`` floored at 1 nm, and the factors are held at ``h0_min``.
+        """
+        x = np.asarray(h0, dtype=float)
+        if np.any(~np.isfinite(x)) or np.any(x <= 0):
+            raise ValueError("h0 must be finite and positive [m]")
+        flat = x.ravel()
+        lo, hi = self.h0[0], self.h0[-1]
+        xc = np.log(np.clip(flat, lo, hi))
+        out = {}
+        for name in ("h_m", "p_con", "A", "b", "C", "d", "contact_fraction"):
+            v = getattr(self, name)
+            if len(self) == 1:
+                out[name] = np.repeat(v[:1], flat.size, axis=0)
+            else:
+                out[name] = self._interpolant(name)(xc)
+        above, below = flat > hi, flat < lo
+        out["h_m"][above] = flat[above]
+        out["p_con"][above] = 0.0
+        out["contact_fraction"][above] = 0.0
+        if len(self) > 1 and below.any():
+            for name, floor in (("h_m", 1e-9), ("p_con", 0.0)):
+                v = getattr(self, name)
+                slope = (v[1] - v[0]) / (self.h0[1] - self.h0[0])
+                out[name][below] = np.maximum(v[0] + slope * (flat[below] - lo), floor)
+        return LocalFactors(h0=x, **{k: v.reshape(x.shape + v.shape[1:]) for k, v in out.items()})
+
+    def _interpolant(self, name):
+        cache = self.__dict__.setdefault("_pchip", {})
+        if name not in cache:
+            cache[name] = PchipInterpolator(np.log(self.h0), getattr(self, name), axis=0)
+        return cache[name]
+
+    def smooth_limit_error(self) -> float:
+        """Largest deviation from the smooth-surface factors ``A = C = I, b = e1, d = 0``."""
+        eye = np.eye(2)
+        return float(max(np.abs(self.A - eye).max(), np.abs(self.C - eye).max(),
+                         np.abs(self.b - [1, 0]).max(), np.abs(self.d).max()))
+
+
+@dataclass(frozen=True, eq=False)
+class LocalFactors:
+    """Flow factors evaluated at separations ``h0`` of any shape (see :meth:`FlowFactors.at`).
+
+    ``h_m``, ``p_con``, ``contact_fraction`` are shaped like ``h0``; ``A``, ``C`` add
+    ``(2, 2)`` and ``b``, ``d`` add ``(2,)`` as trailing axes.
+    """
+
+    h0: np.ndarray
+    h_m: np.ndarray
+    p_con: np.ndarray
+    A: np.ndarray
+    b: np.ndarray
+    C: np.ndarray
+    d: np.ndarray
+    contact_fraction: np.ndarray
+
+
+def average(factors) -> FlowFactors:
+    """Arithmetic mean over patches at the same ``h0`` (the paper's test average, Fig 4-5)."""
+    factors = list(factors)
+    if not factors:
+        raise ValueError("no flow factors to average")
+    h0 = factors[0].h0
+    for f in factors[1:]:
+        if f.h0.shape != h0.shape or not np.allclose(f.h0, h0, rtol=1e-12, atol=0):
+            raise ValueError("flow factors to average must share the same h0 values")
+    mean = {k: np.mean([getattr(f, k) for f in factors], axis=0) for k in _ARRAYS if k != "h0"}
+    meta = {"average_of": [f.meta for f in factors], "method": factors[0].meta.get("method"),
+            "version": factors[0].meta.get("version")}
+    return FlowFactors(h0=h0.copy(), **mean, meta=meta)

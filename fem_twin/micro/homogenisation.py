@@ -1,0 +1,287 @@
+"""Roughness-scale homogenisation of one pin/disk patch pair (paper 2.2.1, eqs 8-16).
+
+For every rigid-body separation h0 the disk patch slides periodically along x1 over the pin
+patch in ``n_steps`` time steps; at each step a periodic dry contact at imposed h0 gives the
+asperity pressure and the deformed gap, then the three cell problems are solved and their
+averages accumulated over space and time.
+
+Kinematics (issue 4).  The pin is at rest and the disk moves at ``U = 2 u_m``.  One pass of
+the disk over the period ``L_r1`` takes ``T_r = L_r1 / U``; in ``N_t`` steps the disk patch
+shifts by ``s = L_r1 / N_t`` per step and ``dt = s / U``.  The time term of eq 8 then reads
+
+    (1 / u_m) dh/dt  ~  (h^n - h^(n-1)) / (u_m dt) = 2 (h^n - h^(n-1)) / s,
+
+free of u_m.  The paper's ``dt = L_r1 / (N_t u_m)`` with a shift of ``L_r1 / N_t`` would be
+a disk moving at ``u_m``, i.e. half the squeeze term.  With ``moving="lower"`` the same
+physics is computed in the disk's frame (the pin moves at ``-U``, ``u_m -> -u_m``); then
+``A``, ``C``, ``h_m``, ``p_con`` are unchanged and ``b' = 2 e1 - b``, ``d' = -d`` up to the
+time discretisation error (a test checks it).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from ..contact import solve as contact_solve
+from ..contact.levelling import TABLE4
+from ..io.atomic import atomic_path
+from ..topography import Topography
+from .flow_factors import FlowFactors
+
+#: the paper's separations: 100 values geometrically spaced in [0.1, 1] um
+DEFAULT_H0 = np.geomspace(1e-7, 1e-6, 100)
+
+
+@dataclass(frozen=True)
+class CellSettings:
+    """Everything besides the surfaces and h0 that the result depends on (SI units)."""
+
+    n_steps: int = 32
+    e_reduced: float = TABLE4["e_reduced"]
+    hardness: float = TABLE4["hardness"]
+    gap_floor: float = 1e-9
+    method: str = "fe"
+    moving: str = "upper"
+    first_step: str = "steady"
+    contact_tol: float = 1e-10
+
+    def __post_init__(self):
+        if int(self.n_steps) != self.n_steps or self.n_steps < 1:
+            raise ValueError(f"n_steps must be a positive integer, got {self.n_steps}")
+        if self.method not in ("fe", "fvm"):
+            raise ValueError(f"method must be 'fe' or 'fvm', got {self.method!r}")
+        if self.moving not in ("upper", "lower"):
+            raise ValueError(f"moving must be 'upper' (disk) or 'lower' (pin), got {self.moving!r}")
+        if self.first_step not in ("steady", "periodic"):
+            raise ValueError(f"first_step must be 'steady' or 'periodic', got {self.first_step!r}")
+        if not (self.e_reduced > 0 and self.hardness > 0 and self.gap_floor > 0):
+            raise ValueError("e_reduced, hardness and gap_floor must be positive (Pa, Pa, m)")
+
+
+def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
+               e_reduced: float = TABLE4["e_reduced"], hardness: float = TABLE4["hardness"],
+               method: str = "fe", moving: str = "upper", first_step: str = "steady",
+               gap_floor: float = 1e-9, workers: int = 1, executor=None,
+               checkpoint=None, progress: bool = False, patch_id=None) -> FlowFactors:
+    """Flow factors of a roughness patch pair versus h0 (eqs 11-16).
+
+    Parameters
+    ----------
+    pin, disk : Topography
+        Periodic roughness cells on the same grid, both with zero mean plane: ``pin`` the
+        lower surface, ``disk`` the upper one already flipped over the pin (as
+        :func:`fem_twin.topography.prepare.prepare_patch` with ``upper=True`` gives).  The gap
+        is ``h0 + disk - pin + deformation``.
+    h0 : rigid-body separations [m] (default: 100 values geometrically in [0.1, 1] um).
+    n_steps : time steps N_t of one sliding pass (paper: 32).
+    e_reduced, hardness : E' of eq 22 and the pressure cap H [Pa] (Table 4).
+    method : ``"fe"`` (Q1 finite elements) or ``"fvm"`` (the paper's finite volumes).
+    moving : ``"upper"``: the disk slides at ``+U`` over the pin at rest (the tribometer);
+        ``"lower"``: the same seen from the disk (the pin slides at ``-U``).
+    first_step : ``"steady"`` (paper: no time term at the first step) or ``"periodic"``
+        (the last configuration precedes the first, a time-periodic implicit Euler).
+    workers : processes for the h0 values (1: in this process); ``executor``: any
+        ``concurrent.futures``-style executor instead (e.g. ``dask.distributed``'s).
+    checkpoint : folder that keeps one file per finished h0; a rerun resumes from it.
+    progress : show a progress bar.
+    patch_id : recorded in the metadata.
+    """
+    settings = CellSettings(int(n_steps), float(e_reduced), float(hardness), float(gap_floor),
+                            method, moving, first_step)
+    z_low, z_up, spacing = _check_patches(pin, disk)
+    h0 = DEFAULT_H0 if h0 is None else np.asarray(h0, dtype=float)
+    if h0.ndim != 1 or h0.size == 0 or not np.all(np.isfinite(h0)) or np.any(h0 <= 0):
+        raise ValueError("h0 must be a non-empty 1D array of positive separations [m]")
+    if np.unique(h0).size != h0.size:
+        raise ValueError("h0 values must be distinct")
+    order = np.argsort(h0)[::-1]                 # large to small: warm starts add contact
+    key = _key(z_low, z_up, spacing, settings)
+    folder = Path(checkpoint) if checkpoint is not None else None
+    done = {}
+    if folder is not None:
+        for i in order:
+            m = _load_point(folder, key, h0[i])
+            if m is not None:
+                done[i] = m
+    todo = [i for i in order if i not in done]
+    chunks = _chunks(todo, 1 if (workers <= 1 and executor is None) else 4 * max(workers, 2))
+    args = dict(z_low=z_low, z_up=z_up, spacing=spacing, settings=settings,
+                folder=None if folder is None else str(folder), key=key)
+    bar = _progress(len(h0), len(done), progress)
+    try:
+        if executor is None and workers <= 1:
+            for chunk in chunks:
+                for i, m in _run_chunk([(i, h0[i]) for i in chunk], **args):
+                    done[i] = m
+                    bar.update(1)
+        else:
+            own = executor is None
+            pool = ProcessPoolExecutor(workers) if own else executor
+            try:
+                futures = [pool.submit(_run_chunk, [(i, h0[i]) for i in c], **args)
+                           for c in chunks]
+                for fut in as_completed(futures):
+                    for i, m in fut.result():
+                        done[i] = m
+                        bar.update(1)
+            finally:
+                if own:
+                    pool.shutdown(cancel_futures=True)
+    finally:
+        bar.close()
+    idx = np.argsort(h0)
+    meta = {"patch_id": patch_id, "shape": list(z_low.shape), "spacing": list(spacing),
+            "e_reduced": settings.e_reduced, "hardness": settings.hardness,
+            "gap_floor": settings.gap_floor, "n_steps": settings.n_steps,
+            "method": settings.method, "moving": settings.moving,
+            "first_step": settings.first_step, "version": __version__,
+            "pin": pin.meta.get("sample", pin.meta.get("source")),
+            "disk": disk.meta.get("sample", disk.meta.get("source"))}
+    return factors_from_moments(h0[idx], [done[i] for i in idx], meta)
+
+
+def factors_from_moments(h0, moments, meta) -> FlowFactors:
+    """Eqs 11-16 from space-time averaged moments (see :meth:`CellSolver.moments`)."""
+    h_m = np.array([m["h"] for m in moments])
+    A = np.array([m["h3_grad"] for m in moments]) / h_m[:, None, None] ** 3
+    b = np.array([[1.0, 0.0] - m["h3_g1"] / m["h"] for m in moments])
+    C = np.array([m["h_grad"] for m in moments]) / h_m[:, None, None]
+    d = np.array([m["h_g1"] for m in moments]) * h_m[:, None]
+    return FlowFactors(h0=np.asarray(h0, float), h_m=h_m,
+                       p_con=np.array([m["p_con"] for m in moments]), A=A, b=b, C=C, d=d,
+                       contact_fraction=np.array([m["contact_fraction"] for m in moments]),
+                       meta=meta)
+
+
+# -- one patch pair, a chunk of separations ------------------------------------------------
+def sliding_shapes(z_low, z_up, settings: CellSettings):
+    """Undeformed gap geometry ``z_up - z_low`` at each time step and ``u_m dt`` [m].
+
+    The moving surface shifts by ``s = L_r1 / N_t`` per step (``+s`` for the disk, ``-s``
+    for the pin in the disk's frame); ``u_m dt = (shift_up + shift_low) / 2`` is ``+-s/2``.
+    """
+    nx = z_low.shape[1]
+    px = nx / settings.n_steps                   # pixels per step
+    up, low = (px, 0.0) if settings.moving == "upper" else (0.0, -px)
+    shapes = [_shift(z_up, n * up) - _shift(z_low, n * low) for n in range(settings.n_steps)]
+    return shapes, (up + low) / 2
+
+
+def _shift(z, px):
+    """Periodic translation of ``z`` by ``px`` pixels along x1 (Fourier for fractions)."""
+    if px == 0:
+        return z
+    if float(px).is_integer():
+        return np.roll(z, int(px), axis=1)
+    k = np.fft.rfftfreq(z.shape[1])
+    return np.fft.irfft(np.fft.rfft(z, axis=1) * np.exp(-2j * np.pi * k * px), n=z.shape[1],
+                        axis=1)
+
+
+def _cell_solver(shape, spacing, method):
+    if method == "fe":
+        from .cell import CellSolver
+        return CellSolver(shape, spacing)
+    from ..fvm.cell import CellSolverFV
+    return CellSolverFV(shape, spacing)
+
+
+def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key):
+    """Moments for ``points = [(index, h0), ...]`` in order, warm-starting contact."""
+    solver = _cell_solver(z_low.shape, spacing, settings.method)
+    shapes, um_dt_px = sliding_shapes(z_low, z_up, settings)
+    um_dt = um_dt_px * spacing[0]
+    warm = [None] * settings.n_steps
+    out = []
+    for i, h0 in points:
+        gaps, pressures, fractions = [], [], []
+        for n, s in enumerate(shapes):
+            r = contact_solve(s, spacing, settings.e_reduced, separation=h0,
+                              hardness=settings.hardness, periodic=True,
+                              gap_floor=settings.gap_floor, initial_pressure=warm[n],
+                              tol=settings.contact_tol)
+            warm[n] = r.pressure if r.load > 0 else None
+            gaps.append(r.gap)
+            pressures.append(r.pressure.mean())
+            fractions.append(r.contact_fraction)
+        sums = None
+        for n, h in enumerate(gaps):
+            if n == 0 and settings.first_step == "steady":
+                squeeze = None
+            else:
+                squeeze = (h - gaps[n - 1]) / um_dt
+            m = solver.solve(h, squeeze).moments
+            sums = m if sums is None else {k: sums[k] + m[k] for k in m}
+        moments = {k: v / settings.n_steps for k, v in sums.items()}
+        moments["p_con"] = float(np.mean(pressures))
+        moments["contact_fraction"] = float(np.mean(fractions))
+        if folder is not None:
+            _save_point(Path(folder), key, h0, moments)
+        out.append((i, moments))
+    return out
+
+
+def _chunks(indices, n):
+    n = max(1, min(n, len(indices)))
+    return [list(c) for c in np.array_split(np.asarray(indices, dtype=int), n) if len(c)]
+
+
+# -- checkpoints ----------------------------------------------------------------------------
+def _check_patches(pin, disk):
+    for name, t in (("pin", pin), ("disk", disk)):
+        if not isinstance(t, Topography):
+            raise TypeError(f"{name} must be a Topography, got {type(t).__name__}")
+        if not np.all(np.isfinite(t.heights)):
+            raise ValueError(f"{name} patch has invalid (NaN) pixels: fill them first")
+    if pin.shape != disk.shape:
+        raise ValueError(f"pin {pin.shape} and disk {disk.shape} patches differ in shape")
+    if not np.allclose(pin.spacing, disk.spacing, rtol=1e-6):
+        raise ValueError(f"pin {pin.spacing} and disk {disk.spacing} pixel pitches differ [m]")
+    if min(pin.shape) < 4:
+        raise ValueError(f"a roughness cell needs at least 4 x 4 pixels, got {pin.shape}")
+    return (np.ascontiguousarray(pin.heights, float), np.ascontiguousarray(disk.heights, float),
+            tuple(float(s) for s in pin.spacing))
+
+
+def _key(z_low, z_up, spacing, settings) -> str:
+    h = hashlib.sha256()
+    for a in (z_low, z_up):
+        h.update(np.ascontiguousarray(a).tobytes())
+    h.update(json.dumps([spacing, settings.__dict__, __version__], sort_keys=True).encode())
+    return h.hexdigest()[:16]
+
+
+def _point_path(folder: Path, key: str, h0: float) -> Path:
+    return folder / f"{key}_h0_{h0:.9e}.json"
+
+
+def _save_point(folder, key, h0, moments):
+    data = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in moments.items()}
+    path = _point_path(folder, key, h0)
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps({"h0": float(h0), "moments": data}))
+
+
+def _load_point(folder, key, h0):
+    path = _point_path(folder, key, h0)
+    if not path.is_file():
+        return None
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None                              # unreadable checkpoint: recompute
+    return {k: (np.array(v) if isinstance(v, list) else v) for k, v in data["moments"].items()}
+
+
+def _progress(total, initial, enabled):
+    from tqdm.auto import tqdm
+    return tqdm(total=total, initial=initial, desc="homogenise h0", unit="h0",
+                disable=not enabled or os.environ.get("FEM_TWIN_NO_PROGRESS") == "1")

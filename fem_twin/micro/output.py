@@ -1,0 +1,90 @@
+"""Plots of flow factors (paper Figures 4-5) and VTU/PVD of the cell fields for ParaView."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..contact import solve as contact_solve
+from ..io.atomic import atomic_path
+from ..io.mesh import grid_mesh, write_pvd, write_vtu
+from .flow_factors import FlowFactors
+from .homogenisation import CellSettings, _cell_solver, _check_patches, _shift, sliding_shapes
+
+
+def plot_flow_factors(factors, path, labels=None) -> Path:
+    """Figures 4-5: h_m, p_con, A11 of each patch pair (and their average if given last),
+    and all components of A and b of the last entry, versus h0 [um].  Written atomically."""
+    import matplotlib
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    factors = [factors] if isinstance(factors, FlowFactors) else list(factors)
+    labels = labels or [f.meta.get("patch_id") or f"patch {i + 1}" for i, f in enumerate(factors)]
+    fig, ax = plt.subplots(2, 2, figsize=(10, 8), constrained_layout=True)
+    for f, label in zip(factors, labels):
+        x = f.h0 * 1e6
+        ax[0, 0].plot(x, f.h_m * 1e6, label=label)
+        ax[0, 1].semilogy(x, np.where(f.p_con > 0, f.p_con * 1e-6, np.nan), label=label)
+        ax[1, 0].plot(x, f.A[:, 0, 0], label=label)
+    last = factors[-1]
+    x = last.h0 * 1e6
+    for (i, j), style in zip([(0, 0), (0, 1), (1, 0), (1, 1)], ["-", "--", ":", "-."]):
+        ax[1, 1].plot(x, last.A[:, i, j], style, label=f"$A_{{{i + 1}{j + 1}}}$")
+    ax[1, 1].plot(x, last.b[:, 0], "-", marker=".", markevery=10, label="$b_1$")
+    ax[1, 1].plot(x, last.b[:, 1], "--", marker=".", markevery=10, label="$b_2$")
+    names = [("$h_m$ [µm]", "(a) mean gap, eq 12"), ("$p_{con}$ [MPa]", "(b) contact pressure, eq 11"),
+             ("$A_{11}$ [-]", "(c) pressure flow factor, eq 13"),
+             ("factor [-]", f"(d) A and b of {labels[-1]}")]
+    for a, (ylabel, title) in zip(ax.ravel(), names):
+        a.set_xlabel("$h_0$ [µm]")
+        a.set_ylabel(ylabel)
+        a.set_title(title)
+        a.grid(True, alpha=0.3)
+        a.legend(fontsize="small")
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def cell_fields(pin, disk, h0: float, *, n_steps: int = 32, method: str = "fe",
+                moving: str = "upper", first_step: str = "steady", **materials) -> list[dict]:
+    """Per time step: pin and disk heights, gap, asperity pressure and chi_1..3 (grid fields).
+
+    ``materials`` are ``e_reduced``, ``hardness``, ``gap_floor`` as in :func:`homogenise`.
+    """
+    settings = CellSettings(int(n_steps), method=method, moving=moving, first_step=first_step,
+                            **materials)
+    z_low, z_up, spacing = _check_patches(pin, disk)
+    shapes, um_dt_px = sliding_shapes(z_low, z_up, settings)
+    solver = _cell_solver(z_low.shape, spacing, method)
+    out, prev, warm = [], None, None
+    for n, s in enumerate(shapes):
+        r = contact_solve(s, spacing, settings.e_reduced, separation=h0,
+                          hardness=settings.hardness, periodic=True, gap_floor=settings.gap_floor,
+                          initial_pressure=warm)
+        warm = r.pressure if r.load > 0 else None
+        squeeze = None if prev is None else (r.gap - prev) / (um_dt_px * spacing[0])
+        chi = solver.solve(r.gap, squeeze).chi
+        prev = r.gap
+        px = n * z_low.shape[1] / settings.n_steps
+        out.append({"pin": z_low if moving == "upper" else _shift(z_low, -px),
+                    "disk": _shift(z_up, px) if moving == "upper" else z_up,
+                    "gap": r.gap, "asperity_pressure": r.pressure,
+                    "chi_1": chi[0], "chi_2": chi[1], "chi_3": chi[2]})
+    return out
+
+
+def write_cell_fields(folder, pin, disk, h0: float, **kwargs) -> Path:
+    """VTU per time step and a PVD time series of :func:`cell_fields` (SI units)."""
+    folder = Path(folder)
+    steps = cell_fields(pin, disk, h0, **kwargs)
+    _, _, spacing = _check_patches(pin, disk)
+    gm = grid_mesh(pin.shape, spacing, periodic=True)
+    name = f"cell_h0_{h0 * 1e9:.0f}nm"
+    entries = [(n / len(steps), write_vtu(folder / f"{name}_{n:03d}.vtu", gm, fields))
+               for n, fields in enumerate(steps)]
+    return write_pvd(folder / f"{name}.pvd", entries)   # time in periods T_r

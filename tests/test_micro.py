@@ -1,0 +1,282 @@
+"""Micro scale: cell problems (eqs 8-10) and flow factors (eqs 11-16), FE and FVM."""
+
+import json
+
+import numpy as np
+import pytest
+
+from fem_twin import Topography
+from fem_twin.fvm import CellSolverFV
+from fem_twin.micro import CellSolver, FlowFactors, average, homogenise
+from fem_twin.micro import homogenisation as homogenise_module
+from fem_twin.micro.cell import couette_form, flow_form, pressure_form_1, squeeze_form
+from fem_twin.topography.synthetic import self_affine
+
+L = 80e-6                                        # cell length [m]
+H, AMP = 0.5e-6, 0.2e-6                          # cosine ridges h = H + a cos(2 pi x / L)
+
+
+def ridges(n, along):
+    """Cosine ridges of one period on an n x n cell, varying along x1 or x2."""
+    dx = L / n
+    z = AMP * np.cos(2 * np.pi * np.arange(n) * dx / L)
+    z = np.tile(z, (n, 1)) if along == "x1" else np.tile(z[:, None], (1, n))
+    return Topography(z, (dx, dx)), Topography(np.zeros((n, n)), (dx, dx))
+
+
+def exact_ridges():
+    """REFERENCES.md: <h^3>, <h^-3>, <h^-2> of h = H + a cos."""
+    h3 = H ** 3 + 1.5 * H * AMP ** 2
+    hm3 = (H ** 2 + AMP ** 2 / 2) * (H ** 2 - AMP ** 2) ** -2.5
+    hm2 = H * (H ** 2 - AMP ** 2) ** -1.5
+    return h3, hm3, hm2
+
+
+def rough_pair(n=32, seed=1, rms=100e-9):
+    dx = 85e-6 / n
+    return (self_affine((n, n), (dx, dx), 0.8, rms, rng=seed),
+            self_affine((n, n), (dx, dx), 0.8, rms, rng=seed + 1))
+
+
+# -- assembly ------------------------------------------------------------------------------
+def test_fast_assembly_equals_scikit_fem_forms():
+    """Re-assembly from element tensors is the skfem assembly of the same forms (round-off)."""
+    rng = np.random.default_rng(0)
+    cs = CellSolver((12, 10), (1.3e-7, 1.1e-7), pinned=7)
+    h = 1e-7 * (1 + 0.5 * rng.random((12, 10)))
+    tau = rng.standard_normal((12, 10))
+    P, keep = cs.grid.periodic_map, cs.unknowns
+    h_q, tau_q = cs.at_quadrature(h), cs.at_quadrature(tau)
+    assert np.allclose(np.asarray(cs.basis.interpolate(cs.grid.to_nodes(h))), h_q, rtol=1e-14)
+    K = (P.T @ flow_form.assemble(cs.basis, a=h_q ** 3) @ P).toarray()[np.ix_(keep, keep)]
+    assert np.abs(cs.operator(h_q ** 3).toarray() - K).max() < 1e-14 * np.abs(K).max()
+    F = cs.right_hand_sides(h_q, h_q ** 3, tau_q)
+    f1 = P.T @ (couette_form.assemble(cs.basis, h=h_q) + squeeze_form.assemble(cs.basis, tau=tau_q))
+    f2 = P.T @ pressure_form_1.assemble(cs.basis, a=h_q ** 3)
+    assert np.abs(F[:, 0] - f1[keep]).max() < 1e-14 * np.abs(f1).max()
+    assert np.abs(F[:, 1] - f2[keep]).max() < 1e-14 * np.abs(f2).max()
+
+
+# -- exact cases -----------------------------------------------------------------------------
+@pytest.mark.parametrize("method", ["fe", "fvm"])
+def test_smooth_limit_is_exact(method):
+    n = 16
+    flat = Topography(np.zeros((n, n)), (L / n, L / n))
+    ff = homogenise(flat, flat, [0.2e-6, 1e-6], n_steps=4, method=method)
+    assert ff.smooth_limit_error() < 1e-12
+    assert np.allclose(ff.h_m, ff.h0, rtol=1e-15) and np.all(ff.p_con == 0)
+
+
+@pytest.mark.parametrize("method", ["fe", "fvm"])
+def test_striated_roughness_converges_second_order(method):
+    """Transverse ridges on the pin: A11 = 1/(<h^-3> h_m^3), b1 = <h^-2>/(<h^-3> h_m)
+    (REFERENCES.md).  Both discretisations are second order: the error falls 4x per
+    refinement; at 64 px per period it is below 2.5e-3 (measured 1.5e-3 FE, 2.0e-3 FVM)."""
+    h3, hm3, hm2 = exact_ridges()
+    errors = []
+    for n in (16, 32, 64):
+        pin, disk = ridges(n, "x1")
+        ff = homogenise(pin, disk, [H], n_steps=4, method=method)
+        errors.append([ff.A[0, 0, 0] * H ** 3 * hm3 - 1, ff.b[0, 0] * H * hm3 / hm2 - 1,
+                       ff.A[0, 1, 1] * H ** 3 / h3 - 1])
+    errors = np.abs(errors)
+    order = np.log2(errors[:-1, :2] / errors[1:, :2])
+    assert np.all((order > 1.9) & (order < 2.1)), order
+    assert errors[-1, :2].max() < 2.5e-3
+    # along the ridges A22 = <h^3>/h_m^3: FVM's pixel mean is exact for a cosine, FE's
+    # quadrature of the cubed bilinear gap converges at second order
+    assert errors[-1, 2] < 1e-12 or 3.8 < errors[-2, 2] / errors[-1, 2] < 4.2
+
+
+@pytest.mark.parametrize("method", ["fe", "fvm"])
+def test_longitudinal_ridges_on_the_moving_disk(method):
+    """Ridges along x1 sliding along themselves: no time dependence, A11 = <h^3>/h_m^3 and
+    b1 = 1; FE converges at second order (FVM's face means make it exact here)."""
+    h3, hm3, _ = exact_ridges()
+    errors = []
+    for n in (16, 32):
+        disk, pin = ridges(n, "x2")
+        ff = homogenise(pin, disk, [H], n_steps=4, method=method)
+        errors.append(abs(ff.A[0, 0, 0] * H ** 3 / h3 - 1))
+        assert abs(ff.b[0, 0] - 1) < 1e-12 and abs(ff.A[0, 1, 1] * H ** 3 * hm3 - 1) < 3.5e-2
+    assert errors[1] < 1.3e-3 and (errors[1] < 1e-13 or 3.5 < errors[0] / errors[1] < 4.5)
+
+
+@pytest.mark.parametrize("method", ["fe", "fvm"])
+def test_wiener_bounds_and_symmetry(method):
+    """Stationary random roughness (flat moving disk): 1/<h^-3> <= eig(h_m^3 A) <= <h^3>.
+    FE's upper bound is exact for its own quadrature; the FVM means are pixel means."""
+    pin, _ = rough_pair(32)
+    flat = pin.with_heights(np.zeros(pin.shape))
+    ff = homogenise(pin, flat, [0.25e-6, 0.6e-6], n_steps=2, method=method)
+    from fem_twin.contact import solve
+    for k, h0 in enumerate(ff.h0):
+        gap = solve(-pin.heights, pin.spacing, ff.meta["e_reduced"], separation=h0,
+                    hardness=ff.meta["hardness"], periodic=True).gap
+        lam = np.linalg.eigvalsh(ff.A[k]) * ff.h_m[k] ** 3
+        assert np.allclose(ff.A[k], ff.A[k].T, rtol=1e-10, atol=1e-14)
+        assert lam.min() >= 1 / np.mean(gap ** -3) * (1 - 1e-3)
+        assert lam.max() <= np.mean(gap ** 3) * (1 + 5e-2)
+        assert lam.max() < np.mean(gap ** 3) * 1.05 and lam.min() < lam.max()
+
+
+def test_large_separation_limit_and_monotone_contact():
+    pin, disk = rough_pair(32)
+    ff = homogenise(pin, disk, np.geomspace(0.1e-6, 1.5e-6, 6), n_steps=4)
+    assert ff.p_con[-1] == 0 and ff.contact_fraction[-1] == 0
+    assert abs(ff.h_m[-1] / ff.h0[-1] - 1) < 1e-13
+    assert np.all(np.diff(ff.p_con) <= 0) and ff.p_con[0] > 0
+    assert np.all(ff.h_m >= ff.h0 * (1 - 1e-12))          # contact deformation opens the gap
+    assert np.all(np.diff(ff.A[:, 0, 0]) > 0)             # flow factor grows with the gap
+
+
+@pytest.mark.parametrize("solver", [CellSolver, CellSolverFV])
+def test_pinned_node_does_not_matter(solver):
+    rng = np.random.default_rng(3)
+    h = 1e-7 * (1 + 3 * rng.random((16, 20)))
+    tau = 0.1 * rng.standard_normal((16, 20))
+    a = solver((16, 20), (1e-7, 1.2e-7), pinned=0).solve(h, tau)
+    b = solver((16, 20), (1e-7, 1.2e-7), pinned=123).solve(h, tau)
+    for key in a.moments:
+        assert np.allclose(a.moments[key], b.moments[key], rtol=1e-9, atol=1e-12 * np.abs(
+            a.moments[key]).max()), key
+    d = a.chi - b.chi                                      # differ by constants only
+    assert np.allclose(d, d.reshape(3, -1)[:, :1, None], atol=1e-9 * np.abs(a.chi).max())
+
+
+def test_galilean_consistency_converges_with_time_steps():
+    """The disk's frame (pin sliding at -U) sees the same physics: A, h_m, p_con identical;
+    b' = 2 e1 - b and d' = -d up to the implicit-Euler error, which falls with N_t
+    (measured at 64 px: 0.048, 0.114, 0.24 for N_t = 32, 16, 8 at h0 = 0.2 um)."""
+    pin, disk = rough_pair(64)
+    errors = []
+    for nt in (8, 16, 32):
+        a = homogenise(pin, disk, [0.2e-6], n_steps=nt)
+        b = homogenise(pin, disk, [0.2e-6], n_steps=nt, moving="lower")
+        assert np.allclose(a.A, b.A, rtol=1e-9) and np.allclose(a.C, b.C, rtol=1e-9)
+        assert np.allclose(a.p_con, b.p_con, rtol=1e-9) and np.allclose(a.h_m, b.h_m, rtol=1e-12)
+        errors.append(np.abs(a.b + b.b - [2, 0]).max())
+    assert errors[0] > 1.6 * errors[1] > 1.6 ** 2 * errors[2]
+
+
+def test_time_step_matches_the_disk_motion():
+    """A rigid (no contact) cell with one rough moving disk: implicit Euler with the derived
+    u_m dt = s / 2 reduces the disk-only problem to a frozen pattern in the disk frame,
+    where chi_1 solves (h^3 chi_1')' = -(h)' with flat pin: b1 of a moving rough disk over a
+    flat pin is 2 - b1 of the same disk at rest (with 1 px per step, to discretisation)."""
+    n = 32
+    dx = L / n
+    z = AMP * np.cos(2 * np.pi * np.arange(n) * dx / L)
+    rough = Topography(np.tile(z, (n, 1)), (dx, dx))
+    flat = rough.with_heights(np.zeros((n, n)))
+    moving = homogenise(flat, rough, [H], n_steps=n, first_step="periodic")
+    at_rest = homogenise(rough.with_heights(-rough.heights), flat, [H], n_steps=n)
+    assert abs(moving.b[0, 0] - (2 - at_rest.b[0, 0])) < 0.02 * abs(1 - at_rest.b[0, 0])
+    assert np.allclose(moving.A, at_rest.A, rtol=1e-9)
+
+
+def test_fe_and_fvm_agree_better_under_refinement():
+    """Both discretise the same continuum problem: their A and b differences shrink."""
+    diffs = []
+    for n in (32, 64):
+        pin, disk = rough_pair(n, seed=5, rms=80e-9)
+        fe = homogenise(pin, disk, [0.3e-6], n_steps=4, method="fe")
+        fv = homogenise(pin, disk, [0.3e-6], n_steps=4, method="fvm")
+        assert fe.h_m == pytest.approx(fv.h_m, rel=1e-14)
+        diffs.append(max(np.abs(fe.A - fv.A).max(), np.abs(fe.b - fv.b).max()))
+    assert diffs[1] < 0.7 * diffs[0]
+
+
+# -- FlowFactors value ------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def small_factors():
+    pin, disk = rough_pair(16)
+    return homogenise(pin, disk, np.geomspace(0.1e-6, 1e-6, 5), n_steps=2, patch_id="p1")
+
+
+def test_save_load_round_trip(tmp_path, small_factors):
+    path = small_factors.save(tmp_path / "ff.npz")
+    back = FlowFactors.load(path)
+    for k in ("h0", "h_m", "p_con", "A", "b", "C", "d", "contact_fraction"):
+        assert np.array_equal(getattr(back, k), getattr(small_factors, k))
+    assert back.meta == json.loads(json.dumps(small_factors.meta))
+    assert back.meta["method"] == "fe" and back.meta["patch_id"] == "p1"
+    table = np.loadtxt(small_factors.write_csv(tmp_path / "ff.csv"), delimiter=",", skiprows=1)
+    assert np.allclose(table[:, 0], small_factors.h0 * 1e6)
+    (tmp_path / "bad.npz").write_bytes(b"not a zip")
+    with pytest.raises(ValueError, match="cannot read"):
+        FlowFactors.load(tmp_path / "bad.npz")
+
+
+def test_interpolation_rules(small_factors):
+    ff = small_factors
+    at_nodes = ff.at(ff.h0)
+    assert np.allclose(at_nodes.A, ff.A, rtol=1e-12) and np.allclose(at_nodes.p_con, ff.p_con)
+    field = np.array([[2e-6, 5e-6], [ff.h0[2], 0.05e-6]])
+    loc = ff.at(field)
+    assert loc.A.shape == (2, 2, 2, 2) and loc.b.shape == (2, 2, 2)
+    assert np.array_equal(loc.h_m[0], field[0]) and np.all(loc.p_con[0] == 0)
+    assert np.allclose(loc.A[0, 1], ff.A[-1]) and np.allclose(loc.b[0, 0], ff.b[-1])
+    assert loc.p_con[1, 1] > ff.p_con[0] and np.allclose(loc.A[1, 1], ff.A[0])
+    with pytest.raises(ValueError):
+        ff.at([-1e-7])
+
+
+def test_average_over_patches(small_factors):
+    other = FlowFactors(**{k: getattr(small_factors, k) * (1 if k == "h0" else 3)
+                           for k in ("h0", "h_m", "p_con", "A", "b", "C", "d",
+                                     "contact_fraction")}, meta={"patch_id": "x3"})
+    mean = average([small_factors, other])
+    assert np.allclose(mean.A, 2 * small_factors.A) and len(mean.meta["average_of"]) == 2
+    shifted = FlowFactors(**{**{k: getattr(other, k) for k in ("h_m", "p_con", "A", "b", "C",
+                                                               "d", "contact_fraction")},
+                             "h0": other.h0 * 1.01})
+    with pytest.raises(ValueError, match="same h0"):
+        average([small_factors, shifted])
+
+
+# -- runs: checkpoints, processes, bad input ---------------------------------------------------
+def test_checkpoint_resume_computes_only_missing(tmp_path, monkeypatch):
+    pin, disk = rough_pair(16)
+    h0 = np.geomspace(0.15e-6, 0.8e-6, 3)
+    first = homogenise(pin, disk, h0[:2], n_steps=2, checkpoint=tmp_path)
+    assert len(list(tmp_path.glob("*.json"))) == 2
+    calls = []
+    real = homogenise_module._run_chunk
+
+    def counting(points, **kw):
+        calls.extend(h for _, h in points)
+        return real(points, **kw)
+
+    monkeypatch.setattr(homogenise_module, "_run_chunk", counting)
+    again = homogenise(pin, disk, h0, n_steps=2, checkpoint=tmp_path)
+    assert calls == [h0[2]]
+    assert np.array_equal(again.A[:2], first.A) and np.array_equal(again.p_con[:2], first.p_con)
+    calls.clear()
+    other = homogenise(pin, disk, h0[:1], n_steps=4, checkpoint=tmp_path)   # other settings
+    assert calls == [h0[0]] and other.meta["n_steps"] == 4
+
+
+def test_process_pool_gives_the_serial_numbers():
+    pin, disk = rough_pair(16)
+    h0 = np.geomspace(0.12e-6, 0.6e-6, 4)
+    serial = homogenise(pin, disk, h0, n_steps=2)
+    pooled = homogenise(pin, disk, h0, n_steps=2, workers=2)
+    for k in ("h_m", "p_con", "A", "b", "C", "d"):
+        assert np.allclose(getattr(pooled, k), getattr(serial, k), rtol=1e-7, atol=1e-12), k
+
+
+def test_bad_input_is_refused():
+    pin, disk = rough_pair(16)
+    with pytest.raises(ValueError, match="differ in shape"):
+        homogenise(pin, Topography(np.zeros((16, 8)), pin.spacing), [1e-6])
+    nan = pin.heights.copy()
+    nan[3, 3] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        homogenise(pin.with_heights(nan), disk, [1e-6])
+    with pytest.raises(ValueError, match="positive"):
+        homogenise(pin, disk, [1e-6, -1e-7])
+    with pytest.raises(ValueError, match="method"):
+        homogenise(pin, disk, [1e-6], method="fdm")
+    with pytest.raises(ValueError, match="truncate"):
+        CellSolver((8, 8), (1e-7, 1e-7)).solve(np.zeros((8, 8)))
