@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import sys
 from pathlib import Path
 
@@ -47,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="fem-twin",
         description="Digital twin of a pin-on-disk tribometer in mixed lubrication. "
-                    "Stages: topography -> contact -> (homogenise -> macro -> stribeck); "
+                    "Stages: topography -> contact -> homogenise -> (macro -> stribeck); "
                     "'run' executes the whole pipeline of a case file.")
     p.add_argument("--version", action="version", version=f"fem-twin {__version__}")
     p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
@@ -86,6 +87,29 @@ def build_parser() -> argparse.ArgumentParser:
     av.add_argument("pins", type=Path, nargs="+")
     av.add_argument("-o", "--output", type=Path, required=True)
     av.set_defaults(func=_contact_average)
+
+    h = sub.add_parser("homogenise", help="micro scale: flow factors of roughness patch pairs "
+                                          "versus h0 (eqs 8-16)")
+    hs = h.add_subparsers(dest="step", required=True, metavar="STEP")
+    hr = hs.add_parser("run", help="flow factors of one pin/disk patch pair (checkpointed)")
+    hr.add_argument("pin", type=Path, help="pin patch (fem-twin topography prepare-patch)")
+    hr.add_argument("disk", type=Path, help="disk patch flipped over the pin (--upper)")
+    hr.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    hr.add_argument("--h0", type=float, nargs=3, default=(1e-7, 1e-6, 100),
+                    metavar=("MIN", "MAX", "N"), help="geometric h0 range [m] and count "
+                    "(default: 1e-7 1e-6 100, the paper's)")
+    hr.add_argument("--steps", type=int, default=32, help="time steps N_t (default 32)")
+    hr.add_argument("--method", choices=("fe", "fvm"), default="fe")
+    hr.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+                    help="processes over h0 values (default: all cores)")
+    hr.add_argument("--fields", type=float, nargs="*", default=(), metavar="H0",
+                    help="also write the cell fields (VTU/PVD) at these h0 [m]")
+    hr.add_argument("--no-progress", action="store_true")
+    hr.set_defaults(func=_homogenise_run)
+    ha = hs.add_parser("average", help="average flow factors over patches (same h0 values)")
+    ha.add_argument("inputs", type=Path, nargs="+", help="flow_factors.npz files")
+    ha.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    ha.set_defaults(func=_homogenise_average)
 
     m = sub.add_parser("mesh", help="topography -> structured FE mesh written as VTU for ParaView")
     m.add_argument("input", type=Path)
@@ -204,6 +228,49 @@ def _contact_average(args):
     print(json.dumps({"pins": len(args.pins), "tilt_rad": res.tilt,
                       "residuals": res.residuals}, indent=2))
     return 0
+
+
+def _homogenise_run(args):
+    import numpy as np
+
+    from .io.files import read_topography
+    from .micro import homogenise
+    from .micro.output import plot_flow_factors, write_cell_fields
+    pin, disk = read_topography(args.pin), read_topography(args.disk)
+    lo, hi, n = args.h0
+    if int(n) != n or n < 1:
+        raise ValueError(f"the number of h0 values must be a positive integer, got {n}")
+    ff = homogenise(pin, disk, np.geomspace(lo, hi, int(n)), n_steps=args.steps,
+                    method=args.method, workers=args.workers,
+                    checkpoint=args.output / "checkpoints", progress=not args.no_progress,
+                    patch_id=f"{args.pin.stem}/{args.disk.stem}")
+    _write_factors(args.output, ff)
+    for h0 in args.fields:
+        print(write_cell_fields(args.output / "fields", pin, disk, h0, n_steps=args.steps,
+                                method=args.method))
+    return 0
+
+
+def _homogenise_average(args):
+    from .micro import FlowFactors, average
+    factors = [FlowFactors.load(p) for p in args.inputs]
+    _write_factors(args.output, average(factors), factors)
+    return 0
+
+
+def _write_factors(folder, ff, patches=()):
+    from .micro.output import plot_flow_factors
+    ff.save(folder / "flow_factors.npz")
+    ff.write_csv(folder / "flow_factors.csv")
+    labels = [f.meta.get("patch_id") or f"patch {i + 1}" for i, f in enumerate(patches)]
+    plot_flow_factors([*patches, ff], folder / "flow_factors.png",
+                      labels=[*labels, "average" if patches else ff.meta.get("patch_id") or "patch"])
+    print(json.dumps({"h0_um": [ff.h0[0] * 1e6, ff.h0[-1] * 1e6], "points": len(ff),
+                      "p_con_max_MPa": float(ff.p_con.max() * 1e-6),
+                      "A11_range": [float(ff.A[:, 0, 0].min()), float(ff.A[:, 0, 0].max())],
+                      "files": [str(folder / n) for n in ("flow_factors.npz",
+                                                          "flow_factors.csv",
+                                                          "flow_factors.png")]}, indent=2))
 
 
 def _mesh(args):

@@ -19,7 +19,7 @@ def test_help_lists_pipeline_stages(capsys):
         main(["--help"])
     assert exit_.value.code == 0
     out = capsys.readouterr().out
-    for stage in ("run", "topography", "contact", "mesh", "sample"):
+    for stage in ("run", "topography", "contact", "homogenise", "mesh", "sample"):
         assert stage in out
 
 
@@ -97,3 +97,35 @@ def test_run_bundled_case_and_resume(tmp_path):
     stamps = {f.name: f.stat().st_mtime_ns for f in files}
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0   # resumes
     assert {f.name: f.stat().st_mtime_ns for f in (out / "geometry").iterdir()} == stamps
+
+
+def test_homogenise_run_average_and_fields(tmp_path, capsys):
+    """CLI micro stage: two patch pairs -> flow factors, CSV, plot, VTU/PVD, then average."""
+    from fem_twin.io.mesh import read_vtu
+    from fem_twin.micro import FlowFactors, homogenise
+    outs = []
+    for k in (1, 2):
+        pin, disk = tmp_path / f"pin{k}.npz", tmp_path / f"disk{k}.npz"
+        src = ROOT / "meshes" / "sample"
+        assert main(["topography", "prepare-patch", str(src / f"patch_{k}_pin.npz"), str(pin),
+                     "--shape", "16", "16"]) == 0
+        assert main(["topography", "prepare-patch", str(src / f"patch_{k}_disk.npz"), str(disk),
+                     "--shape", "16", "16", "--upper"]) == 0
+        out = tmp_path / f"ff{k}"
+        extra = ["--fields", "2e-7"] if k == 1 else []
+        assert main(["homogenise", "run", str(pin), str(disk), "-o", str(out), "--h0", "1e-7",
+                     "1e-6", "4", "--steps", "4", "--workers", "1", "--no-progress",
+                     *extra]) == 0
+        ff = FlowFactors.load(out / "flow_factors.npz")
+        api = homogenise(read_topography(pin), read_topography(disk), np.geomspace(1e-7, 1e-6, 4),
+                         n_steps=4)
+        assert np.array_equal(ff.A, api.A) and (out / "flow_factors.png").stat().st_size > 0
+        outs.append(ff)
+    _, fields = read_vtu(tmp_path / "ff1" / "fields" / "cell_h0_200nm_003.vtu")
+    assert {"gap", "asperity_pressure", "chi_1", "chi_2", "chi_3"} <= set(fields)
+    assert fields["gap"].min() >= 1e-9
+    assert (tmp_path / "ff1" / "fields" / "cell_h0_200nm.pvd").is_file()
+    assert main(["homogenise", "average", str(tmp_path / "ff1" / "flow_factors.npz"),
+                 str(tmp_path / "ff2" / "flow_factors.npz"), "-o", str(tmp_path / "avg")]) == 0
+    mean = FlowFactors.load(tmp_path / "avg" / "flow_factors.npz")
+    assert np.allclose(mean.A, (outs[0].A + outs[1].A) / 2, rtol=1e-14)

@@ -23,6 +23,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -144,7 +145,10 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
             "method": settings.method, "moving": settings.moving,
             "first_step": settings.first_step, "version": __version__,
             "pin": pin.meta.get("sample", pin.meta.get("source")),
-            "disk": disk.meta.get("sample", disk.meta.get("source"))}
+            "disk": disk.meta.get("sample", disk.meta.get("source")),
+            "seconds": {"contact": sum(done[i].get("seconds_contact", 0.0) for i in todo),
+                        "cell": sum(done[i].get("seconds_cell", 0.0) for i in todo),
+                        "computed_h0": len(todo)}}
     return factors_from_moments(h0[idx], [done[i] for i in idx], meta)
 
 
@@ -203,6 +207,7 @@ def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key):
     out = []
     for i, h0 in points:
         gaps, pressures, fractions = [], [], []
+        t0 = time.perf_counter()
         for n, s in enumerate(shapes):
             r = contact_solve(s, spacing, settings.e_reduced, separation=h0,
                               hardness=settings.hardness, periodic=True,
@@ -212,6 +217,7 @@ def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key):
             gaps.append(r.gap)
             pressures.append(r.pressure.mean())
             fractions.append(r.contact_fraction)
+        t1 = time.perf_counter()
         sums = None
         for n, h in enumerate(gaps):
             if n == 0 and settings.first_step == "steady":
@@ -223,6 +229,8 @@ def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key):
         moments = {k: v / settings.n_steps for k, v in sums.items()}
         moments["p_con"] = float(np.mean(pressures))
         moments["contact_fraction"] = float(np.mean(fractions))
+        moments["seconds_contact"] = t1 - t0
+        moments["seconds_cell"] = time.perf_counter() - t1
         if folder is not None:
             _save_point(Path(folder), key, h0, moments)
         out.append((i, moments))

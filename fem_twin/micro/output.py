@@ -26,7 +26,7 @@ def plot_flow_factors(factors, path, labels=None) -> Path:
     for f, label in zip(factors, labels):
         x = f.h0 * 1e6
         ax[0, 0].plot(x, f.h_m * 1e6, label=label)
-        ax[0, 1].semilogy(x, np.where(f.p_con > 0, f.p_con * 1e-6, np.nan), label=label)
+        ax[0, 1].semilogy(x, np.where(f.p_con > 0, f.p_con * 1e-6, np.nan), ".-", label=label)
         ax[1, 0].plot(x, f.A[:, 0, 0], label=label)
     last = factors[-1]
     x = last.h0 * 1e6
