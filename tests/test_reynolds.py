@@ -1,0 +1,149 @@
+"""Rigid-gap Reynolds with JFO cavitation (eqs 17-18, A = I, b = e1), FE and FVM.
+
+1D closed forms are checked on the centre row of a strip 40 times wider (x2) than long (x1):
+side leakage from the ambient edges decays like exp(-pi x2 / L1) and is invisible there.
+"""
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from fem_twin.macro import ReynoldsNotConverged, solve_reynolds
+
+MU, U = 0.05, 1.0
+
+
+def strip(h_x, dx, ny=41, wide=40):
+    length = dx * (len(h_x) - 1)
+    return np.tile(h_x, (ny, 1)), (dx, wide * length / (ny - 1)), ny // 2
+
+
+@pytest.mark.parametrize("method", ["fe", "fvm"])
+@pytest.mark.parametrize("K, W_ref", [(0.5, 2.623252e4), (1.0, 3.177662e4), (2.0, 2.958369e4)])
+def test_inclined_slider(method, K, W_ref):
+    """REFERENCES.md slider loads; second order: 2e-4 at 101 nodes, 4x less at 201."""
+    L, ho = 20e-3, 10e-6
+    errs = []
+    for nx in (101, 201):
+        x = np.linspace(0, L, nx)
+        h, dx, c = strip(ho * (1 + K * (1 - x / L)), x[1])
+        r = solve_reynolds(h, dx, U, MU, method=method)
+        xi = x / L
+        p_ex = 6 * MU * U * L / ho ** 2 * K * xi * (1 - xi) / ((2 + K) * (1 + K * (1 - xi)) ** 2)
+        errs.append(abs(np.trapezoid(r.pressure[c], x) / W_ref - 1))
+        assert np.abs(r.pressure[c] - p_ex).max() < 1e-3 * p_ex.max()
+        assert r.cavity_fraction.max() == 0
+    assert errs[1] < 1e-3 and 3.5 < errs[0] / errs[1] < 4.5
+
+
+@pytest.mark.parametrize("method", ["fe", "fvm"])
+def test_rayleigh_step_converges_first_order(method):
+    """Step in the middle of a cell face: first order, 0.16 % at 201 nodes, 0.08 % at 401."""
+    L1, L2, h1, h2 = 12e-3, 8e-3, 20e-6, 10e-6
+    p_max = 6 * MU * U * L1 * L2 * (h1 - h2) / (h1 ** 3 * L2 + h2 ** 3 * L1)
+    errs = []
+    for nx in (201, 401):
+        x = np.linspace(0, L1 + L2, nx)
+        h_x = np.where(x < L1 - 1e-12, h1, h2)
+        h, dx, c = strip(h_x, x[1])
+        r = solve_reynolds(h, dx, U, MU, method=method)
+        errs.append(abs(np.trapezoid(r.pressure[c], x) / (p_max * (L1 + L2) / 2) - 1))
+    assert errs[1] < 1e-2 and 1.8 < errs[0] / errs[1] < 2.2
+
+
+def swift_stieber(x_in):
+    """Rupture X_c and W' / (mu u_m R / h0) for a flooded inlet at X = -x_in (quadrature)."""
+    def p(X, Xc):
+        return quad(lambda s: (s * s - Xc * Xc) / (1 + s * s) ** 3, -x_in, X)[0]
+    Xc = brentq(lambda Xc: p(Xc, Xc), 0.01, 2)
+    w = quad(lambda X: p(X, Xc), -x_in, Xc, limit=200)[0]
+    return Xc, 24 * w        # (6 mu U b^2 / h0^2) / (mu U/2 R / h0) = 24 with b^2 = 2 R h0
+
+
+def test_swift_stieber_reference_quadrature():
+    """The quadrature reproduces REFERENCES.md for an inlet at -infinity."""
+    Xc, W = swift_stieber(1e3)
+    assert Xc == pytest.approx(0.47513, abs=2e-5) and W == pytest.approx(4.8950, rel=1e-4)
+
+
+@pytest.mark.parametrize("method", ["fe", "fvm"])
+def test_swift_stieber_rupture_and_load(method):
+    """Cylinder on plane with the inlet at X = -6 (exact: X_c = 0.4736, W' = 4.582): the JFO
+    solution ruptures with Swift-Stieber conditions.  Convergence is first order (upwind
+    flux at the rupture line): +1.5 % at 801 nodes, +0.75 % at 1601; Richardson with the
+    observed order gives the load within 0.1 %."""
+    R, h0, x_in = 10e-3, 5e-6, 6.0
+    b = np.sqrt(2 * R * h0)
+    Xc_ex, W_ex = swift_stieber(x_in)
+    loads = []
+    for nx in (801, 1601):
+        x = np.linspace(-x_in * b, x_in * b, nx)
+        h, dx, c = strip(h0 * (1 + (x / b) ** 2), x[1] - x[0], ny=21)
+        r = solve_reynolds(h, dx, U, MU, method=method)
+        loads.append(np.trapezoid(r.pressure[c], x) / (MU * U / 2 * R / h0))
+        theta = r.cavity_fraction[c]
+        Xc = x[np.argmax(theta > 0)] / b
+        assert abs(Xc - Xc_ex) < 2 * (x[1] - x[0]) / b
+        assert np.all(r.pressure[c][theta > 0] == 0) and np.all(theta[x < 0] == 0)
+        # in the cavitated zone the liquid flux h (1 - theta) is constant (mass conservation)
+        flow = h[c] * (1 - theta)
+        tail = (theta > 0) & (x < 0.9 * x_in * b)
+        assert np.ptp(flow[tail][1:]) < 1e-12 * flow[tail].max()
+    assert abs(loads[1] / W_ex - 1) < 1e-2
+    order = np.log2((loads[0] - W_ex) / (loads[1] - W_ex))
+    assert 0.8 < order < 1.2
+    assert abs((2 * loads[1] - loads[0]) / W_ex - 1) < 1e-3
+
+
+@pytest.mark.parametrize("method", ["fe", "fvm"])
+def test_pocket_carries_no_load_and_fills_to_h1_over_h2(method):
+    """Parallel slider with a pocket: exact JFO solution p = 0, theta = 1 - h1/h2."""
+    L, h1, h2 = 20e-3, 10e-6, 20e-6
+    x = np.linspace(0, L, 201)
+    h, dx, c = strip(np.where((x > 6e-3) & (x < 10e-3), h2, h1), x[1])
+    r = solve_reynolds(h, dx, U, MU, method=method, ambient_pressure=1e5,
+                       cavitation_pressure=1e5)
+    assert abs(r.load) < 1e-12 * MU * U * L ** 2 / h1 ** 2
+    pocket = (x > 6e-3 + x[1]) & (x < 10e-3)
+    assert np.allclose(r.cavity_fraction[c][pocket], 1 - h1 / h2, rtol=1e-12)
+    assert np.all(r.pressure >= 1e5 - 1e-6)
+
+
+def test_cavitation_pressure_and_ambient_shift():
+    """p_hd >= p_cav everywhere; the load is measured against the ambient pressure."""
+    R, h0 = 10e-3, 5e-6
+    b = np.sqrt(2 * R * h0)
+    x = np.linspace(-4 * b, 4 * b, 201)
+    h, dx, c = strip(h0 * (1 + (x / b) ** 2), x[1] - x[0], ny=21)
+    r = solve_reynolds(h, dx, U, MU, ambient_pressure=1e5, cavitation_pressure=8e4)
+    assert r.pressure.min() >= 8e4 - 1e-6 and r.cavity_fraction.max() > 0
+    assert np.all(r.pressure[r.cavity_fraction > 0] == 8e4)
+
+
+def test_fe_and_fvm_differ_in_2d_but_converge_together():
+    """A 2D bump with cavitation: the 9- and 5-point Poiseuille operators differ, and the
+    difference (1.5 % at 33^2) halves per refinement: first order, set by the rupture line."""
+    diffs = []
+    for n in (33, 65):
+        x = np.linspace(-1, 1, n)
+        X, Y = np.meshgrid(x, x)
+        h = 5e-6 * (1 + 2 * X ** 2 + 2 * Y ** 2 + 0.5 * X)
+        dx = (2e-3 / (n - 1), 2e-3 / (n - 1))
+        fe = solve_reynolds(h, dx, U, MU, method="fe")
+        fv = solve_reynolds(h, dx, U, MU, method="fvm")
+        diffs.append(abs(fe.load / fv.load - 1))
+    assert diffs[0] > 0 and 1.6 < diffs[0] / diffs[1] < 2.5
+
+
+def test_bad_input_is_refused():
+    with pytest.raises(ValueError, match="positive"):
+        solve_reynolds(np.zeros((5, 5)), (1e-4, 1e-4), 1.0, 0.05)
+    with pytest.raises(ValueError, match="method"):
+        solve_reynolds(np.ones((5, 5)) * 1e-5, (1e-4, 1e-4), 1.0, 0.05, method="fdm")
+    with pytest.raises(ValueError, match="viscosity"):
+        solve_reynolds(np.ones((5, 5)) * 1e-5, (1e-4, 1e-4), 1.0, -1)
+    x = np.linspace(-1, 1, 41)
+    with pytest.raises(ReynoldsNotConverged):
+        solve_reynolds(np.tile(1e-5 * (1 + 4 * x ** 2), (9, 1)), (1e-4, 1e-3), 1.0, 0.05,
+                       max_iter=1)
