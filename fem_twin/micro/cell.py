@@ -18,7 +18,6 @@ than ``BilinearForm.assemble``).  One node is pinned (chi = 0) to remove the con
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -139,10 +138,6 @@ class CellSolver:
         return {"k": np.array(k), "g": np.transpose(np.array(g), (1, 0, 2)), "m": np.array(m),
                 "phi": phi, "dphi": dphi}
 
-    @property
-    def nq(self) -> int:
-        return self._k.shape[0]
-
     # -- fields at quadrature points -----------------------------------------------------
     def at_quadrature(self, field: np.ndarray) -> np.ndarray:
         """Grid field ``(ny, nx)`` -> values at the quadrature points ``(nelems, nq)``."""
@@ -232,10 +227,6 @@ class CellSolver:
                 "h3_g1": (a_q * g1).mean(axis=(1, 2)),
                 "h_grad": (h_q * (eye + G)).mean(axis=(2, 3)),
                 "h_g1": (h_q * g1).mean(axis=(1, 2))}
-
-    @cached_property
-    def area(self) -> float:
-        return self.shape[0] * self.shape[1] * self.spacing[0] * self.spacing[1]
 
 
 def nested_dissection_torus(shape, leaf: int = 4) -> np.ndarray:
