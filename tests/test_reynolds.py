@@ -122,8 +122,8 @@ def test_cavitation_pressure_and_ambient_shift():
 
 
 def test_fe_and_fvm_differ_in_2d_but_converge_together():
-    """A 2D bump with cavitation: the 9- and 5-point Poiseuille operators differ, and the
-    difference (1.5 % at 33^2) halves per refinement: first order, set by the rupture line."""
+    """A 2D bump with cavitation: the 9- and 5-point Poiseuille operators differ at second
+    order (measured 0.10 %, 0.026 %, 0.0063 % at 33^2, 65^2, 129^2)."""
     diffs = []
     for n in (33, 65):
         x = np.linspace(-1, 1, n)
@@ -133,7 +133,7 @@ def test_fe_and_fvm_differ_in_2d_but_converge_together():
         fe = solve_reynolds(h, dx, U, MU, method="fe")
         fv = solve_reynolds(h, dx, U, MU, method="fvm")
         diffs.append(abs(fe.load / fv.load - 1))
-    assert diffs[0] > 0 and 1.6 < diffs[0] / diffs[1] < 2.5
+    assert diffs[0] > 0 and 3.5 < diffs[0] / diffs[1] < 4.5
 
 
 def test_bad_input_is_refused():
