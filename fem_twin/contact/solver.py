@@ -13,15 +13,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from ..errors import NotConverged
 from .elastic import elastic_operator
 
 
-class ContactNotConverged(RuntimeError):
+class ContactNotConverged(NotConverged):
     """The CG-FFT iteration did not reach the tolerance; ``history`` holds the residuals."""
-
-    def __init__(self, message, history):
-        super().__init__(f"{message}; last residuals {np.array(history[-5:])}")
-        self.history = list(history)
 
 
 @dataclass(frozen=True, eq=False)

@@ -31,15 +31,12 @@ import scipy.sparse.linalg as spla
 import skfem
 from skfem.helpers import dot, grad
 
+from ..errors import NotConverged
 from ..io.mesh import grid_mesh
 
 
-class ReynoldsNotConverged(RuntimeError):
+class ReynoldsNotConverged(NotConverged):
     """The complementarity Newton loop failed; ``history`` holds the residuals."""
-
-    def __init__(self, message, history):
-        super().__init__(f"{message}; last residuals {np.array(history[-5:])}")
-        self.history = list(history)
 
 
 @dataclass(frozen=True, eq=False)

@@ -198,37 +198,46 @@ def _cell_solver(shape, spacing, method):
     return CellSolverFV(shape, spacing)
 
 
+def sliding_contacts(shapes, spacing, settings: CellSettings, h0: float, warm=None):
+    """Periodic contact at imposed ``h0`` for each step's shape; ``warm`` (a list, one
+    pressure or None per step) is used as the initial guess and updated in place."""
+    warm = [None] * len(shapes) if warm is None else warm
+    results = []
+    for n, s in enumerate(shapes):
+        r = contact_solve(s, spacing, settings.e_reduced, separation=h0,
+                          hardness=settings.hardness, periodic=True,
+                          gap_floor=settings.gap_floor, initial_pressure=warm[n],
+                          tol=settings.contact_tol)
+        warm[n] = r.pressure if r.load > 0 else None
+        results.append(r)
+    return results
+
+
+def sliding_cells(gaps, solver, settings: CellSettings, um_dt: float):
+    """Cell solutions of each step, implicit Euler in time (``um_dt = u_m dt`` [m])."""
+    for n, h in enumerate(gaps):
+        steady = n == 0 and settings.first_step == "steady"
+        yield solver.solve(h, None if steady else (h - gaps[n - 1]) / um_dt)
+
+
 def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key):
     """Moments for ``points = [(index, h0), ...]`` in order, warm-starting contact."""
     solver = _cell_solver(z_low.shape, spacing, settings.method)
     shapes, um_dt_px = sliding_shapes(z_low, z_up, settings)
-    um_dt = um_dt_px * spacing[0]
     warm = [None] * settings.n_steps
     out = []
     for i, h0 in points:
-        gaps, pressures, fractions = [], [], []
         t0 = time.perf_counter()
-        for n, s in enumerate(shapes):
-            r = contact_solve(s, spacing, settings.e_reduced, separation=h0,
-                              hardness=settings.hardness, periodic=True,
-                              gap_floor=settings.gap_floor, initial_pressure=warm[n],
-                              tol=settings.contact_tol)
-            warm[n] = r.pressure if r.load > 0 else None
-            gaps.append(r.gap)
-            pressures.append(r.pressure.mean())
-            fractions.append(r.contact_fraction)
+        contacts = sliding_contacts(shapes, spacing, settings, h0, warm)
         t1 = time.perf_counter()
         sums = None
-        for n, h in enumerate(gaps):
-            if n == 0 and settings.first_step == "steady":
-                squeeze = None
-            else:
-                squeeze = (h - gaps[n - 1]) / um_dt
-            m = solver.solve(h, squeeze).moments
+        for cell in sliding_cells([r.gap for r in contacts], solver, settings,
+                                  um_dt_px * spacing[0]):
+            m = cell.moments
             sums = m if sums is None else {k: sums[k] + m[k] for k in m}
         moments = {k: v / settings.n_steps for k, v in sums.items()}
-        moments["p_con"] = float(np.mean(pressures))
-        moments["contact_fraction"] = float(np.mean(fractions))
+        moments["p_con"] = float(np.mean([r.pressure.mean() for r in contacts]))
+        moments["contact_fraction"] = float(np.mean([r.contact_fraction for r in contacts]))
         moments["seconds_contact"] = t1 - t0
         moments["seconds_cell"] = time.perf_counter() - t1
         if folder is not None:

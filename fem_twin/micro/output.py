@@ -6,11 +6,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..contact import solve as contact_solve
 from ..io.atomic import atomic_path
 from ..io.mesh import grid_mesh, write_pvd, write_vtu
 from .flow_factors import FlowFactors
-from .homogenisation import CellSettings, _cell_solver, _check_patches, _shift, sliding_shapes
+from .homogenisation import (CellSettings, _cell_solver, _check_patches, _shift, sliding_cells,
+                             sliding_contacts, sliding_shapes)
 
 
 def plot_flow_factors(factors, path, labels=None) -> Path:
@@ -61,20 +61,15 @@ def cell_fields(pin, disk, h0: float, *, n_steps: int = 32, method: str = "fe",
     z_low, z_up, spacing = _check_patches(pin, disk)
     shapes, um_dt_px = sliding_shapes(z_low, z_up, settings)
     solver = _cell_solver(z_low.shape, spacing, method)
-    out, prev, warm = [], None, None
-    for n, s in enumerate(shapes):
-        r = contact_solve(s, spacing, settings.e_reduced, separation=h0,
-                          hardness=settings.hardness, periodic=True, gap_floor=settings.gap_floor,
-                          initial_pressure=warm)
-        warm = r.pressure if r.load > 0 else None
-        squeeze = None if prev is None else (r.gap - prev) / (um_dt_px * spacing[0])
-        chi = solver.solve(r.gap, squeeze).chi
-        prev = r.gap
+    contacts = sliding_contacts(shapes, spacing, settings, h0)
+    cells = sliding_cells([r.gap for r in contacts], solver, settings, um_dt_px * spacing[0])
+    out = []
+    for n, (r, cell) in enumerate(zip(contacts, cells)):
         px = n * z_low.shape[1] / settings.n_steps
         out.append({"pin": z_low if moving == "upper" else _shift(z_low, -px),
                     "disk": _shift(z_up, px) if moving == "upper" else z_up,
                     "gap": r.gap, "asperity_pressure": r.pressure,
-                    "chi_1": chi[0], "chi_2": chi[1], "chi_3": chi[2]})
+                    "chi_1": cell.chi[0], "chi_2": cell.chi[1], "chi_3": cell.chi[2]})
     return out
 
 

@@ -1,0 +1,13 @@
+"""Errors shared by the solvers."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class NotConverged(RuntimeError):
+    """An iterative solver missed its tolerance; ``history`` holds its residuals."""
+
+    def __init__(self, message, history):
+        super().__init__(f"{message}; last residuals {np.array(history[-5:])}")
+        self.history = list(history)
