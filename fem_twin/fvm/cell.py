@@ -18,7 +18,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..micro.cell import CellSolution, nested_dissection_torus
+from ..micro.cell import CellSolution
+from ..ordering import nested_dissection_torus
 
 
 class CellSolverFV:

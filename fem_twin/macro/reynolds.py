@@ -24,6 +24,7 @@ stops when the active set no longer changes and the mass residual is below ``tol
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import scipy.sparse as sp
@@ -33,6 +34,7 @@ from skfem.helpers import dot, grad
 
 from ..errors import NotConverged
 from ..io.mesh import grid_mesh
+from ..ordering import nested_dissection
 
 
 class ReynoldsNotConverged(NotConverged):
@@ -60,6 +62,14 @@ class ReynoldsResult:
 def poiseuille_form(u, v, w):
     """Pressure flow of eq 17 with a scalar coefficient ``g = rho h^3 / (12 mu)`` [m^3/(Pa s)]."""
     return w.g * dot(grad(u), grad(v))
+
+
+@skfem.BilinearForm
+def homogenised_poiseuille_form(u, v, w):
+    """Pressure flow of eq 17, ``g (A grad p) . grad v`` with the flow factor tensor ``A``."""
+    du, dv = grad(u), grad(v)
+    return w.g * (w.a11 * du[0] * dv[0] + w.a12 * du[1] * dv[0]
+                  + w.a21 * du[0] * dv[1] + w.a22 * du[1] * dv[1])
 
 
 def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 0.0,
@@ -99,7 +109,7 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     boundary = np.zeros(h.shape, bool)
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
     scale = 12 * viscosity * max(abs(speed), 1e-30) / 2 * float(np.mean(dx)) / np.mean(h) ** 2
-    phi, its, history = solve_complementarity(K, B, boundary.ravel(),
+    phi, its, history = solve_complementarity(K, B, boundary,
                                               ambient_pressure - cavitation_pressure, scale,
                                               tol=tol, max_iter=max_iter)
     p = np.maximum(phi, 0).reshape(h.shape)
@@ -113,11 +123,28 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     return ReynoldsResult(p_hd, theta, load, its, tuple(history))
 
 
-def fe_poiseuille(g, spacing) -> sp.csr_matrix:
-    """Q1 stiffness of ``div(g grad p)`` on the node grid (nodes = pixels), non-periodic."""
-    gm = grid_mesh(g.shape, spacing)
-    basis = skfem.Basis(gm.mesh, skfem.ElementQuad1(), intorder=2)
-    return poiseuille_form.assemble(basis, g=basis.interpolate(gm.to_nodes(g))).tocsr()
+def fe_poiseuille(g, spacing, A=None) -> sp.csr_matrix:
+    """Q1 stiffness of ``-div(g A grad p)`` on the node grid (nodes = pixels), non-periodic.
+
+    ``g`` is ``(ny, nx)``; ``A`` is ``(ny, nx, 2, 2)`` (identity if None).  Nodal fields
+    are interpolated to the 2 x 2 Gauss points.
+    """
+    gm, basis = _basis(tuple(g.shape), tuple(float(v) for v in spacing))
+
+    def at_q(f):
+        return basis.interpolate(gm.to_nodes(f))
+
+    if A is None:
+        return poiseuille_form.assemble(basis, g=at_q(g)).tocsr()
+    return homogenised_poiseuille_form.assemble(
+        basis, g=at_q(g), a11=at_q(A[..., 0, 0]), a12=at_q(A[..., 0, 1]),
+        a21=at_q(A[..., 1, 0]), a22=at_q(A[..., 1, 1])).tocsr()
+
+
+@lru_cache(maxsize=8)
+def _basis(shape, spacing):
+    gm = grid_mesh(shape, spacing)
+    return gm, skfem.Basis(gm.mesh, skfem.ElementQuad1(), intorder=2)
 
 
 def upwind_couette(q1, q2, spacing) -> sp.csr_matrix:
@@ -145,34 +172,71 @@ def upwind_couette(q1, q2, spacing) -> sp.csr_matrix:
                          shape=(n, n))
 
 
-def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, tol=1e-10, max_iter=200):
+def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=1e-10,
+                          max_iter=200):
     """Semismooth Newton on ``K p + B (1 - theta) = 0`` with the p-theta switch ``phi``.
 
-    Dirichlet nodes keep ``p = p_boundary``, ``theta = 0``.  Returns ``phi``, the number of
-    iterations and the residual history (scaled by the Couette flux ``|B| 1``).
+    Dirichlet nodes keep ``p = p_boundary``, ``theta = 0``.  ``phi0`` warm-starts the
+    interior.  Returns ``phi``, the number of iterations and the residual history (scaled by
+    the size of each node's fluxes, ``|K| p + |B| 1``).  Each Newton matrix is factorised by SuperLU in a
+    nested-dissection order of the grid (computed once per grid).
     """
     n = K.shape[0]
     interior = np.flatnonzero(~dirichlet)
     phi = np.full(n, float(p_boundary))
+    if phi0 is not None:
+        phi[interior] = np.asarray(phi0, float).ravel()[interior]
     ones = np.ones(n)
-    flux_scale = max(float((abs(B) @ ones).mean()), 1e-300)
+    absK, absB = abs(K[interior]), abs(B[interior])
+    couette_size = absB @ ones
+    floor = 1e-300 + 1e-12 * float(couette_size.max())
+    order = _interior_order(tuple(dirichlet.shape) if dirichlet.ndim == 2 else None,
+                            dirichlet.ravel(), interior)
     KI, BI = K[interior], B[interior]
-    history, active_old = [], None
-    for it in range(1, max_iter + 1):
+
+    def residual(phi):
         pos = phi >= 0
         p = np.where(pos, phi, 0.0)
-        theta = np.where(pos, 0.0, -phi / scale)
-        r = KI @ p + BI @ (ones - theta)
-        res = float(np.abs(r).max() / flux_scale)
+        r = KI @ p + BI @ (ones - np.where(pos, 0.0, -phi / scale))
+        # each node's mass residual relative to the size of its own fluxes
+        res = float(np.max(np.abs(r) / (absK @ p + couette_size + floor)))
+        return r, pos, res
+
+    history, active_old = [], None
+    r, pos, res = residual(phi)
+    for it in range(1, max_iter + 1):
         history.append(res)
         if res < tol and active_old is not None and np.array_equal(pos, active_old):
             return phi, it, history
         active_old = pos
-        dp = pos.astype(float)
         dtheta = np.where(pos, 0.0, 1.0 / scale)       # d(1 - theta)/dphi = +1/scale
-        J = (KI @ sp.diags(dp) + BI @ sp.diags(dtheta))[:, interior].tocsc()
-        step = spla.spsolve(J, -r)
+        J = (KI @ sp.diags(pos.astype(float)) + BI @ sp.diags(dtheta))[:, interior]
+        step = np.empty(interior.size)
+        try:
+            lu = spla.splu(J[order][:, order].tocsc(), permc_spec="NATURAL",
+                           diag_pivot_thresh=0.1, options={"SymmetricMode": True})
+            step[order] = lu.solve(-r[order])
+        except RuntimeError as err:               # exactly singular
+            raise ReynoldsNotConverged(f"singular Newton matrix in the cavitation loop: {err}",
+                                       history) from err
         if not np.all(np.isfinite(step)):
             raise ReynoldsNotConverged("singular Newton matrix in the cavitation loop", history)
         phi[interior] += step
+        r, pos, res = residual(phi)
     raise ReynoldsNotConverged(f"no convergence in {max_iter} Newton steps (tol {tol})", history)
+
+
+def _interior_order(shape, dirichlet, interior):
+    """Nested-dissection order of the interior unknowns (COLAMD-like fallback: identity)."""
+    if shape is None:
+        return np.arange(interior.size)
+    key = (shape, dirichlet.tobytes())
+    if _ORDER_CACHE.get("key") != key:
+        full = nested_dissection(shape)
+        position = np.full(dirichlet.size, -1)
+        position[interior] = np.arange(interior.size)
+        _ORDER_CACHE.update(key=key, order=position[full][position[full] >= 0])
+    return _ORDER_CACHE["order"]
+
+
+_ORDER_CACHE: dict = {}

@@ -26,6 +26,7 @@ import skfem
 from skfem.helpers import dot, grad
 
 from ..io.mesh import GridMesh, grid_mesh
+from ..ordering import nested_dissection_torus
 
 
 @skfem.BilinearForm
@@ -227,40 +228,3 @@ class CellSolver:
                 "h3_g1": (a_q * g1).mean(axis=(1, 2)),
                 "h_grad": (h_q * (eye + G)).mean(axis=(2, 3)),
                 "h_g1": (h_q * g1).mean(axis=(1, 2))}
-
-
-def nested_dissection_torus(shape, leaf: int = 4) -> np.ndarray:
-    """Fill-reducing order of the pixels of a periodic grid (geometric nested dissection).
-
-    Columns 0 and nx/2 and then rows 0 and ny/2 cut the torus into four open rectangles,
-    which are bisected recursively along their longer side; separators come last.
-    """
-    ny, nx = shape
-    out = []
-
-    def dissect(rows, cols):
-        if len(rows) * len(cols) <= leaf * leaf or min(len(rows), len(cols)) < 3:
-            out.append((rows[:, None] * nx + cols[None, :]).ravel())
-        elif len(cols) >= len(rows):
-            m = len(cols) // 2
-            dissect(rows, cols[:m])
-            dissect(rows, cols[m + 1:])
-            out.append(rows * nx + cols[m])
-        else:
-            m = len(rows) // 2
-            dissect(rows[:m], cols)
-            dissect(rows[m + 1:], cols)
-            out.append(rows[m] * nx + cols)
-
-    cy, cx = ny // 2, nx // 2
-    for cols in (np.arange(1, cx), np.arange(cx + 1, nx)):
-        for rows in (np.arange(1, cy), np.arange(cy + 1, ny)):
-            if len(rows) and len(cols):
-                dissect(rows, cols)
-        out.append(cols)                          # row 0
-        out.append(cy * nx + cols)                # row ny/2
-    out.append(np.unique(np.r_[np.arange(ny) * nx, np.arange(ny) * nx + cx]))
-    order = np.concatenate(out)
-    if np.unique(order).size != ny * nx:          # guard against a wrong partition
-        raise AssertionError("nested dissection lost or repeated pixels")
-    return order

@@ -122,16 +122,35 @@ class FlowFactors:
                 out[name] = np.repeat(v[:1], flat.size, axis=0)
             else:
                 out[name] = self._interpolant(name)(xc)
-        above, below = flat > hi, flat < lo
+        above = flat > hi
         out["h_m"][above] = flat[above]
-        out["p_con"][above] = 0.0
         out["contact_fraction"][above] = 0.0
-        if len(self) > 1 and below.any():
-            for name, floor in (("h_m", 1e-9), ("p_con", 0.0)):
-                v = getattr(self, name)
-                slope = (v[1] - v[0]) / (self.h0[1] - self.h0[0])
-                out[name][below] = np.maximum(v[0] + slope * (flat[below] - lo), floor)
+        out["h_m"] = self._extend_below(flat, out["h_m"], "h_m", 1e-9)
+        out["p_con"] = self.contact_pressure(flat)
         return LocalFactors(h0=x, **{k: v.reshape(x.shape + v.shape[1:]) for k, v in out.items()})
+
+    def contact_pressure(self, h0) -> np.ndarray:
+        """``p_con(h0)`` alone [Pa], with the rules of :meth:`at` (cheaper than ``at``)."""
+        x = np.asarray(h0, dtype=float)
+        if np.any(~np.isfinite(x)) or np.any(x <= 0):
+            raise ValueError("h0 must be finite and positive [m]")
+        flat = x.ravel()
+        lo, hi = self.h0[0], self.h0[-1]
+        if len(self) == 1:
+            p = np.full(flat.size, self.p_con[0])
+        else:
+            p = self._interpolant("p_con")(np.log(np.clip(flat, lo, hi)))
+        p[flat > hi] = 0.0
+        return self._extend_below(flat, p, "p_con", 0.0).reshape(x.shape)
+
+    def _extend_below(self, flat, values, name, floor):
+        """Below ``h0_min``: continue linearly with the end slope, floored."""
+        below = flat < self.h0[0]
+        if len(self) > 1 and below.any():
+            v = getattr(self, name)
+            slope = (v[1] - v[0]) / (self.h0[1] - self.h0[0])
+            values[below] = np.maximum(v[0] + slope * (flat[below] - self.h0[0]), floor)
+        return values
 
     def _interpolant(self, name):
         cache = self.__dict__.setdefault("_pchip", {})

@@ -1,0 +1,27 @@
+"""Friction on the pin: homogenised shear stress (eq 31), boundary shear (eq 32), eqs 33-34."""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Boundary friction coefficient C_f,b of eq 32 (Bowden and Tabor, pure shearing).
+BOUNDARY_FRICTION = 1.0 / (3.0 * np.sqrt(3.0))
+
+
+def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, C, d, spacing,
+                       speed) -> np.ndarray:
+    """tau_hd,31 of eq 31 on the stationary pin [Pa], disk sliding at ``speed`` along +x1.
+
+    ``tau = -(h_m/2) (C grad p)_1 + (mu / h_m) (-6 u_m d_1 + u_r) (1 - theta)`` with
+    ``u_m = U/2``, ``u_r = U``; ``grad p`` by second-order central differences on the grid.
+    """
+    dp2, dp1 = np.gradient(np.asarray(pressure, float), spacing[1], spacing[0])
+    u_m = speed / 2
+    poiseuille = -mean_gap / 2 * (C[..., 0, 0] * dp1 + C[..., 0, 1] * dp2)
+    couette = viscosity / mean_gap * (-6 * u_m * d[..., 0] + speed) * (1 - cavity_fraction)
+    return poiseuille + couette
+
+
+def boundary_shear(contact_pressure, coefficient: float = BOUNDARY_FRICTION) -> np.ndarray:
+    """tau_con = C_f,b p_con of eq 32 [Pa]."""
+    return coefficient * np.asarray(contact_pressure, float)

@@ -1,0 +1,63 @@
+"""Lubricant models: Roelands piezoviscosity (eq 23) and Dowson-Higginson density (eq 24).
+
+Both are functions of the relative pressure ``p = p_hd - p_cav`` [Pa].  The constants
+default to Table 6 of the paper; ``viscosity`` (mu_0 at ambient pressure) depends on the
+temperature (Table 3: 0.066 Pa s at 24 C, 0.024 Pa s at 50 C).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Lubricant:
+    """An isothermal lubricant (SI units).
+
+    viscosity : mu_0 at ambient pressure [Pa s]
+    density : rho_0 at ambient pressure [kg/m^3] (cancels from eq 17; kept for output)
+    roelands_alpha, roelands_p0 : alpha_R [1/Pa] and p_0,R [Pa] of eq 23
+    dh_c1, dh_c2 : C_1 [Pa] and C_2 [-] of eq 24
+    """
+
+    viscosity: float
+    density: float = 850.0
+    roelands_alpha: float = 22e-9
+    roelands_p0: float = 1.96e8
+    dh_c1: float = 5.9e8
+    dh_c2: float = 1.34
+
+    def __post_init__(self):
+        for name in ("viscosity", "density", "roelands_p0", "dh_c1", "dh_c2"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"Lubricant.{name} must be positive and finite, got {v}")
+        if self.viscosity > 10:
+            raise ValueError(f"Lubricant.viscosity {self.viscosity} Pa s is implausible: "
+                             "give mu_0 in Pa s (0.066, not 66 mPa s)")
+        if not (np.isfinite(self.roelands_alpha) and self.roelands_alpha >= 0):
+            raise ValueError("Lubricant.roelands_alpha must be >= 0 [1/Pa]")
+
+    @property
+    def roelands_z(self) -> float:
+        """Pressure-viscosity index ``z_R = alpha_R p_0,R / (ln mu_0 + 9.67)``.
+
+        The paper prints ``ln(mu_0 + 9.67)``; Roelands' index has ``ln(mu_0) + 9.67``, as
+        in eq 23 itself (0.62 instead of 1.89 for 0.066 Pa s), which keeps the low-pressure
+        slope of eq 23 equal to alpha_R.
+        """
+        return self.roelands_alpha * self.roelands_p0 / (np.log(self.viscosity) + 9.67)
+
+    def viscosity_at(self, pressure):
+        """mu_l of eq 23 at relative pressure ``p = p_hd - p_cav >= 0`` [Pa s]."""
+        p = np.maximum(np.asarray(pressure, float), 0.0)
+        mu0 = self.viscosity
+        return mu0 * np.exp((np.log(mu0) + 9.67)
+                            * (-1.0 + (1.0 + p / self.roelands_p0) ** self.roelands_z))
+
+    def density_ratio(self, pressure):
+        """rho_l / rho_0 of eq 24 at relative pressure ``p = p_hd - p_cav >= 0`` [-]."""
+        p = np.maximum(np.asarray(pressure, float), 0.0)
+        return (self.dh_c1 + self.dh_c2 * p) / (self.dh_c1 + p)

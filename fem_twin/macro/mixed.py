@@ -1,0 +1,445 @@
+"""Homogenised mixed elasto-hydrodynamic operating point (paper 2.2.2, eqs 17-34).
+
+One operating point (imposed load F_N,imp, sliding speed U) of the pin-on-disk contact:
+
+* homogenised Reynolds with JFO cavitation (eqs 17-18) on the macro grid, with the flow
+  factors ``A, b`` and the mean gap ``h_m`` of the micro scale at the local separation
+  ``h0`` (:meth:`FlowFactors.at`), Roelands viscosity (eq 23) and Dowson-Higginson density
+  (eq 24) at the current pressure;
+* ``h0 = h_d + h_g + h_el`` (eq 19), ``h_el`` from ``p_tot - p_amb = p_hd + p_con - p_amb``
+  by the non-periodic FFT half-space operator (eqs 20-22);
+* the mean asperity contact pressure ``p_con(h0)`` (eqs 25-27) and the load balance on
+  ``h_d`` (eqs 28-30);
+* friction from eqs 31-34 over the pin face.
+
+Two couplings reach the same state:
+
+``"anderson"`` (default)
+    the fixed point ``(h_el, h_d) -> (op(p_tot - p_amb), h_d + dF/k)`` with ``p_con``
+    taken at the current ``h0`` (no under-relaxation), accelerated by Anderson mixing
+    (Walker and Ni 2011).  ``k`` is a load-stiffness estimate (contact stiffness from the
+    slope of ``p_con(h0)`` plus ``2 F_hd / h``); Anderson mixing corrects it.
+``"pid"``
+    the paper's scheme: ``p_con`` under-relaxed with ``alpha_pcon`` (eq 26), ``h_el``
+    recomputed each iteration, and the incremental PID controller of eq 29 on ``h_d``.
+
+Each iteration solves the Reynolds complementarity problem to 1e-10 at frozen
+coefficients (warm-started).  Converged when, between two iterations, all of the
+following are below ``tol`` (1e-6): the change of ``h_el`` / h_ref, the update of
+``p_con`` / p_ref (eq 27), the change of ``p`` / p_ref (lagged viscosity and density) and
+the load residual (eq 30).  Otherwise :class:`MixedNotConverged` carries the history.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..contact.elastic import elastic_operator, reduced_modulus
+from ..errors import NotConverged
+from ..io.atomic import atomic_path
+from ..micro.flow_factors import FlowFactors
+from .friction import BOUNDARY_FRICTION, boundary_shear, hydrodynamic_shear
+from .lubricant import Lubricant
+from .reynolds import fe_poiseuille, solve_complementarity, upwind_couette
+
+
+#: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
+#: clipped before eqs 23-24 are evaluated, so that the Roelands exponential stays finite.
+MAX_COEFFICIENT_PRESSURE = 1e10
+
+
+class MixedNotConverged(NotConverged):
+    """The coupled macro iteration failed; ``history`` holds the residual rows."""
+
+
+@dataclass(frozen=True)
+class MacroSettings:
+    """Settings of the macro solver (Table 6 defaults, SI units)."""
+
+    ambient_pressure: float = 1e5
+    cavitation_pressure: float = 8e4
+    e_reduced: float = reduced_modulus(210e9, 0.3, 210e9, 0.3)
+    boundary_friction: float = BOUNDARY_FRICTION
+    method: str = "fe"                       # Poiseuille term: "fe" or "fvm"
+    coupling: str = "anderson"               # or "pid" (the paper's)
+    relaxation_pcon: float = 0.05            # alpha_pcon of eq 26 ("pid")
+    gains: tuple = (1.2e-2, 2.4e-2, 1.5e-3)  # K_P, K_I, K_D of eq 29 ("pid")
+    anderson_depth: int = 8
+    p_ref: float = 100e6
+    h_ref: float = 1e-6
+    tol: float = 1e-6
+    max_iter: int = 300
+    gap_floor: float = 1e-9                  # h0 passed to the flow factors [m]
+
+    def __post_init__(self):
+        if self.method not in ("fe", "fvm"):
+            raise ValueError(f"method must be 'fe' or 'fvm', got {self.method!r}")
+        if self.coupling not in ("anderson", "pid"):
+            raise ValueError(f"coupling must be 'anderson' or 'pid', got {self.coupling!r}")
+        if self.ambient_pressure < self.cavitation_pressure:
+            raise ValueError("ambient pressure must not be below the cavitation pressure [Pa]")
+        if not 0 < self.relaxation_pcon <= 1:
+            raise ValueError("relaxation_pcon must be in (0, 1]")
+
+
+_FIELDS = ("pressure", "contact_pressure", "cavity_fraction", "h0", "mean_gap",
+           "elastic_deformation", "viscosity", "density_ratio", "shear_stress", "face")
+
+
+@dataclass(frozen=True, eq=False)
+class MixedResult:
+    """A converged operating point (SI units).
+
+    Scalars: ``speed`` U [m/s], ``imposed_load`` F_N,imp and ``normal_load`` F_N (eq 28) [N],
+    ``h_d`` [m], ``friction_force`` F_T (eq 33) with its ``hydrodynamic_friction`` and
+    ``boundary_friction`` parts [N], ``friction_coefficient`` C_f (eq 34),
+    ``contact_load`` (integral of p_con) [N].
+    Fields (ny, nx): ``pressure`` p_hd, ``contact_pressure`` p_con [Pa], ``cavity_fraction``,
+    ``h0``, ``mean_gap`` h_m, ``elastic_deformation`` h_el [m], ``viscosity`` [Pa s],
+    ``density_ratio`` rho/rho_0, ``shear_stress`` tau_tot [Pa], ``face`` (pin face mask).
+    ``history``: rows (iteration, r_hel, r_pcon, r_p, r_F, h_d, newton steps).
+    """
+
+    speed: float
+    imposed_load: float
+    normal_load: float
+    h_d: float
+    friction_force: float
+    hydrodynamic_friction: float
+    boundary_friction: float
+    friction_coefficient: float
+    contact_load: float
+    spacing: tuple
+    pressure: np.ndarray
+    contact_pressure: np.ndarray
+    cavity_fraction: np.ndarray
+    h0: np.ndarray
+    mean_gap: np.ndarray
+    elastic_deformation: np.ndarray
+    viscosity: np.ndarray
+    density_ratio: np.ndarray
+    shear_stress: np.ndarray
+    face: np.ndarray
+    iterations: int = 0
+    history: np.ndarray = field(default_factory=lambda: np.zeros((0, 7)))
+    meta: dict = field(default_factory=dict)
+
+    def fields(self) -> dict:
+        """The grid fields by name (for VTU output)."""
+        return {k: np.asarray(getattr(self, k), float) for k in _FIELDS}
+
+    def scalars(self) -> dict:
+        return {f.name: getattr(self, f.name) for f in fields(self)
+                if f.name not in _FIELDS and f.name not in ("history", "meta")}
+
+    def save(self, path) -> Path:
+        """Write ``.npz`` (fields, history, scalars and meta as JSON) atomically."""
+        path = Path(path)
+        with atomic_path(path) as tmp:
+            with open(tmp, "wb") as f:
+                np.savez(f, **self.fields(), history=self.history,
+                         scalars=np.array(json.dumps(self.scalars())),
+                         meta=np.array(json.dumps(self.meta, sort_keys=True)))
+        return path
+
+    @classmethod
+    def load(cls, path) -> "MixedResult":
+        with np.load(path) as data:
+            scalars = json.loads(str(data["scalars"]))
+            scalars["spacing"] = tuple(scalars["spacing"])
+            arrays = {k: data[k] for k in _FIELDS}
+            arrays["face"] = arrays["face"].astype(bool)
+            return cls(**scalars, **arrays, history=data["history"],
+                       meta=json.loads(str(data["meta"])))
+
+    def write_vtu(self, path, origin=(0.0, 0.0)) -> Path:
+        """Fields on the structured grid for ParaView (:func:`fem_twin.io.mesh.write_vtu`)."""
+        from ..io.mesh import grid_mesh, write_vtu
+        gm = grid_mesh(self.pressure.shape, self.spacing, origin)
+        return write_vtu(path, gm, self.fields())
+
+
+def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float,
+                lubricant: Lubricant, face=None, settings: MacroSettings = MacroSettings(),
+                initial: MixedResult | None = None, progress=None) -> MixedResult:
+    """Solve one operating point of the homogenised mixed-EHL problem.
+
+    Parameters
+    ----------
+    gap : (ny, nx) rigid gap ``h_g = x3_up - x3_low`` of the macro geometry [m]; x1 (the
+        sliding direction of the disk) along the columns
+    spacing : (dx1, dx2) [m]
+    factors : flow factors of the micro scale (patch average)
+    load : imposed normal load F_N,imp [N]
+    speed : sliding speed U of the disk [m/s] (``u_m = U/2``, ``u_r = U``)
+    lubricant : mu_0 and the constants of eqs 23-24
+    face : (ny, nx) bool, the pin face for the friction integral (eq 33); all if None
+    initial : a result to warm-start from (e.g. the neighbouring speed of a sweep)
+    progress : optional callable ``progress(iteration, residual)``
+    """
+    h_g = np.asarray(gap, float)
+    if h_g.ndim != 2 or min(h_g.shape) < 3:
+        raise ValueError(f"gap must be a 2D field of at least 3 x 3 nodes, got {h_g.shape}")
+    if not np.all(np.isfinite(h_g)):
+        raise ValueError("gap contains NaN or inf: repair the topography first")
+    if not (load > 0 and np.isfinite(load)):
+        raise ValueError(f"load must be a positive force [N], got {load}")
+    if not (speed > 0 and np.isfinite(speed)):
+        raise ValueError(f"speed must be positive [m/s], got {speed}")
+    dx = tuple(float(v) for v in np.broadcast_to(np.asarray(spacing, float), (2,)))
+    face = np.ones(h_g.shape, bool) if face is None else np.asarray(face, bool)
+    if face.shape != h_g.shape:
+        raise ValueError(f"face mask {face.shape} does not match the gap {h_g.shape}")
+    s = settings
+    t0 = time.perf_counter()
+    ny, nx = h_g.shape
+    op = elastic_operator(h_g.shape, dx, s.e_reduced)
+    boundary = np.zeros(h_g.shape, bool)
+    boundary[[0, -1], :] = boundary[:, [0, -1]] = True
+    area = _trapezoid_weights(h_g.shape, dx)
+    u_m = speed / 2
+    p_amb_rel = s.ambient_pressure - s.cavitation_pressure
+    scale = s.p_ref                                     # theta = -phi / scale in cavities
+
+    def poiseuille(g, A):
+        if s.method == "fe":
+            return fe_poiseuille(g, dx, A)
+        from ..fvm.reynolds import fvm_poiseuille
+        return fvm_poiseuille(g, dx, A)
+
+    state = {"phi": None, "p": np.full(h_g.shape, p_amb_rel), "newton": 0}
+    if initial is not None:
+        if initial.pressure.shape != h_g.shape:
+            raise ValueError("initial result is on a different grid")
+        state["p"] = initial.pressure - s.cavitation_pressure
+        theta0 = initial.cavity_fraction
+        state["phi"] = np.where(theta0 > 0, -theta0 * scale, np.maximum(state["p"], 0)).ravel()
+
+    def evaluate(h_el, h_d, p_con=None):
+        """Reynolds at the current state; returns everything the updates need."""
+        h0 = np.maximum(h_d + h_g + h_el, s.gap_floor)
+        loc = factors.at(h0)
+        p_prev = state["p"]
+        p_coef = np.minimum(p_prev, MAX_COEFFICIENT_PRESSURE)
+        mu = lubricant.viscosity_at(p_coef)
+        rho = lubricant.density_ratio(p_coef)
+        g = rho * loc.h_m ** 3 / (12 * mu)
+        q = rho * loc.h_m * u_m
+        K = poiseuille(g, loc.A)
+        B = upwind_couette(q * loc.b[..., 0], q * loc.b[..., 1], dx)
+        phi, its, _ = solve_complementarity(K, B, boundary, p_amb_rel, scale, phi0=state["phi"])
+        state["phi"], state["newton"] = phi, its
+        p = np.maximum(phi, 0).reshape(h_g.shape)
+        theta = (np.maximum(-phi, 0) / scale).reshape(h_g.shape)
+        state["p"] = p
+        p_con_target = loc.p_con
+        p_con_used = p_con_target if p_con is None else p_con
+        p_tot = p + s.cavitation_pressure + p_con_used
+        F = float(np.sum(area * (p_tot - s.ambient_pressure)))
+        return dict(h0=h0, loc=loc, mu=mu, rho=rho, p=p, theta=theta, p_prev=p_prev,
+                    p_con_target=p_con_target, p_con=p_con_used, F=F,
+                    F_hd=float(np.sum(area * (p + s.cavitation_pressure - s.ambient_pressure))),
+                    h_el_new=op(p_tot - s.ambient_pressure))
+
+    # initial state
+    if initial is not None:
+        h_el, h_d = initial.elastic_deformation.copy(), float(initial.h_d)
+        p_con = initial.contact_pressure.copy()
+    else:
+        h_el = np.zeros(h_g.shape)
+        def excess(hd):
+            state["phi"] = None                    # cold inner start: the states differ a lot
+            state["p"] = np.full(h_g.shape, p_amb_rel)
+            return evaluate(h_el, hd)["F"] - load
+
+        h_free = float(factors.h0[-1]) - float(h_g[face].min())
+        h_d = _rigid_separation(excess, h_free, _dry_separation(factors, h_g, area, load, s),
+                                float(factors.h0[-1]))
+        state["p"] = np.full(h_g.shape, p_amb_rel)
+        p_con = factors.contact_pressure(np.maximum(h_d + h_g, s.gap_floor))
+    history = []
+    r_prev = [0.0, 0.0]
+    mixer = _Anderson(s.anderson_depth)
+    p_con_prev = p_con
+    for it in range(1, s.max_iter + 1):
+        ev = evaluate(h_el, h_d, p_con if s.coupling == "pid" else None)
+        r_F = (ev["F"] - load) / load
+        r_hel = float(np.abs(ev["h_el_new"] - h_el).max() / s.h_ref)
+        r_p = float(np.abs(ev["p"] - ev["p_prev"]).max() / s.p_ref)
+        if s.coupling == "pid":
+            delta = ev["p_con_target"] - p_con                     # eq 25
+            r_pcon = float(np.abs(delta).max() / s.p_ref)          # eq 27
+        else:
+            r_pcon = float(np.abs(ev["p_con_target"] - p_con_prev).max() / s.p_ref)
+            p_con_prev = ev["p_con_target"]
+        res = max(r_hel, r_pcon, r_p, abs(r_F))
+        history.append((it, r_hel, r_pcon, r_p, r_F, h_d, state["newton"]))
+        if progress is not None:
+            progress(it, res)
+        if res < s.tol and it > 1:
+            break
+        if s.coupling == "pid":
+            p_con = p_con + s.relaxation_pcon * delta               # eq 26
+            kp, ki, kd = s.gains
+            r1, r2 = r_prev
+            h_d += (kp * (r_F - r1) + ki * r_F + kd * (r_F - 2 * r1 + r2)) * 1e-6   # eq 29
+            r_prev = [r_F, r1]
+            h_el = ev["h_el_new"]
+        else:
+            k = _load_stiffness(factors, ev, area, s)
+            g_hel = ev["h_el_new"]
+            g_hd = h_d + (ev["F"] - load) / k
+            x = np.r_[h_el.ravel(), h_d] / s.h_ref
+            f = np.r_[g_hel.ravel(), g_hd] / s.h_ref - x
+            x = mixer.step(x, f) * s.h_ref
+            h_el, h_d = x[:-1].reshape(h_g.shape), float(x[-1])
+    else:
+        raise MixedNotConverged(
+            f"macro iteration ({s.coupling}) did not reach residuals below {s.tol} in "
+            f"{s.max_iter} iterations (last: h_el {r_hel:.2e}, p_con {r_pcon:.2e}, "
+            f"p {r_p:.2e}, load {r_F:.2e})", history)
+    return _result(ev, h_el, h_d, speed, load, dx, face, area, lubricant, s, it, history,
+                   time.perf_counter() - t0)
+
+
+def _result(ev, h_el, h_d, speed, load, dx, face, area, lubricant, s, it, history, seconds):
+    loc = ev["loc"]
+    p_hd = ev["p"] + s.cavitation_pressure
+    tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev["theta"], ev["mu"], loc.C, loc.d, dx, speed)
+    tau_con = boundary_shear(ev["p_con"], s.boundary_friction)
+    cell = dx[0] * dx[1]
+    F_hd = float(tau_hd[face].sum() * cell)
+    F_con = float(tau_con[face].sum() * cell)
+    F_N = ev["F"]
+    return MixedResult(
+        speed=float(speed), imposed_load=float(load), normal_load=F_N, h_d=float(h_d),
+        friction_force=F_hd + F_con, hydrodynamic_friction=F_hd, boundary_friction=F_con,
+        friction_coefficient=(F_hd + F_con) / F_N,
+        contact_load=float(np.sum(area * ev["p_con"])), spacing=dx,
+        pressure=p_hd, contact_pressure=ev["p_con"], cavity_fraction=ev["theta"],
+        h0=ev["h0"], mean_gap=loc.h_m, elastic_deformation=h_el,
+        viscosity=ev["mu"], density_ratio=ev["rho"], shear_stress=tau_hd + tau_con,
+        face=face, iterations=it, history=np.array(history),
+        meta={"settings": {k: (list(v) if isinstance(v, tuple) else v)
+                           for k, v in s.__dict__.items()},
+              "lubricant": lubricant.__dict__.copy(), "seconds": seconds})
+
+
+def _trapezoid_weights(shape, dx):
+    w1 = np.full(shape[1], dx[0])
+    w1[[0, -1]] /= 2
+    w2 = np.full(shape[0], dx[1])
+    w2[[0, -1]] /= 2
+    return w2[:, None] * w1[None, :]
+
+
+def _dry_separation(factors, h_g, area, load, s):
+    """h_d at which the rigid contact alone carries the load (bisection): the start."""
+    def excess(h_d):
+        p = factors.contact_pressure(np.maximum(h_d + h_g, s.gap_floor))
+        return float(np.sum(area * p)) - load
+    hi = float(factors.h0[-1]) - float(h_g.min())       # first contact at h0_max
+    if excess(hi) >= 0:
+        return hi
+    step = float(factors.h0[-1])
+    lo = hi - step
+    while excess(lo) < 0:                                  # p_con is bounded below h0 -> 0
+        step *= 2
+        lo = hi - step
+        if step > 1e-3:
+            raise MixedNotConverged(f"the contact cannot carry {load} N at any separation "
+                                    "(flow factors' p_con too small)", [])
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if excess(mid) > 0 else (lo, mid)
+    return hi
+
+
+def _rigid_separation(excess, h_free, h_dry, step, rtol=1e-3):
+    """h_d at which the rigid, isoviscous film and contact carry the load: the start.
+
+    ``excess(h_d) = F_N - F_N,imp`` decreases with ``h_d``.  The search starts at
+    ``h_free`` (first asperity contact) and brackets the root by doubling steps upward (a
+    lifting film) or by halving the distance to the dry separation ``h_dry`` (mixed
+    regime), then refines it by regula falsi (Illinois).
+    """
+    f_free = excess(h_free)
+    if f_free > 0:
+        lo, f_lo = h_free, f_free
+        hi, f_hi = lo + step, excess(lo + step)
+        while f_hi > 0:
+            lo, f_lo = hi, f_hi
+            step *= 2
+            if step > 1e-3:
+                raise MixedNotConverged("no separation below 1 mm balances the load", [])
+            hi, f_hi = lo + step, excess(lo + step)
+    else:
+        hi, f_hi = h_free, f_free
+        lo = h_dry
+        for _ in range(30):                      # approach the dry state from above
+            mid = (hi + lo) / 2
+            f_mid = excess(mid)
+            if f_mid > 0:
+                lo, f_lo = mid, f_mid
+                break
+            hi, f_hi = mid, f_mid
+        else:
+            lo, f_lo = h_dry, excess(h_dry)
+    side, mid = 0, hi
+    for _ in range(100):
+        mid = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+        f_mid = excess(mid)
+        if f_mid > 0:
+            lo, f_lo = mid, f_mid
+            if side == 1:
+                f_hi /= 2
+            side = 1
+        else:
+            hi, f_hi = mid, f_mid
+            if side == -1:
+                f_lo /= 2
+            side = -1
+        if hi - lo < rtol * max(abs(mid), step) or f_mid == 0:
+            break
+    return mid
+
+
+def _load_stiffness(factors, ev, area, s):
+    """-dF/dh_d estimate [N/m]: contact slope of p_con(h0) plus 2 F_hd / h (hydrodynamic)."""
+    h0 = ev["h0"]
+    eps = 1e-3 * h0
+    dp = (factors.contact_pressure(h0 - eps) - factors.contact_pressure(h0 + eps)) / (2 * eps)
+    k_con = float(np.sum(area * np.maximum(dp, 0)))
+    loaded = ev["p"] > ev["p"].max() * 0.1 if ev["p"].max() > 0 else np.ones(h0.shape, bool)
+    h_char = float(np.average(h0[loaded], weights=ev["p"][loaded] + 1e-30))
+    k_hd = 2 * max(ev["F_hd"], 0.0) / max(h_char, s.gap_floor)
+    return max(k_con + k_hd, 1e-3 * abs(ev["F"]) / s.h_ref + 1e-300)
+
+
+class _Anderson:
+    """Anderson mixing (type II, Walker and Ni 2011) for ``x = x + f(x)``, depth ``m``."""
+
+    def __init__(self, depth: int):
+        self.depth = depth
+        self.dx, self.df = [], []
+        self.x_old = self.f_old = None
+
+    def step(self, x, f):
+        if self.x_old is not None:
+            self.dx.append(x - self.x_old)
+            self.df.append(f - self.f_old)
+            if len(self.dx) > self.depth:
+                self.dx.pop(0)
+                self.df.pop(0)
+        self.x_old, self.f_old = x.copy(), f.copy()
+        if not self.dx:
+            return x + f
+        DF = np.array(self.df).T
+        DX = np.array(self.dx).T
+        gamma = np.linalg.lstsq(DF, f, rcond=1e-10)[0]
+        return x + f - (DX + DF) @ gamma
