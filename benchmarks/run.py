@@ -1,6 +1,6 @@
 """Run the benchmarks and print wall times with ratios to a same-run baseline.
 
-    python benchmarks/run.py [GROUP ...]      # topography contact micro (micro-full: ~15 min)
+    python benchmarks/run.py [GROUP ...]      # topography contact micro macro (micro-full: ~15 min)
 """
 
 from __future__ import annotations
@@ -141,8 +141,47 @@ def bench_micro(full=False):
     return base, rows
 
 
+def bench_macro():
+    """One operating point (150 N, 0.066 Pa s, 0.1 and 1 m/s), cold start, FE and FVM.
+
+    Sample pin 1 on disk 1 at 128^2 and 256^2; flow factors of sample patch 1 at 64^2
+    (30 h0 x 8 steps, computed first).  Baseline: the FVM point at 128^2, 1 m/s.
+    Goal: a converged 256^2 point in under 20 s.
+    """
+    from fem_twin.macro import Lubricant, MacroSettings, solve_mixed
+    from fem_twin.micro import homogenise
+    from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch
+
+    low = tp.resample(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
+                      (64, 64))
+    up = tp.resample(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
+                                   upper=True), (64, 64))
+    ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), n_steps=8)
+    rows, base = [], None
+    for n in (128, 256):
+        opts = MacroOptions(resolution=(n, n))
+        pin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
+        disk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
+        gap, face = disk.heights - pin.heights, pin.heights > opts.holder_height / 2
+        for speed in (1.0, 0.1):
+            cf = {}
+            for method in ("fvm", "fe"):
+                t0 = time.perf_counter()
+                r = solve_mixed(gap, pin.spacing, ff, load=150.0, speed=speed, face=face,
+                                lubricant=Lubricant(0.066), settings=MacroSettings(method=method))
+                t = time.perf_counter() - t0
+                base = base or t
+                cf[method] = r.friction_coefficient
+                newton = int(r.history[:, 6].sum())
+                rows.append((f"{method.upper()} {n}^2, U = {speed} m/s", t,
+                             f"{r.iterations} it, {newton} Newton steps, C_f {r.friction_coefficient:.5f}"))
+            rows.append(("  FE / FVM time; |C_f,dev|", rows[-1][1] / rows[-2][1],
+                         f"{abs(cf['fe'] - cf['fvm']) / 0.19245:.2e}"))
+    return base, rows
+
+
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
-          "micro-full": lambda: bench_micro(full=True)}
+          "macro": bench_macro, "micro-full": lambda: bench_micro(full=True)}
 
 
 def main(argv):

@@ -9,6 +9,10 @@ import os
 import sys
 from pathlib import Path
 
+import numpy as np
+
+from .errors import NotConverged
+
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
 #: topography steps: name -> help text
@@ -41,6 +45,9 @@ def main(argv=None) -> int:
     except (ValueError, FileNotFoundError) as err:
         print(f"fem-twin {args.command}: error: {err}", file=sys.stderr)
         return 2
+    except NotConverged as err:
+        print(f"fem-twin {args.command}: not converged: {err}", file=sys.stderr)
+        return 3
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -110,6 +117,25 @@ def build_parser() -> argparse.ArgumentParser:
     ha.add_argument("inputs", type=Path, nargs="+", help="flow_factors.npz files")
     ha.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     ha.set_defaults(func=_homogenise_average)
+
+    mc = sub.add_parser("macro", help="macro scale: one operating point of the homogenised "
+                                      "mixed-EHL solver (eqs 17-34)")
+    ms = mc.add_subparsers(dest="step", required=True, metavar="STEP")
+    mp = ms.add_parser("point", help="solve one operating point; write fields (npz, VTU) and "
+                                     "a JSON summary")
+    mp.add_argument("pin", type=Path, help="prepared macro pin (fem-twin topography prepare-pin)")
+    mp.add_argument("factors", type=Path, help="flow_factors.npz (fem-twin homogenise)")
+    mp.add_argument("--disk", type=Path, help="prepared, flipped disk on the pin's grid "
+                                              "(default: flat)")
+    mp.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    mp.add_argument("--speed", type=float, required=True, help="sliding speed U [m/s]")
+    mp.add_argument("--viscosity", type=float, default=0.066, help="mu_0 [Pa s]")
+    mp.add_argument("--load", type=float, default=150.0, help="imposed normal load [N]")
+    mp.add_argument("--diameter", type=float, default=8e-3,
+                    help="pin diameter D of the Hersey number, eq 46 [m]")
+    mp.add_argument("--method", choices=("fe", "fvm"), default="fe")
+    mp.add_argument("--coupling", choices=("anderson", "pid"), default="anderson")
+    mp.set_defaults(func=_macro_point)
 
     m = sub.add_parser("mesh", help="topography -> structured FE mesh written as VTU for ParaView")
     m.add_argument("input", type=Path)
@@ -271,6 +297,32 @@ def _write_factors(folder, ff, patches=()):
                       "files": [str(folder / n) for n in ("flow_factors.npz",
                                                           "flow_factors.csv",
                                                           "flow_factors.png")]}, indent=2))
+
+
+def _macro_point(args):
+    from .io.atomic import atomic_path
+    from .io.files import read_topography
+    from .macro import Lubricant, MacroSettings, solve_mixed
+    from .micro import FlowFactors
+    pin = read_topography(args.pin)
+    upper = read_topography(args.disk).heights if args.disk else 0.0 * pin.heights
+    if np.shape(upper) != pin.shape:
+        raise ValueError(f"disk grid {np.shape(upper)} does not match the pin grid {pin.shape}")
+    face = pin.heights > -0.5e-3                 # the holder sits 1 mm below the face
+    res = solve_mixed(upper - pin.heights, pin.spacing, FlowFactors.load(args.factors),
+                      load=args.load, speed=args.speed, lubricant=Lubricant(args.viscosity),
+                      face=face, settings=MacroSettings(method=args.method,
+                                                        coupling=args.coupling))
+    args.output.mkdir(parents=True, exist_ok=True)
+    res.save(args.output / "point.npz")
+    res.write_vtu(args.output / "point.vtu", origin=pin.origin)
+    summary = {k: v for k, v in res.scalars().items()}
+    summary["hersey"] = args.viscosity * args.speed * args.diameter / args.load   # eq 46
+    summary["seconds"] = res.meta["seconds"]
+    with atomic_path(args.output / "point.json") as tmp:
+        tmp.write_text(json.dumps(summary, indent=2))
+    print(json.dumps(summary, indent=2))
+    return 0
 
 
 def _mesh(args):

@@ -1,5 +1,11 @@
-"""Macro scale: (homogenised) Reynolds equation with mass-conserving cavitation (eqs 17-18)."""
+"""Macro scale: homogenised Reynolds with mass-conserving cavitation, elastic deformation,
+contact pressure and load balance (eqs 17-34)."""
 
+from .friction import BOUNDARY_FRICTION, boundary_shear, hydrodynamic_shear
+from .lubricant import Lubricant
+from .mixed import MacroSettings, MixedNotConverged, MixedResult, solve_mixed
 from .reynolds import ReynoldsNotConverged, ReynoldsResult, solve_reynolds
 
-__all__ = ["ReynoldsNotConverged", "ReynoldsResult", "solve_reynolds"]
+__all__ = ["BOUNDARY_FRICTION", "boundary_shear", "hydrodynamic_shear", "Lubricant",
+           "MacroSettings", "MixedNotConverged", "MixedResult", "solve_mixed",
+           "ReynoldsNotConverged", "ReynoldsResult", "solve_reynolds"]

@@ -20,8 +20,10 @@ Two couplings reach the same state:
     (Walker and Ni 2011).  ``k`` is a load-stiffness estimate (contact stiffness from the
     slope of ``p_con(h0)`` plus ``2 F_hd / h``); Anderson mixing corrects it.
 ``"pid"``
-    the paper's scheme: ``p_con`` under-relaxed with ``alpha_pcon`` (eq 26), ``h_el``
-    recomputed each iteration, and the incremental PID controller of eq 29 on ``h_d``.
+    the paper's scheme: ``p_con`` under-relaxed with ``alpha_pcon`` (eq 26), the
+    incremental PID controller of eq 29 on ``h_d``, and ``h_el`` under-relaxed (the
+    paper's EHL-FBNS solves the elastic coupling inside its Newton system; a plain
+    fixed point on ``h_el`` oscillates here, so it is relaxed with ``relaxation_elastic``).
 
 Each iteration solves the Reynolds complementarity problem to 1e-10 at frozen
 coefficients (warm-started).  Converged when, between two iterations, all of the
@@ -45,12 +47,16 @@ from ..io.atomic import atomic_path
 from ..micro.flow_factors import FlowFactors
 from .friction import BOUNDARY_FRICTION, boundary_shear, hydrodynamic_shear
 from .lubricant import Lubricant
-from .reynolds import fe_poiseuille, solve_complementarity, upwind_couette
+from .reynolds import (ReynoldsNotConverged, fe_poiseuille, solve_complementarity,
+                       upwind_couette)
 
 
 #: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
 #: clipped before eqs 23-24 are evaluated, so that the Roelands exponential stays finite.
 MAX_COEFFICIENT_PRESSURE = 1e10
+
+#: Cold starts on grids of at least twice this size begin with a solve on the coarser grid.
+COARSE_START = 48
 
 
 class MixedNotConverged(NotConverged):
@@ -68,6 +74,7 @@ class MacroSettings:
     method: str = "fe"                       # Poiseuille term: "fe" or "fvm"
     coupling: str = "anderson"               # or "pid" (the paper's)
     relaxation_pcon: float = 0.05            # alpha_pcon of eq 26 ("pid")
+    relaxation_elastic: float = 0.1          # under-relaxation of h_el ("pid")
     gains: tuple = (1.2e-2, 2.4e-2, 1.5e-3)  # K_P, K_I, K_D of eq 29 ("pid")
     anderson_depth: int = 8
     p_ref: float = 100e6
@@ -212,10 +219,15 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
         from ..fvm.reynolds import fvm_poiseuille
         return fvm_poiseuille(g, dx, A)
 
+    if initial is None and min(h_g.shape) >= 2 * COARSE_START:
+        # cold start on the grid coarsened by 2 (recursively), to a looser tolerance
+        coarse = replace(s, tol=max(s.tol, 1e-4))
+        initial = solve_mixed(h_g[::2, ::2], (2 * dx[0], 2 * dx[1]), factors, load=load,
+                              speed=speed, lubricant=lubricant, face=face[::2, ::2],
+                              settings=coarse)
     state = {"phi": None, "p": np.full(h_g.shape, p_amb_rel), "newton": 0}
     if initial is not None:
-        if initial.pressure.shape != h_g.shape:
-            raise ValueError("initial result is on a different grid")
+        initial = _on_grid(initial, h_g.shape, dx)
         state["p"] = initial.pressure - s.cavitation_pressure
         theta0 = initial.cavity_fraction
         state["phi"] = np.where(theta0 > 0, -theta0 * scale, np.maximum(state["p"], 0)).ravel()
@@ -266,8 +278,24 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
     r_prev = [0.0, 0.0]
     mixer = _Anderson(s.anderson_depth)
     p_con_prev = p_con
+    good, retries, best, stall = None, 0, np.inf, 0
     for it in range(1, s.max_iter + 1):
-        ev = evaluate(h_el, h_d, p_con if s.coupling == "pid" else None)
+        try:
+            ev = evaluate(h_el, h_d, p_con if s.coupling == "pid" else None)
+        except ReynoldsNotConverged as err:
+            # an over-long step (gap far too thin): halve it and restart the mixing
+            retries += 1
+            if good is None or retries > 12:
+                raise MixedNotConverged(f"the Reynolds solve failed at iteration {it}: {err}",
+                                        history) from err
+            h_el, h_d = (h_el + good[0]) / 2, (h_d + good[1]) / 2
+            state["phi"], state["p"] = good[2], good[3]
+            mixer = _Anderson(s.anderson_depth)
+            history.append((it, np.nan, np.nan, np.nan, np.nan, h_d, -1))
+            continue
+        retries = 0
+        good = (h_el, h_d, state["phi"], ev["p_prev"])
+        stall += 1
         r_F = (ev["F"] - load) / load
         r_hel = float(np.abs(ev["h_el_new"] - h_el).max() / s.h_ref)
         r_p = float(np.abs(ev["p"] - ev["p_prev"]).max() / s.p_ref)
@@ -283,20 +311,28 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
             progress(it, res)
         if res < s.tol and it > 1:
             break
+        if res < 0.5 * best:
+            best, stall = res, 0
+        elif stall > 25:                   # Anderson mixing stagnates: restart its history
+            mixer, best, stall = _Anderson(s.anderson_depth), res, 0
         if s.coupling == "pid":
             p_con = p_con + s.relaxation_pcon * delta               # eq 26
             kp, ki, kd = s.gains
             r1, r2 = r_prev
             h_d += (kp * (r_F - r1) + ki * r_F + kd * (r_F - 2 * r1 + r2)) * 1e-6   # eq 29
             r_prev = [r_F, r1]
-            h_el = ev["h_el_new"]
+            h_el = h_el + s.relaxation_elastic * (ev["h_el_new"] - h_el)
         else:
             k = _load_stiffness(factors, ev, area, s)
             g_hel = ev["h_el_new"]
             g_hd = h_d + (ev["F"] - load) / k
             x = np.r_[h_el.ravel(), h_d] / s.h_ref
             f = np.r_[g_hel.ravel(), g_hd] / s.h_ref - x
-            x = mixer.step(x, f) * s.h_ref
+            step = mixer.step(x, f) - x
+            # trust region: no step moves the surfaces by more than half the thinnest film
+            bound = 0.5 * max(float(ev["h0"][face].min()), 1e-8) / s.h_ref
+            step *= min(1.0, bound / max(float(np.abs(step).max()), 1e-300))
+            x = (x + step) * s.h_ref
             h_el, h_d = x[:-1].reshape(h_g.shape), float(x[-1])
     else:
         raise MixedNotConverged(
@@ -330,6 +366,23 @@ def _result(ev, h_el, h_d, speed, load, dx, face, area, lubricant, s, it, histor
               "lubricant": lubricant.__dict__.copy(), "seconds": seconds})
 
 
+def _on_grid(result: MixedResult, shape, dx) -> MixedResult:
+    """``result`` interpolated (linearly, by coordinates from the first node) onto a grid."""
+    if result.pressure.shape == tuple(shape) and np.allclose(result.spacing, dx):
+        return result
+    from scipy.ndimage import map_coordinates
+    rows = np.arange(shape[0]) * dx[1] / result.spacing[1]
+    cols = np.arange(shape[1]) * dx[0] / result.spacing[0]
+    where = np.meshgrid(rows, cols, indexing="ij")
+
+    def interp(f):
+        return map_coordinates(np.asarray(f, float), where, order=1, mode="nearest")
+
+    return replace(result, spacing=tuple(dx), **{k: interp(getattr(result, k))
+                                                 for k in _FIELDS if k != "face"},
+                   face=interp(result.face) > 0.5)
+
+
 def _trapezoid_weights(shape, dx):
     w1 = np.full(shape[1], dx[0])
     w1[[0, -1]] /= 2
@@ -339,21 +392,19 @@ def _trapezoid_weights(shape, dx):
 
 
 def _dry_separation(factors, h_g, area, load, s):
-    """h_d at which the rigid contact alone carries the load (bisection): the start."""
+    """h_d at which the rigid contact alone carries the load (bisection), or at which the
+    surfaces touch (``h0 = gap_floor``) if the contact pressure cannot carry it."""
     def excess(h_d):
         p = factors.contact_pressure(np.maximum(h_d + h_g, s.gap_floor))
         return float(np.sum(area * p)) - load
+
+    touch = s.gap_floor - float(h_g.min())
     hi = float(factors.h0[-1]) - float(h_g.min())       # first contact at h0_max
     if excess(hi) >= 0:
         return hi
-    step = float(factors.h0[-1])
-    lo = hi - step
-    while excess(lo) < 0:                                  # p_con is bounded below h0 -> 0
-        step *= 2
-        lo = hi - step
-        if step > 1e-3:
-            raise MixedNotConverged(f"the contact cannot carry {load} N at any separation "
-                                    "(flow factors' p_con too small)", [])
+    if excess(touch) < 0:
+        return touch
+    lo = touch
     for _ in range(60):
         mid = (lo + hi) / 2
         lo, hi = (mid, hi) if excess(mid) > 0 else (lo, mid)

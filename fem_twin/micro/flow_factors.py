@@ -104,7 +104,8 @@ class FlowFactors:
     def at(self, h0) -> "LocalFactors":
         """Factors at any separations ``h0`` [m] (e.g. a macro gap field), paper 2.2.2 rules.
 
-        Inside the computed range: monotone cubic (PCHIP) interpolation in ``log h0``.
+        Inside the computed range: monotone cubic (PCHIP) interpolation in ``log h0`` (of
+        ``h_m / h0`` for the mean gap, which makes the smooth limit ``h_m = h0`` exact).
         Above ``h0_max``: ``h_m = h0``, ``p_con = 0`` and the factors at ``h0_max``.
         Below ``h0_min`` (not covered by the paper): ``h_m`` and ``p_con`` continue linearly
         with their end slopes, ``h_m`` floored at 1 nm, and the factors are held at ``h0_min``.
@@ -116,12 +117,13 @@ class FlowFactors:
         lo, hi = self.h0[0], self.h0[-1]
         xc = np.log(np.clip(flat, lo, hi))
         out = {}
-        for name in ("h_m", "p_con", "A", "b", "C", "d", "contact_fraction"):
+        for name in ("h_m", "A", "b", "C", "d", "contact_fraction"):
             v = getattr(self, name)
             if len(self) == 1:
                 out[name] = np.repeat(v[:1], flat.size, axis=0)
             else:
                 out[name] = self._interpolant(name)(xc)
+        out["h_m"] = out["h_m"] * np.exp(xc)      # h_m / h0 is what is interpolated
         above = flat > hi
         out["h_m"][above] = flat[above]
         out["contact_fraction"][above] = 0.0
@@ -155,7 +157,8 @@ class FlowFactors:
     def _interpolant(self, name):
         cache = self.__dict__.setdefault("_pchip", {})
         if name not in cache:
-            cache[name] = PchipInterpolator(np.log(self.h0), getattr(self, name), axis=0)
+            v = getattr(self, name) / (self.h0 if name == "h_m" else 1.0)
+            cache[name] = PchipInterpolator(np.log(self.h0), v, axis=0)
         return cache[name]
 
     def smooth_limit_error(self) -> float:

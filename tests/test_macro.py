@@ -1,0 +1,200 @@
+"""Homogenised mixed-EHL macro solver (paper 2.2.2, eqs 17-34).
+
+A small but complete case: the bundled sample pin 1 on its disk at 32 x 32 (or 64 x 64)
+nodes over 8 x 8 mm, and flow factors of sample patch 1 at 32 x 32 pixels (14 h0 x 4 steps).
+Tolerances: the coupled solver converges to 1e-6 in every residual, so states reached by two
+couplings agree to about 1e-5 (two independent 1e-6 stops); exact invariances hold to that.
+"""
+
+import numpy as np
+import pytest
+
+from fem_twin.fvm.reynolds import fvm_poiseuille
+from fem_twin.io.files import read_topography
+from fem_twin.macro import (BOUNDARY_FRICTION, Lubricant, MacroSettings, MixedNotConverged,
+                            MixedResult, solve_mixed, solve_reynolds)
+from fem_twin.macro.reynolds import fe_poiseuille
+from fem_twin.micro import FlowFactors, homogenise
+from fem_twin.topography import resample
+from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
+
+from pathlib import Path
+
+SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "sample"
+
+ISOVISCOUS = dict(roelands_alpha=0.0)
+
+
+def macro_case(n):
+    opts = MacroOptions(resolution=(n, n))
+    pin = prepare_pin(read_topography(SAMPLE / "pin_1.npz"), opts)
+    disk = prepare_disk(read_topography(SAMPLE / "disk_1.npz"), opts)
+    return disk.heights - pin.heights, pin.spacing, pin.heights > opts.holder_height / 2
+
+
+@pytest.fixture(scope="module")
+def factors():
+    low = resample(prepare_patch(read_topography(SAMPLE / "patch_1_pin.npz")), (32, 32))
+    up = resample(prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"), upper=True),
+                  (32, 32))
+    return homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), n_steps=4)
+
+
+@pytest.fixture(scope="module")
+def case32():
+    return macro_case(32)
+
+
+def smooth_factors():
+    h0 = np.geomspace(1e-9, 1e-3, 7)
+    n = h0.size
+    return FlowFactors(h0=h0, h_m=h0.copy(), p_con=np.zeros(n), A=np.tile(np.eye(2), (n, 1, 1)),
+                       b=np.tile([1.0, 0.0], (n, 1)), C=np.tile(np.eye(2), (n, 1, 1)),
+                       d=np.zeros((n, 2)), contact_fraction=np.zeros(n))
+
+
+@pytest.mark.parametrize("assemble", [fe_poiseuille, fvm_poiseuille])
+def test_tensor_poiseuille_converges_second_order(assemble):
+    """Manufactured p = sin(pi x) sin(pi y) with a full, non-symmetric A and variable g."""
+    import scipy.sparse.linalg as spla
+    errors = []
+    a = np.array([[1.0, 0.3], [0.2, 0.7]])
+    for n in (17, 33, 65):
+        x = np.linspace(0, 1, n)
+        X, Y = np.meshgrid(x, x)
+        g = 1 + 0.5 * X
+        s, c = np.sin(np.pi * X), np.cos(np.pi * X)
+        sy, cy = np.sin(np.pi * Y), np.cos(np.pi * Y)
+        px, py = np.pi * c * sy, np.pi * s * cy
+        pxx = pyy = -np.pi ** 2 * s * sy
+        pxy = np.pi ** 2 * c * cy
+        f = -(0.5 * (a[0, 0] * px + a[0, 1] * py)
+              + g * (a[0, 0] * pxx + (a[0, 1] + a[1, 0]) * pxy + a[1, 1] * pyy))
+        K = assemble(g, (x[1], x[1]), np.broadcast_to(a, (n, n, 2, 2))).tocsr()
+        inner = np.zeros((n, n), bool)
+        inner[1:-1, 1:-1] = True
+        idx = np.flatnonzero(inner)
+        p = spla.spsolve(K[idx][:, idx].tocsc(), (f * x[1] ** 2).ravel()[idx])
+        errors.append(np.abs(p - (s * sy).ravel()[idx]).max())
+    order = np.log2(np.array(errors[:-1]) / errors[1:])
+    assert np.all(order > 1.8), (errors, order)
+
+
+def test_smooth_factors_reproduce_plain_reynolds(case32):
+    """A = I, b = e1, h_m = h0, p_con = 0, rigid and isoviscous, incompressible: the
+    converged pressure is the plain Reynolds solution on the final gap (to the 1e-10
+    Newton tolerance)."""
+    gap, spacing, face = case32
+    lub = Lubricant(0.066, dh_c2=1.0, **ISOVISCOUS)
+    res = solve_mixed(gap, spacing, smooth_factors(), load=150.0, speed=1.0, lubricant=lub,
+                      face=face, settings=MacroSettings(e_reduced=1e30))
+    assert abs(res.normal_load - 150.0) < 1e-6 * 150
+    assert np.abs(res.elastic_deformation).max() < 1e-20
+    plain = solve_reynolds(res.h0, spacing, 1.0, 0.066, ambient_pressure=1e5,
+                           cavitation_pressure=8e4)
+    assert np.abs(plain.pressure - res.pressure).max() < 1e-8 * res.pressure.max()
+    assert np.abs(plain.cavity_fraction - res.cavity_fraction).max() < 1e-8
+
+
+def test_converged_state_balances_load_and_is_consistent(case32, factors):
+    gap, spacing, face = case32
+    res = solve_mixed(gap, spacing, factors, load=150.0, speed=0.03,
+                      lubricant=Lubricant(0.066), face=face)
+    assert abs(res.normal_load / 150.0 - 1) < 1e-6                        # eq 30
+    assert np.all(res.pressure >= 8e4 - 1e-6) and np.all(res.cavity_fraction >= 0)
+    assert np.all((res.pressure - 8e4) * res.cavity_fraction < 1e-6)      # eq 18
+    assert np.all(res.pressure[[0, -1], :] == 1e5)
+    # eq 19 and p_con(h0) at the converged state
+    assert np.allclose(res.h0, np.maximum(res.h_d + gap + res.elastic_deformation, 1e-9))
+    assert np.allclose(res.contact_pressure, factors.contact_pressure(res.h0))
+    assert 0 < res.contact_load < 150
+    # friction parts add up (eqs 32-34)
+    assert res.friction_force == pytest.approx(res.hydrodynamic_friction
+                                               + res.boundary_friction)
+    assert res.friction_coefficient == pytest.approx(res.friction_force / res.normal_load)
+
+
+def test_paper_pid_coupling_reaches_the_same_state(case32, factors):
+    gap, spacing, face = case32
+    kw = dict(load=150.0, speed=0.03, lubricant=Lubricant(0.066), face=face)
+    fast = solve_mixed(gap, spacing, factors, **kw)
+    pid = solve_mixed(gap, spacing, factors, **kw,
+                      settings=MacroSettings(coupling="pid", max_iter=5000))
+    assert pid.iterations > 3 * fast.iterations
+    assert pid.h_d == pytest.approx(fast.h_d, rel=1e-4)
+    assert pid.friction_coefficient == pytest.approx(fast.friction_coefficient, rel=1e-4)
+
+
+def test_hersey_invariance_and_stribeck_limits(case32, factors):
+    """Isoviscous: the state depends on mu_0 U only, so C_f is a function of the Hersey
+    number (eq 46); C_f rises toward C_f,b at low speed and falls with speed when the film
+    carries the load."""
+    gap, spacing, face = case32
+
+    def cf(mu, speed, initial=None):
+        return solve_mixed(gap, spacing, factors, load=150.0, speed=speed, face=face,
+                           lubricant=Lubricant(mu, **ISOVISCOUS), initial=initial)
+
+    a, b = cf(0.066, 0.05), cf(0.024, 0.05 * 0.066 / 0.024)
+    assert b.friction_coefficient == pytest.approx(a.friction_coefficient, rel=1e-5)
+    fast, faster = cf(0.066, 1.0), cf(0.066, 2.0)
+    assert fast.contact_load == 0
+    exponent = np.log(faster.friction_coefficient / fast.friction_coefficient) / np.log(2)
+    assert 0.4 < exponent < 0.8          # eq 45: C_f ~ sqrt(H) for a film of fixed shape
+    slow = a
+    for speed in (0.01, 0.003, 1e-3):        # a Stribeck sweep warm-starts downward
+        slow = cf(0.066, speed, initial=slow)
+    assert slow.contact_load > 0.9 * 150
+    assert 0.85 * BOUNDARY_FRICTION < slow.friction_coefficient <= BOUNDARY_FRICTION * 1.01
+
+
+def test_fe_and_fvm_operating_points_converge_together(factors):
+    """|C_f,dev| between FE and FVM: 0.10 % at 32^2, 0.034 % at 64^2 (0.011 % at 128^2)."""
+    diffs = []
+    for n in (32, 64):
+        gap, spacing, face = macro_case(n)
+        cf = [solve_mixed(gap, spacing, factors, load=150.0, speed=1.0, face=face,
+                          lubricant=Lubricant(0.066),
+                          settings=MacroSettings(method=m)).friction_coefficient
+              for m in ("fe", "fvm")]
+        diffs.append(abs(cf[0] - cf[1]) / BOUNDARY_FRICTION)   # |C_f,dev|, eq 35
+    assert diffs[1] < diffs[0] / 2 and diffs[0] < 0.02, diffs
+
+
+def test_result_files_round_trip(tmp_path, case32, factors):
+    gap, spacing, face = case32
+    res = solve_mixed(gap, spacing, factors, load=150.0, speed=0.5,
+                      lubricant=Lubricant(0.066), face=face)
+    back = MixedResult.load(res.save(tmp_path / "point.npz"))
+    assert back.friction_coefficient == res.friction_coefficient
+    assert np.array_equal(back.pressure, res.pressure) and back.face.dtype == bool
+    import meshio
+    mesh = meshio.read(res.write_vtu(tmp_path / "point.vtu"))
+    assert {"pressure", "cavity_fraction", "contact_pressure", "h0"} <= set(mesh.point_data)
+
+
+def test_bad_input_and_non_convergence(case32, factors):
+    gap, spacing, face = case32
+    lub = Lubricant(0.066)
+    with pytest.raises(ValueError, match="NaN"):
+        solve_mixed(np.full_like(gap, np.nan), spacing, factors, load=150, speed=1,
+                    lubricant=lub)
+    with pytest.raises(ValueError, match="load"):
+        solve_mixed(gap, spacing, factors, load=-1, speed=1, lubricant=lub)
+    with pytest.raises(ValueError, match="Pa s"):
+        Lubricant(66.0)
+    with pytest.raises(MixedNotConverged) as err:
+        solve_mixed(gap, spacing, factors, load=150, speed=0.03, lubricant=lub,
+                    settings=MacroSettings(max_iter=2))
+    assert len(err.value.history) == 2
+
+
+def test_roelands_and_dowson_higginson():
+    lub = Lubricant(0.066)
+    assert lub.viscosity_at(0.0) == pytest.approx(0.066)
+    # low-pressure slope of eq 23 is alpha_R (with z_R = alpha p0 / (ln mu0 + 9.67))
+    dp = 1e3
+    slope = np.log(lub.viscosity_at(dp) / 0.066) / dp
+    assert slope == pytest.approx(22e-9, rel=1e-4)
+    assert lub.density_ratio(0.0) == 1.0
+    assert lub.density_ratio(1e12) == pytest.approx(1.34, rel=1e-3)
