@@ -25,12 +25,95 @@ class Geometry:
 
 
 @dataclass(frozen=True)
+class Tribometer:
+    """Operating conditions (Table 6): imposed load [N], pin diameter [m], sliding radius [m]."""
+
+    load: float = 150.0
+    pin_diameter: float = 8e-3
+    sliding_radius: float = 20e-3
+
+
+@dataclass(frozen=True)
+class LubricantSpec:
+    """mu_0 per temperature (Table 3) and the constants of eqs 23-24 (Table 6)."""
+
+    viscosities: tuple[float, ...] = (0.066, 0.024)
+    temperatures: tuple[float, ...] = (24.0, 50.0)
+    density: float = 850.0
+    roelands_alpha: float = 22e-9
+    roelands_p0: float = 1.96e8
+    dh_c1: float = 5.9e8
+    dh_c2: float = 1.34
+
+
+@dataclass(frozen=True)
+class Materials:
+    """Elastic constants of pin and disk (Table 4) and the hardness cap [Pa]."""
+
+    e_pin: float = 210e9
+    nu_pin: float = 0.3
+    e_disk: float = 210e9
+    nu_disk: float = 0.3
+    hardness: float = 6.99e9
+
+
+@dataclass(frozen=True)
+class MicroSpec:
+    """Micro scale: patch resolution (resampled), h0 range [m] and count, time steps."""
+
+    resolution: tuple[int, int] = (256, 256)
+    h0_min: float = 1e-7
+    h0_max: float = 1e-6
+    h0_count: int = 100
+    steps: int = 32
+    method: str = "fe"
+
+
+@dataclass(frozen=True)
+class MacroSpec:
+    """Macro scale: which pin ("average" of the set or 1-based index), FE/FVM, coupling."""
+
+    pin: str | int = "average"
+    method: str = "fe"
+    coupling: str = "anderson"
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """Speeds from ``speed_max`` down to ``speed_min`` [m/s], ``count`` log-spaced."""
+
+    speed_max: float = 2.0
+    speed_min: float = 0.01
+    count: int = 25
+
+    @property
+    def speeds(self):
+        import numpy as np
+        return np.geomspace(self.speed_max, self.speed_min, self.count)
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Where independent work runs: local processes, or a Dask scheduler address."""
+
+    workers: int = 0                 # 0: all cores
+    scheduler: str | None = None     # e.g. "tcp://10.0.0.1:8786"
+
+
+@dataclass(frozen=True)
 class Case:
-    """A whole case: geometry sources and the macroscopic reconstruction settings."""
+    """A whole case: geometry sources, pre-processing, physics, scales, sweep, execution."""
 
     name: str
     geometry: Geometry
     macro_geometry: MacroOptions = field(default_factory=MacroOptions)
+    tribometer: Tribometer = field(default_factory=Tribometer)
+    lubricant: LubricantSpec = field(default_factory=LubricantSpec)
+    materials: Materials = field(default_factory=Materials)
+    micro: MicroSpec = field(default_factory=MicroSpec)
+    macro: MacroSpec = field(default_factory=MacroSpec)
+    sweep: SweepSpec = field(default_factory=SweepSpec)
+    run: RunSpec = field(default_factory=RunSpec)
     source: Path | None = None
 
 
@@ -49,7 +132,8 @@ def load_case(path) -> Case:
 def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -> Case:
     """Validate a case given as a dict (as read from TOML)."""
     where = str(source or "case")
-    _only(data, {"name", "geometry", "preprocessing"}, where)
+    _only(data, {"name", "geometry", "preprocessing", "tribometer", "lubricant", "materials",
+                 "micro", "macro", "sweep", "run"}, where)
     if "geometry" not in data:
         raise CaseError(f"{where}: missing [geometry] section")
     g = data["geometry"]
@@ -92,8 +176,64 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
                         f"got {opts['clip']} (20 um is 20e-6)")
     if opts.get("fwhm_px", 0) < 0:
         raise CaseError(f"{where} [preprocessing] fwhm_px must be >= 0 pixels")
+    tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
+    lubricant = _section(data, "lubricant", LubricantSpec, where, positive=True)
+    if len(lubricant.temperatures) != len(lubricant.viscosities):
+        raise CaseError(f"{where} [lubricant]: give one temperature per viscosity")
+    if any(v > 10 for v in lubricant.viscosities):
+        raise CaseError(f"{where} [lubricant] viscosities: expected Pa s (0.066, not 66 mPa s)")
+    materials = _section(data, "materials", Materials, where, positive=True)
+    micro = _section(data, "micro", MicroSpec, where)
+    if micro.method not in ("fe", "fvm"):
+        raise CaseError(f"{where} [micro] method: 'fe' or 'fvm'")
+    if not (0 < micro.h0_min < micro.h0_max < 1e-3) or micro.h0_count < 2 or micro.steps < 1:
+        raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
+                        "h0_count >= 2 and steps >= 1")
+    macro = _section(data, "macro", MacroSpec, where)
+    if macro.method not in ("fe", "fvm") or macro.coupling not in ("anderson", "pid"):
+        raise CaseError(f"{where} [macro]: method 'fe'|'fvm', coupling 'anderson'|'pid'")
+    if macro.pin != "average" and not (isinstance(macro.pin, int)
+                                       and 1 <= macro.pin <= len(geometry.pins)):
+        raise CaseError(f"{where} [macro] pin: 'average' or a pin number 1..{len(geometry.pins)}")
+    sweep = _section(data, "sweep", SweepSpec, where, positive=True)
+    if sweep.speed_min > sweep.speed_max or sweep.count < 1:
+        raise CaseError(f"{where} [sweep]: need speed_min <= speed_max [m/s] and count >= 1")
+    run = _section(data, "run", RunSpec, where)
+    if not geometry.patches:
+        raise CaseError(f"{where} [geometry]: at least one roughness patch pair is required")
     return Case(name=str(data.get("name", source.stem if source else "case")),
-                geometry=geometry, macro_geometry=MacroOptions(**opts), source=source)
+                geometry=geometry, macro_geometry=MacroOptions(**opts), tribometer=tribometer,
+                lubricant=lubricant, materials=materials, micro=micro, macro=macro,
+                sweep=sweep, run=run, source=source)
+
+
+def _section(data, name, cls, where, positive=False):
+    """A table of scalars/lists into the dataclass ``cls`` (lists become tuples)."""
+    table = data.get(name, {})
+    _only(table, {f.name for f in fields(cls)}, f"{where} [{name}]")
+    values = {}
+    for f in fields(cls):
+        if f.name not in table:
+            continue
+        v = table[f.name]
+        default = getattr(cls(), f.name)
+        if isinstance(default, tuple):
+            if not isinstance(v, list) or not all(isinstance(x, (int, float)) for x in v):
+                raise CaseError(f"{where} [{name}] {f.name}: expected a list of numbers")
+            v = tuple(type(default[0])(x) if default else x for x in v)
+            if positive and any(x <= 0 for x in v):
+                raise CaseError(f"{where} [{name}] {f.name}: values must be positive (SI units)")
+        elif isinstance(default, bool) or default is None or isinstance(default, str):
+            if not isinstance(v, (str, int)) or isinstance(v, bool):
+                raise CaseError(f"{where} [{name}] {f.name}: expected a string")
+        elif isinstance(default, (int, float)):
+            if not isinstance(v, (int, float)) or isinstance(v, bool):
+                raise CaseError(f"{where} [{name}] {f.name}: expected a number (SI units)")
+            if positive and v <= 0:
+                raise CaseError(f"{where} [{name}] {f.name}: must be positive (SI units)")
+            v = type(default)(v) if isinstance(default, float) else v
+        values[f.name] = v
+    return cls(**values)
 
 
 def _only(section, allowed: set, where: str):

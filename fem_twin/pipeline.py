@@ -1,40 +1,97 @@
-"""The main job: from a case file to results in an output folder.
+"""The main job: from a case file to a Stribeck curve in an output folder.
 
-Stages run so far: virtual geometry reconstruction (pins, disks, roughness patches).
-Each stage writes its results atomically into the output folder; a stage whose outputs
-exist is not recomputed when the job runs again.
+Stages: virtual geometry reconstruction (pins, disks, roughness patches) -> pin levelling
+by torque balance and set averaging -> homogenisation of every patch pair and the patch
+average -> Stribeck sweeps (one per viscosity) -> CSV, plots, VTU/PVD, JSON summary, log.
+Every stage writes its results atomically; finished results (and the checkpoints inside
+long stages) are reused when the job runs again, so an interrupted run resumes.
 """
 
 from __future__ import annotations
 
 import json
 import logging
+import os
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
 from .case import Case
+from .contact.elastic import reduced_modulus
+from .contact.levelling import average_pins, level_pin
 from .io.atomic import atomic_path
 from .io.files import read_topography, write_topography
 from .io.mesh import grid_mesh, write_vtu
+from .macro import Lubricant, MacroSettings
+from .micro import FlowFactors, average, homogenise
+from .micro.output import plot_flow_factors
+from .stribeck import (friction_deviation, plot_stribeck, stribeck_sweep,
+                       write_stribeck_csv)
+from .topography import resample
 from .topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
 
 log = logging.getLogger("fem_twin")
 
 
 def run(case: Case, outdir, *, progress: bool = True) -> dict:
-    """Run every stage of the pipeline that exists for ``case``; return the summary."""
+    """Run the whole pipeline of ``case`` into ``outdir``; return the summary."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    summary = {"case": case.name, "stages": {}}
-    summary["stages"]["geometry"] = reconstruct_geometry(case, outdir / "geometry", progress)
+    summary = {"case": case.name, "stages": {}, "seconds": {}}
+    with _logfile(outdir / "run.log"), executor_for(case) as executor:
+        log.info("case %s -> %s", case.source, outdir)
+        stages = (("geometry", lambda: reconstruct_geometry(case, outdir / "geometry", progress)),
+                  ("levelling", lambda: level_pins(case, outdir, progress)),
+                  ("micro", lambda: homogenise_patches(case, outdir / "micro", executor,
+                                                       progress)),
+                  ("stribeck", lambda: stribeck_curves(case, outdir, executor, progress)))
+        for name, stage in stages:
+            t = time.perf_counter()
+            log.info("stage %s", name)
+            summary["stages"][name] = stage()
+            summary["seconds"][name] = round(time.perf_counter() - t, 2)
+            log.info("stage %s done in %.1f s", name, summary["seconds"][name])
     summary["wall_time_s"] = time.perf_counter() - t0
     with atomic_path(outdir / "summary.json") as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     return summary
+
+
+@contextmanager
+def _logfile(path):
+    handler = logging.FileHandler(path)
+    handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(message)s"))
+    log.addHandler(handler)
+    level = log.level
+    log.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        log.removeHandler(handler)
+        log.setLevel(level)
+        handler.close()
+
+
+@contextmanager
+def executor_for(case: Case):
+    """Local process pool (``[run] workers``, 0 = all cores) or a Dask cluster's executor
+    (``[run] scheduler`` address); None for one worker."""
+    if case.run.scheduler:
+        from distributed import Client
+        with Client(case.run.scheduler) as client:
+            yield client.get_executor()
+        return
+    workers = case.run.workers or os.cpu_count() or 1
+    if workers <= 1:
+        yield None
+        return
+    from concurrent.futures import ProcessPoolExecutor
+    with ProcessPoolExecutor(workers) as pool:
+        yield pool
 
 
 def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dict:
@@ -84,3 +141,143 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
             result["patches"].append({"files": [low_out.name, up_out.name], "sq_low_m": sq_low,
                                       "sq_up_m": sq_up, "sq_m": float(np.hypot(sq_low, sq_up))})
     return result
+
+
+def level_pins(case: Case, outdir: Path, progress: bool = True) -> dict:
+    """Level every pin against its disk (torque balance, Table 4 at 50 N); average the
+    levelled set and level the average (paper 2.2.1).  Writes ``levelling/``."""
+    folder = outdir / "levelling"
+    folder.mkdir(parents=True, exist_ok=True)
+    geo = outdir / "geometry"
+    m = case.materials
+    e_red = reduced_modulus(m.e_pin, m.nu_pin, m.e_disk, m.nu_disk)
+    holder = case.macro_geometry.holder_height
+    result = {"pins": []}
+    levelled = []
+    n = len(case.geometry.pins)
+    for i in tqdm(range(n), desc="levelling", disable=not progress, unit="pin"):
+        out = folder / f"pin_{i + 1}.npz"
+        if not out.exists():
+            lev = level_pin(read_topography(geo / f"pin_{i + 1}.npz"),
+                            read_topography(geo / f"disk_{i + 1}.npz"), e_reduced=e_red,
+                            hardness=m.hardness, holder_height=holder)
+            write_topography(out, lev.pin.with_heights(lev.pin.heights, meta={
+                **lev.pin.meta, "tilt_rad": list(lev.tilt),
+                "torque_residuals": list(lev.residuals)}))
+        pin = read_topography(out)
+        levelled.append(pin)
+        result["pins"].append({"file": out.name, "tilt_rad": pin.meta.get("tilt_rad")})
+    avg_out = folder / "pin_average.npz"
+    if n > 1 and not avg_out.exists():
+        lev = level_pin(average_pins(levelled, radius=case.macro_geometry.level_radius,
+                                     truncation=case.macro_geometry.truncation,
+                                     holder_height=holder),
+                        read_topography(geo / "disk_1.npz"), e_reduced=e_red,
+                        hardness=m.hardness, holder_height=holder)
+        write_topography(avg_out, lev.pin)
+    result["macro_pin"] = (avg_out.name if case.macro.pin == "average" and n > 1
+                           else f"pin_{case.macro.pin if case.macro.pin != 'average' else 1}.npz")
+    return result
+
+
+def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool = True):
+    """Flow factors of every patch pair (checkpointed per h0) and their average."""
+    folder.mkdir(parents=True, exist_ok=True)
+    geo = folder.parent / "geometry"
+    mc, m = case.micro, case.materials
+    h0 = np.geomspace(mc.h0_min, mc.h0_max, mc.h0_count)
+    e_red = reduced_modulus(m.e_pin, m.nu_pin, m.e_disk, m.nu_disk)
+    factors = []
+    for i in range(len(case.geometry.patches)):
+        out = folder / f"patch_{i + 1}" / "flow_factors.npz"
+        if not out.exists():
+            low = read_topography(geo / f"patch_{i + 1}_low.npz")
+            up = read_topography(geo / f"patch_{i + 1}_up.npz")
+            if low.shape != tuple(mc.resolution):
+                low, up = resample(low, mc.resolution), resample(up, mc.resolution)
+            ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=e_red,
+                            hardness=m.hardness, method=mc.method, executor=executor,
+                            checkpoint=out.parent / "checkpoints", progress=progress,
+                            patch_id=f"patch {i + 1}")
+            ff.save(out)
+        factors.append(FlowFactors.load(out))
+    mean = average(factors)
+    mean.save(folder / "flow_factors.npz")
+    mean.write_csv(folder.parent / "flow_factors.csv")
+    plot_flow_factors([*factors, mean], folder.parent / "flow_factors.png",
+                      labels=[f"patch {i + 1}" for i in range(len(factors))] + ["average"])
+    return {"patches": len(factors), "h0_m": [float(h0[0]), float(h0[-1]), len(h0)],
+            "grid": list(mc.resolution), "steps": mc.steps,
+            "p_con_max_Pa": float(mean.p_con.max()), "files": ["flow_factors.csv",
+                                                               "flow_factors.png"]}
+
+
+def macro_geometry(case: Case, outdir: Path):
+    """Gap ``h_g = x3_up - x3_low``, spacing, pin-face mask and origin of the macro pin."""
+    lev = outdir / "levelling"
+    pin_file = (lev / "pin_average.npz" if case.macro.pin == "average"
+                and (lev / "pin_average.npz").exists()
+                else lev / f"pin_{1 if case.macro.pin == 'average' else case.macro.pin}.npz")
+    pin = read_topography(pin_file)
+    k = 1 if case.macro.pin == "average" else case.macro.pin
+    disk = read_topography(outdir / "geometry" / f"disk_{k}.npz")
+    face = pin.heights > case.macro_geometry.holder_height / 2
+    return disk.heights - pin.heights, pin.spacing, face, pin.origin
+
+
+def _sweep_task(args):
+    """One viscosity's sweep (a picklable unit of work for process pools and Dask)."""
+    kwargs, lub = args
+    return stribeck_sweep(lubricant=lub, **kwargs)
+
+
+def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = True) -> dict:
+    """One Stribeck sweep per viscosity (in parallel on ``executor``); CSV, plots, fields."""
+    gap, spacing, face, origin = macro_geometry(case, outdir)
+    factors = FlowFactors.load(outdir / "micro" / "flow_factors.npz")
+    lb, tr = case.lubricant, case.tribometer
+    m = case.materials
+    settings = MacroSettings(e_reduced=reduced_modulus(m.e_pin, m.nu_pin, m.e_disk, m.nu_disk),
+                             method=case.macro.method, coupling=case.macro.coupling)
+    lubricants = [Lubricant(mu, density=lb.density, roelands_alpha=lb.roelands_alpha,
+                            roelands_p0=lb.roelands_p0, dh_c1=lb.dh_c1, dh_c2=lb.dh_c2)
+                  for mu in lb.viscosities]
+    common = dict(gap=gap, spacing=spacing, factors=factors, speeds=case.sweep.speeds,
+                  load=tr.load, diameter=tr.pin_diameter, face=face, settings=settings,
+                  checkpoint=outdir / "stribeck" / "checkpoints", fields=outdir / "fields",
+                  origin=origin)
+    curves = run_sweeps(common, lubricants, executor, progress)
+    write_stribeck_csv(outdir / "stribeck.csv", curves)
+    labels = [f"{t:g} C, mu_0 = {c.viscosity:g} Pa s" for t, c in zip(lb.temperatures, curves)]
+    plot_stribeck(curves, outdir / "stribeck_speed.png", x="speed", labels=labels)
+    plot_stribeck(curves, outdir / "stribeck_hersey.png", x="hersey", labels=labels)
+    out = {"curves": [{"viscosity_Pa_s": c.viscosity,
+                       "friction_coefficient_range": [float(c.friction_coefficient.min()),
+                                                      float(c.friction_coefficient.max())]}
+                      for c in curves],
+           "files": ["stribeck.csv", "stribeck_speed.png", "stribeck_hersey.png",
+                     "fields/"]}
+    if len(curves) > 1:
+        out["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves)
+    return out
+
+
+def run_sweeps(common: dict, lubricants, executor=None, progress: bool = True):
+    """Sweeps for several lubricants; serial, or one task per lubricant on ``executor``."""
+    if executor is None or len(lubricants) == 1:
+        return [_sweep_task((dict(common, progress=progress), lub)) for lub in lubricants]
+    futures = [executor.submit(_sweep_task, (dict(common, progress=False), lub))
+               for lub in lubricants]
+    return [f.result() for f in tqdm(futures, desc="Stribeck sweeps", disable=not progress)]
+
+
+def hersey_collapse(curves) -> float:
+    """max |C_f,dev| (eq 35) between the first curve and the others over the Hersey numbers
+    where they overlap (the others' points, interpolated on the first curve)."""
+    ref = curves[0]
+    devs = []
+    for c in curves[1:]:
+        cf_ref = ref.at_hersey(c.hersey)
+        ok = np.isfinite(cf_ref)
+        devs.extend(np.abs(friction_deviation(c.friction_coefficient[ok], cf_ref[ok])))
+    return float(max(devs)) if devs else float("nan")

@@ -1,5 +1,6 @@
 """Command line and the main job on the bundled case."""
 
+import csv
 import json
 import subprocess
 import sys
@@ -85,18 +86,69 @@ def test_case_validation(tmp_path):
             load_case(tmp_path / name)
 
 
-def test_run_bundled_case_and_resume(tmp_path):
-    case = ROOT / "examples" / "pin_on_disk.toml"
+def small_case(tmp_path, workers=1):
+    """The bundled case with reduced settings (48^2 macro, 16^2 x 6 h0 x 4 steps micro,
+    2 patches, 5 speeds) so the whole pipeline runs in seconds."""
+    text = (ROOT / "examples" / "pin_on_disk.toml").read_text()
+    text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
+    for old, new in (("resolution = [128, 128]", "resolution = [48, 48]"),
+                     ("resolution = [32, 32]", "resolution = [16, 16]"),
+                     ("h0_count = 16", "h0_count = 6"), ("steps = 8", "steps = 4"),
+                     ("count = 12", "count = 5"), ("speed_min = 0.005", "speed_min = 0.01"),
+                     ("workers = 0", f"workers = {workers}")):
+        assert old in text
+        text = text.replace(old, new)
+    lines = [ln for ln in text.splitlines() if "patch_3" not in ln and "patch_4" not in ln
+             and "patch_5" not in ln and "patch_6" not in ln]
+    path = tmp_path / "case.toml"
+    path.write_text("\n".join(lines))
+    return path
+
+
+def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkeypatch):
+    """fem-twin run CASE -o OUT: geometry -> levelling -> flow factors -> Stribeck CSV.
+    An interrupted run, run again, gives the same CSV as an uninterrupted one."""
+    import fem_twin.stribeck.sweep as sweep
+    case = small_case(tmp_path)
+    ref = tmp_path / "ref"
+    assert main(["run", str(case), "-o", str(ref), "--no-progress"]) == 0
+    rows = list(csv.DictReader(open(ref / "stribeck.csv")))
+    assert {"speed", "hersey", "friction_coefficient", "viscosity"} <= set(rows[0])
+    assert len(rows) == 10 and {float(r["viscosity"]) for r in rows} == {0.066, 0.024}
+    for mu in (0.066, 0.024):
+        r = [x for x in rows if float(x["viscosity"]) == mu]
+        speed = np.array([float(x["speed"]) for x in r])
+        cf = np.array([float(x["friction_coefficient"]) for x in r])
+        assert np.all(np.diff(speed) < 0)
+        assert cf[-1] > 10 * cf.min()                      # rises toward boundary friction
+        assert np.allclose([float(x["hersey"]) for x in r], mu * speed * 8e-3 / 150)
+    for name in ("stribeck_speed.png", "stribeck_hersey.png", "flow_factors.csv",
+                 "summary.json", "run.log", "fields/stribeck_mu0.066.pvd"):
+        assert (ref / name).is_file(), name
+    summary = json.loads((ref / "summary.json").read_text())
+    assert summary["stages"]["levelling"]["macro_pin"] == "pin_average.npz"
+
+    calls = {"n": 0}
+    real = sweep.solve_mixed
+
+    def interrupted(*args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 4:
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
     out = tmp_path / "out"
+    monkeypatch.setattr(sweep, "solve_mixed", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        main(["run", str(case), "-o", str(out), "--no-progress"])
+    assert not (out / "stribeck.csv").exists()
+    monkeypatch.setattr(sweep, "solve_mixed", real)
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
-    summary = json.loads((out / "summary.json").read_text())
-    pins = summary["stages"]["geometry"]["pins"]
-    assert len(pins) == 3 and all(abs(p["face_fraction"] - np.pi / 4) < 0.05 for p in pins)
-    assert len(summary["stages"]["geometry"]["patches"]) == 6
-    files = sorted((out / "geometry").iterdir())
-    stamps = {f.name: f.stat().st_mtime_ns for f in files}
-    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0   # resumes
-    assert {f.name: f.stat().st_mtime_ns for f in (out / "geometry").iterdir()} == stamps
+    assert (out / "stribeck.csv").read_text() == (ref / "stribeck.csv").read_text()
+    stamps = {p: p.stat().st_mtime_ns for p in (out / "stribeck" / "checkpoints").iterdir()}
+    assert len(stamps) == 10
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0   # all cached
+    assert {p: p.stat().st_mtime_ns for p in stamps} == stamps
 
 
 def test_homogenise_run_average_and_fields(tmp_path, capsys):

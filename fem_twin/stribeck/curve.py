@@ -1,0 +1,121 @@
+"""A Stribeck curve, its Hersey number (eq 46) and deviations between curves (eq 35)."""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..io.atomic import atomic_path
+from ..macro.friction import BOUNDARY_FRICTION
+
+COLUMNS = ("speed", "hersey", "friction_coefficient", "viscosity", "hydrodynamic_friction",
+           "boundary_friction", "contact_load_fraction", "h_d", "iterations")
+
+
+def hersey_number(viscosity, speed, diameter: float, load: float):
+    """H = mu_0 U D / F_N,imp of eq 46 [-] (SI inputs)."""
+    return np.asarray(viscosity) * np.asarray(speed) * diameter / load
+
+
+def friction_deviation(cf, cf_ref, boundary: float = BOUNDARY_FRICTION):
+    """C_f,dev = (C_f - C_f,ref) / C_f,b of eq 35 [-]."""
+    return (np.asarray(cf) - np.asarray(cf_ref)) / boundary
+
+
+@dataclass(frozen=True, eq=False)
+class StribeckCurve:
+    """C_f versus sliding speed at one viscosity; arrays ordered as computed (fast first).
+
+    speed [m/s], hersey [-], friction_coefficient [-], viscosity mu_0 [Pa s] (scalar),
+    hydrodynamic_friction and boundary_friction: F_T parts [N], contact_load_fraction:
+    share of F_N carried by p_con, h_d [m], iterations of the macro solver.
+    """
+
+    speed: np.ndarray
+    hersey: np.ndarray
+    friction_coefficient: np.ndarray
+    viscosity: float
+    hydrodynamic_friction: np.ndarray
+    boundary_friction: np.ndarray
+    contact_load_fraction: np.ndarray
+    h_d: np.ndarray
+    iterations: np.ndarray
+
+    def rows(self):
+        for i in range(len(self.speed)):
+            yield [self.speed[i], self.hersey[i], self.friction_coefficient[i], self.viscosity,
+                   self.hydrodynamic_friction[i], self.boundary_friction[i],
+                   self.contact_load_fraction[i], self.h_d[i], int(self.iterations[i])]
+
+    def at_hersey(self, hersey):
+        """C_f interpolated (monotone cubic, PCHIP, in log H) at Hersey numbers inside this
+        curve's range; NaN outside it."""
+        from scipy.interpolate import PchipInterpolator
+        order = np.argsort(self.hersey)
+        x, y = np.log(self.hersey[order]), self.friction_coefficient[order]
+        h = np.log(np.asarray(hersey, float))
+        inside = (h >= x[0]) & (h <= x[-1])
+        if x.size < 2:
+            return np.where(inside, y[0], np.nan)
+        return np.where(inside, PchipInterpolator(x, y)(np.clip(h, x[0], x[-1])), np.nan)
+
+
+def write_stribeck_csv(path, curves) -> Path:
+    """All curves into one CSV (columns :data:`COLUMNS`, SI units), atomically."""
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        with open(tmp, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(COLUMNS)
+            for c in curves:
+                for row in c.rows():
+                    w.writerow([f"{v:.10g}" if isinstance(v, float) else v for v in row])
+    return path
+
+
+def read_stribeck_csv(path) -> list[StribeckCurve]:
+    """Curves written by :func:`write_stribeck_csv`, one per viscosity."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows or set(COLUMNS) - set(rows[0]):
+        raise ValueError(f"{path}: not a Stribeck CSV with columns {COLUMNS}")
+    out = []
+    for mu in dict.fromkeys(float(r["viscosity"]) for r in rows):
+        sel = [r for r in rows if float(r["viscosity"]) == mu]
+        col = {k: np.array([float(r[k]) for r in sel]) for k in COLUMNS if k != "viscosity"}
+        col["iterations"] = col["iterations"].astype(int)
+        out.append(StribeckCurve(viscosity=mu, **col))
+    return out
+
+
+def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None) -> Path:
+    """C_f versus sliding speed (``x="speed"``) or Hersey number (``"hersey"``), log x.
+
+    ``reference``: optional measured curve ``(x values, C_f, optional (low, high) band)``.
+    """
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for i, c in enumerate(curves):
+        label = labels[i] if labels else f"mu_0 = {c.viscosity:g} Pa s"
+        ax.plot(getattr(c, x), c.friction_coefficient, "o-", ms=3, label=label)
+    if reference is not None:
+        ax.plot(reference[0], reference[1], "k--", label="measured")
+        if len(reference) > 2 and reference[2] is not None:
+            ax.fill_between(reference[0], *reference[2], color="0.8", label="scatter")
+    ax.axhline(BOUNDARY_FRICTION, color="0.5", lw=0.8, ls=":")
+    ax.set_xscale("log")
+    ax.set_xlabel("sliding speed U [m/s]" if x == "speed" else "Hersey number H [-] (eq 46)")
+    ax.set_ylabel("friction coefficient C_f [-]")
+    ax.legend()
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=120)
+    plt.close(fig)
+    return path
