@@ -68,6 +68,13 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--no-progress", action="store_true", help="no progress bars")
     r.set_defaults(func=_run)
 
+    cp = sub.add_parser("compare", help="cross-check FE against the FVM reference on a case: "
+                                        "flow factors, fields, C_f,dev (eq 35)")
+    cp.add_argument("case", nargs="?", type=Path, default=DEFAULT_CASE)
+    cp.add_argument("-o", "--output", type=Path, default=Path("compare"), help="output folder")
+    cp.add_argument("--no-progress", action="store_true", help="no progress bars")
+    cp.set_defaults(func=_compare)
+
     t = sub.add_parser("topography", help="read and pre-process measured topographies")
     steps = t.add_subparsers(dest="step", required=True, metavar="STEP")
     for name, text in _STEPS.items():
@@ -353,6 +360,14 @@ def _run(args):
     summary = run(case, args.output, progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
     print(f"results in {args.output}/")
+    return 0
+
+
+def _compare(args):
+    from .case import load_case
+    from .compare import compare
+    summary = compare(load_case(args.case), args.output, progress=not args.no_progress)
+    print(json.dumps(summary, indent=2))
     return 0
 
 

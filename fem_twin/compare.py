@@ -1,0 +1,138 @@
+"""Cross-check of the FE solvers against the FVM reference twin on one case (issue: FVM).
+
+Both methods run on the same prepared geometry: the cell problems of every patch pair
+(flow factors per h0), and a Stribeck sweep at the case's first viscosity, FE with the FE
+factors and FVM with the FVM factors.  Reported: per-h0 relative differences of the
+averaged flow factors, the pressure and cavity-fraction field differences per speed, and
+C_f,dev (eq 35) along the curve, with a plot.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from .case import Case
+from .io.atomic import atomic_path
+from .macro import Lubricant, MacroSettings, MixedResult
+from .micro import FlowFactors
+from .stribeck import friction_deviation, stribeck_sweep
+
+
+def flow_factor_differences(fe: FlowFactors, fvm: FlowFactors) -> dict:
+    """Per-h0 differences [-]: max |Delta A| / max |A| (likewise b, C), |Delta h_m| / h0,
+    |Delta d|, and |Delta p_con| / max p_con."""
+    if not np.allclose(fe.h0, fvm.h0):
+        raise ValueError("flow factors to compare must share their h0 values")
+
+    def rel(a, b, axes):
+        return np.abs(a - b).max(axis=axes) / np.maximum(np.abs(b).max(axis=axes), 1e-300)
+
+    return {"h0": fe.h0, "A": rel(fe.A, fvm.A, (1, 2)), "b": rel(fe.b, fvm.b, 1),
+            "C": rel(fe.C, fvm.C, (1, 2)), "d": np.abs(fe.d - fvm.d).max(axis=1),
+            "h_m": np.abs(fe.h_m - fvm.h_m) / fe.h0,
+            "p_con": np.abs(fe.p_con - fvm.p_con) / max(float(fvm.p_con.max()), 1e-300)}
+
+
+def field_differences(fe: MixedResult, fvm: MixedResult) -> dict:
+    """max |Delta p_hd| / max(p_hd - p_amb) and max |Delta theta| of two operating points."""
+    p_amb = fe.meta.get("settings", {}).get("ambient_pressure", 0.0)
+    return {"pressure": float(np.abs(fe.pressure - fvm.pressure).max()
+                              / max(float((fvm.pressure - p_amb).max()), 1e-300)),
+            "cavity_fraction": float(np.abs(fe.cavity_fraction - fvm.cavity_fraction).max())}
+
+
+def compare(case: Case, outdir, *, progress: bool = True) -> dict:
+    """Run the case's micro and macro stages with both methods; write ``compare.json``,
+    ``compare_flow_factors.csv``, ``compare_stribeck.csv`` and ``compare.png``."""
+    from .pipeline import (executor_for, homogenise_patches, level_pins, macro_geometry,
+                           reconstruct_geometry)
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    reconstruct_geometry(case, outdir / "geometry", progress)
+    level_pins(case, outdir, progress)
+    factors = {}
+    with executor_for(case) as executor:
+        for method in ("fe", "fvm"):
+            sub = outdir / method
+            sub.mkdir(exist_ok=True)
+            for name in ("geometry", "levelling"):
+                link = sub / name
+                if not link.exists():
+                    link.symlink_to((outdir / name).resolve(), target_is_directory=True)
+            c = replace(case, micro=replace(case.micro, method=method))
+            homogenise_patches(c, sub / "micro", executor, progress)
+            factors[method] = FlowFactors.load(sub / "micro" / "flow_factors.npz")
+    ffd = flow_factor_differences(factors["fe"], factors["fvm"])
+    gap, spacing, face, origin = macro_geometry(case, outdir)
+    lb = case.lubricant
+    lub = Lubricant(lb.viscosities[0], density=lb.density, roelands_alpha=lb.roelands_alpha,
+                    roelands_p0=lb.roelands_p0, dh_c1=lb.dh_c1, dh_c2=lb.dh_c2)
+    curves, points = {}, {}
+    for method in ("fe", "fvm"):
+        ckpt = outdir / method / "stribeck"
+        curves[method] = stribeck_sweep(
+            gap, spacing, factors[method], case.sweep.speeds, load=case.tribometer.load,
+            lubricant=lub, diameter=case.tribometer.pin_diameter, face=face,
+            settings=MacroSettings(method=method, coupling=case.macro.coupling),
+            checkpoint=ckpt, progress=progress)
+        points[method] = [MixedResult.load(p) for p in sorted(ckpt.glob("point_*.npz"))]
+    dev = friction_deviation(curves["fe"].friction_coefficient,
+                             curves["fvm"].friction_coefficient)
+    fields = [field_differences(a, b) for a, b in zip(points["fe"], points["fvm"])]
+    _write_csv(outdir / "compare_flow_factors.csv", ffd)
+    _write_csv(outdir / "compare_stribeck.csv", {
+        "speed": curves["fe"].speed, "cf_fe": curves["fe"].friction_coefficient,
+        "cf_fvm": curves["fvm"].friction_coefficient, "cf_dev": dev,
+        "pressure_diff": np.array([f["pressure"] for f in fields]),
+        "cavity_fraction_diff": np.array([f["cavity_fraction"] for f in fields])})
+    _plot(outdir / "compare.png", ffd, curves, dev)
+    summary = {"max_flow_factor_diff": {k: float(np.max(v)) for k, v in ffd.items()
+                                        if k != "h0"},
+               "max_abs_cf_dev": float(np.abs(dev).max()),
+               "max_pressure_diff": max(f["pressure"] for f in fields),
+               "max_cavity_fraction_diff": max(f["cavity_fraction"] for f in fields),
+               "viscosity_Pa_s": lub.viscosity,
+               "files": ["compare_flow_factors.csv", "compare_stribeck.csv", "compare.png"]}
+    with atomic_path(outdir / "compare.json") as tmp:
+        tmp.write_text(json.dumps(summary, indent=2))
+    return summary
+
+
+def _write_csv(path, columns: dict):
+    with atomic_path(path) as tmp:
+        with open(tmp, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(list(columns))
+            for row in zip(*columns.values()):
+                w.writerow([f"{v:.10g}" for v in row])
+
+
+def _plot(path, ffd, curves, dev):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 3, figsize=(13, 3.8))
+    for k in ("A", "b", "C", "h_m", "p_con"):
+        ax[0].semilogy(ffd["h0"] * 1e6, np.maximum(ffd[k], 1e-16), label=k)
+    ax[0].set_xlabel("h0 [um]")
+    ax[0].set_ylabel("FE vs FVM relative difference")
+    ax[0].legend()
+    for m, c in curves.items():
+        ax[1].semilogx(c.speed, c.friction_coefficient, "o-", ms=3, label=m.upper())
+    ax[1].set_xlabel("sliding speed U [m/s]")
+    ax[1].set_ylabel("C_f [-]")
+    ax[1].legend()
+    ax[2].semilogx(curves["fe"].speed, 100 * dev, "o-", ms=3)
+    ax[2].set_xlabel("sliding speed U [m/s]")
+    ax[2].set_ylabel("C_f,dev FE vs FVM [%] (eq 35)")
+    for a in ax:
+        a.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)

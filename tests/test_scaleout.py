@@ -1,0 +1,43 @@
+"""Scale-out: a small Stribeck sweep on a Dask LocalCluster equals the serial one."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fem_twin.io.files import read_topography
+from fem_twin.macro import Lubricant
+from fem_twin.micro import homogenise
+from fem_twin.pipeline import run_sweeps
+from fem_twin.topography import resample
+from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
+
+SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "sample"
+
+
+def small_sweep():
+    opts = MacroOptions(resolution=(32, 32))
+    pin = prepare_pin(read_topography(SAMPLE / "pin_2.npz"), opts)
+    disk = prepare_disk(read_topography(SAMPLE / "disk_2.npz"), opts)
+    low = resample(prepare_patch(read_topography(SAMPLE / "patch_2_pin.npz")), (16, 16))
+    up = resample(prepare_patch(read_topography(SAMPLE / "patch_2_disk.npz"), upper=True),
+                  (16, 16))
+    ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 8), n_steps=4)
+    return dict(gap=disk.heights - pin.heights, spacing=pin.spacing, factors=ff,
+                speeds=np.geomspace(1.0, 0.02, 4), load=150.0,
+                face=pin.heights > -0.5e-3)
+
+
+def test_dask_local_cluster_gives_the_serial_numbers(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    common = small_sweep()
+    lubricants = [Lubricant(0.066), Lubricant(0.024)]
+    serial = run_sweeps(common, lubricants, None, progress=False)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        remote = run_sweeps(common, lubricants, client.get_executor(), progress=False)
+    for a, b in zip(serial, remote):
+        assert a.viscosity == b.viscosity
+        assert np.array_equal(a.friction_coefficient, b.friction_coefficient)
+        assert np.array_equal(a.h_d, b.h_d)
