@@ -1,6 +1,7 @@
 """Run the benchmarks and print wall times with ratios to a same-run baseline.
 
-    python benchmarks/run.py [GROUP ...]      # topography contact micro macro (micro-full: ~15 min)
+    python benchmarks/run.py [GROUP ...]      # topography contact micro macro stribeck
+                                              # (micro-full: ~15 min)
 """
 
 from __future__ import annotations
@@ -180,8 +181,57 @@ def bench_macro():
     return base, rows
 
 
+def bench_stribeck():
+    """The bundled case end to end (fresh output folder), and one paper-grade Stribeck curve:
+    25 speeds 2 -> 0.01 m/s at 256^2 with the flow factors given (sample patch 1 at 64^2,
+    30 h0 x 8 steps).  Baseline: the first (cold) point of that curve.  Goal: curve < 600 s.
+    """
+    import json
+    import subprocess
+    import tempfile
+
+    from fem_twin.macro import Lubricant, solve_mixed
+    from fem_twin.micro import homogenise
+    from fem_twin.stribeck import stribeck_sweep
+    from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch
+
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        case = os.path.join(HERE, "..", "examples", "pin_on_disk.toml")
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "fem_twin.cli", "run", case, "-o", tmp,
+                        "--no-progress"], check=True, capture_output=True)
+        wall = time.perf_counter() - t0
+        sec = json.loads(open(os.path.join(tmp, "summary.json")).read())["seconds"]
+    low = tp.resample(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
+                      (64, 64))
+    up = tp.resample(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
+                                   upper=True), (64, 64))
+    ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), n_steps=8)
+    opts = MacroOptions(resolution=(256, 256))
+    pin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
+    disk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
+    gap, face = disk.heights - pin.heights, pin.heights > opts.holder_height / 2
+    t0 = time.perf_counter()
+    solve_mixed(gap, pin.spacing, ff, load=150.0, speed=2.0, face=face,
+                lubricant=Lubricant(0.066))
+    base = time.perf_counter() - t0
+    rows.append(("baseline: cold 256^2 point at 2 m/s", base, ""))
+    rows.append(("bundled case, fem-twin run (2 viscosities)", wall,
+                 ", ".join(f"{k} {v:.0f} s" for k, v in sec.items())))
+    t0 = time.perf_counter()
+    curve = stribeck_sweep(gap, pin.spacing, ff, np.geomspace(2.0, 0.01, 25), load=150.0,
+                           lubricant=Lubricant(0.066), face=face)
+    t = time.perf_counter() - t0
+    rows.append(("paper-grade curve: 25 speeds at 256^2", t,
+                 f"{int(curve.iterations.sum())} iterations, C_f {curve.friction_coefficient[0]:.4f}"
+                 f" -> {curve.friction_coefficient[-1]:.4f}; goal 600 s"))
+    return base, rows
+
+
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
-          "macro": bench_macro, "micro-full": lambda: bench_micro(full=True)}
+          "macro": bench_macro, "stribeck": bench_stribeck,
+          "micro-full": lambda: bench_micro(full=True)}
 
 
 def main(argv):

@@ -71,9 +71,18 @@ def test_cli_reports_bad_input_clearly(tmp_path, capsys):
 def test_case_validation(tmp_path):
     pin = tmp_path / "pin.npz"
     write_topography(pin, Topography(np.zeros((8, 8)), 1e-3 / 8))
-    (tmp_path / "ok.toml").write_text('[geometry]\npins = ["pin.npz"]\n')
+    geo = '[geometry]\npins = ["pin.npz"]\npatches = [["pin.npz", "pin.npz"]]\n'
+    (tmp_path / "ok.toml").write_text(geo)
     assert load_case(tmp_path / "ok.toml").geometry.pins == (pin.resolve(),)
+    paper = load_case(ROOT / "examples" / "paper.toml")
+    assert paper.micro.h0_count == 100 and paper.micro.steps == 32
+    assert paper.sweep.count == 25 and len(paper.geometry.patches) == 6
     bad = {
+        "mpas.toml": (geo + "[lubricant]\nviscosities = [66.0, 24.0]\n", "Pa s"),
+        "section.toml": (geo + "[sweep]\nspeeds = 3\n", "unknown key"),
+        "h0.toml": (geo + "[micro]\nh0_min = 1.0\n", "h0_min"),
+        "pinno.toml": (geo + '[macro]\npin = 4\n', "pin number"),
+        "nopatch.toml": ('[geometry]\npins = ["pin.npz"]\n', "patch pair"),
         "typo.toml": ('[geometry]\npins = ["pin.npz"]\n[preprocessing]\nfwhm = 9\n', "unknown key"),
         "missing.toml": ('[geometry]\npins = ["nope.npz"]\n', "file not found"),
         "units.toml": ('[geometry]\npins = ["pin.npz"]\n[preprocessing]\nclip = 20\n', "metres"),
@@ -195,3 +204,29 @@ def test_compare_fe_against_fvm(tmp_path):
     assert summary["max_abs_cf_dev"] < 0.02                       # the issue's 2 % bar
     rows = list(csv.DictReader(open(out / "compare_stribeck.csv")))
     assert len(rows) == 5 and (out / "compare.png").stat().st_size > 0
+
+
+def test_macro_point_step(tmp_path, capsys):
+    """fem-twin macro point: same operating point as the API, fields in npz and VTU."""
+    from fem_twin.macro import Lubricant, MixedResult, solve_mixed
+    from fem_twin.micro import homogenise
+    src = ROOT / "meshes" / "sample"
+    pin, disk = tmp_path / "pin.npz", tmp_path / "disk.npz"
+    assert main(["topography", "prepare-pin", str(src / "pin_1.npz"), str(pin),
+                 "--resolution", "32", "32"]) == 0
+    assert main(["topography", "prepare-disk", str(src / "disk_1.npz"), str(disk),
+                 "--resolution", "32", "32"]) == 0
+    rng = np.random.default_rng(3)
+    rough = [Topography(rng.normal(size=(16, 16)) * 5e-8, 5e-7) for _ in range(2)]
+    ff = homogenise(*rough, np.geomspace(2e-8, 1e-6, 6), n_steps=2)
+    ff.save(tmp_path / "ff.npz")
+    capsys.readouterr()
+    assert main(["macro", "point", str(pin), str(tmp_path / "ff.npz"), "--disk", str(disk),
+                 "--speed", "0.5", "-o", str(tmp_path / "pt")]) == 0
+    out = json.loads(capsys.readouterr().out)
+    p, d = read_topography(pin), read_topography(disk)
+    api = solve_mixed(d.heights - p.heights, p.spacing, ff, load=150.0, speed=0.5,
+                      lubricant=Lubricant(0.066), face=p.heights > -0.5e-3)
+    assert out["friction_coefficient"] == api.friction_coefficient
+    assert MixedResult.load(tmp_path / "pt" / "point.npz").h_d == api.h_d
+    assert (tmp_path / "pt" / "point.vtu").stat().st_size > 0
