@@ -75,6 +75,18 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("--no-progress", action="store_true", help="no progress bars")
     cp.set_defaults(func=_compare)
 
+    cb = sub.add_parser("calibrate", help="calibration study of a case (paper 3.2): C_f,dev "
+                                          "of variants against a reference curve")
+    cb.add_argument("case", nargs="?", type=Path, default=DEFAULT_CASE)
+    cb.add_argument("--study", required=True,
+                    choices=("filter", "resolution", "disk", "pins", "patches"))
+    cb.add_argument("--values", type=float, nargs="+",
+                    help="filter FWHMs [px] or resolutions [px] (defaults: 0 3 5 7 9 11; "
+                         "64 128 256)")
+    cb.add_argument("-o", "--output", type=Path, default=Path("calibration"))
+    cb.add_argument("--no-progress", action="store_true", help="no progress bars")
+    cb.set_defaults(func=_calibrate)
+
     t = sub.add_parser("topography", help="read and pre-process measured topographies")
     steps = t.add_subparsers(dest="step", required=True, metavar="STEP")
     for name, text in _STEPS.items():
@@ -360,6 +372,15 @@ def _run(args):
     summary = run(case, args.output, progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
     print(f"results in {args.output}/")
+    return 0
+
+
+def _calibrate(args):
+    from .calibration import calibrate
+    from .case import load_case
+    summary = calibrate(load_case(args.case), args.study, args.output, values=args.values,
+                        progress=not args.no_progress)
+    print(json.dumps(summary, indent=2))
     return 0
 
 

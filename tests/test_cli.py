@@ -230,3 +230,20 @@ def test_macro_point_step(tmp_path, capsys):
     assert out["friction_coefficient"] == api.friction_coefficient
     assert MixedResult.load(tmp_path / "pt" / "point.npz").h_d == api.h_d
     assert (tmp_path / "pt" / "point.vtu").stat().st_size > 0
+
+
+def test_calibration_studies(tmp_path):
+    """Flat disk against measured disks, and single patches against the average (paper 3.2):
+    the reference has zero deviation, the variants differ from it and stay bounded."""
+    case = small_case(tmp_path)
+    for study in ("disk", "patches"):
+        out = tmp_path / study
+        assert main(["calibrate", str(case), "--study", study, "-o", str(out),
+                     "--no-progress"]) == 0
+        summary = json.loads((out / "calibration.json").read_text())
+        ref = summary["variants"].pop(summary["reference"])
+        assert ref["max_abs_cf_dev"] == 0
+        devs = [v["max_abs_cf_dev"] for v in summary["variants"].values()]
+        assert all(0 < d < 1 for d in devs), devs
+        assert (out / "cf_dev.png").stat().st_size > 0
+    assert len(summary["variants"]) == 2                       # two patches in the small case

@@ -1,0 +1,127 @@
+"""Calibration studies (paper 3.2, Figures 9-13): how the Stribeck curve depends on choices.
+
+Each study runs variants of a case and reports C_f,dev (eq 35) of every variant against a
+reference curve, at the case's first viscosity:
+
+``filter``      Gaussian FWHM of the macro geometry [px] (0: unfiltered); reference 11 px
+``resolution``  macro grid size [px]; reference: the largest
+``disk``        measured disks against a flat disk; reference: measured
+``pins``        every single levelled pin against the set average; reference: average
+``patches``     flow factors of every single patch against the patch average; reference:
+                the average
+
+The micro scale is computed once (it does not depend on the macro choices) and shared by
+the variants; every variant keeps its own checkpoints, so an interrupted study resumes.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from .case import Case
+from .io.atomic import atomic_path
+from .macro import Lubricant, MacroSettings
+from .micro import FlowFactors
+from .stribeck import friction_deviation, plot_stribeck, stribeck_sweep, write_stribeck_csv
+
+STUDIES = ("filter", "resolution", "disk", "pins", "patches")
+
+
+def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
+    """``{label: (case, patch index or None)}`` of a study and the reference label."""
+    g = case.macro_geometry
+    if study == "filter":
+        values = values or [0, 3, 5, 7, 9, 11]
+        out = {f"fwhm {v:g} px": (replace(case, macro_geometry=replace(g, fwhm_px=float(v))),
+                                  None) for v in values}
+        ref = max(values, key=lambda v: (v == 11, v))
+        return out, f"fwhm {ref:g} px"
+    if study == "resolution":
+        values = values or [64, 128, 256]
+        out = {f"{int(v)} px": (replace(case, macro_geometry=replace(
+            g, resolution=(int(v), int(v)))), None) for v in values}
+        return out, f"{int(max(values))} px"
+    if study == "disk":
+        if not case.geometry.disks:
+            raise ValueError("the disk study needs measured disks in [geometry] disks")
+        flat = replace(case, geometry=replace(case.geometry, disks=()))
+        return {"measured disk": (case, None), "flat disk": (flat, None)}, "measured disk"
+    if study == "pins":
+        out = {"set average": (replace(case, macro=replace(case.macro, pin="average")), None)}
+        for k in range(1, len(case.geometry.pins) + 1):
+            out[f"pin {k}"] = (replace(case, macro=replace(case.macro, pin=k)), None)
+        return out, "set average"
+    if study == "patches":
+        out = {"patch average": (case, None)}
+        for k in range(1, len(case.geometry.patches) + 1):
+            out[f"patch {k}"] = (case, k)
+        return out, "patch average"
+    raise ValueError(f"unknown study {study!r}; choose one of {STUDIES}")
+
+
+def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = True) -> dict:
+    """Run a study into ``outdir``; write ``calibration.json``, ``stribeck.csv`` (all
+    variants) and plots of C_f and C_f,dev versus speed.  Returns the summary."""
+    from .pipeline import (executor_for, homogenise_patches, level_pins, macro_geometry,
+                           reconstruct_geometry)
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    cases, ref_label = variants(case, study, values)
+    shared = outdir / "micro"
+    reconstruct_geometry(case, outdir / "geometry", progress)
+    with executor_for(case) as executor:
+        homogenise_patches(case, shared, executor, progress)
+    lb = case.lubricant
+    lub = Lubricant(lb.viscosities[0], density=lb.density, roelands_alpha=lb.roelands_alpha,
+                    roelands_p0=lb.roelands_p0, dh_c1=lb.dh_c1, dh_c2=lb.dh_c2)
+    curves = {}
+    for i, (label, (variant, patch)) in enumerate(cases.items()):
+        folder = outdir / f"variant_{i + 1}"
+        reconstruct_geometry(variant, folder / "geometry", progress)
+        level_pins(variant, folder, progress)
+        factors = FlowFactors.load(shared / (f"patch_{patch}/flow_factors.npz" if patch
+                                             else "flow_factors.npz"))
+        gap, spacing, face, _ = macro_geometry(variant, folder)
+        curves[label] = stribeck_sweep(
+            gap, spacing, factors, variant.sweep.speeds, load=variant.tribometer.load,
+            lubricant=lub, diameter=variant.tribometer.pin_diameter, face=face,
+            settings=MacroSettings(method=variant.macro.method,
+                                   coupling=variant.macro.coupling),
+            checkpoint=folder / "stribeck", progress=progress)
+    ref = curves[ref_label]
+    dev = {k: friction_deviation(c.friction_coefficient, ref.friction_coefficient)
+           for k, c in curves.items()}
+    labels = list(curves)
+    write_stribeck_csv(outdir / "stribeck.csv", curves.values())
+    plot_stribeck(list(curves.values()), outdir / "stribeck_speed.png", labels=labels)
+    _plot_deviation(outdir / "cf_dev.png", ref.speed, dev, ref_label, study)
+    summary = {"study": study, "reference": ref_label, "viscosity_Pa_s": lub.viscosity,
+               "variants": {k: {"folder": f"variant_{i + 1}",
+                                "max_abs_cf_dev": float(np.abs(dev[k]).max())}
+                            for i, k in enumerate(labels)},
+               "files": ["stribeck.csv", "stribeck_speed.png", "cf_dev.png"]}
+    with atomic_path(outdir / "calibration.json") as tmp:
+        tmp.write_text(json.dumps(summary, indent=2))
+    return summary
+
+
+def _plot_deviation(path, speed, dev, ref_label, study):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for label, d in dev.items():
+        ax.semilogx(speed, 100 * d, "o-", ms=3, label=label)
+    ax.set_xlabel("sliding speed U [m/s]")
+    ax.set_ylabel(f"C_f,dev vs {ref_label} [%] (eq 35)")
+    ax.set_title(f"calibration study: {study}")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
