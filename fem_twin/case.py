@@ -114,6 +114,7 @@ class Case:
     macro: MacroSpec = field(default_factory=MacroSpec)
     sweep: SweepSpec = field(default_factory=SweepSpec)
     run: RunSpec = field(default_factory=RunSpec)
+    measured: tuple[Path | None, ...] = ()   # [validation] measured curves per viscosity
     source: Path | None = None
 
 
@@ -133,7 +134,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     """Validate a case given as a dict (as read from TOML)."""
     where = str(source or "case")
     _only(data, {"name", "geometry", "preprocessing", "tribometer", "lubricant", "materials",
-                 "micro", "macro", "sweep", "run"}, where)
+                 "micro", "macro", "sweep", "run", "validation"}, where)
     if "geometry" not in data:
         raise CaseError(f"{where}: missing [geometry] section")
     g = data["geometry"]
@@ -201,10 +202,21 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     run = _section(data, "run", RunSpec, where)
     if not geometry.patches:
         raise CaseError(f"{where} [geometry]: at least one roughness patch pair is required")
+    val = data.get("validation", {})
+    _only(val, {"measured"}, f"{where} [validation]")
+    measured = val.get("measured", [])
+    if (not isinstance(measured, list) or len(measured) > len(lubricant.viscosities)
+            or not all(isinstance(m, str) for m in measured)):
+        raise CaseError(f"{where} [validation] measured: a list of CSV files, one per viscosity "
+                        "(\"\" for none)")
+    measured = tuple((base / m).resolve() if m else None for m in measured)
+    for m in measured:
+        if m is not None and not m.is_file():
+            raise CaseError(f"{where} [validation] measured: file not found: {m}")
     return Case(name=str(data.get("name", source.stem if source else "case")),
                 geometry=geometry, macro_geometry=MacroOptions(**opts), tribometer=tribometer,
                 lubricant=lubricant, materials=materials, micro=micro, macro=macro,
-                sweep=sweep, run=run, source=source)
+                sweep=sweep, run=run, measured=measured, source=source)
 
 
 def _section(data, name, cls, where, positive=False):

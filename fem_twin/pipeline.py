@@ -28,8 +28,8 @@ from .io.mesh import grid_mesh, write_vtu
 from .macro import Lubricant, MacroSettings
 from .micro import FlowFactors, average, homogenise
 from .micro.output import plot_flow_factors
-from .stribeck import (friction_deviation, plot_stribeck, stribeck_sweep,
-                       write_stribeck_csv)
+from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
+                       read_measured_csv, stribeck_sweep, write_stribeck_csv)
 from .topography import resample
 from .topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
 
@@ -44,6 +44,7 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
     summary = {"case": case.name, "stages": {}, "seconds": {}}
     with _logfile(outdir / "run.log"), executor_for(case) as executor:
         log.info("case %s -> %s", case.source, outdir)
+        invalidate_changed_stages(case, outdir)
         stages = (("geometry", lambda: reconstruct_geometry(case, outdir / "geometry", progress)),
                   ("levelling", lambda: level_pins(case, outdir, progress)),
                   ("micro", lambda: homogenise_patches(case, outdir / "micro", executor,
@@ -59,6 +60,41 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
     with atomic_path(outdir / "summary.json") as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     return summary
+
+
+def stage_keys(case: Case) -> dict:
+    """Hash of the case settings each cached stage depends on."""
+    import hashlib
+
+    def key(*parts):
+        return hashlib.sha256(repr(parts).encode()).hexdigest()[:16]
+
+    g = case.geometry
+    files = [(str(p), p.stat().st_mtime_ns, p.stat().st_size)
+             for p in (*g.pins, *g.disks, *(q for pair in g.patches for q in pair))]
+    geometry = key(files, g, case.macro_geometry)
+    return {"geometry": geometry,
+            "levelling": key(geometry, case.materials, case.macro.pin),
+            "micro": key(geometry, case.micro, case.materials)}
+
+
+def invalidate_changed_stages(case: Case, outdir: Path) -> None:
+    """Remove cached stage results whose inputs changed since they were written (the
+    Stribeck points and micro checkpoints are keyed by their inputs already)."""
+    import shutil
+    path = outdir / "stage_keys.json"
+    old = json.loads(path.read_text()) if path.exists() else {}
+    new = stage_keys(case)
+    for stage, key in new.items():
+        if old.get(stage) not in (None, key):
+            log.info("inputs of stage %s changed: recomputing it", stage)
+            if stage == "micro":
+                for f in (outdir / "micro").glob("patch_*/flow_factors.npz"):
+                    f.unlink()
+            else:
+                shutil.rmtree(outdir / stage, ignore_errors=True)
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(new, indent=2))
 
 
 @contextmanager
@@ -259,7 +295,30 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                      "fields/"]}
     if len(curves) > 1:
         out["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves)
+    if any(case.measured):
+        out["validation"] = validate(case, curves, outdir, labels)
     return out
+
+
+def validate(case: Case, curves, outdir: Path, labels) -> list:
+    """C_f,dev (eq 35) of each simulated curve against its measured CSV (paper 3.3)."""
+    rows, result = [], []
+    for curve, path, label in zip(curves, case.measured, labels):
+        if path is None:
+            continue
+        measured = read_measured_csv(path)
+        dev = deviation_from_measured(curve, measured)
+        rows += [(curve.viscosity, u, cf, d) for u, cf, d in
+                 zip(measured.speed, measured.friction_coefficient, dev)]
+        band = None if measured.low is None else (measured.low, measured.high)
+        plot_stribeck([curve], outdir / f"validation_mu{curve.viscosity:g}.png", labels=[label],
+                      reference=(measured.speed, measured.friction_coefficient, band))
+        result.append({"viscosity_Pa_s": curve.viscosity, "measured": str(path),
+                       "max_abs_cf_dev": float(np.nanmax(np.abs(dev)))})
+    with atomic_path(outdir / "validation.csv") as tmp:
+        tmp.write_text("viscosity,speed,measured_cf,cf_dev\n" + "".join(
+            f"{a:.10g},{b:.10g},{c:.10g},{d:.10g}\n" for a, b, c, d in rows))
+    return result
 
 
 def run_sweeps(common: dict, lubricants, executor=None, progress: bool = True):

@@ -137,6 +137,19 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     summary = json.loads((ref / "summary.json").read_text())
     assert summary["stages"]["levelling"]["macro_pin"] == "pin_average.npz"
 
+    # validation (paper 3.3): a "measured" curve 1 % of C_f,b above the simulated one
+    r66 = [x for x in rows if float(x["viscosity"]) == 0.066]
+    measured = tmp_path / "measured_24C.csv"
+    measured.write_text("speed,friction_coefficient,cf_min,cf_max\n" + "".join(
+        f"{x['speed']},{float(x['friction_coefficient']) + 0.01 / (3 * 3 ** 0.5)!r},0,1\n"
+        for x in r66))
+    with_val = tmp_path / "case_val.toml"
+    with_val.write_text(case.read_text() + f'\n[validation]\nmeasured = ["{measured}"]\n')
+    assert main(["run", str(with_val), "-o", str(ref), "--no-progress"]) == 0
+    val = list(csv.DictReader(open(ref / "validation.csv")))
+    assert len(val) == 5 and all(abs(float(v["cf_dev"]) + 0.01) < 1e-8 for v in val)
+    assert (ref / "validation_mu0.066.png").is_file()
+
     calls = {"n": 0}
     real = sweep.solve_mixed
 
@@ -158,6 +171,13 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     assert len(stamps) == 10
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0   # all cached
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps
+    # a changed setting invalidates the stages that depend on it, and only those
+    pin_stamp = (out / "geometry" / "pin_1.npz").stat().st_mtime_ns
+    ff_stamp = (out / "micro" / "patch_1" / "flow_factors.npz").stat().st_mtime_ns
+    case.write_text(case.read_text().replace("steps = 4", "steps = 2"))
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    assert (out / "geometry" / "pin_1.npz").stat().st_mtime_ns == pin_stamp
+    assert (out / "micro" / "patch_1" / "flow_factors.npz").stat().st_mtime_ns != ff_stamp
 
 
 def test_homogenise_run_average_and_fields(tmp_path, capsys):

@@ -1,8 +1,9 @@
 """Stribeck curves: speed sweeps of the macro solver, Hersey number, deviations (eqs 35, 46)."""
 
-from .curve import (StribeckCurve, friction_deviation, hersey_number, plot_stribeck,
+from .curve import (MeasuredCurve, StribeckCurve, deviation_from_measured,
+                    friction_deviation, hersey_number, plot_stribeck, read_measured_csv,
                     read_stribeck_csv, write_stribeck_csv)
 from .sweep import stribeck_sweep
 
-__all__ = ["StribeckCurve", "friction_deviation", "hersey_number", "plot_stribeck",
+__all__ = ["MeasuredCurve", "deviation_from_measured", "read_measured_csv", "StribeckCurve", "friction_deviation", "hersey_number", "plot_stribeck",
            "read_stribeck_csv", "write_stribeck_csv", "stribeck_sweep"]

@@ -119,3 +119,52 @@ def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None
         fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=120)
     plt.close(fig)
     return path
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredCurve:
+    """A measured Stribeck curve: speed [m/s], C_f, optional scatter band (low, high)."""
+
+    speed: np.ndarray
+    friction_coefficient: np.ndarray
+    low: np.ndarray | None = None
+    high: np.ndarray | None = None
+
+
+def read_measured_csv(path) -> MeasuredCurve:
+    """CSV with a header: ``speed`` [m/s] and ``friction_coefficient`` (or ``cf``), and
+    optionally ``cf_min``/``cf_max`` (the scatter band of a test set)."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        raise ValueError(f"{path}: empty measured curve")
+    cols = set(rows[0])
+    cf_key = "friction_coefficient" if "friction_coefficient" in cols else "cf"
+    if "speed" not in cols or cf_key not in cols:
+        raise ValueError(f"{path}: needs columns 'speed' [m/s] and 'friction_coefficient' "
+                         f"(found {sorted(cols)})")
+
+    def col(k):
+        try:
+            return np.array([float(r[k]) for r in rows])
+        except ValueError as err:
+            raise ValueError(f"{path}: column {k!r} is not numeric: {err}") from err
+
+    speed = col("speed")
+    if np.any(~(speed > 0)) or speed.max() > 100:
+        raise ValueError(f"{path}: speeds must be positive and in m/s (max {speed.max()})")
+    band = ("cf_min" in cols and "cf_max" in cols)
+    return MeasuredCurve(speed, col(cf_key), col("cf_min") if band else None,
+                         col("cf_max") if band else None)
+
+
+def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve):
+    """C_f,dev (eq 35) of the simulated curve against the measured one, at the measured
+    speeds inside the simulated range (PCHIP in log speed); NaN outside it."""
+    from scipy.interpolate import PchipInterpolator
+    order = np.argsort(curve.speed)
+    x = np.log(curve.speed[order])
+    u = np.log(measured.speed)
+    inside = (u >= x[0]) & (u <= x[-1])
+    sim = PchipInterpolator(x, curve.friction_coefficient[order])(np.clip(u, x[0], x[-1]))
+    return np.where(inside, friction_deviation(sim, measured.friction_coefficient), np.nan)
