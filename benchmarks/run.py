@@ -178,6 +178,14 @@ def bench_macro():
                              f"{r.iterations} it, {newton} Newton steps, C_f {r.friction_coefficient:.5f}"))
             rows.append(("  FE / FVM time; |C_f,dev|", rows[-1][1] / rows[-2][1],
                          f"{abs(cf['fe'] - cf['fvm']) / 0.19245:.2e}"))
+            t0 = time.perf_counter()
+            r = solve_mixed(gap, pin.spacing, ff, load=150.0, speed=speed, face=face,
+                            lubricant=Lubricant(0.066),
+                            settings=MacroSettings(method="fvm", complementarity="fb"))
+            rows.append((f"FVM + FBNS (paper's inner solver) {n}^2, U = {speed}",
+                         time.perf_counter() - t0,
+                         f"{r.iterations} it, {int(r.history[:, 6].sum())} Newton steps, "
+                         f"C_f {r.friction_coefficient:.5f}"))
     return base, rows
 
 

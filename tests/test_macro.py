@@ -198,3 +198,14 @@ def test_roelands_and_dowson_higginson():
     assert slope == pytest.approx(22e-9, rel=1e-4)
     assert lub.density_ratio(0.0) == 1.0
     assert lub.density_ratio(1e12) == pytest.approx(1.34, rel=1e-3)
+
+
+def test_fbns_coupled_point_matches_the_switch(case32, factors):
+    """FVM twin with the paper's FBNS inner solver: same converged operating point."""
+    gap, spacing, face = case32
+    kw = dict(load=150.0, speed=0.1, lubricant=Lubricant(0.066), face=face)
+    a = solve_mixed(gap, spacing, factors, **kw, settings=MacroSettings(method="fvm"))
+    f = solve_mixed(gap, spacing, factors, **kw,
+                    settings=MacroSettings(method="fvm", complementarity="fb"))
+    assert f.friction_coefficient == pytest.approx(a.friction_coefficient, rel=1e-5)
+    assert f.h_d == pytest.approx(a.h_d, rel=1e-5)

@@ -47,7 +47,7 @@ from ..io.atomic import atomic_path
 from ..micro.flow_factors import FlowFactors
 from .friction import BOUNDARY_FRICTION, boundary_shear, hydrodynamic_shear
 from .lubricant import Lubricant
-from .reynolds import (ReynoldsNotConverged, fe_poiseuille, solve_complementarity,
+from .reynolds import (ReynoldsNotConverged, complementarity_solver, fe_poiseuille,
                        upwind_couette)
 
 
@@ -73,6 +73,7 @@ class MacroSettings:
     boundary_friction: float = BOUNDARY_FRICTION
     method: str = "fe"                       # Poiseuille term: "fe" or "fvm"
     coupling: str = "anderson"               # or "pid" (the paper's)
+    complementarity: str = "switch"          # or "fb" (the paper's FBNS; slower)
     relaxation_pcon: float = 0.05            # alpha_pcon of eq 26 ("pid")
     relaxation_elastic: float = 0.1          # under-relaxation of h_el ("pid")
     gains: tuple = (1.2e-2, 2.4e-2, 1.5e-3)  # K_P, K_I, K_D of eq 29 ("pid")
@@ -90,6 +91,9 @@ class MacroSettings:
             raise ValueError(f"coupling must be 'anderson' or 'pid', got {self.coupling!r}")
         if self.ambient_pressure < self.cavitation_pressure:
             raise ValueError("ambient pressure must not be below the cavitation pressure [Pa]")
+        if self.complementarity not in ("switch", "fb"):
+            raise ValueError(f"complementarity must be 'switch' or 'fb', got "
+                             f"{self.complementarity!r}")
         if not 0 < self.relaxation_pcon <= 1:
             raise ValueError("relaxation_pcon must be in (0, 1]")
 
@@ -226,6 +230,7 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
                               speed=speed, lubricant=lubricant, face=face[::2, ::2],
                               settings=coarse)
     state = {"phi": None, "p": np.full(h_g.shape, p_amb_rel), "newton": 0}
+    solver = complementarity_solver(s.complementarity)
     if initial is not None:
         initial = _on_grid(initial, h_g.shape, dx)
         state["p"] = initial.pressure - s.cavitation_pressure
@@ -244,7 +249,7 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
         q = rho * loc.h_m * u_m
         K = poiseuille(g, loc.A)
         B = upwind_couette(q * loc.b[..., 0], q * loc.b[..., 1], dx)
-        phi, its, _ = solve_complementarity(K, B, boundary, p_amb_rel, scale, phi0=state["phi"])
+        phi, its, _ = solver(K, B, boundary, p_amb_rel, scale, phi0=state["phi"])
         state["phi"], state["newton"] = phi, its
         p = np.maximum(phi, 0).reshape(h_g.shape)
         theta = (np.maximum(-phi, 0) / scale).reshape(h_g.shape)

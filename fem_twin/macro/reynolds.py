@@ -74,7 +74,7 @@ def homogenised_poiseuille_form(u, v, w):
 
 def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 0.0,
                    cavitation_pressure: float = 0.0, method: str = "fe", tol: float = 1e-10,
-                   max_iter: int = 200) -> ReynoldsResult:
+                   max_iter: int = 200, complementarity: str = "switch") -> ReynoldsResult:
     """Smooth rigid-gap Reynolds with JFO cavitation, one surface sliding at ``speed``.
 
     Parameters
@@ -85,6 +85,8 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     viscosity : mu [Pa s]
     ambient_pressure, cavitation_pressure : p_amb on the four edges and p_cav [Pa]
     method : ``"fe"`` (Q1 Poiseuille) or ``"fvm"`` (5-point Poiseuille)
+    complementarity : ``"switch"`` (p-theta semismooth Newton) or ``"fb"`` (the paper's
+        Fischer-Burmeister-Newton-Schur, :mod:`fem_twin.fvm.fbns`; slower, same solution)
     """
     h = np.asarray(gap, dtype=float)
     if h.ndim != 2 or min(h.shape) < 3:
@@ -109,7 +111,7 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     boundary = np.zeros(h.shape, bool)
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
     scale = 12 * viscosity * max(abs(speed), 1e-30) / 2 * float(np.mean(dx)) / np.mean(h) ** 2
-    phi, its, history = solve_complementarity(K, B, boundary,
+    phi, its, history = complementarity_solver(complementarity)(K, B, boundary,
                                               ambient_pressure - cavitation_pressure, scale,
                                               tol=tol, max_iter=max_iter)
     p = np.maximum(phi, 0).reshape(h.shape)
@@ -170,6 +172,16 @@ def upwind_couette(q1, q2, spacing) -> sp.csr_matrix:
     n = ny * nx
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                          shape=(n, n))
+
+
+def complementarity_solver(name: str):
+    """``"switch"`` -> :func:`solve_complementarity`, ``"fb"`` -> the FBNS solver."""
+    if name == "switch":
+        return solve_complementarity
+    if name == "fb":
+        from ..fvm.fbns import solve_complementarity_fb
+        return solve_complementarity_fb
+    raise ValueError(f"complementarity must be 'switch' or 'fb', got {name!r}")
 
 
 def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=1e-10,
