@@ -280,7 +280,7 @@ def _homogenise_run(args):
 
     from .io.files import read_topography
     from .micro import homogenise
-    from .micro.output import plot_flow_factors, write_cell_fields
+    from .micro.output import write_cell_fields
     pin, disk = read_topography(args.pin), read_topography(args.disk)
     lo, hi, n = args.h0
     if int(n) != n or n < 1:
