@@ -24,7 +24,6 @@ import numpy as np
 
 from .case import Case
 from .io.atomic import atomic_path
-from .macro import Lubricant, MacroSettings
 from .micro import FlowFactors
 from .stribeck import friction_deviation, plot_stribeck, stribeck_sweep, write_stribeck_csv
 
@@ -67,7 +66,7 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     """Run a study into ``outdir``; write ``calibration.json``, ``stribeck.csv`` (all
     variants) and plots of C_f and C_f,dev versus speed.  Returns the summary."""
     from .pipeline import (executor_for, homogenise_patches, level_pins, macro_geometry,
-                           reconstruct_geometry)
+                           macro_settings, reconstruct_geometry)
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     cases, ref_label = variants(case, study, values)
@@ -75,9 +74,7 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     reconstruct_geometry(case, outdir / "geometry", progress)
     with executor_for(case) as executor:
         homogenise_patches(case, shared, executor, progress)
-    lb = case.lubricant
-    lub = Lubricant(lb.viscosities[0], density=lb.density, roelands_alpha=lb.roelands_alpha,
-                    roelands_p0=lb.roelands_p0, dh_c1=lb.dh_c1, dh_c2=lb.dh_c2)
+    lub = case.lubricant.lubricants()[0]
     curves = {}
     for i, (label, (variant, patch)) in enumerate(cases.items()):
         folder = outdir / f"variant_{i + 1}"
@@ -89,8 +86,7 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
         curves[label] = stribeck_sweep(
             gap, spacing, factors, variant.sweep.speeds, load=variant.tribometer.load,
             lubricant=lub, diameter=variant.tribometer.pin_diameter, face=face,
-            settings=MacroSettings(method=variant.macro.method,
-                                   coupling=variant.macro.coupling),
+            settings=macro_settings(variant),
             checkpoint=folder / "stribeck", progress=progress)
     ref = curves[ref_label]
     dev = {k: friction_deviation(c.friction_coefficient, ref.friction_coefficient)

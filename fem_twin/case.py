@@ -45,6 +45,13 @@ class LubricantSpec:
     dh_c1: float = 5.9e8
     dh_c2: float = 1.34
 
+    def lubricants(self) -> list:
+        """One :class:`fem_twin.macro.Lubricant` per viscosity."""
+        from .macro.lubricant import Lubricant
+        return [Lubricant(mu, density=self.density, roelands_alpha=self.roelands_alpha,
+                          roelands_p0=self.roelands_p0, dh_c1=self.dh_c1, dh_c2=self.dh_c2)
+                for mu in self.viscosities]
+
 
 @dataclass(frozen=True)
 class Materials:
@@ -55,6 +62,12 @@ class Materials:
     e_disk: float = 210e9
     nu_disk: float = 0.3
     hardness: float = 6.99e9
+
+    @property
+    def e_reduced(self) -> float:
+        """E' of eq 22 [Pa]."""
+        from .contact.elastic import reduced_modulus
+        return reduced_modulus(self.e_pin, self.nu_pin, self.e_disk, self.nu_disk)
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ import numpy as np
 
 from .case import Case
 from .io.atomic import atomic_path
-from .macro import Lubricant, MacroSettings, MixedResult
+from .macro import MixedResult
 from .micro import FlowFactors
 from .stribeck import friction_deviation, stribeck_sweep
 
@@ -50,7 +50,7 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     """Run the case's micro and macro stages with both methods; write ``compare.json``,
     ``compare_flow_factors.csv``, ``compare_stribeck.csv`` and ``compare.png``."""
     from .pipeline import (executor_for, homogenise_patches, level_pins, macro_geometry,
-                           reconstruct_geometry)
+                           macro_settings, reconstruct_geometry)
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     reconstruct_geometry(case, outdir / "geometry", progress)
@@ -69,16 +69,14 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
             factors[method] = FlowFactors.load(sub / "micro" / "flow_factors.npz")
     ffd = flow_factor_differences(factors["fe"], factors["fvm"])
     gap, spacing, face, origin = macro_geometry(case, outdir)
-    lb = case.lubricant
-    lub = Lubricant(lb.viscosities[0], density=lb.density, roelands_alpha=lb.roelands_alpha,
-                    roelands_p0=lb.roelands_p0, dh_c1=lb.dh_c1, dh_c2=lb.dh_c2)
+    lub = case.lubricant.lubricants()[0]
     curves, points = {}, {}
     for method in ("fe", "fvm"):
         ckpt = outdir / method / "stribeck"
         curves[method] = stribeck_sweep(
             gap, spacing, factors[method], case.sweep.speeds, load=case.tribometer.load,
             lubricant=lub, diameter=case.tribometer.pin_diameter, face=face,
-            settings=MacroSettings(method=method, coupling=case.macro.coupling),
+            settings=macro_settings(case, method),
             checkpoint=ckpt, progress=progress)
         points[method] = [MixedResult.load(p) for p in sorted(ckpt.glob("point_*.npz"))]
     dev = friction_deviation(curves["fe"].friction_coefficient,

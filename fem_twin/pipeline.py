@@ -20,12 +20,11 @@ import numpy as np
 from tqdm import tqdm
 
 from .case import Case
-from .contact.elastic import reduced_modulus
 from .contact.levelling import average_pins, level_pin
 from .io.atomic import atomic_path
 from .io.files import read_topography, write_topography
 from .io.mesh import grid_mesh, write_vtu
-from .macro import Lubricant, MacroSettings
+from .macro import MacroSettings
 from .micro import FlowFactors, average, homogenise
 from .micro.output import plot_flow_factors
 from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
@@ -186,7 +185,7 @@ def level_pins(case: Case, outdir: Path, progress: bool = True) -> dict:
     folder.mkdir(parents=True, exist_ok=True)
     geo = outdir / "geometry"
     m = case.materials
-    e_red = reduced_modulus(m.e_pin, m.nu_pin, m.e_disk, m.nu_disk)
+    e_red = m.e_reduced
     holder = case.macro_geometry.holder_height
     result = {"pins": []}
     levelled = []
@@ -222,7 +221,7 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
     geo = folder.parent / "geometry"
     mc, m = case.micro, case.materials
     h0 = np.geomspace(mc.h0_min, mc.h0_max, mc.h0_count)
-    e_red = reduced_modulus(m.e_pin, m.nu_pin, m.e_disk, m.nu_disk)
+    e_red = m.e_reduced
     factors = []
     for i in range(len(case.geometry.patches)):
         out = folder / f"patch_{i + 1}" / "flow_factors.npz"
@@ -267,22 +266,23 @@ def _sweep_task(args):
     return stribeck_sweep(lubricant=lub, **kwargs)
 
 
+def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
+    """The macro solver settings of a case (``method`` overrides ``[macro] method``)."""
+    return MacroSettings(e_reduced=case.materials.e_reduced,
+                         method=method or case.macro.method, coupling=case.macro.coupling)
+
+
 def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = True) -> dict:
     """One Stribeck sweep per viscosity (in parallel on ``executor``); CSV, plots, fields."""
     gap, spacing, face, origin = macro_geometry(case, outdir)
     factors = FlowFactors.load(outdir / "micro" / "flow_factors.npz")
     lb, tr = case.lubricant, case.tribometer
-    m = case.materials
-    settings = MacroSettings(e_reduced=reduced_modulus(m.e_pin, m.nu_pin, m.e_disk, m.nu_disk),
-                             method=case.macro.method, coupling=case.macro.coupling)
-    lubricants = [Lubricant(mu, density=lb.density, roelands_alpha=lb.roelands_alpha,
-                            roelands_p0=lb.roelands_p0, dh_c1=lb.dh_c1, dh_c2=lb.dh_c2)
-                  for mu in lb.viscosities]
     common = dict(gap=gap, spacing=spacing, factors=factors, speeds=case.sweep.speeds,
-                  load=tr.load, diameter=tr.pin_diameter, face=face, settings=settings,
+                  load=tr.load, diameter=tr.pin_diameter, face=face,
+                  settings=macro_settings(case),
                   checkpoint=outdir / "stribeck" / "checkpoints", fields=outdir / "fields",
                   origin=origin)
-    curves = run_sweeps(common, lubricants, executor, progress)
+    curves = run_sweeps(common, lb.lubricants(), executor, progress)
     write_stribeck_csv(outdir / "stribeck.csv", curves)
     labels = [f"{t:g} C, mu_0 = {c.viscosity:g} Pa s" for t, c in zip(lb.temperatures, curves)]
     plot_stribeck(curves, outdir / "stribeck_speed.png", x="speed", labels=labels)

@@ -48,7 +48,7 @@ from ..micro.flow_factors import FlowFactors
 from .friction import BOUNDARY_FRICTION, boundary_shear, hydrodynamic_shear
 from .lubricant import Lubricant
 from .reynolds import (ReynoldsNotConverged, complementarity_solver, fe_poiseuille,
-                       upwind_couette)
+                       trapezoid_weights, upwind_couette)
 
 
 #: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
@@ -212,7 +212,7 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
     op = elastic_operator(h_g.shape, dx, s.e_reduced)
     boundary = np.zeros(h_g.shape, bool)
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
-    area = _trapezoid_weights(h_g.shape, dx)
+    area = trapezoid_weights(h_g.shape, dx)
     u_m = speed / 2
     p_amb_rel = s.ambient_pressure - s.cavitation_pressure
     scale = s.p_ref                                     # theta = -phi / scale in cavities
@@ -386,14 +386,6 @@ def _on_grid(result: MixedResult, shape, dx) -> MixedResult:
     return replace(result, spacing=tuple(dx), **{k: interp(getattr(result, k))
                                                  for k in _FIELDS if k != "face"},
                    face=interp(result.face) > 0.5)
-
-
-def _trapezoid_weights(shape, dx):
-    w1 = np.full(shape[1], dx[0])
-    w1[[0, -1]] /= 2
-    w2 = np.full(shape[0], dx[1])
-    w2[[0, -1]] /= 2
-    return w2[:, None] * w1[None, :]
 
 
 def _dry_separation(factors, h_g, area, load, s):

@@ -117,12 +117,17 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     p = np.maximum(phi, 0).reshape(h.shape)
     theta = (np.maximum(-phi, 0) / scale).reshape(h.shape)
     p_hd = p + cavitation_pressure
-    w1 = np.full(h.shape[1], dx[0])
-    w1[[0, -1]] /= 2
-    w2 = np.full(h.shape[0], dx[1])
-    w2[[0, -1]] /= 2
-    load = float(w2 @ (p_hd - ambient_pressure) @ w1)
+    load = float(np.sum(trapezoid_weights(h.shape, dx) * (p_hd - ambient_pressure)))
     return ReynoldsResult(p_hd, theta, load, its, tuple(history))
+
+
+def trapezoid_weights(shape, dx) -> np.ndarray:
+    """Nodal weights [m^2] of the trapezoidal rule on the node grid (half at the edges)."""
+    w1 = np.full(shape[1], dx[0])
+    w1[[0, -1]] /= 2
+    w2 = np.full(shape[0], dx[1])
+    w2[[0, -1]] /= 2
+    return w2[:, None] * w1[None, :]
 
 
 def fe_poiseuille(g, spacing, A=None) -> sp.csr_matrix:
