@@ -1,15 +1,27 @@
 """Finite-volume cell problems (paper eqs 8-10, its own discretisation).
 
-Cell-centred finite volumes on the periodic pixel grid: one control volume per pixel, face
-values by the arithmetic mean of the two neighbours (``h_f``, ``h^3_f``), so the fluxes are
-second-order central,
+Cell-centred finite volumes on the periodic pixel grid: one control volume per pixel and
+second-order central fluxes,
 
-    flux of chi_2 through an x1 face = h^3_f ((chi_2[i+1] - chi_2[i]) / dx1 + 1),
+    flux of chi_2 through an x1 face = c_f ((chi_2[i+1] - chi_2[i]) / dx1 + 1),
 
-and the divergence of eq 9's right-hand side is the central difference of h^3.  Eq 8 takes
-the Couette flux ``h_f`` and the time term at the cell centre.  Averages (eqs 13-16) are
-face averages of the fluxes: ``A[i, j] = <h^3_f (delta_ij + D_i chi_{j+2})>`` over the faces
-normal to x_i, which keeps ``A`` exactly symmetric.  One pixel is pinned (chi = 0).
+with the face conductance ``c_f`` for ``h^3`` and the arithmetic mean ``h_f`` for the Couette
+flux of eq 8, whose time term sits at the cell centre.  Averages (eqs 13-16) are face
+averages of the fluxes: ``A[i, j] = <c_f (delta_ij + D_i chi_{j+2})>`` over the faces normal
+to x_i, which keeps ``A`` exactly symmetric.  One pixel is pinned (chi = 0).
+
+Face conductance (``face=``).  The flux through a face is the face integral of
+``h^3 (d chi / dn + ...)`` with the central difference of chi constant along the face.
+``"bilinear"`` (default) integrates ``h^3`` exactly along the face for the bilinear gap
+through the pixel centres, the gap the FE path interpolates: from the face centre
+``m0 = (h_P + h_E) / 2`` the gap varies linearly to the corners
+``(h_P + h_E + h_N + h_NE) / 4`` (and likewise to the south), and the mean of the cube of a
+linear function from ``a`` to ``b`` is ``(a + b)(a^2 + b^2) / 4``.  ``"arithmetic"`` is the
+two-point mean ``(h_P^3 + h_E^3) / 2``.  Both are second order for a smooth gap; they differ
+where contact spots (gaps at the 1 nm floor) meet open pixels, where the two-point mean
+leaks flow through the contact.  Measured on sample patch 3 at 256^2 and h0 = 0.15 um (18 %
+contact, one steady step): the bilinear-gap continuum (FE on the gap refined 4x) has
+A11 = 0.0331; FE gives 0.0337, FVM ``"bilinear"`` 0.0336, FVM ``"arithmetic"`` 0.0355.
 """
 
 from __future__ import annotations
@@ -22,10 +34,30 @@ from ..micro.cell import CellSolution
 from ..ordering import nested_dissection_torus
 
 
+def _cube_mean(a, b):
+    """Mean of ``f^3`` for ``f`` linear from ``a`` to ``b``."""
+    return (a + b) * (a * a + b * b) / 4
+
+
+def _bilinear_face(h, axis):
+    """Face mean of ``h^3`` over the faces between each pixel and its ``+axis`` neighbour."""
+    other = 1 - axis
+    m0 = (h + np.roll(h, -1, axis=axis)) / 2                 # face centre
+    return sum(_cube_mean(m0, (m0 + np.roll(m0, s, axis=other)) / 2) for s in (-1, 1)) / 2
+
+
+#: face conductance of h^3, per axis (1: x1 faces, 0: x2 faces), for the gap ``h`` [m]
+FACE_RULES = {"bilinear": _bilinear_face,
+              "arithmetic": lambda h, axis: (h ** 3 + np.roll(h ** 3, -1, axis=axis)) / 2}
+
+
 class CellSolverFV:
     """Periodic 5-point FVM cell problems on a ``(ny, nx)`` grid of pitch ``spacing`` [m]."""
 
-    def __init__(self, shape, spacing, *, pinned: int = 0):
+    def __init__(self, shape, spacing, *, pinned: int = 0, face: str = "bilinear"):
+        if face not in FACE_RULES:
+            raise ValueError(f"face must be one of {sorted(FACE_RULES)}, got {face!r}")
+        self.face = face
         self.shape = (int(shape[0]), int(shape[1]))
         self.spacing = tuple(float(s) for s in np.broadcast_to(np.asarray(spacing, float), (2,)))
         ny, nx = self.shape
@@ -67,8 +99,14 @@ class CellSolverFV:
         f = np.asarray(field, float)
         return np.stack([(f + np.roll(f, -1, axis=1)) / 2, (f + np.roll(f, -1, axis=0)) / 2])
 
+    def face_conductance(self, gap):
+        """Conductance ``c_f`` of the x1 faces and the x2 faces [m^3], ``(2, ny, nx)``."""
+        h = np.asarray(gap, float)
+        rule = FACE_RULES[self.face]
+        return np.stack([rule(h, 1), rule(h, 0)])
+
     def operator(self, c_faces) -> sp.csc_matrix:
-        """Reduced operator for face conductances ``c = h^3_f`` (x1 faces, x2 faces)."""
+        """Reduced operator for the face conductances ``c_f`` (x1 faces, x2 faces)."""
         dx1, dx2 = self.spacing
         w = np.r_[c_faces[0].ravel() * (dx2 / dx1), c_faces[1].ravel() * (dx1 / dx2)]
         data = np.r_[w, w, -w, -w][self._keep]
@@ -92,7 +130,7 @@ class CellSolverFV:
             raise ValueError("the gap must be finite and positive (truncate it first) [m]")
         dx1, dx2 = self.spacing
         hf = self.face_values(h)
-        cf = self.face_values(h ** 3)
+        cf = self.face_conductance(h)
         zero = np.zeros_like(h)
         f1 = -self._divergence(np.stack([hf[0], zero]))
         if squeeze is not None:                   # mean removed: see the FE CellSolver
