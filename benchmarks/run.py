@@ -121,11 +121,14 @@ def bench_micro(full=False):
     rows = [("baseline: skfem assemble + P^T K P, 256^2", base, "")]
     t, _ = best_of(lambda: cs.operator(a_q), 5)
     rows.append(("re-assembly from element tensors", t, ""))
-    t, _ = best_of(lambda: cs.solve(gap))
-    rows.append(("FE cell step: assemble + LU + 3 solves + means", t, "h0 = 0.2 um"))
-    fv = CellSolverFV(pin.shape, pin.spacing)
-    t, _ = best_of(lambda: fv.solve(gap))
-    rows.append(("FVM cell step (5-point)", t, ""))
+    from fem_twin.linalg import _mkl_rt, default_backend
+    backends = ["superlu"] + (["pardiso"] if _mkl_rt() is not None else [])
+    for name, make in (("FE", CellSolver), ("FVM", CellSolverFV)):
+        for backend in backends:
+            solver = make(pin.shape, pin.spacing, backend=backend)
+            t, _ = best_of(lambda: solver.solve(gap))
+            rows.append((f"{name} cell step, {backend}", t,
+                         "assemble + factor + 3 solves + means, h0 = 0.2 um"))
     t, r = best_of(lambda: solve(shape, pin.spacing, TABLE4["e_reduced"], separation=0.2e-6,
                                  hardness=TABLE4["hardness"], periodic=True))
     rows.append(("periodic contact, cold", t, f"{r.iterations} it"))
@@ -136,7 +139,8 @@ def bench_micro(full=False):
     wall = time.perf_counter() - t0
     sec = ff.meta["seconds"]
     note = (f"contact {sec['contact']:.0f} s + cells {sec['cell']:.0f} s (CPU, summed)")
-    rows.append((f"patch pair {len(h0)} h0 x 32 steps, {workers} process(es)", wall, note))
+    rows.append((f"patch pair {len(h0)} h0 x 32 steps, {workers} process(es)", wall,
+                 note + f", {default_backend()}"))
     if not full:
         rows.append(("  estimate 100 h0 on 2 processes", wall * 10 / 2, "goal: 300 s"))
     return base, rows

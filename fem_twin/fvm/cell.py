@@ -28,9 +28,9 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..micro.cell import CellSolution
+from ..linalg import SPDSolver
 from ..ordering import nested_dissection_torus
 
 
@@ -52,9 +52,13 @@ FACE_RULES = {"bilinear": _bilinear_face,
 
 
 class CellSolverFV:
-    """Periodic 5-point FVM cell problems on a ``(ny, nx)`` grid of pitch ``spacing`` [m]."""
+    """Periodic 5-point FVM cell problems on a ``(ny, nx)`` grid of pitch ``spacing`` [m].
 
-    def __init__(self, shape, spacing, *, pinned: int = 0, face: str = "bilinear"):
+    ``backend``: the sparse direct solver (see :mod:`fem_twin.linalg`).
+    """
+
+    def __init__(self, shape, spacing, *, pinned: int = 0, face: str = "bilinear",
+                 backend: str | None = None):
         if face not in FACE_RULES:
             raise ValueError(f"face must be one of {sorted(FACE_RULES)}, got {face!r}")
         self.face = face
@@ -88,6 +92,7 @@ class CellSolverFV:
         self._keep, self._slot, self._nnz = keep, slot, uniq.size
         self._indptr, self._indices = pattern.indptr, pattern.indices
         self._free = free
+        self._factor = SPDSolver(self._indptr, self._indices, backend)
 
     @property
     def unknowns(self) -> np.ndarray:
@@ -141,9 +146,7 @@ class CellSolverFV:
         F = np.column_stack([f.ravel()[self._free] for f in (f1, f2, f3)])
         K = self.operator(cf)
         scale = cf.mean()
-        lu = spla.splu(K / scale, permc_spec="NATURAL", diag_pivot_thresh=0.0,
-                       options={"SymmetricMode": True})
-        X = lu.solve(F / scale)
+        X = self._factor.factor(K.data / scale).solve(F / scale)
         chi = np.zeros((3, h.size))
         chi[:, self._free] = X.T
         chi = chi.reshape(3, *self.shape)

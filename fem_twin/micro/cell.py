@@ -21,11 +21,11 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 import skfem
 from skfem.helpers import dot, grad
 
 from ..io.mesh import GridMesh, grid_mesh
+from ..linalg import SPDSolver
 from ..ordering import nested_dissection_torus
 
 
@@ -76,11 +76,12 @@ class CellSolver:
     """Periodic Q1 cell problems on a ``(ny, nx)`` grid of pitch ``spacing`` [m].
 
     Everything that does not depend on the gap is built once: the mesh, the per-quadrature-
-    point element tensors, the sparsity pattern with the pinned node removed, and the scatter
-    maps of the right-hand sides.
+    point element tensors, the sparsity pattern with the pinned node removed, the scatter
+    maps of the right-hand sides, and the symbolic factorisation (``backend``: see
+    :mod:`fem_twin.linalg`).
     """
 
-    def __init__(self, shape, spacing, *, pinned: int = 0):
+    def __init__(self, shape, spacing, *, pinned: int = 0, backend: str | None = None):
         self.shape = (int(shape[0]), int(shape[1]))
         self.spacing = tuple(float(s) for s in np.broadcast_to(np.asarray(spacing, float), (2,)))
         self.grid: GridMesh = grid_mesh(self.shape, self.spacing, periodic=True)
@@ -118,6 +119,7 @@ class CellSolver:
         # csr data order equals the sorted keys, which np.unique returned
         self._indptr, self._indices = pattern.indptr, pattern.indices
         self._free = free                       # pixel of each unknown
+        self._factor = SPDSolver(self._indptr, self._indices, backend)
 
     # -- reference element --------------------------------------------------------------
     def _reference_element(self) -> dict:
@@ -204,9 +206,7 @@ class CellSolver:
         K = self.operator(a_q)
         F = self.right_hand_sides(h_q, a_q, tau_q)
         scale = a_q.mean()
-        lu = spla.splu(K / scale, permc_spec="NATURAL", diag_pivot_thresh=0.0,
-                       options={"SymmetricMode": True})
-        X = lu.solve(F / scale)
+        X = self._factor.factor(K.data / scale).solve(F / scale)
         n = self.shape[0] * self.shape[1]
         chi = np.zeros((3, n))
         chi[:, self._free] = X.T

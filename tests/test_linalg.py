@@ -1,0 +1,92 @@
+"""Sparse SPD solves with a fixed pattern (fem_twin.linalg): SuperLU and MKL PARDISO."""
+
+import pickle
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from fem_twin.fvm import CellSolverFV
+from fem_twin.linalg import SPDSolver, _mkl_rt, default_backend
+from fem_twin.micro import CellSolver
+
+BACKENDS = ["superlu", pytest.param("pardiso", marks=pytest.mark.skipif(
+    _mkl_rt() is None, reason="MKL not installed (pip install 'fem-twin[pardiso]')"))]
+
+
+def diffusion(n, seed):
+    """Periodic 5-point operator with random positive face weights plus a small mass term:
+    SPD with a fixed pattern, as the cell operators."""
+    rng = np.random.default_rng(seed)
+    idx = np.arange(n * n).reshape(n, n)
+    i = np.r_[idx.ravel(), idx.ravel()]
+    j = np.r_[np.roll(idx, -1, 1).ravel(), np.roll(idx, -1, 0).ravel()]
+    w = 10.0 ** rng.uniform(-6, 0, i.size)              # 1e6 contrast, like a rough gap
+    K = sp.coo_matrix((np.r_[w, w, -w, -w], (np.r_[i, j, i, j], np.r_[i, j, j, i])),
+                      shape=(n * n, n * n)).tocsr() + 1e-3 * sp.identity(n * n)
+    K.sum_duplicates()
+    K.sort_indices()
+    return K
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_factor_and_refactor_solve_exactly(backend):
+    """Residual at round-off for two matrices on one pattern (the second one reuses the
+    symbolic analysis), several right-hand sides."""
+    K1, K2 = diffusion(24, 1), diffusion(24, 2)
+    assert np.array_equal(K1.indices, K2.indices)
+    solver = SPDSolver(K1.indptr, K1.indices, backend)
+    rhs = np.random.default_rng(0).standard_normal((K1.shape[0], 3))
+    for K in (K1, K2, K1):
+        x = solver.factor(K.data).solve(rhs)
+        assert np.abs(K @ x - rhs).max() < 1e-9 * np.abs(rhs).max()
+        assert np.allclose(x, spla.spsolve(K.tocsc(), rhs), rtol=1e-8, atol=1e-10)
+    one = solver.solve(rhs[:, 0])
+    assert one.shape == (K1.shape[0],) and np.allclose(one, x[:, 0], rtol=1e-12)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_pickled_solver_needs_a_new_factorisation(backend):
+    K = diffusion(8, 3)
+    solver = SPDSolver(K.indptr, K.indices, backend).factor(K.data)
+    clone = pickle.loads(pickle.dumps(solver))
+    with pytest.raises(RuntimeError, match="factor"):
+        clone.solve(np.ones(K.shape[0]))
+    b = np.ones(K.shape[0])
+    assert np.allclose(clone.factor(K.data).solve(b), solver.solve(b), rtol=1e-12)
+
+
+@pytest.mark.skipif(_mkl_rt() is None, reason="MKL not installed")
+def test_pardiso_rejects_an_indefinite_matrix():
+    K = diffusion(8, 4)
+    K.data[K.indices == np.repeat(np.arange(64), np.diff(K.indptr))] *= -1  # flip diagonal
+    with pytest.raises(np.linalg.LinAlgError, match="positive definite"):
+        SPDSolver(K.indptr, K.indices, "pardiso").factor(K.data)
+
+
+def test_backend_choice(monkeypatch):
+    K = diffusion(4, 5)
+    with pytest.raises(ValueError, match="backend"):
+        SPDSolver(K.indptr, K.indices, "cholmod")
+    monkeypatch.setenv("FEM_TWIN_SPARSE", "superlu")
+    assert default_backend() == "superlu"
+    monkeypatch.setenv("FEM_TWIN_SPARSE", "umfpack")
+    with pytest.raises(ValueError, match="FEM_TWIN_SPARSE"):
+        default_backend()
+    monkeypatch.setenv("FEM_TWIN_SPARSE", "auto")
+    assert default_backend() == ("pardiso" if _mkl_rt() is not None else "superlu")
+
+
+@pytest.mark.skipif(_mkl_rt() is None, reason="MKL not installed")
+@pytest.mark.parametrize("solver", [CellSolver, CellSolverFV])
+def test_cell_moments_do_not_depend_on_the_backend(solver):
+    rng = np.random.default_rng(6)
+    h = 1e-7 * (1 + 3 * rng.random((32, 24)))
+    h[rng.random(h.shape) < 0.2] = 1e-9                 # contact spots at the gap floor
+    tau = 0.1 * rng.standard_normal(h.shape)
+    a = solver(h.shape, (1e-7, 1.2e-7), backend="superlu").solve(h, tau)
+    b = solver(h.shape, (1e-7, 1.2e-7), backend="pardiso").solve(h, tau)
+    for key in a.moments:
+        assert np.allclose(a.moments[key], b.moments[key], rtol=1e-9,
+                           atol=1e-12 * np.abs(a.moments[key]).max()), key
