@@ -174,3 +174,30 @@ def test_fbns_solves_the_same_problems_as_the_switch():
         assert f.iterations >= a.iterations
     with pytest.raises(ValueError, match="complementarity"):
         solve_reynolds(h, dx, U, MU, complementarity="lcp")
+
+
+def test_poiseuille_reassembly_equals_the_scikit_fem_form():
+    """Element-tensor re-assembly is the skfem assembly of the same form (round-off), with
+    a full non-symmetric A and without A."""
+    import skfem
+
+    from fem_twin.io.mesh import grid_mesh
+    from fem_twin.macro.reynolds import (fe_poiseuille, homogenised_poiseuille_form,
+                                         poiseuille_form)
+    rng = np.random.default_rng(0)
+    shape, dx = (9, 12), (1.3e-5, 1.1e-5)
+    g, A = rng.random(shape), rng.random(shape + (2, 2))
+    gm = grid_mesh(shape, dx)
+    basis = skfem.Basis(gm.mesh, skfem.ElementQuad1(), intorder=2)
+
+    def at(f):
+        return basis.interpolate(gm.to_nodes(f))
+
+    ref = homogenised_poiseuille_form.assemble(
+        basis, g=at(g), a11=at(A[..., 0, 0]), a12=at(A[..., 0, 1]), a21=at(A[..., 1, 0]),
+        a22=at(A[..., 1, 1]))
+    assert abs(fe_poiseuille(g, dx, A) - ref).max() < 1e-14 * abs(ref).max()
+    ref = poiseuille_form.assemble(basis, g=at(g))
+    assert abs(fe_poiseuille(g, dx) - ref).max() < 1e-14 * abs(ref).max()
+    with pytest.raises(ValueError, match="shape"):
+        fe_poiseuille(g, dx, A[:-1])
