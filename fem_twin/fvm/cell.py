@@ -30,8 +30,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..micro.cell import CellSolution
+from ..assembly import FixedPattern, periodic_unknowns
 from ..linalg import SPDSolver
-from ..ordering import nested_dissection_torus
 
 
 def _cube_mean(a, b):
@@ -77,22 +77,13 @@ class CellSolverFV:
         # face list: x1 faces (me, east) then x2 faces (me, north); each adds w (e_i - e_j)^2
         self._fi = np.r_[me, me]
         self._fj = np.r_[east, north]
-        order = nested_dissection_torus(self.shape)
-        free = order[order != self.pinned]
-        renum = np.full(n, -1)
-        renum[free] = np.arange(n - 1)
+        self._free, renum = periodic_unknowns(self.shape, self.pinned)
         rows = np.r_[self._fi, self._fj, self._fi, self._fj]
         cols = np.r_[self._fi, self._fj, self._fj, self._fi]
-        keep = (rows != self.pinned) & (cols != self.pinned)
-        key = renum[rows[keep]].astype(np.int64) * (n - 1) + renum[cols[keep]]
-        uniq, slot = np.unique(key, return_inverse=True)
-        pattern = sp.csr_matrix((np.ones(uniq.size), (uniq // (n - 1), uniq % (n - 1))),
-                                shape=(n - 1, n - 1))
-        pattern.sort_indices()
-        self._keep, self._slot, self._nnz = keep, slot, uniq.size
-        self._indptr, self._indices = pattern.indptr, pattern.indices
-        self._free = free
-        self._factor = SPDSolver(self._indptr, self._indices, backend)
+        self._keep = (rows != self.pinned) & (cols != self.pinned)
+        self._pattern = FixedPattern.from_entries(renum[rows[self._keep]],
+                                                  renum[cols[self._keep]], n - 1)
+        self._factor = SPDSolver(self._pattern.indptr, self._pattern.indices, backend)
 
     @property
     def unknowns(self) -> np.ndarray:
@@ -110,14 +101,11 @@ class CellSolverFV:
         rule = FACE_RULES[self.face]
         return np.stack([rule(h, 1), rule(h, 0)])
 
-    def operator(self, c_faces) -> sp.csc_matrix:
+    def operator(self, c_faces) -> sp.csr_matrix:
         """Reduced operator for the face conductances ``c_f`` (x1 faces, x2 faces)."""
         dx1, dx2 = self.spacing
         w = np.r_[c_faces[0].ravel() * (dx2 / dx1), c_faces[1].ravel() * (dx1 / dx2)]
-        data = np.r_[w, w, -w, -w][self._keep]
-        values = np.bincount(self._slot, weights=data, minlength=self._nnz)
-        n = self._free.size
-        return sp.csc_matrix((values, self._indices, self._indptr), shape=(n, n))
+        return self._pattern.csr(np.r_[w, w, -w, -w][self._keep])
 
     def _divergence(self, flux):
         """Net outflow of face fluxes ``(2, ny, nx)`` [per unit length] times face length."""

@@ -33,6 +33,7 @@ import skfem
 from skfem.helpers import dot, grad
 
 from ..errors import NotConverged
+from ..assembly import FixedPattern, element_entries, unit_element
 from ..io.mesh import grid_mesh
 from ..ordering import nested_dissection
 
@@ -161,10 +162,7 @@ class PoiseuilleAssembly:
         gm = grid_mesh(shape, spacing)
         self.shape = tuple(shape)
         self._pix = gm.node_pixel[gm.mesh.t]                   # (4, nelems)
-        dx1, dx2 = spacing
-        one = skfem.MeshQuad1(np.array([[0, dx1, dx1, 0], [0, 0, dx2, dx2]], float),
-                              np.array([[0], [1], [2], [3]]))
-        b = skfem.Basis(one, skfem.ElementQuad1(), intorder=2)
+        b = unit_element(spacing)
         nq = b.X.shape[1]
         T = np.zeros((nq, 2, 2, 16))
         names = (("a11", "a12"), ("a21", "a22"))
@@ -179,13 +177,8 @@ class PoiseuilleAssembly:
                         b, g=np.ones((1, nq)), **coef).toarray().ravel()
         self._T = T
         self._phi = np.array([np.asarray(b.basis[i][0])[0] for i in range(4)])   # (4, nq)
-        rows = np.repeat(self._pix, 4, axis=0).T.ravel()        # element-major, (i, j) inner
-        cols = np.tile(self._pix, (4, 1)).T.ravel()
-        n = shape[0] * shape[1]
-        uniq, self._slot = np.unique(rows.astype(np.int64) * n + cols, return_inverse=True)
-        pattern = sp.csr_matrix((np.ones(uniq.size), (uniq // n, uniq % n)), shape=(n, n))
-        pattern.sort_indices()
-        self._indptr, self._indices, self._nnz = pattern.indptr, pattern.indices, uniq.size
+        self._pattern = FixedPattern.from_entries(*element_entries(self._pix),
+                                                  shape[0] * shape[1])
 
     def at_quadrature(self, field) -> np.ndarray:
         """Nodal field ``(ny, nx, ...)`` -> values at the Gauss points ``(nelems, nq, ...)``."""
@@ -204,9 +197,7 @@ class PoiseuilleAssembly:
         else:
             coef = gq * self.at_quadrature(np.asarray(A, float).reshape(*self.shape, 4))
             data = coef.reshape(coef.shape[0], -1) @ self._T.reshape(-1, 16)
-        values = np.bincount(self._slot, weights=data.ravel(), minlength=self._nnz)
-        n = self.shape[0] * self.shape[1]
-        return sp.csr_matrix((values, self._indices, self._indptr), shape=(n, n))
+        return self._pattern.csr(data)
 
 
 @lru_cache(maxsize=8)

@@ -25,8 +25,8 @@ import skfem
 from skfem.helpers import dot, grad
 
 from ..io.mesh import GridMesh, grid_mesh
+from ..assembly import FixedPattern, element_entries, periodic_unknowns, unit_element
 from ..linalg import SPDSolver
-from ..ordering import nested_dissection_torus
 
 
 @skfem.BilinearForm
@@ -98,36 +98,17 @@ class CellSolver:
         self._dphi = ref["dphi"]                 # (2, 4, nq) dphi_i/dx_d
         pix = self.grid.node_pixel[self.grid.mesh.t]          # (4, nelems) pixel of each dof
         self._pix = pix
-        rows = np.repeat(pix, 4, axis=0).T.ravel()             # element-major, (i, j) inner
-        cols = np.tile(pix, (4, 1)).T.ravel()
+        rows, cols = element_entries(pix)
         keep = (rows != self.pinned) & (cols != self.pinned)
-        # unknowns are numbered in a nested-dissection order of the torus (fill-reducing,
-        # 1.6 x faster to factorise than SuperLU's own MMD ordering at 256^2)
-        order = nested_dissection_torus(self.shape)
-        free = order[order != self.pinned]
-        renum = np.full(n, -1)
-        renum[free] = np.arange(n - 1)
-        r, c = renum[rows[keep]], renum[cols[keep]]
-        key = r.astype(np.int64) * (n - 1) + c
-        uniq, slot = np.unique(key, return_inverse=True)
+        self._free, renum = periodic_unknowns(self.shape, self.pinned)   # pixel of each unknown
         self._keep = keep
-        self._slot = slot
-        self._nnz = uniq.size
-        pattern = sp.csr_matrix((np.ones(uniq.size), (uniq // (n - 1), uniq % (n - 1))),
-                                shape=(n - 1, n - 1))
-        pattern.sort_indices()
-        # csr data order equals the sorted keys, which np.unique returned
-        self._indptr, self._indices = pattern.indptr, pattern.indices
-        self._free = free                       # pixel of each unknown
-        self._factor = SPDSolver(self._indptr, self._indices, backend)
+        self._pattern = FixedPattern.from_entries(renum[rows[keep]], renum[cols[keep]], n - 1)
+        self._factor = SPDSolver(self._pattern.indptr, self._pattern.indices, backend)
 
     # -- reference element --------------------------------------------------------------
     def _reference_element(self) -> dict:
         """Element tensors of the forms per quadrature point, computed by scikit-fem."""
-        dx1, dx2 = self.spacing
-        one = skfem.MeshQuad1(np.array([[0, dx1, dx1, 0], [0, 0, dx2, dx2]], float),
-                              np.array([[0], [1], [2], [3]]))
-        b = skfem.Basis(one, skfem.ElementQuad1(), intorder=2)
+        b = unit_element(self.spacing)
         nq = b.X.shape[1]
         k, g, m = [], [], []
         for q in range(nq):
@@ -152,16 +133,12 @@ class CellSolver:
         return np.stack([f @ self._dphi[0], f @ self._dphi[1]])
 
     # -- assembly ------------------------------------------------------------------------
-    def operator(self, a_q: np.ndarray) -> sp.csc_matrix:
+    def operator(self, a_q: np.ndarray) -> sp.csr_matrix:
         """Reduced flow operator for ``a = h^3`` at the quadrature points.
 
         Pinned node removed, unknowns in the order of ``self.unknowns`` (pixel indices).
-        The matrix is symmetric, so its CSR arrays are also its CSC arrays.
         """
-        data = (a_q @ self._k).ravel()[self._keep]
-        values = np.bincount(self._slot, weights=data, minlength=self._nnz)
-        n = self._free.size
-        return sp.csc_matrix((values, self._indices, self._indptr), shape=(n, n))
+        return self._pattern.csr((a_q @ self._k).ravel()[self._keep])
 
     @property
     def unknowns(self) -> np.ndarray:

@@ -1,0 +1,71 @@
+"""Re-assembly on structured pixel grids, shared by the cell problems and the macro scale.
+
+Every element of a pixel mesh is the same rectangle, so element matrices are sums of
+reference tensors that scikit-fem assembles once on a single element (:func:`unit_element`);
+a new matrix is then a dense product and a ``bincount`` of the element entries onto a sparse
+pattern fixed in advance (:class:`FixedPattern`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import skfem
+
+from .ordering import nested_dissection_torus
+
+
+def unit_element(spacing, intorder: int = 2) -> skfem.Basis:
+    """Q1 basis on one ``dx1 x dx2`` rectangle [m], local nodes as in the pixel meshes."""
+    dx1, dx2 = spacing
+    one = skfem.MeshQuad1(np.array([[0, dx1, dx1, 0], [0, 0, dx2, dx2]], float),
+                          np.array([[0], [1], [2], [3]]))
+    return skfem.Basis(one, skfem.ElementQuad1(), intorder=intorder)
+
+
+def element_entries(dofs):
+    """Row and column of every entry of the 4 x 4 element matrices, element-major with the
+    ``(i, j)`` pair inner, for the ``(4, nelems)`` global dofs ``dofs``."""
+    return np.repeat(dofs, 4, axis=0).T.ravel(), np.tile(dofs, (4, 1)).T.ravel()
+
+
+@dataclass(frozen=True, eq=False)
+class FixedPattern:
+    """CSR pattern of an ``n x n`` matrix whose entries arrive as a list ``(rows, cols)``
+    with repeats (summed).  ``slot[k]`` is the position of entry ``k`` in the CSR data."""
+
+    slot: np.ndarray
+    indptr: np.ndarray
+    indices: np.ndarray
+    n: int
+
+    @classmethod
+    def from_entries(cls, rows, cols, n) -> "FixedPattern":
+        key = np.asarray(rows, np.int64) * n + np.asarray(cols, np.int64)
+        uniq, slot = np.unique(key, return_inverse=True)
+        pattern = sp.csr_matrix((np.ones(uniq.size), (uniq // n, uniq % n)), shape=(n, n))
+        pattern.sort_indices()          # CSR data order = the sorted keys np.unique returns
+        return cls(slot, pattern.indptr, pattern.indices, int(n))
+
+    def values(self, data) -> np.ndarray:
+        """CSR data of the matrix with entries ``data`` (one per listed entry)."""
+        return np.bincount(self.slot, weights=np.ravel(data), minlength=self.indices.size)
+
+    def csr(self, data) -> sp.csr_matrix:
+        return sp.csr_matrix((self.values(data), self.indices, self.indptr),
+                             shape=(self.n, self.n))
+
+
+def periodic_unknowns(shape, pinned: int):
+    """Unknowns of a periodic cell with one pixel pinned, numbered in the nested-dissection
+    order of the torus (fill-reducing, 1.6x faster to factorise than SuperLU's own MMD
+    ordering at 256^2): ``free`` (pixel of each unknown) and ``renum`` (unknown of each
+    pixel, -1 for the pinned one)."""
+    n = shape[0] * shape[1]
+    order = nested_dissection_torus(shape)
+    free = order[order != pinned]
+    renum = np.full(n, -1)
+    renum[free] = np.arange(n - 1)
+    return free, renum
