@@ -61,31 +61,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     sub = p.add_subparsers(dest="command", required=True, metavar="STAGE")
 
-    r = sub.add_parser("run", help="run the pipeline of a case file (TOML) into an output folder")
-    r.add_argument("case", nargs="?", type=Path, default=DEFAULT_CASE,
-                   help=f"case file (default: {DEFAULT_CASE})")
-    r.add_argument("-o", "--output", type=Path, default=Path("out"), help="output folder")
-    r.add_argument("--no-progress", action="store_true", help="no progress bars")
-    r.set_defaults(func=_run)
-
-    cp = sub.add_parser("compare", help="cross-check FE against the FVM reference on a case: "
-                                        "flow factors, fields, C_f,dev (eq 35)")
-    cp.add_argument("case", nargs="?", type=Path, default=DEFAULT_CASE)
-    cp.add_argument("-o", "--output", type=Path, default=Path("compare"), help="output folder")
-    cp.add_argument("--no-progress", action="store_true", help="no progress bars")
-    cp.set_defaults(func=_compare)
-
-    cb = sub.add_parser("calibrate", help="calibration study of a case (paper 3.2): C_f,dev "
-                                          "of variants against a reference curve")
-    cb.add_argument("case", nargs="?", type=Path, default=DEFAULT_CASE)
+    _case_command(sub, "run", "run the pipeline of a case file (TOML) into an output folder",
+                  "out", _run)
+    _case_command(sub, "compare", "cross-check FE against the FVM reference on a case: "
+                                  "flow factors, fields, C_f,dev (eq 35)", "compare", _compare)
+    cb = _case_command(sub, "calibrate", "calibration study of a case (paper 3.2): C_f,dev "
+                                         "of variants against a reference curve",
+                       "calibration", _calibrate)
     cb.add_argument("--study", required=True,
                     choices=("filter", "resolution", "disk", "pins", "patches"))
     cb.add_argument("--values", type=float, nargs="+",
                     help="filter FWHMs [px] or resolutions [px] (defaults: 0 3 5 7 9 11; "
                          "64 128 256)")
-    cb.add_argument("-o", "--output", type=Path, default=Path("calibration"))
-    cb.add_argument("--no-progress", action="store_true", help="no progress bars")
-    cb.set_defaults(func=_calibrate)
 
     t = sub.add_parser("topography", help="read and pre-process measured topographies")
     steps = t.add_subparsers(dest="step", required=True, metavar="STEP")
@@ -168,6 +155,17 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("-o", "--output", type=Path, default=Path("meshes/sample"))
     g.set_defaults(func=_sample)
     return p
+
+
+def _case_command(sub, name, text, output, func):
+    """A subcommand on a case file: ``CASE`` (default: the bundled case), ``-o``, progress."""
+    c = sub.add_parser(name, help=text)
+    c.add_argument("case", nargs="?", type=Path, default=DEFAULT_CASE,
+                   help=f"case file (default: {DEFAULT_CASE})")
+    c.add_argument("-o", "--output", type=Path, default=Path(output), help="output folder")
+    c.add_argument("--no-progress", action="store_true", help="no progress bars")
+    c.set_defaults(func=func)
+    return c
 
 
 def _step_options(name, s):
