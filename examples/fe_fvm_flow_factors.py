@@ -29,7 +29,7 @@ from fem_twin.compare import flow_factor_differences
 from fem_twin.fvm import CellSolverFV
 from fem_twin.io.files import read_topography
 from fem_twin.micro import CellSolver, FlowFactors, average, homogenise
-from fem_twin.micro.homogenisation import CellSettings, sliding_contacts, sliding_shapes
+from fem_twin.micro.homogenisation import CellSettings, sliding_contacts, sliding_pass
 from fem_twin.topography.prepare import prepare_patch
 
 SAMPLE = Path(__file__).resolve().parent.parent / "meshes" / "sample"
@@ -63,7 +63,7 @@ def factors(moments):
 def refinement_study(k=3, h0=0.15e-6):
     pin, disk = patch_pair(k)
     settings = CellSettings(n_steps=8)
-    shapes, _ = sliding_shapes(pin.heights, disk.heights, settings)
+    shapes = sliding_pass(pin.heights, disk.heights, pin.spacing, settings).shapes
     contact = sliding_contacts(shapes[:1], pin.spacing, settings, h0)[0]
     print(f"\npatch {k}, h0 = {h0 * 1e6:.2f} um, first step, "
           f"contact fraction {contact.contact_fraction:.3f}")

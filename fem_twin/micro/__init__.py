@@ -5,7 +5,7 @@
 
 from .cell import CellSolution, CellSolver
 from .flow_factors import FlowFactors, LocalFactors, average
-from .homogenisation import DEFAULT_H0, CellSettings, homogenise, sliding_shapes
+from .homogenisation import DEFAULT_H0, CellSettings, homogenise, sliding_pass
 
 __all__ = ["CellSolution", "CellSolver", "FlowFactors", "LocalFactors", "average", "DEFAULT_H0",
-           "CellSettings", "homogenise", "sliding_shapes"]
+           "CellSettings", "homogenise", "sliding_pass"]

@@ -5,17 +5,34 @@ patch in ``n_steps`` time steps; at each step a periodic dry contact at imposed 
 asperity pressure and the deformed gap, then the three cell problems are solved and their
 averages accumulated over space and time.
 
-Kinematics (issue 4).  The pin is at rest and the disk moves at ``U = 2 u_m``.  One pass of
-the disk over the period ``L_r1`` takes ``T_r = L_r1 / U``; in ``N_t`` steps the disk patch
-shifts by ``s = L_r1 / N_t`` per step and ``dt = s / U``.  The time term of eq 8 then reads
+Kinematics.  The pin is at rest and the disk moves at ``U = 2 u_m``.  One pass of the disk
+over the period ``L_r1`` takes ``T_r = L_r1 / U``; in ``N_t`` instants the disk patch shifts
+by ``s = L_r1 / N_t`` each.  The gap is ``h = h0 + z_up(x1 - U t, x2) - z_low + w`` with the
+contact deformation ``w``, so the time term of eq 8 is, exactly,
 
-    (1 / u_m) dh/dt  ~  (h^n - h^(n-1)) / (u_m dt) = 2 (h^n - h^(n-1)) / s,
+    tau = (1 / u_m) dh/dt = -2 d z_up / dx1 + (1 / u_m) dw/dt,
 
-free of u_m.  The paper's ``dt = L_r1 / (N_t u_m)`` with a shift of ``L_r1 / N_t`` would be
-a disk moving at ``u_m``, i.e. half the squeeze term.  With ``moving="lower"`` the same
-physics is computed in the disk's frame (the pin moves at ``-U``, ``u_m -> -u_m``); then
-``A``, ``C``, ``h_m``, ``p_con`` are unchanged and ``b' = 2 e1 - b``, ``d' = -d`` up to the
-time discretisation error (a test checks it).
+free of u_m.  The default ``time_derivative="exact"`` evaluates it at every instant (the
+deformation rate from the tangent of the contact problem), so only the quadrature of the
+time average over the ``N_t`` instants remains: the trapezoidal rule of a periodic function.
+The paper's implicit Euler ``2 (h^n - h^(n-1)) / s`` (``time_derivative="backward"``) is
+first order in ``1 / N_t`` and kept to reproduce the paper.  (The paper's
+``dt = L_r1 / (N_t u_m)`` with a shift of ``L_r1 / N_t`` would be a disk moving at ``u_m``,
+i.e. half the squeeze term.)
+
+Frame identities (tested).  ``moving="lower"`` computes the same physics in the disk's frame:
+the pin slides at ``-U`` and ``u_m -> -u_m``, and ``tau = -2 d(-z_low)/dx1 + ...``.  In that
+frame the right-hand side of eq 8 is ``dh/dx1 + tau' = -(dh/dx1 + tau)`` (the sum is
+``2 d h/dx1 - 2 d(h_rigid + w)/dx1 = 0``), so ``chi_1' = -chi_1`` and
+
+    A' = A,  C' = C,  h_m' = h_m,  p_con' = p_con  (eqs 9, 10 do not see the motion),
+    b' = 2 e1 - b  (from eq 14: <h (1 + h^2 d chi_1/dx1)> / h_m = 2 e1 - b),
+    d' = -d        (eq 16 is linear in chi_1).
+
+The same holds for a rough surface moving over a smooth one against the same surface at
+rest under the smooth one.  Without contact the FVM satisfies these identities to
+round-off (its Couette flux difference is the central difference used for ``tau``), the FE
+to its second-order spatial error; with contact, to the discretisation of the contact edge.
 """
 
 from __future__ import annotations
@@ -31,6 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..contact import contact_rate
 from ..contact import solve as contact_solve
 from ..contact.levelling import TABLE4
 from ..io.atomic import atomic_path
@@ -53,6 +71,8 @@ class CellSettings:
     moving: str = "upper"
     first_step: str = "steady"
     contact_tol: float = 1e-10
+    time_derivative: str = "exact"
+    rate_tol: float = 1e-8
 
     def __post_init__(self):
         if int(self.n_steps) != self.n_steps or self.n_steps < 1:
@@ -61,6 +81,9 @@ class CellSettings:
             raise ValueError(f"method must be 'fe' or 'fvm', got {self.method!r}")
         if self.moving not in ("upper", "lower"):
             raise ValueError(f"moving must be 'upper' (disk) or 'lower' (pin), got {self.moving!r}")
+        if self.time_derivative not in ("exact", "backward"):
+            raise ValueError("time_derivative must be 'exact' or 'backward' (paper), got "
+                             f"{self.time_derivative!r}")
         if self.first_step not in ("steady", "periodic"):
             raise ValueError(f"first_step must be 'steady' or 'periodic', got {self.first_step!r}")
         if not (self.e_reduced > 0 and self.hardness > 0 and self.gap_floor > 0):
@@ -69,8 +92,8 @@ class CellSettings:
 
 def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
                e_reduced: float = TABLE4["e_reduced"], hardness: float = TABLE4["hardness"],
-               method: str = "fe", moving: str = "upper", first_step: str = "steady",
-               gap_floor: float = 1e-9, workers: int = 1, executor=None,
+               method: str = "fe", moving: str = "upper", time_derivative: str = "exact",
+               first_step: str = "steady", gap_floor: float = 1e-9, workers: int = 1, executor=None,
                checkpoint=None, progress: bool = False, patch_id=None) -> FlowFactors:
     """Flow factors of a roughness patch pair versus h0 (eqs 11-16).
 
@@ -87,8 +110,11 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     method : ``"fe"`` (Q1 finite elements) or ``"fvm"`` (the paper's finite volumes).
     moving : ``"upper"``: the disk slides at ``+U`` over the pin at rest (the tribometer);
         ``"lower"``: the same seen from the disk (the pin slides at ``-U``).
-    first_step : ``"steady"`` (paper: no time term at the first step) or ``"periodic"``
-        (the last configuration precedes the first, a time-periodic implicit Euler).
+    time_derivative : ``"exact"`` (default): the squeeze term of eq 8 at every instant from
+        the translating surface and the contact rate, no time-step error (see
+        :func:`sliding_squeeze`); ``"backward"``: the paper's implicit Euler difference.
+    first_step : with ``"backward"`` only: ``"steady"`` (paper: no time term at the first
+        step) or ``"periodic"`` (the last configuration precedes the first).
     workers : processes for the h0 values (1: in this process); ``executor``: any
         ``concurrent.futures``-style executor instead (e.g. ``dask.distributed``'s).
     checkpoint : folder that keeps one file per finished h0; a rerun resumes from it.
@@ -96,7 +122,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     patch_id : recorded in the metadata.
     """
     settings = CellSettings(int(n_steps), float(e_reduced), float(hardness), float(gap_floor),
-                            method, moving, first_step)
+                            method, moving, first_step, time_derivative=time_derivative)
     z_low, z_up, spacing = _check_patches(pin, disk)
     h0 = DEFAULT_H0 if h0 is None else np.asarray(h0, dtype=float)
     if h0.ndim != 1 or h0.size == 0 or not np.all(np.isfinite(h0)) or np.any(h0 <= 0):
@@ -143,7 +169,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
             "e_reduced": settings.e_reduced, "hardness": settings.hardness,
             "gap_floor": settings.gap_floor, "n_steps": settings.n_steps,
             "method": settings.method, "moving": settings.moving,
-            "first_step": settings.first_step, "version": __version__,
+            "first_step": settings.first_step, "time_derivative": settings.time_derivative,
+            "version": __version__,
             "pin": pin.meta.get("sample", pin.meta.get("source")),
             "disk": disk.meta.get("sample", disk.meta.get("source")),
             "seconds": {"contact": sum(done[i].get("seconds_contact", 0.0) for i in todo),
@@ -166,17 +193,33 @@ def factors_from_moments(h0, moments, meta) -> FlowFactors:
 
 
 # -- one patch pair, a chunk of separations ------------------------------------------------
-def sliding_shapes(z_low, z_up, settings: CellSettings):
-    """Undeformed gap geometry ``z_up - z_low`` at each time step and ``u_m dt`` [m].
+@dataclass(frozen=True, eq=False)
+class SlidingPass:
+    """One periodic pass of the moving surface over the cell, in ``N_t`` instants.
 
-    The moving surface shifts by ``s = L_r1 / N_t`` per step (``+s`` for the disk, ``-s``
-    for the pin in the disk's frame); ``u_m dt = (shift_up + shift_low) / 2`` is ``+-s/2``.
+    shapes : undeformed gap geometry ``z_up - z_low`` at each instant [m]
+    moving : the moving surface's part of that geometry at each instant (``z_up`` shifted
+        for the disk, ``-z_low`` shifted for the pin in the disk's frame) [m]
+    um_dt : ``u_m dt`` between instants [m], ``+s/2`` (disk moving) or ``-s/2`` (pin)
     """
+
+    shapes: list
+    moving: list
+    um_dt: float
+
+
+def sliding_pass(z_low, z_up, spacing, settings: CellSettings) -> SlidingPass:
+    """The moving surface shifts by ``s = L_r1 / N_t`` per step (``+s`` for the disk, ``-s``
+    for the pin in the disk's frame); ``u_m dt = (shift_up + shift_low) / 2``."""
     nx = z_low.shape[1]
     px = nx / settings.n_steps                   # pixels per step
-    up, low = (px, 0.0) if settings.moving == "upper" else (0.0, -px)
-    shapes = [_shift(z_up, n * up) - _shift(z_low, n * low) for n in range(settings.n_steps)]
-    return shapes, (up + low) / 2
+    n = range(settings.n_steps)
+    if settings.moving == "upper":
+        moving = [_shift(z_up, k * px) for k in n]
+        shapes = [m - z_low for m in moving]
+        return SlidingPass(shapes, moving, px * spacing[0] / 2)
+    moving = [-_shift(z_low, -k * px) for k in n]
+    return SlidingPass([z_up + m for m in moving], moving, -px * spacing[0] / 2)
 
 
 def _shift(z, px):
@@ -188,6 +231,11 @@ def _shift(z, px):
     k = np.fft.rfftfreq(z.shape[1])
     return np.fft.irfft(np.fft.rfft(z, axis=1) * np.exp(-2j * np.pi * k * px), n=z.shape[1],
                         axis=1)
+
+
+def _d_dx1(z, dx1):
+    """Periodic central difference along x1 (the Couette flux difference of the FVM)."""
+    return (np.roll(z, -1, axis=1) - np.roll(z, 1, axis=1)) / (2 * dx1)
 
 
 def _cell_solver(shape, spacing, method):
@@ -213,29 +261,53 @@ def sliding_contacts(shapes, spacing, settings: CellSettings, h0: float, warm=No
     return results
 
 
-def sliding_cells(gaps, solver, settings: CellSettings, um_dt: float):
-    """Cell solutions of each step, implicit Euler in time (``um_dt = u_m dt`` [m])."""
-    for n, h in enumerate(gaps):
-        steady = n == 0 and settings.first_step == "steady"
-        yield solver.solve(h, None if steady else (h - gaps[n - 1]) / um_dt)
+def sliding_squeeze(contacts, sliding: SlidingPass, spacing, settings: CellSettings):
+    """The squeeze term ``tau = (1/u_m) dh/dt`` of eq 8 at each instant (None: steady).
+
+    ``"exact"``: the moving surface translates at ``V = 2 u_m``, so the rate of the rigid
+    geometry is ``-2 d(moving)/dx1`` exactly at every instant (central difference, the
+    discrete derivative of the Couette flux); the contact deformation adds ``K p'`` from
+    :func:`fem_twin.contact.contact_rate`; ``tau = 0`` where the gap sits at the floor.
+    No time-step error: the time average of eqs 11-16 over the ``N_t`` instants is then the
+    trapezoidal rule of a periodic function.
+    ``"backward"`` (paper): ``(h^n - h^(n-1)) / (u_m dt)``, the first step steady
+    (``first_step="steady"``) or preceded by the last (``"periodic"``); first order.
+    """
+    if settings.time_derivative == "backward":
+        gaps = [r.gap for r in contacts]
+        steady = settings.first_step == "steady"
+        return [None if (n == 0 and steady) else (h - gaps[n - 1]) / sliding.um_dt
+                for n, h in enumerate(gaps)]
+    out = []
+    for r, m in zip(contacts, sliding.moving):
+        rigid = -2.0 * _d_dx1(m, spacing[0])
+        _, elastic = contact_rate(r, rigid, spacing, settings.e_reduced,
+                                  hardness=settings.hardness, periodic=True,
+                                  tol=settings.rate_tol)
+        out.append(np.where(r.raw_gap > settings.gap_floor, rigid + elastic, 0.0))
+    return out
+
+
+def sliding_cells(gaps, squeezes, solver):
+    """Cell solutions of each step for its gap and squeeze term."""
+    for h, tau in zip(gaps, squeezes):
+        yield solver.solve(h, tau)
 
 
 def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key):
     """Moments for ``points = [(index, h0), ...]`` in order, warm-starting contact."""
     solver = _cell_solver(z_low.shape, spacing, settings.method)
-    shapes, um_dt_px = sliding_shapes(z_low, z_up, settings)
+    sliding = sliding_pass(z_low, z_up, spacing, settings)
     warm = [None] * settings.n_steps
     out = []
     for i, h0 in points:
         t0 = time.perf_counter()
-        contacts = sliding_contacts(shapes, spacing, settings, h0, warm)
+        contacts = sliding_contacts(sliding.shapes, spacing, settings, h0, warm)
+        squeezes = sliding_squeeze(contacts, sliding, spacing, settings)
         t1 = time.perf_counter()
-        sums = None
-        for cell in sliding_cells([r.gap for r in contacts], solver, settings,
-                                  um_dt_px * spacing[0]):
-            m = cell.moments
-            sums = m if sums is None else {k: sums[k] + m[k] for k in m}
-        moments = {k: v / settings.n_steps for k, v in sums.items()}
+        steps = [cell.moments for cell in
+                 sliding_cells([r.gap for r in contacts], squeezes, solver)]
+        moments = {k: sum(m[k] for m in steps) / settings.n_steps for k in steps[0]}
         moments["p_con"] = float(np.mean([r.pressure.mean() for r in contacts]))
         moments["contact_fraction"] = float(np.mean([r.contact_fraction for r in contacts]))
         moments["seconds_contact"] = t1 - t0

@@ -9,8 +9,8 @@ import numpy as np
 from ..io.atomic import atomic_path
 from ..io.mesh import grid_mesh, write_pvd, write_vtu
 from .flow_factors import FlowFactors
-from .homogenisation import (CellSettings, _cell_solver, _check_patches, _shift, sliding_cells,
-                             sliding_contacts, sliding_shapes)
+from .homogenisation import (CellSettings, _cell_solver, _check_patches, sliding_cells,
+                             sliding_contacts, sliding_pass, sliding_squeeze)
 
 
 def plot_flow_factors(factors, path, labels=None) -> Path:
@@ -51,24 +51,27 @@ def plot_flow_factors(factors, path, labels=None) -> Path:
 
 
 def cell_fields(pin, disk, h0: float, *, n_steps: int = 32, method: str = "fe",
-                moving: str = "upper", first_step: str = "steady", **materials) -> list[dict]:
-    """Per time step: pin and disk heights, gap, asperity pressure and chi_1..3 (grid fields).
+                moving: str = "upper", time_derivative: str = "exact",
+                first_step: str = "steady", **materials) -> list[dict]:
+    """Per time step: pin and disk heights, gap, asperity pressure, squeeze term ``tau`` of
+    eq 8 and chi_1..3 (grid fields, SI units).
 
     ``materials`` are ``e_reduced``, ``hardness``, ``gap_floor`` as in :func:`homogenise`.
     """
     settings = CellSettings(int(n_steps), method=method, moving=moving, first_step=first_step,
-                            **materials)
+                            time_derivative=time_derivative, **materials)
     z_low, z_up, spacing = _check_patches(pin, disk)
-    shapes, um_dt_px = sliding_shapes(z_low, z_up, settings)
+    sliding = sliding_pass(z_low, z_up, spacing, settings)
     solver = _cell_solver(z_low.shape, spacing, method)
-    contacts = sliding_contacts(shapes, spacing, settings, h0)
-    cells = sliding_cells([r.gap for r in contacts], solver, settings, um_dt_px * spacing[0])
+    contacts = sliding_contacts(sliding.shapes, spacing, settings, h0)
+    squeezes = sliding_squeeze(contacts, sliding, spacing, settings)
+    cells = sliding_cells([r.gap for r in contacts], squeezes, solver)
     out = []
-    for n, (r, cell) in enumerate(zip(contacts, cells)):
-        px = n * z_low.shape[1] / settings.n_steps
-        out.append({"pin": z_low if moving == "upper" else _shift(z_low, -px),
-                    "disk": _shift(z_up, px) if moving == "upper" else z_up,
+    for r, m, tau, cell in zip(contacts, sliding.moving, squeezes, cells):
+        out.append({"pin": z_low if moving == "upper" else -m,
+                    "disk": m if moving == "upper" else z_up,
                     "gap": r.gap, "asperity_pressure": r.pressure,
+                    "squeeze": np.zeros_like(r.gap) if tau is None else tau,
                     "chi_1": cell.chi[0], "chi_2": cell.chi[1], "chi_3": cell.chi[2]})
     return out
 
