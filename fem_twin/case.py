@@ -72,7 +72,9 @@ class Materials:
 
 @dataclass(frozen=True)
 class MicroSpec:
-    """Micro scale: patch resolution (resampled), h0 range [m] and count, time steps."""
+    """Micro scale: patch resolution (resampled), h0 range [m] and count, time steps, the
+    squeeze term (``"exact"`` or the paper's ``"backward"``) and the relative error above
+    which the run warns (its estimate: :mod:`fem_twin.micro.estimate`)."""
 
     resolution: tuple[int, int] = (256, 256)
     h0_min: float = 1e-7
@@ -80,6 +82,8 @@ class MicroSpec:
     h0_count: int = 100
     steps: int = 32
     method: str = "fe"
+    time_derivative: str = "exact"
+    error_tolerance: float = 0.02
 
 
 @dataclass(frozen=True)
@@ -200,6 +204,10 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     micro = _section(data, "micro", MicroSpec, where)
     if micro.method not in ("fe", "fvm"):
         raise CaseError(f"{where} [micro] method: 'fe' or 'fvm'")
+    if micro.time_derivative not in ("exact", "backward"):
+        raise CaseError(f"{where} [micro] time_derivative: 'exact' or 'backward' (paper)")
+    if not 0 < micro.error_tolerance < 1:
+        raise CaseError(f"{where} [micro] error_tolerance: a fraction in (0, 1), e.g. 0.02")
     if not (0 < micro.h0_min < micro.h0_max < 1e-3) or micro.h0_count < 2 or micro.steps < 1:
         raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
                         "h0_count >= 2 and steps >= 1")

@@ -113,6 +113,9 @@ def build_parser() -> argparse.ArgumentParser:
                     "(default: 1e-7 1e-6 100, the paper's)")
     hr.add_argument("--steps", type=int, default=32, help="time steps N_t (default 32)")
     hr.add_argument("--method", choices=("fe", "fvm"), default="fe")
+    hr.add_argument("--time-derivative", choices=("exact", "backward"), default="exact",
+                    help="squeeze term of eq 8: exact at every instant (default) or the "
+                         "paper's backward difference")
     hr.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                     help="processes over h0 values (default: all cores)")
     hr.add_argument("--fields", type=float, nargs="*", default=(), metavar="H0",
@@ -284,13 +287,14 @@ def _homogenise_run(args):
     if int(n) != n or n < 1:
         raise ValueError(f"the number of h0 values must be a positive integer, got {n}")
     ff = homogenise(pin, disk, np.geomspace(lo, hi, int(n)), n_steps=args.steps,
-                    method=args.method, workers=args.workers,
+                    method=args.method, time_derivative=args.time_derivative,
+                    workers=args.workers,
                     checkpoint=args.output / "checkpoints", progress=not args.no_progress,
                     patch_id=f"{args.pin.stem}/{args.disk.stem}")
     _write_factors(args.output, ff)
     for h0 in args.fields:
         print(write_cell_fields(args.output / "fields", pin, disk, h0, n_steps=args.steps,
-                                method=args.method))
+                                method=args.method, time_derivative=args.time_derivative))
     return 0
 
 
@@ -311,6 +315,10 @@ def _write_factors(folder, ff, patches=()):
     print(json.dumps({"h0_um": [ff.h0[0] * 1e6, ff.h0[-1] * 1e6], "points": len(ff),
                       "p_con_max_MPa": float(ff.p_con.max() * 1e-6),
                       "A11_range": [float(ff.A[:, 0, 0].min()), float(ff.A[:, 0, 0].max())],
+                      "estimated_relative_error": {
+                          kind: {q: round(e, 5) for q, e in errors.items()}
+                          for kind, errors in ff.meta.get("error_estimate", {}).items()
+                          if kind in ("time", "grid")},
                       "files": [str(folder / n) for n in ("flow_factors.npz",
                                                           "flow_factors.csv",
                                                           "flow_factors.png")]}, indent=2))
@@ -369,6 +377,11 @@ def _run(args):
     case = load_case(args.case)
     summary = run(case, args.output, progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
+    micro = summary["stages"]["micro"]
+    for kind, errors in micro.get("above_tolerance", {}).items():
+        print(f"fem-twin run: warning: estimated {kind} error of the flow factors above "
+              f"{micro['error_tolerance']:.0%}: " + ", ".join(
+                  f"{q} {e:.1%}" for q, e in errors.items()), file=sys.stderr)
     print(f"results in {args.output}/")
     return 0
 

@@ -26,6 +26,7 @@ from .io.files import read_topography, write_topography
 from .io.mesh import grid_mesh, write_vtu
 from .macro import MacroSettings
 from .micro import FlowFactors, average, homogenise
+from .micro.estimate import exceeding
 from .micro.output import plot_flow_factors
 from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)
@@ -231,7 +232,8 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
             if low.shape != tuple(mc.resolution):
                 low, up = resample(low, mc.resolution), resample(up, mc.resolution)
             ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=e_red,
-                            hardness=m.hardness, method=mc.method, executor=executor,
+                            hardness=m.hardness, method=mc.method,
+                            time_derivative=mc.time_derivative, executor=executor,
                             checkpoint=out.parent / "checkpoints", progress=progress,
                             patch_id=f"patch {i + 1}")
             ff.save(out)
@@ -241,8 +243,18 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
     mean.write_csv(folder.parent / "flow_factors.csv")
     plot_flow_factors([*factors, mean], folder.parent / "flow_factors.png",
                       labels=[f"patch {i + 1}" for i in range(len(factors))] + ["average"])
+    estimate = mean.meta.get("error_estimate", {})
+    above = exceeding(estimate, mc.error_tolerance)
+    if above:
+        log.warning("flow factors: estimated relative errors above the tolerance %g: %s "
+                    "(raise [micro] resolution or steps)", mc.error_tolerance,
+                    "; ".join(f"{kind} {q} {e:.1%}" for kind, errs in above.items()
+                              for q, e in errs.items()))
     return {"patches": len(factors), "h0_m": [float(h0[0]), float(h0[-1]), len(h0)],
             "grid": list(mc.resolution), "steps": mc.steps,
+            "time_derivative": mc.time_derivative,
+            "error_estimate": estimate, "error_tolerance": mc.error_tolerance,
+            "above_tolerance": above,
             "p_con_max_Pa": float(mean.p_con.max()), "files": ["flow_factors.csv",
                                                                "flow_factors.png"]}
 

@@ -17,6 +17,7 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from ..io.atomic import atomic_path
+from .estimate import combine
 
 _ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "contact_fraction")
 
@@ -197,5 +198,6 @@ def average(factors) -> FlowFactors:
             raise ValueError("flow factors to average must share the same h0 values")
     mean = {k: np.mean([getattr(f, k) for f in factors], axis=0) for k in _ARRAYS if k != "h0"}
     meta = {"average_of": [f.meta for f in factors], "method": factors[0].meta.get("method"),
-            "version": factors[0].meta.get("version")}
+            "version": factors[0].meta.get("version"),
+            "error_estimate": combine(f.meta.get("error_estimate") for f in factors)}
     return FlowFactors(h0=h0.copy(), **mean, meta=meta)

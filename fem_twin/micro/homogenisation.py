@@ -53,6 +53,7 @@ from ..contact import solve as contact_solve
 from ..contact.levelling import TABLE4
 from ..io.atomic import atomic_path
 from ..topography import Topography
+from .estimate import discrepancy, grid_separations
 from .flow_factors import FlowFactors
 
 #: the paper's separations: 100 values geometrically spaced in [0.1, 1] um
@@ -94,7 +95,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
                e_reduced: float = TABLE4["e_reduced"], hardness: float = TABLE4["hardness"],
                method: str = "fe", moving: str = "upper", time_derivative: str = "exact",
                first_step: str = "steady", gap_floor: float = 1e-9, workers: int = 1, executor=None,
-               checkpoint=None, progress: bool = False, patch_id=None) -> FlowFactors:
+               checkpoint=None, progress: bool = False, patch_id=None,
+               error_estimate: bool = True) -> FlowFactors:
     """Flow factors of a roughness patch pair versus h0 (eqs 11-16).
 
     Parameters
@@ -120,6 +122,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     checkpoint : folder that keeps one file per finished h0; a rerun resumes from it.
     progress : show a progress bar.
     patch_id : recorded in the metadata.
+    error_estimate : estimate the time and grid errors (``meta["error_estimate"]``, see
+        :mod:`fem_twin.micro.estimate`; about ``3 / (4 len(h0))`` of the run's cost).
     """
     settings = CellSettings(int(n_steps), float(e_reduced), float(hardness), float(gap_floor),
                             method, moving, first_step, time_derivative=time_derivative)
@@ -176,20 +180,47 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
             "seconds": {"contact": sum(done[i].get("seconds_contact", 0.0) for i in todo),
                         "cell": sum(done[i].get("seconds_cell", 0.0) for i in todo),
                         "computed_h0": len(todo)}}
-    return factors_from_moments(h0[idx], [done[i] for i in idx], meta)
+    factors = factors_from_moments(h0[idx], [done[i] for i in idx], meta)
+    if error_estimate:
+        meta["error_estimate"] = estimate_errors(factors, [done[i] for i in idx], z_low, z_up,
+                                                 spacing, settings, folder)
+    return factors
 
 
-def factors_from_moments(h0, moments, meta) -> FlowFactors:
-    """Eqs 11-16 from space-time averaged moments (see :meth:`CellSolver.moments`)."""
-    h_m = np.array([m["h"] for m in moments])
-    A = np.array([m["h3_grad"] for m in moments]) / h_m[:, None, None] ** 3
-    b = np.array([[1.0, 0.0] - m["h3_g1"] / m["h"] for m in moments])
-    C = np.array([m["h_grad"] for m in moments]) / h_m[:, None, None]
-    d = np.array([m["h_g1"] for m in moments]) * h_m[:, None]
-    return FlowFactors(h0=np.asarray(h0, float), h_m=h_m,
-                       p_con=np.array([m["p_con"] for m in moments]), A=A, b=b, C=C, d=d,
-                       contact_fraction=np.array([m["contact_fraction"] for m in moments]),
-                       meta=meta)
+def estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder=None) -> dict:
+    """Time and grid error estimates (see :mod:`fem_twin.micro.estimate`): every other
+    instant of this run, and the cell coarsened by two at three separations."""
+    out = {}
+    if "half_h" in moments[0]:
+        half = factors_from_moments(factors.h0, moments, {}, prefix="half_")
+        out["time"] = discrepancy(factors, half)
+        out["time_steps"] = [settings.n_steps, settings.n_steps // 2]
+    if min(z_low.shape) >= 16 and z_low.shape[0] % 2 == 0 == z_low.shape[1] % 2:
+        low, up = z_low[::2, ::2].copy(), z_up[::2, ::2].copy()
+        wide = (2 * spacing[0], 2 * spacing[1])
+        h0 = grid_separations(factors.h0)
+        sub = None if folder is None else folder / "coarse"
+        done = _run_chunk(list(enumerate(h0)), z_low=low, z_up=up, spacing=wide,
+                          settings=settings, folder=sub, key=_key(low, up, wide, settings),
+                          resume=True)
+        out["grid"] = discrepancy(factors, factors_from_moments(h0, [m for _, m in done], {}))
+        out["grid_h0"] = h0.tolist()
+        out["grid_shape"] = list(low.shape)
+    return out
+
+
+def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
+    """Eqs 11-16 from space-time averaged moments (see :meth:`CellSolver.moments`);
+    ``prefix="half_"`` takes the averages over every other instant."""
+    def get(key):
+        return np.array([m[prefix + key] for m in moments])
+
+    h_m = get("h")
+    return FlowFactors(h0=np.asarray(h0, float), h_m=h_m, p_con=get("p_con"),
+                       A=get("h3_grad") / h_m[:, None, None] ** 3,
+                       b=np.array([1.0, 0.0]) - get("h3_g1") / h_m[:, None],
+                       C=get("h_grad") / h_m[:, None, None], d=get("h_g1") * h_m[:, None],
+                       contact_fraction=get("contact_fraction"), meta=meta)
 
 
 # -- one patch pair, a chunk of separations ------------------------------------------------
@@ -294,28 +325,55 @@ def sliding_cells(gaps, squeezes, solver):
         yield solver.solve(h, tau)
 
 
-def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key):
+def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=False):
     """Moments for ``points = [(index, h0), ...]`` in order, warm-starting contact."""
     solver = _cell_solver(z_low.shape, spacing, settings.method)
     sliding = sliding_pass(z_low, z_up, spacing, settings)
     warm = [None] * settings.n_steps
     out = []
     for i, h0 in points:
+        if resume and folder is not None:
+            m = _load_point(Path(folder), key, h0)
+            if m is not None:
+                out.append((i, m))
+                continue
         t0 = time.perf_counter()
         contacts = sliding_contacts(sliding.shapes, spacing, settings, h0, warm)
         squeezes = sliding_squeeze(contacts, sliding, spacing, settings)
         t1 = time.perf_counter()
         steps = [cell.moments for cell in
                  sliding_cells([r.gap for r in contacts], squeezes, solver)]
-        moments = {k: sum(m[k] for m in steps) / settings.n_steps for k in steps[0]}
-        moments["p_con"] = float(np.mean([r.pressure.mean() for r in contacts]))
-        moments["contact_fraction"] = float(np.mean([r.contact_fraction for r in contacts]))
+        for m, r in zip(steps, contacts):
+            m["p_con"], m["contact_fraction"] = float(r.pressure.mean()), r.contact_fraction
+        moments = _time_average(steps)
+        if settings.n_steps % 2 == 0:             # every other instant: the time-error estimate
+            half = _half_pass(steps, contacts, sliding, solver, spacing, settings)
+            moments.update({"half_" + k: v for k, v in _time_average(half).items()})
         moments["seconds_contact"] = t1 - t0
         moments["seconds_cell"] = time.perf_counter() - t1
         if folder is not None:
             _save_point(Path(folder), key, h0, moments)
         out.append((i, moments))
     return out
+
+
+def _half_pass(steps, contacts, sliding, solver, spacing, settings):
+    """Moments of the pass with ``N_t / 2`` instants: every other instant; the backward
+    difference quotient is redone over the doubled step (its error is not in the sampling)."""
+    if settings.time_derivative == "exact":
+        return steps[::2]
+    half = SlidingPass(sliding.shapes[::2], sliding.moving[::2], 2 * sliding.um_dt)
+    squeezes = sliding_squeeze(contacts[::2], half, spacing, settings)
+    out = [cell.moments for cell in
+           sliding_cells([r.gap for r in contacts[::2]], squeezes, solver)]
+    for m, full in zip(out, steps[::2]):
+        m["p_con"], m["contact_fraction"] = full["p_con"], full["contact_fraction"]
+    return out
+
+
+def _time_average(steps):
+    """Mean of each moment over the instants (the trapezoidal rule of a periodic function)."""
+    return {k: sum(m[k] for m in steps) / len(steps) for k in steps[0]}
 
 
 def _chunks(indices, n):
