@@ -10,4 +10,9 @@ class NotConverged(RuntimeError):
 
     def __init__(self, message, history):
         super().__init__(f"{message}; last residuals {np.array(history[-5:])}")
+        self.message = message
         self.history = list(history)
+
+    def __reduce__(self):
+        # rebuilt from its arguments when it crosses to or from a worker process
+        return type(self), (self.message, self.history)

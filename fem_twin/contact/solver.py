@@ -165,8 +165,11 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
         wrong &= ~free
         delta = 0.0 if wrong.any() else 1.0
         if wrong.any():
-            # no free point yet: pressure that closes a uniform overlap on the wrong set
-            step = tau if tau > 0 else 1.0 / op(wrong.astype(float)).max()
+            # pressure that closes a uniform overlap on the wrong set, no larger than the CG
+            # step: the set's joint stiffness, not one point's, limits it (else points
+            # released from and pressed back to the cap can cycle forever)
+            step = 1.0 / op(wrong.astype(float)).max()
+            step = min(step, tau) if tau > 0 else step
             p[wrong] = np.clip(p[wrong] - step * g[wrong], p_min, hardness)
         if load is not None:
             p = _enforce_load(p, load / area, p_min, hardness)

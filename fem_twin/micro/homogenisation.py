@@ -189,7 +189,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
 
 def estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder=None) -> dict:
     """Time and grid error estimates (see :mod:`fem_twin.micro.estimate`): every other
-    instant of this run, and the cell coarsened by two at three separations."""
+    instant of this run, and the cell coarsened by two at three separations (large to
+    small, warm-starting contact as the main run does)."""
     out = {}
     if "half_h" in moments[0]:
         half = factors_from_moments(factors.h0, moments, {}, prefix="half_")
@@ -200,10 +201,11 @@ def estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder=Non
         wide = (2 * spacing[0], 2 * spacing[1])
         h0 = grid_separations(factors.h0)
         sub = None if folder is None else folder / "coarse"
-        done = _run_chunk(list(enumerate(h0)), z_low=low, z_up=up, spacing=wide,
+        done = _run_chunk(list(enumerate(h0))[::-1], z_low=low, z_up=up, spacing=wide,
                           settings=settings, folder=sub, key=_key(low, up, wide, settings),
                           resume=True)
-        out["grid"] = discrepancy(factors, factors_from_moments(h0, [m for _, m in done], {}))
+        done = [m for _, m in sorted(done, key=lambda item: item[0])]
+        out["grid"] = discrepancy(factors, factors_from_moments(h0, done, {}))
         out["grid_h0"] = h0.tolist()
         out["grid_shape"] = list(low.shape)
     return out
