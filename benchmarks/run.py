@@ -157,9 +157,9 @@ def bench_macro():
     from fem_twin.micro import homogenise
     from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch
 
-    low = tp.resample(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
+    low = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
                       (64, 64))
-    up = tp.resample(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
+    up = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
                                    upper=True), (64, 64))
     ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), n_steps=8)
     rows, base = [], None
@@ -215,9 +215,9 @@ def bench_stribeck():
                         "--no-progress"], check=True, capture_output=True)
         wall = time.perf_counter() - t0
         sec = json.loads(open(os.path.join(tmp, "summary.json")).read())["seconds"]
-    low = tp.resample(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
+    low = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
                       (64, 64))
-    up = tp.resample(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
+    up = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
                                    upper=True), (64, 64))
     ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), n_steps=8)
     opts = MacroOptions(resolution=(256, 256))

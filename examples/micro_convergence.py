@@ -5,7 +5,7 @@
 For each patch pair, at h0 = 0.1, 0.14, 0.3, 0.6 um:
 - time: N_t = 4, 8, 16, 32, 64 at 128 px with the exact squeeze term (the default), against
   N_t = 128 (every pixel translation of the 128 px cell);
-- grid: the patches resampled to 32, 64, 128 px (N_t = 16) against the measured 256 px, with
+- grid: the periodic patches resampled to 32, 64, 128 px (N_t = 16) against the measured 256 px, with
   the observed order from the last three grids.
 Prints relative differences of A11, b1, d1, C11, p_con, h_m and writes them to
 ``OUT/micro_convergence.json`` (default ``out/micro_convergence``).  About 10 minutes per
@@ -22,7 +22,7 @@ import numpy as np
 
 from fem_twin.io.files import read_topography
 from fem_twin.micro import homogenise
-from fem_twin.topography import resample
+from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import prepare_patch
 
 SAMPLE = Path(__file__).resolve().parent.parent / "meshes" / "sample"
@@ -34,7 +34,7 @@ def patch_pair(k, shape):
     pin = prepare_patch(read_topography(SAMPLE / f"patch_{k}_pin.npz"), (256, 256))
     disk = prepare_patch(read_topography(SAMPLE / f"patch_{k}_disk.npz"), (256, 256), upper=True)
     if shape != 256:
-        pin, disk = resample(pin, (shape, shape)), resample(disk, (shape, shape))
+        pin, disk = resample_cell(pin, (shape, shape)), resample_cell(disk, (shape, shape))
     return pin, disk
 
 

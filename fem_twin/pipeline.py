@@ -30,7 +30,7 @@ from .micro.estimate import exceeding
 from .micro.output import plot_flow_factors
 from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)
-from .topography import resample
+from .topography import resample_cell
 from .topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
 
 log = logging.getLogger("fem_twin")
@@ -230,7 +230,7 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
             low = read_topography(geo / f"patch_{i + 1}_low.npz")
             up = read_topography(geo / f"patch_{i + 1}_up.npz")
             if low.shape != tuple(mc.resolution):
-                low, up = resample(low, mc.resolution), resample(up, mc.resolution)
+                low, up = resample_cell(low, mc.resolution), resample_cell(up, mc.resolution)
             ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=e_red,
                             hardness=m.hardness, method=mc.method,
                             time_derivative=mc.time_derivative, executor=executor,

@@ -15,7 +15,7 @@ from fem_twin.macro import (BOUNDARY_FRICTION, Lubricant, MacroSettings, MixedNo
                             MixedResult, solve_mixed, solve_reynolds)
 from fem_twin.macro.reynolds import fe_poiseuille
 from fem_twin.micro import FlowFactors, homogenise
-from fem_twin.topography import resample
+from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 
 from pathlib import Path
@@ -34,8 +34,8 @@ def macro_case(n):
 
 @pytest.fixture(scope="module")
 def factors():
-    low = resample(prepare_patch(read_topography(SAMPLE / "patch_1_pin.npz")), (32, 32))
-    up = resample(prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"), upper=True),
+    low = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_pin.npz")), (32, 32))
+    up = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"), upper=True),
                   (32, 32))
     return homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), n_steps=4)
 

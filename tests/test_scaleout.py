@@ -9,7 +9,7 @@ from fem_twin.io.files import read_topography
 from fem_twin.macro import Lubricant
 from fem_twin.micro import homogenise
 from fem_twin.pipeline import run_sweeps
-from fem_twin.topography import resample
+from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 
 SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "sample"
@@ -19,8 +19,8 @@ def small_sweep():
     opts = MacroOptions(resolution=(32, 32))
     pin = prepare_pin(read_topography(SAMPLE / "pin_2.npz"), opts)
     disk = prepare_disk(read_topography(SAMPLE / "disk_2.npz"), opts)
-    low = resample(prepare_patch(read_topography(SAMPLE / "patch_2_pin.npz")), (16, 16))
-    up = resample(prepare_patch(read_topography(SAMPLE / "patch_2_disk.npz"), upper=True),
+    low = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_2_pin.npz")), (16, 16))
+    up = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_2_disk.npz"), upper=True),
                   (16, 16))
     ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 8), n_steps=4)
     return dict(gap=disk.heights - pin.heights, spacing=pin.spacing, factors=ff,

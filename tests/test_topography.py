@@ -172,6 +172,25 @@ def test_resample_linear_function_exact_and_cubic_keeps_nodes():
         tp.resample(Topography(np.where(z > 2e-6, np.nan, z), 1e-6), (10, 10))
 
 
+def test_resample_cell_keeps_the_period_and_wraps_around():
+    """Roughness cells are periodic: coarsening by 2 keeps every other pixel, refining by 2
+    keeps every pixel and puts the mean of neighbours between them, including across the
+    wrap from the last pixel to the first; the period n dx is unchanged.  A cosine of one
+    period stays a cosine of one period (resample would stretch it by (n-1)/(m-1))."""
+    z = np.random.default_rng(8).normal(size=(12, 20)) * 1e-7
+    t = Topography(z, (1e-6, 2e-6))
+    coarse = tp.resample_cell(t, (6, 10))
+    assert np.array_equal(coarse.heights, z[::2, ::2])
+    fine = tp.resample_cell(t, (24, 40))
+    assert np.array_equal(fine.heights[::2, ::2], z)
+    assert np.allclose(fine.heights[::2, 1::2], (z + np.roll(z, -1, axis=1)) / 2, rtol=1e-14)
+    for out in (coarse, fine):
+        assert np.allclose(np.array(out.shape[::-1]) * out.spacing, [20e-6, 24e-6], rtol=1e-14)
+    cos = t.with_heights(1e-7 * np.cos(2 * np.pi * np.arange(20) / 20) * np.ones((12, 1)))
+    c = tp.resample_cell(cos, (12, 10)).heights[0]
+    assert np.allclose(c, 1e-7 * np.cos(2 * np.pi * np.arange(10) / 10), rtol=1e-12)
+
+
 # -- placement ---------------------------------------------------------------------------
 def test_extract_patch_takes_original_pixels():
     z = np.random.default_rng(7).normal(size=(576, 768)) * 1e-7

@@ -44,3 +44,25 @@ def refine(topo: Topography, factor: int, method: str = "linear") -> Topography:
         raise ValueError(f"refinement factor must be a positive integer, got {factor}")
     ny, nx = topo.shape
     return resample(topo, (factor * (ny - 1) + 1, factor * (nx - 1) + 1), method)
+
+
+def resample_cell(topo: Topography, shape: tuple[int, int]) -> Topography:
+    """Periodic roughness cell onto ``shape = (ny, nx)`` pixels over the same period.
+
+    The new pitch is ``n / m`` times the old one and the interpolation is linear and wraps
+    around (the last pixel's neighbour is the first), so the result is the same periodic
+    bilinear surface sampled anew: coarsening by an integer factor keeps every ``k``-th
+    pixel, refinement by ``k`` keeps every pixel and adds ``k - 1`` between neighbours.
+    (:func:`resample` spans the first and last pixels instead, which changes the period.)
+    """
+    if topo.mask is not None:
+        raise ValueError("resample_cell needs a fully valid topography: call fill_defects first")
+    ny, nx = (int(v) for v in shape)
+    if ny < 2 or nx < 2:
+        raise ValueError(f"target shape must be at least 2 x 2, got {shape}")
+    oy, ox = topo.shape
+    p2, p1 = np.meshgrid(np.arange(ny) * oy / ny, np.arange(nx) * ox / nx, indexing="ij")
+    new = ndi.map_coordinates(topo.heights, [p2, p1], order=1, mode="grid-wrap")
+    spacing = (topo.spacing[0] * ox / nx, topo.spacing[1] * oy / ny)
+    return topo.with_heights(new, spacing=spacing,
+                             meta=topo.with_history(f"resample_cell({ny}x{nx})"))
