@@ -12,7 +12,10 @@ the differences of
 OUT/patch_<k>_<method>.npz (``FlowFactors.load``), so a rerun only recomputes what is
 missing.
 
-Then, for sample patch 3 at h0 = 0.15 um (18 % contact, the first, steady step), it solves
+Then FE and FVM against a converged reference (FE on the cell refined 2x to 512^2 with
+twice the steps) for patches 1 and 3 (``--reference-patches``; about 10 minutes more).
+
+Last, for sample patch 3 at h0 = 0.15 um (18 % contact, the first, steady step), it solves
 the cell problems again on the gap refined 2x and 4x by bilinear interpolation: the table
 shows how far each method is from the continuum of that gap, and how the FVM's two face
 rules compare (``face="bilinear"``, the default, against the two-point ``"arithmetic"``).
@@ -30,6 +33,7 @@ from fem_twin.fvm import CellSolverFV
 from fem_twin.io.files import read_topography
 from fem_twin.micro import CellSolver, FlowFactors, average, homogenise
 from fem_twin.micro.homogenisation import CellSettings, sliding_contacts, sliding_pass
+from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import prepare_patch
 
 SAMPLE = Path(__file__).resolve().parent.parent / "meshes" / "sample"
@@ -84,6 +88,8 @@ def main():
     parser.add_argument("out", nargs="?", default="fe_fvm")
     parser.add_argument("--steps", type=int, default=8)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--reference-patches", type=int, nargs="*", default=[1, 3],
+                        help="patches also computed at 512^2 with twice the steps")
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -125,7 +131,32 @@ def main():
         writer.writerows(rows)
     print("worst: " + ", ".join(f"{k} {v * (1 if k == 'd' else 100):.3f}"
                                 + ("" if k == "d" else " %") for k, v in worst.items()))
+    against_reference(out, args, patches)
     refinement_study()
+
+
+def against_reference(out, args, patches):
+    """FE and FVM against a converged reference: FE on the cell refined 2x (512^2, periodic
+    bilinear) with twice the steps, for the patches of ``--reference-patches``."""
+    print(f"\nagainst the reference (FE, 512^2, {2 * args.steps} steps): "
+          "max |Delta A| / max |A|, likewise b, |Delta d|")
+    print(f"{'patch':>7} {'h0 [um]':>8} {'FE A':>8} {'FVM A':>8} {'FE b':>8} {'FVM b':>8}"
+          f" {'FE |dd|':>8} {'FVM |dd|':>8}")
+    for k in args.reference_patches:
+        path = out / f"patch_{k}_reference_{2 * args.steps}steps.npz"
+        if path.is_file():
+            ref = FlowFactors.load(path)
+        else:
+            pin, disk = (resample_cell(t, (512, 512)) for t in patch_pair(k))
+            ref = homogenise(pin, disk, H0, n_steps=2 * args.steps, workers=args.workers,
+                             error_estimate=False)
+            ref.save(path)
+        fe = flow_factor_differences(patches["fe"][k - 1], ref)
+        fv = flow_factor_differences(patches["fvm"][k - 1], ref)
+        for i, h0 in enumerate(H0):
+            print(f"{k:>7} {h0 * 1e6:8.2f} " + " ".join(
+                f"{d[key][i] * (1 if key == 'd' else 100):7.3f}{' ' if key == 'd' else '%'}"
+                for key in ("A", "b", "d") for d in (fe, fv)), flush=True)
 
 
 if __name__ == "__main__":

@@ -4,7 +4,8 @@ Both methods run on the same prepared geometry: the cell problems of every patch
 (flow factors per h0), and a Stribeck sweep at the case's first viscosity, FE with the FE
 factors and FVM with the FVM factors.  Reported: per-h0 relative differences of the
 averaged flow factors, the pressure and cavity-fraction field differences per speed, and
-C_f,dev (eq 35) along the curve, with a plot.
+C_f,dev (eq 35) along the curve, with a plot; and each method against a converged
+reference (FE on the cells refined by two with twice the steps, at three h0).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from .case import Case
 from .io.atomic import atomic_path
 from .macro import MixedResult
 from .micro import FlowFactors
+from .micro.estimate import discrepancy, grid_separations
 from .stribeck import friction_deviation, stribeck_sweep
 
 
@@ -36,6 +38,29 @@ def flow_factor_differences(fe: FlowFactors, fvm: FlowFactors) -> dict:
             "C": rel(fe.C, fvm.C, (1, 2)), "d": np.abs(fe.d - fvm.d).max(axis=1),
             "h_m": np.abs(fe.h_m - fvm.h_m) / fe.h0,
             "p_con": np.abs(fe.p_con - fvm.p_con) / max(float(fvm.p_con.max()), 1e-300)}
+
+
+def reference_factors(case: Case, outdir: Path, h0, *, executor=None,
+                      progress: bool = True) -> FlowFactors:
+    """The converged reference of the case's flow factors: FE on every patch cell refined
+    by two (periodic bilinear, :func:`~fem_twin.topography.resample_cell`) with twice the
+    time steps, at the smallest, middle and largest ``h0``; the patch average.  Both
+    refinements halve the first-order grid error and the time error of the case's
+    settings, so ``|f - f_ref|`` measures each method's own discretisation error."""
+    from .pipeline import homogenise_patches
+    mc = case.micro
+    fine = replace(case, micro=replace(mc, method="fe", steps=2 * mc.steps,
+                                       resolution=tuple(2 * n for n in mc.resolution)))
+    folder = outdir / "reference"
+    folder.mkdir(exist_ok=True)
+    if not (folder / "geometry").exists():
+        (folder / "geometry").symlink_to((outdir / "geometry").resolve(), target_is_directory=True)
+    homogenise_patches(fine, folder / "micro", executor, progress, h0=grid_separations(h0))
+    ref = FlowFactors.load(folder / "micro" / "flow_factors.npz")
+    return FlowFactors(**{k: getattr(ref, k) for k in ("h0", "h_m", "p_con", "A", "b", "C",
+                                                     "d", "contact_fraction")},
+                       meta={**ref.meta, "grid": list(fine.micro.resolution),
+                             "steps": fine.micro.steps})
 
 
 def field_differences(fe: MixedResult, fvm: MixedResult) -> dict:
@@ -67,6 +92,9 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
             c = replace(case, micro=replace(case.micro, method=method))
             homogenise_patches(c, sub / "micro", executor, progress)
             factors[method] = FlowFactors.load(sub / "micro" / "flow_factors.npz")
+    reference = reference_factors(case, outdir, factors["fe"].h0, executor=None,
+                                  progress=progress)
+    against = {m: discrepancy(factors[m], reference) for m in ("fe", "fvm")}
     ffd = flow_factor_differences(factors["fe"], factors["fvm"])
     gap, spacing, face, origin = macro_geometry(case, outdir)
     lub = case.lubricant.lubricants()[0]
@@ -91,6 +119,10 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     _plot(outdir / "compare.png", ffd, curves, dev)
     summary = {"max_flow_factor_diff": {k: float(np.max(v)) for k, v in ffd.items()
                                         if k != "h0"},
+               "against_reference": against,
+               "reference": {"grid": list(reference.meta["grid"]),
+                             "steps": reference.meta["steps"],
+                             "h0_m": reference.h0.tolist()},
                "max_abs_cf_dev": float(np.abs(dev).max()),
                "max_pressure_diff": max(f["pressure"] for f in fields),
                "max_cavity_fraction_diff": max(f["cavity_fraction"] for f in fields),

@@ -216,12 +216,14 @@ def level_pins(case: Case, outdir: Path, progress: bool = True) -> dict:
     return result
 
 
-def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool = True):
-    """Flow factors of every patch pair (checkpointed per h0) and their average."""
+def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool = True,
+                       h0=None):
+    """Flow factors of every patch pair (checkpointed per h0) and their average (``h0``:
+    the case's range unless given)."""
     folder.mkdir(parents=True, exist_ok=True)
     geo = folder.parent / "geometry"
     mc, m = case.micro, case.materials
-    h0 = np.geomspace(mc.h0_min, mc.h0_max, mc.h0_count)
+    h0 = np.geomspace(mc.h0_min, mc.h0_max, mc.h0_count) if h0 is None else np.asarray(h0)
     e_red = m.e_reduced
     factors = []
     for i in range(len(case.geometry.patches)):

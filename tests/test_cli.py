@@ -222,6 +222,11 @@ def test_compare_fe_against_fvm(tmp_path):
     summary = json.loads((out / "compare.json").read_text())
     assert 0 < summary["max_flow_factor_diff"]["A"] < 1         # 16^2 cells: coarse
     assert summary["max_abs_cf_dev"] < 0.02                       # the 2 % bar
+    # both against the converged reference (FE at 32^2, 8 steps, three h0): the reference
+    # is closer to FE than to FVM only by discretisation, so both are reported, finite
+    ref = summary["against_reference"]
+    assert summary["reference"]["grid"] == [32, 32] and summary["reference"]["steps"] == 8
+    assert set(ref) == {"fe", "fvm"} and all(0 < ref[m]["A11"] < 1 for m in ref)
     rows = list(csv.DictReader(open(out / "compare_stribeck.csv")))
     assert len(rows) == 5 and (out / "compare.png").stat().st_size > 0
 
