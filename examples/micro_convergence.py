@@ -5,8 +5,8 @@
 For each patch pair, at h0 = 0.1, 0.14, 0.3, 0.6 um:
 - time: N_t = 4, 8, 16, 32, 64 at 128 px with the exact squeeze term (the default), against
   N_t = 128 (every pixel translation of the 128 px cell);
-- grid: the periodic patches resampled to 32, 64, 128 px (N_t = 16) against the measured 256 px, with
-  the observed order from the last three grids.
+- grid: the periodic patches resampled to 32, 64, 128 px (N_t = 16) against the measured
+  256 px, with the observed order from the last three grids.
 Prints relative differences of A11, b1, d1, C11, p_con, h_m and writes them to
 ``OUT/micro_convergence.json`` (default ``out/micro_convergence``).  About 10 minutes per
 patch on 2 cores.

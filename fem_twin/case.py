@@ -192,6 +192,10 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if opts.get("clip", 1) <= 0 or opts.get("clip", 0) > 1e-3:
         raise CaseError(f"{where} [preprocessing] clip: expected metres in (0, 1e-3], "
                         f"got {opts['clip']} (20 um is 20e-6)")
+    if opts.get("sliding_direction", "+x1") not in ("+x1", "-x1", "+x2", "-x2"):
+        raise CaseError(f"{where} [preprocessing] sliding_direction: one of +x1, -x1, +x2, "
+                        f"-x2 (the measured axis along the disk velocity), got "
+                        f"{opts['sliding_direction']!r}")
     if opts.get("fwhm_px", 0) < 0:
         raise CaseError(f"{where} [preprocessing] fwhm_px must be >= 0 pixels")
     tribometer = _section(data, "tribometer", Tribometer, where, positive=True)

@@ -163,10 +163,12 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
             low_out, up_out = outdir / f"patch_{i + 1}_low.npz", outdir / f"patch_{i + 1}_up.npz"
             if not (low_out.exists() and up_out.exists()):
                 src_pin, src_disk = case.geometry.patches[i]
+                axis = case.macro_geometry.sliding_direction
                 low = prepare_patch(read_topography(src_pin), case.geometry.patch_shape,
-                                    case.geometry.patch_start)
+                                    case.geometry.patch_start, sliding_direction=axis)
                 up = prepare_patch(read_topography(src_disk), case.geometry.patch_shape,
-                                   case.geometry.patch_start, upper=True)
+                                   case.geometry.patch_start, upper=True,
+                                   sliding_direction=axis)
                 write_vtu(outdir / f"patch_{i + 1}.vtu",
                           grid_mesh(low.shape, low.spacing, periodic=True),
                           {"x3_low": low.heights, "x3_up": up.heights})

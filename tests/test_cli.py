@@ -272,3 +272,35 @@ def test_calibration_studies(tmp_path):
         assert all(0 < d < 1 for d in devs), devs
         assert (out / "cf_dev.png").stat().st_size > 0
     assert len(summary["variants"]) == 2                       # two patches in the small case
+
+
+def test_sliding_direction_turns_the_roughness_patches_too(tmp_path):
+    """Issue 18: with ``sliding_direction = "+x2"`` the measured maps are turned so that
+    x1 is the sliding direction, patches included (they were cut unturned before, so
+    ridges across the sliding direction became ridges along it).  The bundled patches
+    written as if measured with the disk moving along +x2 give the same cells, bit for
+    bit, as the bundled case."""
+    from fem_twin.pipeline import reconstruct_geometry
+    case = load_case(small_case(tmp_path))
+    turned = {}
+    for pair in case.geometry.patches:
+        for src in pair:
+            t = read_topography(src)                   # measured frame: x1 of the case is +x2
+            turned[src] = write_topography(tmp_path / "turned" / src.name, t.with_heights(
+                t.heights[::-1, :].T.copy(), spacing=t.spacing[::-1]))
+    text = small_case(tmp_path).read_text()
+    for src, dst in turned.items():
+        text = text.replace(str(src), str(dst))
+    text = text.replace('sliding_direction = "+x1"', 'sliding_direction = "+x2"')
+    (tmp_path / "turned.toml").write_text(text)
+    other = load_case(tmp_path / "turned.toml")
+    assert other.macro_geometry.sliding_direction == "+x2"
+    for c, out in ((case, tmp_path / "a"), (other, tmp_path / "b")):
+        reconstruct_geometry(c, out, progress=False)
+    for name in ("patch_1_low.npz", "patch_1_up.npz", "patch_2_up.npz"):
+        a, b = read_topography(tmp_path / "a" / name), read_topography(tmp_path / "b" / name)
+        assert np.array_equal(a.heights, b.heights) and np.allclose(a.spacing, b.spacing)
+    bad = text.replace('sliding_direction = "+x2"', 'sliding_direction = "y"')
+    (tmp_path / "bad.toml").write_text(bad)
+    with pytest.raises(CaseError, match="sliding_direction"):
+        load_case(tmp_path / "bad.toml")

@@ -6,5 +6,5 @@ from .rate import contact_rate
 from .solver import ContactNotConverged, ContactResult, solve
 
 __all__ = ["ElasticOperator", "elastic_operator", "love_rectangle", "reduced_modulus",
-           "ContactNotConverged", "ContactResult", "solve", "contact_rate", "LevellingResult", "average_pins",
-           "level_pin", "tilt_pin", "torque_residuals"]
+           "ContactNotConverged", "ContactResult", "solve", "contact_rate", "LevellingResult",
+           "average_pins", "level_pin", "tilt_pin", "torque_residuals"]

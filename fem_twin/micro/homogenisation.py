@@ -42,7 +42,7 @@ import json
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -94,8 +94,8 @@ class CellSettings:
 def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
                e_reduced: float = TABLE4["e_reduced"], hardness: float = TABLE4["hardness"],
                method: str = "fe", moving: str = "upper", time_derivative: str = "exact",
-               first_step: str = "steady", gap_floor: float = 1e-9, workers: int = 1, executor=None,
-               checkpoint=None, progress: bool = False, patch_id=None,
+               first_step: str = "steady", gap_floor: float = 1e-9, workers: int = 1,
+               executor=None, checkpoint=None, progress: bool = False, patch_id=None,
                error_estimate: bool = True) -> FlowFactors:
     """Flow factors of a roughness patch pair versus h0 (eqs 11-16).
 
@@ -180,11 +180,12 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
             "seconds": {"contact": sum(done[i].get("seconds_contact", 0.0) for i in todo),
                         "cell": sum(done[i].get("seconds_cell", 0.0) for i in todo),
                         "computed_h0": len(todo)}}
-    factors = factors_from_moments(h0[idx], [done[i] for i in idx], meta)
-    if error_estimate:
-        meta["error_estimate"] = estimate_errors(factors, [done[i] for i in idx], z_low, z_up,
-                                                 spacing, settings, folder)
-    return factors
+    moments = [done[i] for i in idx]
+    factors = factors_from_moments(h0[idx], moments, meta)
+    if not error_estimate:
+        return factors
+    estimate = estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder)
+    return replace(factors, meta={**meta, "error_estimate": estimate})
 
 
 def estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder=None) -> dict:
