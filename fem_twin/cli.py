@@ -377,11 +377,6 @@ def _run(args):
     case = load_case(args.case)
     summary = run(case, args.output, progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
-    micro = summary["stages"]["micro"]
-    for kind, errors in micro.get("above_tolerance", {}).items():
-        print(f"fem-twin run: warning: estimated {kind} error of the flow factors above "
-              f"{micro['error_tolerance']:.0%}: " + ", ".join(
-                  f"{q} {e:.1%}" for q, e in errors.items()), file=sys.stderr)
     print(f"results in {args.output}/")
     return 0
 

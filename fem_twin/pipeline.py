@@ -22,6 +22,7 @@ from tqdm import tqdm
 from .case import Case
 from .contact.levelling import average_pins, level_pin
 from .io.atomic import atomic_path
+from .io.checkpoint import load_or_none
 from .io.files import read_topography, write_topography
 from .io.mesh import grid_mesh, write_vtu
 from .macro import MacroSettings
@@ -139,7 +140,7 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
     for kind, i in tqdm(jobs, desc="geometry", disable=not progress, unit="surface"):
         if kind == "pin":
             pin_out, disk_out = outdir / f"pin_{i + 1}.npz", outdir / f"disk_{i + 1}.npz"
-            if not (pin_out.exists() and disk_out.exists()):
+            if not all(load_or_none(f, read_topography) for f in (pin_out, disk_out)):
                 pin = prepare_pin(read_topography(case.geometry.pins[i]), opts)
                 disk = (prepare_disk(read_topography(case.geometry.disks[i]), opts)
                         if case.geometry.disks else flat_disk(pin))
@@ -161,7 +162,7 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
                                                     float(pin.heights[face].max())]})
         else:
             low_out, up_out = outdir / f"patch_{i + 1}_low.npz", outdir / f"patch_{i + 1}_up.npz"
-            if not (low_out.exists() and up_out.exists()):
+            if not all(load_or_none(f, read_topography) for f in (low_out, up_out)):
                 src_pin, src_disk = case.geometry.patches[i]
                 axis = case.macro_geometry.sliding_direction
                 low = prepare_patch(read_topography(src_pin), case.geometry.patch_shape,
@@ -195,7 +196,7 @@ def level_pins(case: Case, outdir: Path, progress: bool = True) -> dict:
     n = len(case.geometry.pins)
     for i in tqdm(range(n), desc="levelling", disable=not progress, unit="pin"):
         out = folder / f"pin_{i + 1}.npz"
-        if not out.exists():
+        if load_or_none(out, read_topography) is None:
             lev = level_pin(read_topography(geo / f"pin_{i + 1}.npz"),
                             read_topography(geo / f"disk_{i + 1}.npz"), e_reduced=e_red,
                             hardness=m.hardness, holder_height=holder)
@@ -206,7 +207,7 @@ def level_pins(case: Case, outdir: Path, progress: bool = True) -> dict:
         levelled.append(pin)
         result["pins"].append({"file": out.name, "tilt_rad": pin.meta.get("tilt_rad")})
     avg_out = folder / "pin_average.npz"
-    if n > 1 and not avg_out.exists():
+    if n > 1 and load_or_none(avg_out, read_topography) is None:
         lev = level_pin(average_pins(levelled, radius=case.macro_geometry.level_radius,
                                      truncation=case.macro_geometry.truncation,
                                      holder_height=holder),
@@ -230,7 +231,7 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
     factors = []
     for i in range(len(case.geometry.patches)):
         out = folder / f"patch_{i + 1}" / "flow_factors.npz"
-        if not out.exists():
+        if load_or_none(out, FlowFactors.load) is None:
             low = read_topography(geo / f"patch_{i + 1}_low.npz")
             up = read_topography(geo / f"patch_{i + 1}_up.npz")
             if low.shape != tuple(mc.resolution):
@@ -297,7 +298,7 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                   load=tr.load, diameter=tr.pin_diameter, face=face,
                   settings=macro_settings(case),
                   checkpoint=outdir / "stribeck" / "checkpoints", fields=outdir / "fields",
-                  origin=origin)
+                  origin=origin, factors_key=stage_keys(case)["micro"])
     curves = run_sweeps(common, lb.lubricants(), executor, progress)
     write_stribeck_csv(outdir / "stribeck.csv", curves)
     labels = [f"{t:g} C, mu_0 = {c.viscosity:g} Pa s" for t, c in zip(lb.temperatures, curves)]

@@ -304,3 +304,46 @@ def test_sliding_direction_turns_the_roughness_patches_too(tmp_path):
     (tmp_path / "bad.toml").write_text(bad)
     with pytest.raises(CaseError, match="sliding_direction"):
         load_case(tmp_path / "bad.toml")
+
+
+def test_damaged_results_are_set_aside_and_recomputed(tmp_path):
+    """Issue 15 item 2: a truncated Stribeck point, a truncated patch flow-factor file and a
+    micro checkpoint that is valid JSON with the wrong content no longer crash every rerun:
+    each is moved to NAME.corrupt, reported in run.log and recomputed, and the run writes
+    the same CSV."""
+    case = small_case(tmp_path)
+    out = tmp_path / "out"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    before = (out / "stribeck.csv").read_text()
+    point = sorted((out / "stribeck" / "checkpoints").glob("point_*.npz"))[2]
+    point.write_bytes(point.read_bytes()[:100])
+    factors = out / "micro" / "patch_1" / "flow_factors.npz"
+    factors.write_bytes(factors.read_bytes()[:50])
+    ckpt = sorted((out / "micro" / "patch_2" / "checkpoints").glob("*.json"))[0]
+    ckpt.write_text(json.dumps({"h0": 1e-7, "moments": {"h": 1e-7}}))
+    (out / "micro" / "patch_2" / "flow_factors.npz").unlink()
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    assert (out / "stribeck.csv").read_text() == before
+    for damaged in (point, factors, ckpt):
+        assert damaged.with_name(damaged.name + ".corrupt").is_file(), damaged
+        assert damaged.is_file()                                        # recomputed
+    log = (out / "run.log").read_text()
+    assert log.count("unreadable result") == 3
+
+
+def test_a_lost_micro_checkpoint_does_not_recompute_the_sweep(tmp_path):
+    """Issue 15 item 7: recomputing one lost h0 checkpoint may change the flow factors at
+    round-off; the Stribeck points are keyed by the micro stage's inputs, not by those bits,
+    so none of them is recomputed and the CSV is the same."""
+    case = small_case(tmp_path)
+    out = tmp_path / "out"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    points = sorted((out / "stribeck" / "checkpoints").glob("point_*.npz"))
+    stamps = [p.stat().st_mtime_ns for p in points]
+    before = (out / "stribeck.csv").read_text()
+    sorted((out / "micro" / "patch_1" / "checkpoints").glob("*.json"))[3].unlink()
+    (out / "micro" / "patch_1" / "flow_factors.npz").unlink()
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    assert sorted((out / "stribeck" / "checkpoints").glob("point_*.npz")) == points
+    assert [p.stat().st_mtime_ns for p in points] == stamps
+    assert (out / "stribeck.csv").read_text() == before

@@ -52,6 +52,7 @@ from ..contact import contact_rate
 from ..contact import solve as contact_solve
 from ..contact.levelling import TABLE4
 from ..io.atomic import atomic_path
+from ..io.checkpoint import load_or_none
 from ..topography import Topography
 from .estimate import discrepancy, grid_separations
 from .flow_factors import FlowFactors
@@ -145,7 +146,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     todo = [i for i in order if i not in done]
     chunks = _chunks(todo, 1 if (workers <= 1 and executor is None) else 4 * max(workers, 2))
     args = dict(z_low=z_low, z_up=z_up, spacing=spacing, settings=settings,
-                folder=None if folder is None else str(folder), key=key)
+                folder=None if folder is None else str(folder), key=key,
+                half_pass=error_estimate)
     bar = _progress(len(h0), len(done), progress)
     try:
         if executor is None and workers <= 1:
@@ -193,7 +195,7 @@ def estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder=Non
     instant of this run, and the cell coarsened by two at three separations (large to
     small, warm-starting contact as the main run does)."""
     out = {}
-    if "half_h" in moments[0]:
+    if all("half_h" in m for m in moments):
         half = factors_from_moments(factors.h0, moments, {}, prefix="half_")
         out["time"] = discrepancy(factors, half)
         out["time_steps"] = [settings.n_steps, settings.n_steps // 2]
@@ -204,7 +206,7 @@ def estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder=Non
         sub = None if folder is None else folder / "coarse"
         done = _run_chunk(list(enumerate(h0))[::-1], z_low=low, z_up=up, spacing=wide,
                           settings=settings, folder=sub, key=_key(low, up, wide, settings),
-                          resume=True)
+                          resume=True, half_pass=False)
         done = [m for _, m in sorted(done, key=lambda item: item[0])]
         out["grid"] = discrepancy(factors, factors_from_moments(h0, done, {}))
         out["grid_h0"] = h0.tolist()
@@ -328,7 +330,8 @@ def sliding_cells(gaps, squeezes, solver):
         yield solver.solve(h, tau)
 
 
-def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=False):
+def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=False,
+               half_pass=True):
     """Moments for ``points = [(index, h0), ...]`` in order, warm-starting contact."""
     solver = _cell_solver(z_low.shape, spacing, settings.method)
     sliding = sliding_pass(z_low, z_up, spacing, settings)
@@ -349,7 +352,7 @@ def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=Fa
         for m, r in zip(steps, contacts):
             m["p_con"], m["contact_fraction"] = float(r.pressure.mean()), r.contact_fraction
         moments = _time_average(steps)
-        if settings.n_steps % 2 == 0:             # every other instant: the time-error estimate
+        if half_pass and settings.n_steps % 2 == 0:   # N_t / 2 instants: time-error estimate
             half = _half_pass(steps, contacts, sliding, solver, spacing, settings)
             moments.update({"half_" + k: v for k, v in _time_average(half).items()})
         moments["seconds_contact"] = t1 - t0
@@ -420,15 +423,22 @@ def _save_point(folder, key, h0, moments):
         tmp.write_text(json.dumps({"h0": float(h0), "moments": data}))
 
 
+#: the moments a checkpoint must hold (eqs 11-16)
+_MOMENTS = ("h", "h3_grad", "h3_g1", "h_grad", "h_g1", "p_con", "contact_fraction")
+
+
+def _read_point(path):
+    data = json.loads(path.read_text())
+    moments = {k: (np.array(v) if isinstance(v, list) else v)
+               for k, v in data["moments"].items()}
+    missing = [k for k in _MOMENTS if k not in moments]
+    if missing or not np.all([np.all(np.isfinite(moments[k])) for k in _MOMENTS]):
+        raise ValueError(f"checkpoint lacks or has non-finite moments {missing or ''}")
+    return moments
+
+
 def _load_point(folder, key, h0):
-    path = _point_path(folder, key, h0)
-    if not path.is_file():
-        return None
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None                              # unreadable checkpoint: recompute
-    return {k: (np.array(v) if isinstance(v, list) else v) for k, v in data["moments"].items()}
+    return load_or_none(_point_path(folder, key, h0), _read_point)
 
 
 def _progress(total, initial, enabled):

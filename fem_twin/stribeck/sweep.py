@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from ..io.checkpoint import load_or_none
 from ..io.mesh import write_pvd
 from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
 from ..micro.flow_factors import FlowFactors
@@ -18,19 +19,24 @@ from .curve import StribeckCurve, hersey_number
 def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    lubricant: Lubricant, diameter: float = 8e-3, face=None,
                    settings: MacroSettings = MacroSettings(), checkpoint=None, fields=None,
-                   origin=(0.0, 0.0), progress: bool = False) -> StribeckCurve:
+                   origin=(0.0, 0.0), progress: bool = False,
+                   factors_key: str | None = None) -> StribeckCurve:
     """C_f over ``speeds`` [m/s] at one viscosity (paper 3.2: from 2 m/s down to 0.01 m/s).
 
     Each point warm-starts from the previous one (give speeds from fast to slow: the
     hydrodynamic film is the easy start).  ``checkpoint``: folder that keeps every
     finished point (``MixedResult`` npz, keyed by a hash of all inputs); a rerun loads
     them instead of recomputing.  ``fields``: folder for one VTU per speed and a PVD.
+    ``factors_key``: a key of the inputs the flow factors were computed from (the pipeline's
+    micro-stage key); the checkpoints then depend on it instead of the factors' bits, so
+    recomputing a lost micro checkpoint (same numbers to ~1e-10) keeps the points.
     """
     speeds = np.asarray(speeds, float)
     if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
         raise ValueError("speeds must be a non-empty list of positive values [m/s]")
     gap = np.asarray(gap, float)
-    key = _key(gap, spacing, factors, load, lubricant, settings, face)
+    key = _key(gap, spacing, factors if factors_key is None else factors_key, load, lubricant,
+               settings, face)
     folder = Path(checkpoint) if checkpoint is not None else None
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
@@ -38,9 +44,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     for i, speed in enumerate(tqdm(speeds, desc=f"Stribeck mu0={lubricant.viscosity:g}",
                                    disable=not progress, unit="speed")):
         path = None if folder is None else folder / f"point_{key}_{i:03d}_{speed:.6e}.npz"
-        if path is not None and path.exists():
-            res = MixedResult.load(path)
-        else:
+        res = None if path is None else load_or_none(path, MixedResult.load)
+        if res is None:
             res = solve_mixed(gap, spacing, factors, load=load, speed=float(speed),
                               lubricant=lubricant, face=face, settings=settings,
                               initial=previous)
@@ -69,8 +74,10 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
 
 def _key(gap, spacing, factors, load, lubricant, settings, face) -> str:
     h = hashlib.sha256()
-    for a in (gap, np.asarray(spacing, float), factors.h0, factors.h_m, factors.p_con,
-              factors.A, factors.b, factors.C, factors.d,
+    flow = ((factors.h0, factors.h_m, factors.p_con, factors.A, factors.b, factors.C,
+             factors.d) if isinstance(factors, FlowFactors) else (np.frombuffer(
+                 str(factors).encode(), np.uint8),))
+    for a in (gap, np.asarray(spacing, float), *flow,
               np.zeros(0) if face is None else np.asarray(face, bool)):
         h.update(np.ascontiguousarray(a).tobytes())
     h.update(json.dumps([load, lubricant.__dict__, settings.__dict__], sort_keys=True,
