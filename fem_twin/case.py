@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -133,6 +134,20 @@ class Case:
     run: RunSpec = field(default_factory=RunSpec)
     measured: tuple[Path | None, ...] = ()   # [validation] measured curves per viscosity
     source: Path | None = None
+    defaulted: tuple[str, ...] = ()          # sections absent from the file (defaults used)
+
+    def estimated_seconds(self, cores: int = 2) -> float:
+        """Rough wall time of ``fem-twin run`` on ``cores`` cores [s], from the costs measured
+        on this project's 2-core machine: ~3 us per cell pixel and time step of the micro
+        stage on one core, ~1 s per Stribeck point at 128^2 growing as N^1.2 (pixels)."""
+        patches = len(self.geometry.patches)
+        micro = (3e-6 * self.micro.resolution[0] * self.micro.resolution[1] * self.micro.steps
+                 * self.micro.h0_count * patches / max(cores, 1))
+        res = self.macro_geometry.resolution or (256, 256)
+        point = ((res[0] * res[1]) / 128 ** 2) ** 1.2
+        n_mu = len(self.lubricant.viscosities)
+        macro = point * self.sweep.count * n_mu / max(1, min(cores, n_mu))
+        return micro + macro
 
 
 def load_case(path) -> Case:
@@ -187,8 +202,11 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if "resolution" in opts:
         opts["resolution"] = _int_pair(opts["resolution"], f"{where} [preprocessing] resolution")
     for key in ("fwhm_px", "clip", "truncation", "holder_height", "level_radius"):
-        if key in opts and not isinstance(opts[key], (int, float)):
-            raise CaseError(f"{where} [preprocessing] {key}: expected a number (SI units)")
+        if key in opts and (not isinstance(opts[key], (int, float))
+                            or not math.isfinite(opts[key])):
+            raise CaseError(f"{where} [preprocessing] {key}: expected a finite number (SI "
+                            "units)")
+        _plausible("preprocessing", key, opts.get(key), where)
     if opts.get("clip", 1) <= 0 or opts.get("clip", 0) > 1e-3:
         raise CaseError(f"{where} [preprocessing] clip: expected metres in (0, 1e-3], "
                         f"got {opts['clip']} (20 um is 20e-6)")
@@ -200,6 +218,8 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
         raise CaseError(f"{where} [preprocessing] fwhm_px must be >= 0 pixels")
     tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
     lubricant = _section(data, "lubricant", LubricantSpec, where, positive=True)
+    if not lubricant.viscosities:
+        raise CaseError(f"{where} [lubricant] viscosities: give at least one mu_0 [Pa s]")
     if len(lubricant.temperatures) != len(lubricant.viscosities):
         raise CaseError(f"{where} [lubricant]: give one temperature per viscosity")
     if any(v > 10 for v in lubricant.viscosities):
@@ -238,10 +258,13 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     for m in measured:
         if m is not None and not m.is_file():
             raise CaseError(f"{where} [validation] measured: file not found: {m}")
+    defaulted = tuple(name for name in ("preprocessing", "tribometer", "lubricant",
+                                        "materials", "micro", "macro", "sweep", "run")
+                      if name not in data)
     return Case(name=str(data.get("name", source.stem if source else "case")),
                 geometry=geometry, macro_geometry=MacroOptions(**opts), tribometer=tribometer,
                 lubricant=lubricant, materials=materials, micro=micro, macro=macro,
-                sweep=sweep, run=run, measured=measured, source=source)
+                sweep=sweep, run=run, measured=measured, source=source, defaulted=defaulted)
 
 
 def _section(data, name, cls, where, positive=False):
@@ -252,12 +275,15 @@ def _section(data, name, cls, where, positive=False):
     for f in fields(cls):
         if f.name not in table:
             continue
+        _plausible(name, f.name, table[f.name], where)
         v = table[f.name]
         default = getattr(cls(), f.name)
         if isinstance(default, tuple):
             if not isinstance(v, list) or not all(isinstance(x, (int, float)) for x in v):
                 raise CaseError(f"{where} [{name}] {f.name}: expected a list of numbers")
             v = tuple(type(default[0])(x) if default else x for x in v)
+            if not all(math.isfinite(x) for x in v):
+                raise CaseError(f"{where} [{name}] {f.name}: values must be finite numbers")
             if positive and any(x <= 0 for x in v):
                 raise CaseError(f"{where} [{name}] {f.name}: values must be positive (SI units)")
         elif isinstance(default, bool) or default is None or isinstance(default, str):
@@ -266,11 +292,49 @@ def _section(data, name, cls, where, positive=False):
         elif isinstance(default, (int, float)):
             if not isinstance(v, (int, float)) or isinstance(v, bool):
                 raise CaseError(f"{where} [{name}] {f.name}: expected a number (SI units)")
+            if not math.isfinite(v):
+                raise CaseError(f"{where} [{name}] {f.name}: must be a finite number, got {v}")
             if positive and v <= 0:
                 raise CaseError(f"{where} [{name}] {f.name}: must be positive (SI units)")
             v = type(default)(v) if isinstance(default, float) else v
         values[f.name] = v
     return cls(**values)
+
+
+#: (section, key) -> (lowest, highest) plausible value in SI units, and the hint shown
+PLAUSIBLE = {
+    ("tribometer", "load"): (1e-3, 1e4, "N"),
+    ("tribometer", "pin_diameter"): (1e-4, 0.1, "m (8 mm is 8e-3)"),
+    ("tribometer", "sliding_radius"): (1e-3, 1.0, "m (20 mm is 20e-3)"),
+    ("lubricant", "viscosities"): (1e-5, 10.0, "Pa s (66 mPa s is 0.066)"),
+    ("lubricant", "density"): (100.0, 2e4, "kg/m^3"),
+    ("lubricant", "roelands_alpha"): (0.0, 1e-7, "1/Pa (22 GPa^-1 is 22e-9)"),
+    ("materials", "e_pin"): (1e8, 2e12, "Pa (210 GPa is 210e9)"),
+    ("materials", "e_disk"): (1e8, 2e12, "Pa (210 GPa is 210e9)"),
+    ("materials", "nu_pin"): (0.0, 0.4999, "Poisson ratio in [0, 0.5)"),
+    ("materials", "nu_disk"): (0.0, 0.4999, "Poisson ratio in [0, 0.5)"),
+    ("materials", "hardness"): (1e7, 1e11, "Pa (6.99 GPa is 6.99e9)"),
+    ("micro", "h0_min"): (1e-10, 1e-4, "m (0.1 um is 1e-7)"),
+    ("micro", "h0_max"): (1e-10, 1e-4, "m (1 um is 1e-6)"),
+    ("sweep", "speed_max"): (1e-6, 100.0, "m/s"),
+    ("sweep", "speed_min"): (1e-6, 100.0, "m/s"),
+    ("preprocessing", "fwhm_px"): (0.0, 200.0, "pixels (0 or at least 1)"),
+}
+
+
+def _plausible(section, key, value, where):
+    """Refuse a value outside the plausible SI range of ``PLAUSIBLE``, naming the key."""
+    if (section, key) not in PLAUSIBLE or isinstance(value, bool):
+        return
+    lo, hi, unit = PLAUSIBLE[(section, key)]
+    values = value if isinstance(value, list) else [value]
+    for v in values:
+        if isinstance(v, (int, float)) and math.isfinite(v) and not lo <= v <= hi:
+            raise CaseError(f"{where} [{section}] {key} = {v}: implausible; expected "
+                            f"{lo:g} to {hi:g} {unit}")
+    if key == "fwhm_px" and isinstance(value, (int, float)) and 0 < value < 1:
+        raise CaseError(f"{where} [preprocessing] fwhm_px = {value}: the filter width is in "
+                        "pixels (0: no filter, else at least 1; the paper's is 9)")
 
 
 def _only(section, allowed: set, where: str):

@@ -61,8 +61,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     sub = p.add_subparsers(dest="command", required=True, metavar="STAGE")
 
-    _case_command(sub, "run", "run the pipeline of a case file (TOML) into an output folder",
-                  "out", _run)
+    rn = _case_command(sub, "run", "run the pipeline of a case file (TOML) into an output "
+                                   "folder", "out", _run)
+    rn.add_argument("--yes", action="store_true",
+                    help=f"start even if estimated longer than {LONG_RUN_SECONDS // 60} min")
     _case_command(sub, "compare", "cross-check FE against the FVM reference on a case: "
                                   "flow factors, fields, C_f,dev (eq 35)", "compare", _compare)
     cb = _case_command(sub, "calibrate", "calibration study of a case (paper 3.2): C_f,dev "
@@ -368,6 +370,31 @@ def _sample(args):
     return 0
 
 
+#: runs estimated longer than this ask for --yes (the bundled case: about 1 minute)
+LONG_RUN_SECONDS = 10 * 60
+
+
+def _confirm_cost(case, yes: bool) -> bool:
+    """Say which sections take defaults and what the run will cost; refuse a long run
+    without ``--yes``."""
+    if case.defaulted:
+        print(f"fem-twin run: sections not in {case.source.name}, defaults used: " + ", ".join(
+            f"[{s}]" for s in case.defaulted), file=sys.stderr)
+    cores = case.run.workers or os.cpu_count() or 1
+    seconds = case.estimated_seconds(cores)
+    mc = case.micro
+    print(f"fem-twin run: {len(case.geometry.patches)} patch pairs at {mc.resolution[0]}x"
+          f"{mc.resolution[1]}, {mc.h0_count} h0 x {mc.steps} steps; "
+          f"{len(case.lubricant.viscosities)} x {case.sweep.count} speeds; estimated "
+          f"{seconds / 60:.0f} min on {cores} cores", file=sys.stderr)
+    if seconds > LONG_RUN_SECONDS and not yes:
+        print(f"fem-twin run: error: this run is estimated at {seconds / 60:.0f} min (the "
+              "bundled case: about 1 min); check the case and run again with --yes",
+              file=sys.stderr)
+        return False
+    return True
+
+
 def _run(args):
     from .case import load_case
     from .pipeline import run
@@ -375,6 +402,8 @@ def _run(args):
         raise FileNotFoundError(f"case file not found: {args.case} (give the case file as "
                                 "the first argument)")
     case = load_case(args.case)
+    if not _confirm_cost(case, args.yes):
+        return 2
     summary = run(case, args.output, progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
     print(f"results in {args.output}/")

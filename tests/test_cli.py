@@ -347,3 +347,39 @@ def test_a_lost_micro_checkpoint_does_not_recompute_the_sweep(tmp_path):
     assert sorted((out / "stribeck" / "checkpoints").glob("point_*.npz")) == points
     assert [p.stat().st_mtime_ns for p in points] == stamps
     assert (out / "stribeck.csv").read_text() == before
+
+
+@pytest.mark.parametrize("old,new,key", [
+    ("load = 150.0", "load = nan", "load"), ("speed_max = 2.0", "speed_max = inf", "speed_max"),
+    ("load = 150.0", "load = 150000", "load"), ("e_pin = 210e9", "e_pin = 210", "e_pin"),
+    ("nu_pin = 0.3", "nu_pin = 1.0", "nu_pin"), ("nu_disk = 0.3", "nu_disk = 0.7", "nu_disk"),
+    ("pin_diameter = 8e-3", "pin_diameter = 8", "pin_diameter"),
+    ("speed_max = 2.0", "speed_max = 2000", "speed_max"),
+    ("fwhm_px = 9 ", "fwhm_px = 9e-6 ", "fwhm_px"), ("hardness = 6.99e9", "hardness = 7", "hardness"),
+    ("viscosities = [0.066, 0.024] # mu_0 [Pa s] at the temperatures below\n"
+     "temperatures = [24.0, 50.0]", "viscosities = []\ntemperatures = []", "viscosities")])
+def test_implausible_case_values_are_refused_naming_the_key(tmp_path, old, new, key):
+    """Issues 15 (item 5) and 18 (item 3): non-finite numbers and unit slips (mm, GPa, mPa s
+    typed as SI) are refused when the case is read, with the key in the message."""
+    text = small_case(tmp_path).read_text()
+    assert old in text
+    (tmp_path / "bad.toml").write_text(text.replace(old, new))
+    with pytest.raises(CaseError, match=key):
+        load_case(tmp_path / "bad.toml")
+    assert main(["run", str(tmp_path / "bad.toml"), "-o", str(tmp_path / "o"),
+                 "--no-progress"]) == 2
+
+
+def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, capsys):
+    """Issue 15 item 3: a case cut off after [geometry] is valid TOML; the defaults (the
+    paper's 256^2, 100 h0 x 32 steps) are named before work starts, and a run estimated
+    far above the bundled case's stops with exit 2 unless --yes is given."""
+    text = (ROOT / "examples" / "pin_on_disk.toml").read_text()
+    text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
+    cut = tmp_path / "cut.toml"
+    cut.write_text(text[:text.index("[preprocessing]")])
+    assert main(["run", str(cut), "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "defaults used: [preprocessing], [tribometer]" in err and "[micro]" in err
+    assert "256x256, 100 h0 x 32 steps" in err and "--yes" in err
+    assert not (tmp_path / "o" / "geometry").exists()
