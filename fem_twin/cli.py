@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NotConverged
+from .errors import NotConverged, RunLocked, SchedulerUnreachable
 
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
@@ -35,6 +35,17 @@ _STEPS = {
 }
 
 
+#: exit codes (README "When something goes wrong"): exception types -> (code, label, advice)
+EXIT_CODES = (
+    ((ValueError, FileNotFoundError, IsADirectoryError, NotADirectoryError), 2, "error",
+     "check the input named above"),
+    ((NotConverged,), 3, "not converged", "the residual history is in run.log; see README"),
+    ((OSError,), 4, "file system", "check free space and write permission of the folder"),
+    ((SchedulerUnreachable,), 5, "cluster", "start the scheduler or remove [run] scheduler"),
+    ((RunLocked,), 6, "busy", ""),
+)
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -42,12 +53,31 @@ def main(argv=None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     try:
         return args.func(args) or 0
-    except (ValueError, FileNotFoundError) as err:
-        print(f"fem-twin {args.command}: error: {err}", file=sys.stderr)
-        return 2
-    except NotConverged as err:
-        print(f"fem-twin {args.command}: not converged: {err}", file=sys.stderr)
-        return 3
+    except KeyboardInterrupt:
+        print(f"fem-twin {args.command}: interrupted; finished work is kept, run the same "
+              "command again to resume", file=sys.stderr)
+        return 130
+    except Exception as err:                   # one line for the user, traceback on request
+        if args.debug:
+            raise
+        return _report(args.command, err)
+
+
+def _report(command: str, err: Exception) -> int:
+    """Print one line (what, and what to do) and return the documented exit code."""
+    for types, code, label, advice in EXIT_CODES:
+        if isinstance(err, types):
+            hint = f" ({advice})" if advice and code != 2 else ""
+            print(f"fem-twin {command}: {label}: {_one_line(err)}{hint}", file=sys.stderr)
+            return code
+    print(f"fem-twin {command}: internal error: {type(err).__name__}: {_one_line(err)} "
+          "(run again with --debug for the traceback, and please report it)", file=sys.stderr)
+    return 1
+
+
+def _one_line(err: Exception) -> str:
+    text = " ".join(str(err).split())
+    return text if len(text) < 400 else text[:400] + " ..."
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -59,6 +89,8 @@ def build_parser() -> argparse.ArgumentParser:
                     "'run' executes the whole pipeline of a case file.")
     p.add_argument("--version", action="version", version=f"fem-twin {__version__}")
     p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    p.add_argument("--debug", action="store_true",
+                   help="show the Python traceback of an error (otherwise one line)")
     sub = p.add_subparsers(dest="command", required=True, metavar="STAGE")
 
     rn = _case_command(sub, "run", "run the pipeline of a case file (TOML) into an output "

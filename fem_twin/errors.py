@@ -16,3 +16,11 @@ class NotConverged(RuntimeError):
     def __reduce__(self):
         # rebuilt from its arguments when it crosses to or from a worker process
         return type(self), (self.message, self.history)
+
+
+class RunLocked(RuntimeError):
+    """Another process holds the output folder of a run."""
+
+
+class SchedulerUnreachable(RuntimeError):
+    """The Dask scheduler of ``[run] scheduler`` could not be reached."""

@@ -21,6 +21,7 @@ from tqdm import tqdm
 
 from .case import Case
 from .contact.levelling import average_pins, level_pin
+from .errors import RunLocked, SchedulerUnreachable
 from .io.atomic import atomic_path
 from .io.checkpoint import load_or_none
 from .io.files import read_topography, write_topography
@@ -43,7 +44,7 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     summary = {"case": case.name, "stages": {}, "seconds": {}}
-    with _logfile(outdir / "run.log"), executor_for(case) as executor:
+    with _lock(outdir), _logfile(outdir / "run.log"), executor_for(case) as executor:
         log.info("case %s -> %s", case.source, outdir)
         invalidate_changed_stages(case, outdir)
         stages = (("geometry", lambda: reconstruct_geometry(case, outdir / "geometry", progress)),
@@ -54,7 +55,11 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
         for name, stage in stages:
             t = time.perf_counter()
             log.info("stage %s", name)
-            summary["stages"][name] = stage()
+            try:
+                summary["stages"][name] = stage()
+            except BaseException:
+                log.exception("stage %s failed", name)
+                raise
             summary["seconds"][name] = round(time.perf_counter() - t, 2)
             log.info("stage %s done in %.1f s", name, summary["seconds"][name])
     summary["wall_time_s"] = time.perf_counter() - t0
@@ -114,12 +119,40 @@ def _logfile(path):
 
 
 @contextmanager
+def _lock(outdir: Path):
+    """One run per output folder: an exclusive lock on ``OUT/.lock``, released when the run
+    ends, however it ends (the system drops it with the process, also on kill -9)."""
+    import fcntl
+    f = open(outdir / ".lock", "a+")
+    try:
+        try:
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            f.seek(0)
+            holder = f.read().strip() or "another process"
+            raise RunLocked(f"{outdir} is in use by fem-twin run (pid {holder}); wait for it "
+                            "to finish or choose another output folder (-o)") from None
+        f.seek(0)
+        f.truncate()
+        f.write(str(os.getpid()))
+        f.flush()
+        yield
+    finally:
+        f.close()
+
+
+@contextmanager
 def executor_for(case: Case):
     """Local process pool (``[run] workers``, 0 = all cores) or a Dask cluster's executor
     (``[run] scheduler`` address); None for one worker."""
     if case.run.scheduler:
         from distributed import Client
-        with Client(case.run.scheduler) as client:
+        try:
+            client = Client(case.run.scheduler, timeout="5s")
+        except (OSError, TimeoutError) as err:
+            raise SchedulerUnreachable(f"could not reach the Dask scheduler "
+                                       f"{case.run.scheduler} ([run] scheduler): {err}") from err
+        with client:
             yield client.get_executor()
         return
     workers = case.run.workers or os.cpu_count() or 1

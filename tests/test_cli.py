@@ -161,8 +161,7 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
 
     out = tmp_path / "out"
     monkeypatch.setattr(sweep, "solve_mixed", interrupted)
-    with pytest.raises(KeyboardInterrupt):
-        main(["run", str(case), "-o", str(out), "--no-progress"])
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 130   # Ctrl-C
     assert not (out / "stribeck.csv").exists()
     monkeypatch.setattr(sweep, "solve_mixed", real)
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
@@ -383,3 +382,68 @@ def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, 
     assert "defaults used: [preprocessing], [tribometer]" in err and "[micro]" in err
     assert "256x256, 100 h0 x 32 steps" in err and "--yes" in err
     assert not (tmp_path / "o" / "geometry").exists()
+
+
+def test_failures_are_one_line_with_documented_exit_codes(tmp_path, monkeypatch, capsys):
+    """Issue 15 item 6: every failure is one line on stderr and an exit code from the README
+    table; the traceback only with --debug (and in run.log)."""
+    import errno
+
+    import fem_twin.pipeline as pipeline
+    case = small_case(tmp_path)
+    out = tmp_path / "o"
+
+    def fail_with(err):
+        def stage(*args, **kwargs):
+            raise err
+        monkeypatch.setattr(pipeline, "reconstruct_geometry", stage)
+
+    for err, code, words in ((OSError(errno.ENOSPC, "No space left on device"), 4, "space"),
+                             (KeyError("pins"), 1, "internal error: KeyError"),
+                             (KeyboardInterrupt(), 130, "run the same command again")):
+        fail_with(err)
+        assert main(["run", str(case), "-o", str(out), "--no-progress"]) == code
+        lines = capsys.readouterr().err.strip().splitlines()
+        assert words in lines[-1] and not any("Traceback" in ln for ln in lines)
+    assert "Traceback" in (out / "run.log").read_text()             # the details are kept
+    fail_with(KeyError("pins"))
+    with pytest.raises(KeyError):
+        main(["--debug", "run", str(case), "-o", str(out), "--no-progress"])
+    text = case.read_text().replace("workers = 1", 'scheduler = "tcp://127.0.0.1:9"')
+    (tmp_path / "dask.toml").write_text(text)
+    monkeypatch.undo()
+    assert main(["run", str(tmp_path / "dask.toml"), "-o", str(out), "--no-progress"]) == 5
+    assert "could not reach the Dask scheduler tcp://127.0.0.1:9" in capsys.readouterr().err
+
+
+def test_one_run_per_output_folder(tmp_path, capsys):
+    """Issue 15 item 8: a second run into a folder in use refuses with exit 6 and says who
+    holds it; the lock goes with the process that held it, also on kill -9."""
+    import fcntl
+    import signal
+    import time
+    case = small_case(tmp_path)
+    out = tmp_path / "o"
+    out.mkdir()
+    holder = subprocess.Popen([sys.executable, "-c", (
+        "import fcntl, os, time\n"
+        f"f = open({str(out / '.lock')!r}, 'a+'); fcntl.flock(f, fcntl.LOCK_EX)\n"
+        "f.seek(0); f.truncate(); f.write(str(os.getpid())); f.flush()\n"
+        "print('locked', flush=True); time.sleep(60)\n")], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 6
+        err = capsys.readouterr().err
+        assert f"in use by fem-twin run (pid {holder.pid})" in err
+    finally:
+        holder.send_signal(signal.SIGKILL)
+        holder.wait()
+    with open(out / ".lock", "a+") as f:                 # released by the kill
+        for _ in range(50):
+            try:
+                fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                time.sleep(0.1)
+        else:
+            pytest.fail("lock not released after kill -9")
