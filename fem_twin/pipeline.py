@@ -33,6 +33,7 @@ from .micro.output import plot_flow_factors
 from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)
 from .topography import resample_cell
+from .topography.plausibility import check_patch, check_pin
 from .topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
 
 log = logging.getLogger("fem_twin")
@@ -174,7 +175,9 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
         if kind == "pin":
             pin_out, disk_out = outdir / f"pin_{i + 1}.npz", outdir / f"disk_{i + 1}.npz"
             if not all(load_or_none(f, read_topography) for f in (pin_out, disk_out)):
-                pin = prepare_pin(read_topography(case.geometry.pins[i]), opts)
+                raw = read_topography(case.geometry.pins[i])
+                check_pin(raw, case.geometry.pins[i].name, case.tribometer.pin_diameter)
+                pin = prepare_pin(raw, opts)
                 disk = (prepare_disk(read_topography(case.geometry.disks[i]), opts)
                         if case.geometry.disks else flat_disk(pin))
                 if disk.shape != pin.shape:
@@ -203,6 +206,9 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
                 up = prepare_patch(read_topography(src_disk), case.geometry.patch_shape,
                                    case.geometry.patch_start, upper=True,
                                    sliding_direction=axis)
+                for t, src in ((low, src_pin), (up, src_disk)):
+                    for warning in check_patch(t, src.name, case.tribometer.pin_diameter):
+                        log.warning("%s", warning)
                 write_vtu(outdir / f"patch_{i + 1}.vtu",
                           grid_mesh(low.shape, low.spacing, periodic=True),
                           {"x3_low": low.heights, "x3_up": up.heights})

@@ -447,3 +447,21 @@ def test_one_run_per_output_folder(tmp_path, capsys):
                 time.sleep(0.1)
         else:
             pytest.fail("lock not released after kill -9")
+
+
+@pytest.mark.parametrize("which,heights,pitch,words", [
+    ("patch", 1e3, 1, "Sq = "), ("patch", 1e-3, 1, "Sq = "),
+    ("patch", 1, 1e3, "pixel pitch"), ("pin", 1, 1e3, "against a pin")])
+def test_unit_slips_in_topographies_are_refused(tmp_path, capsys, which, heights, pitch, words):
+    """Issue 15 item 9: a roughness patch 1e3 too high (p_con at the hardness everywhere) or
+    too low (a smooth cell), a pitch in mm taken as m: refused before any work, exit 2."""
+    case = small_case(tmp_path)
+    text = case.read_text()
+    src = (ROOT / "meshes" / "sample" / ("patch_1_pin.npz" if which == "patch" else "pin_1.npz"))
+    t = read_topography(src)
+    bad = write_topography(tmp_path / f"bad_{src.name}", t.with_heights(
+        t.heights * heights, spacing=tuple(pitch * v for v in t.spacing)), height_scale=None)
+    case.write_text(text.replace(str(src), str(bad)))
+    assert main(["run", str(case), "-o", str(tmp_path / "o"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert words in err and bad.name in err
