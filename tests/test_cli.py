@@ -465,3 +465,20 @@ def test_unit_slips_in_topographies_are_refused(tmp_path, capsys, which, heights
     assert main(["run", str(case), "-o", str(tmp_path / "o"), "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert words in err and bad.name in err
+
+
+def test_a_point_that_does_not_converge_in_a_worker_reports_its_history(tmp_path, monkeypatch,
+                                                                         capsys):
+    """Issue 15 item 1: a non-converged Stribeck point inside a worker process (two
+    viscosities on two processes) came back as 'process terminated abruptly' (its error did
+    not survive pickling); now exit 3 with the residual history."""
+    from dataclasses import replace
+
+    import fem_twin.pipeline as pipeline
+    real = pipeline.macro_settings
+    monkeypatch.setattr(pipeline, "macro_settings",
+                        lambda case, method=None: replace(real(case, method), max_iter=2))
+    case = small_case(tmp_path, workers=2)
+    assert main(["run", str(case), "-o", str(tmp_path / "o"), "--no-progress"]) == 3
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "not converged" in err and "last residuals" in err and "abruptly" not in err
