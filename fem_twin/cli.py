@@ -437,9 +437,28 @@ def _run(args):
     if not _confirm_cost(case, args.yes):
         return 2
     summary = run(case, args.output, progress=not args.no_progress)
-    print(json.dumps(summary, indent=2))
-    print(f"results in {args.output}/")
+    print(_short_summary(summary, args.output))
     return 0
+
+
+def _short_summary(summary: dict, out: Path) -> str:
+    """A few lines for the terminal; everything is in ``OUT/summary.json``."""
+    stages = summary["stages"]
+    lines = [f"fem-twin run: {summary['case']} done in {summary['wall_time_s']:.0f} s ("
+             + ", ".join(f"{k} {v:.0f} s" for k, v in summary["seconds"].items()) + ")"]
+    for c in stages["stribeck"]["curves"]:
+        lo, hi = c["friction_coefficient_range"]
+        lines.append(f"  mu_0 = {c['viscosity_Pa_s']:g} Pa s: C_f from {lo:.4f} to {hi:.4f}")
+    if "hersey_collapse_max_abs_cf_dev" in stages["stribeck"]:
+        lines.append("  Hersey collapse: max |C_f,dev| = "
+                     f"{stages['stribeck']['hersey_collapse_max_abs_cf_dev']:.2%} (eq 35)")
+    est = stages["micro"].get("error_estimate", {})
+    for kind in ("time", "grid"):
+        if kind in est:
+            lines.append(f"  flow factors, estimated {kind} error: " + ", ".join(
+                f"{q} {e:.1%}" for q, e in est[kind].items() if q in ("A11", "b1", "p_con")))
+    lines.append(f"results in {out}/ (stribeck.csv, plots, fields/, summary.json, run.log)")
+    return "\n".join(lines)
 
 
 def _calibrate(args):

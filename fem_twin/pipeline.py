@@ -44,7 +44,8 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    summary = {"case": case.name, "stages": {}, "seconds": {}}
+    summary = {"case": case.name, "provenance": provenance(case), "stages": {},
+               "seconds": {}}
     with _lock(outdir), _logfile(outdir / "run.log"), executor_for(case) as executor:
         log.info("case %s -> %s", case.source, outdir)
         invalidate_changed_stages(case, outdir)
@@ -67,6 +68,25 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
     with atomic_path(outdir / "summary.json") as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     return summary
+
+
+def provenance(case: Case) -> dict:
+    """fem_twin version, git commit of the source when it is a checkout, case file hash."""
+    import hashlib
+    import subprocess
+
+    from . import __version__
+    commit = None
+    try:
+        commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
+                                cwd=Path(__file__).parent, timeout=10).stdout.strip() or None
+    except (OSError, subprocess.SubprocessError):
+        pass
+    digest = (hashlib.sha256(case.source.read_bytes()).hexdigest()[:16]
+              if case.source is not None else None)
+    return {"fem_twin_version": __version__, "git_commit": commit,
+            "case_file": str(case.source), "case_sha256": digest,
+            "started": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
 
 
 def stage_keys(case: Case) -> dict:
@@ -343,6 +363,11 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
     labels = [f"{t:g} C, mu_0 = {c.viscosity:g} Pa s" for t, c in zip(lb.temperatures, curves)]
     plot_stribeck(curves, outdir / "stribeck_speed.png", x="speed", labels=labels)
     plot_stribeck(curves, outdir / "stribeck_hersey.png", x="hersey", labels=labels)
+    for c in curves:
+        for u, cf, it, share in zip(c.speed, c.friction_coefficient, c.iterations,
+                                    c.contact_load_fraction):
+            log.info("point mu_0 = %g Pa s, U = %.4g m/s: C_f = %.5f, contact share %.3f, "
+                     "%d iterations", c.viscosity, u, cf, share, it)
     out = {"curves": [{"viscosity_Pa_s": c.viscosity,
                        "friction_coefficient_range": [float(c.friction_coefficient.min()),
                                                       float(c.friction_coefficient.max())]}

@@ -136,6 +136,11 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
         assert (ref / name).is_file(), name
     summary = json.loads((ref / "summary.json").read_text())
     assert summary["stages"]["levelling"]["macro_pin"] == "pin_average.npz"
+    import hashlib
+    prov = summary["provenance"]                                   # issue 18 item 6
+    assert prov["case_sha256"] == hashlib.sha256(case.read_bytes()).hexdigest()[:16]
+    assert prov["fem_twin_version"] and "git_commit" in prov
+    assert "point mu_0 = 0.066 Pa s, U = 2 m/s" in (ref / "run.log").read_text()
 
     # validation (paper 3.3): a "measured" curve 1 % of C_f,b above the simulated one
     r66 = [x for x in rows if float(x["viscosity"]) == 0.066]
