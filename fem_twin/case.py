@@ -31,7 +31,7 @@ class Tribometer:
 
     load: float = 150.0
     pin_diameter: float = 8e-3
-    sliding_radius: float = 20e-3
+    sliding_radius: float = 30e-3
 
 
 @dataclass(frozen=True)

@@ -85,8 +85,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="fem-twin",
         description="Digital twin of a pin-on-disk tribometer in mixed lubrication. "
-                    "Stages: topography -> contact -> homogenise -> (macro -> stribeck); "
-                    "'run' executes the whole pipeline of a case file.")
+                    "Stages: topography -> contact -> homogenise -> macro; 'run' executes "
+                    "the whole pipeline of a case file (up to the Stribeck curve). Exit "
+                    "codes: README, 'When something goes wrong'.")
     p.add_argument("--version", action="version", version=f"fem-twin {__version__}")
     p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     p.add_argument("--debug", action="store_true",

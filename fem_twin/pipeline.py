@@ -28,10 +28,12 @@ from .io.files import read_topography, write_topography
 from .io.mesh import grid_mesh, write_vtu
 from .macro import MacroSettings
 from .micro import FlowFactors, average, homogenise
+from .micro.homogenisation import prune_checkpoints
 from .micro.estimate import exceeding
 from .micro.output import plot_flow_factors
 from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)
+from .stribeck.sweep import sweep_key
 from .topography import resample_cell
 from .topography.plausibility import check_patch, check_pin
 from .topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
@@ -301,6 +303,9 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
                             checkpoint=out.parent / "checkpoints", progress=progress,
                             patch_id=f"patch {i + 1}")
             ff.save(out)
+            stale = prune_checkpoints(out.parent / "checkpoints", ff.meta["checkpoint_keys"])
+            if stale:
+                log.info("patch %d: %d stale h0 checkpoints removed", i + 1, stale)
         factors.append(FlowFactors.load(out))
     mean = average(factors)
     mean.save(folder / "flow_factors.npz")
@@ -359,6 +364,14 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                   checkpoint=outdir / "stribeck" / "checkpoints", fields=outdir / "fields",
                   origin=origin, factors_key=stage_keys(case)["micro"])
     curves = run_sweeps(common, lb.lubricants(), executor, progress)
+    keep = {sweep_key(gap, spacing, common["factors_key"], tr.load, lub, common["settings"],
+                      face) for lub in lb.lubricants()}
+    stale = [p for p in common["checkpoint"].glob("point_*.npz")
+             if p.name.split("_")[1] not in keep]
+    for p in stale:
+        p.unlink()
+    if stale:
+        log.info("%d stale Stribeck checkpoints removed", len(stale))
     write_stribeck_csv(outdir / "stribeck.csv", curves)
     labels = [f"{t:g} C, mu_0 = {c.viscosity:g} Pa s" for t, c in zip(lb.temperatures, curves)]
     plot_stribeck(curves, outdir / "stribeck_speed.png", x="speed", labels=labels)

@@ -11,6 +11,7 @@ import pytest
 from fem_twin import Topography, read_topography, write_topography
 from fem_twin.case import CaseError, load_case
 from fem_twin.cli import main
+from fem_twin.micro import FlowFactors
 
 from conftest import ROOT
 
@@ -182,6 +183,12 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
     assert (out / "geometry" / "pin_1.npz").stat().st_mtime_ns == pin_stamp
     assert (out / "micro" / "patch_1" / "flow_factors.npz").stat().st_mtime_ns != ff_stamp
+    # stale checkpoints of the old settings are pruned (issue 15 item 7)
+    keys = FlowFactors.load(out / "micro" / "patch_1" / "flow_factors.npz").meta[
+        "checkpoint_keys"]
+    ckpts = list((out / "micro" / "patch_1" / "checkpoints").rglob("*_h0_*.json"))
+    assert len(ckpts) == 6 + 3 and {p.name.split("_h0_")[0] for p in ckpts} == set(keys)
+    assert len(list((out / "stribeck" / "checkpoints").glob("point_*.npz"))) == 10
 
 
 def test_homogenise_run_average_and_fields(tmp_path, capsys):

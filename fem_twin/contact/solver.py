@@ -106,7 +106,10 @@ def _solve_load_by_separation(shape, spacing, e_reduced, load, initial_pressure,
         lo -= step
         step *= 2
         if len(history) > 60:
-            raise ContactNotConverged("could not bracket the separation for the load", history)
+            raise ContactNotConverged(
+                f"could not bracket the separation for the load {load} N: the hardness "
+                f"{kw['hardness']:.3g} Pa caps the load at what the surfaces reach; check the "
+                "load [N], the hardness [Pa] and the heights [m]", history)
     h0 = brentq(excess, lo, hi, xtol=1e-16 * max(abs(lo), abs(hi), 1e-9), rtol=1e-15, maxiter=100)
     r = state["result"]
     if r is None or r.separation != h0:

@@ -176,7 +176,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
             "gap_floor": settings.gap_floor, "n_steps": settings.n_steps,
             "method": settings.method, "moving": settings.moving,
             "first_step": settings.first_step, "time_derivative": settings.time_derivative,
-            "version": __version__,
+            "version": __version__, "checkpoint_keys": [key],
             "pin": pin.meta.get("sample", pin.meta.get("source")),
             "disk": disk.meta.get("sample", disk.meta.get("source")),
             "seconds": {"contact": sum(done[i].get("seconds_contact", 0.0) for i in todo),
@@ -187,7 +187,20 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     if not error_estimate:
         return factors
     estimate = estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder)
-    return replace(factors, meta={**meta, "error_estimate": estimate})
+    keys = meta["checkpoint_keys"] + estimate.pop("checkpoint_keys", [])
+    return replace(factors, meta={**meta, "error_estimate": estimate, "checkpoint_keys": keys})
+
+
+def prune_checkpoints(folder, keep) -> int:
+    """Delete the h0 checkpoints in ``folder`` (and ``folder/coarse``) whose key is not in
+    ``keep`` (``FlowFactors.meta["checkpoint_keys"]``): left by other settings or surfaces.
+    Returns the number of files removed."""
+    removed = 0
+    for path in (*Path(folder).glob("*_h0_*.json"), *Path(folder).glob("coarse/*_h0_*.json")):
+        if path.name.split("_h0_")[0] not in keep:
+            path.unlink()
+            removed += 1
+    return removed
 
 
 def estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder=None) -> dict:
@@ -211,6 +224,7 @@ def estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder=Non
         out["grid"] = discrepancy(factors, factors_from_moments(h0, done, {}))
         out["grid_h0"] = h0.tolist()
         out["grid_shape"] = list(low.shape)
+        out["checkpoint_keys"] = [_key(low, up, wide, settings)]
     return out
 
 

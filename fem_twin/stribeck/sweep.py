@@ -35,8 +35,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
         raise ValueError("speeds must be a non-empty list of positive values [m/s]")
     gap = np.asarray(gap, float)
-    key = _key(gap, spacing, factors if factors_key is None else factors_key, load, lubricant,
-               settings, face)
+    key = sweep_key(gap, spacing, factors if factors_key is None else factors_key, load,
+                    lubricant, settings, face)
     folder = Path(checkpoint) if checkpoint is not None else None
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
@@ -72,7 +72,9 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         iterations=get("iterations"))
 
 
-def _key(gap, spacing, factors, load, lubricant, settings, face) -> str:
+def sweep_key(gap, spacing, factors, load, lubricant, settings, face) -> str:
+    """Key of a sweep's checkpoints (``point_KEY_*.npz``): a hash of all its inputs, with
+    ``factors`` a :class:`FlowFactors` or a key string of their inputs."""
     h = hashlib.sha256()
     flow = ((factors.h0, factors.h_m, factors.p_con, factors.A, factors.b, factors.C,
              factors.d) if isinstance(factors, FlowFactors) else (np.frombuffer(
