@@ -27,11 +27,14 @@ class Geometry:
 
 @dataclass(frozen=True)
 class Tribometer:
-    """Operating conditions (Table 6): imposed load [N], pin diameter [m], sliding radius [m]."""
+    """Operating conditions (Tables 1 and 6): imposed load [N], pin diameter [m], sliding
+    radius [m] (recorded; speeds are given in m/s), boundary friction coefficient C_f,b of
+    eq 32 [-]."""
 
     load: float = 150.0
     pin_diameter: float = 8e-3
     sliding_radius: float = 30e-3
+    boundary_friction: float = 1.0 / (3.0 * 3.0 ** 0.5)   # the paper's C_f,b, eq 32
 
 
 @dataclass(frozen=True)
@@ -305,7 +308,8 @@ def _section(data, name, cls, where, positive=False):
 PLAUSIBLE = {
     ("tribometer", "load"): (1e-3, 1e4, "N"),
     ("tribometer", "pin_diameter"): (1e-4, 0.1, "m (8 mm is 8e-3)"),
-    ("tribometer", "sliding_radius"): (1e-3, 1.0, "m (20 mm is 20e-3)"),
+    ("tribometer", "sliding_radius"): (1e-3, 1.0, "m (30 mm is 30e-3)"),
+    ("tribometer", "boundary_friction"): (1e-3, 1.0, "(a friction coefficient)"),
     ("lubricant", "viscosities"): (1e-5, 10.0, "Pa s (66 mPa s is 0.066)"),
     ("lubricant", "density"): (100.0, 2e4, "kg/m^3"),
     ("lubricant", "roelands_alpha"): (0.0, 1e-7, "1/Pa (22 GPa^-1 is 22e-9)"),

@@ -80,9 +80,28 @@ def _one_line(err: Exception) -> str:
     return text if len(text) < 400 else text[:400] + " ..."
 
 
+class _Formatter(argparse.HelpFormatter):
+    """Help lines end with the option's default, unless it has none or the text says it."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if ("default" in text or action.required or action.default in (None, False, (), [])
+                or action.default is argparse.SUPPRESS):
+            return text
+        return f"{text} (default: %(default)s)"
+
+
+class _Parser(argparse.ArgumentParser):
+    """Every (sub)command shows the defaults of its options in ``--help``."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", _Formatter)
+        super().__init__(*args, **kwargs)
+
+
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="fem-twin",
         description="Digital twin of a pin-on-disk tribometer in mixed lubrication. "
                     "Stages: topography -> contact -> homogenise -> macro; 'run' executes "
@@ -146,16 +165,17 @@ def build_parser() -> argparse.ArgumentParser:
     hr.add_argument("--h0", type=float, nargs=3, default=(1e-7, 1e-6, 100),
                     metavar=("MIN", "MAX", "N"), help="geometric h0 range [m] and count "
                     "(default: 1e-7 1e-6 100, the paper's)")
-    hr.add_argument("--steps", type=int, default=32, help="time steps N_t (default 32)")
-    hr.add_argument("--method", choices=("fe", "fvm"), default="fe")
+    hr.add_argument("--steps", type=int, default=32, help="time steps N_t of one sliding pass")
+    hr.add_argument("--method", choices=("fe", "fvm"), default="fe",
+                    help="Q1 finite elements or the paper's finite volumes")
     hr.add_argument("--time-derivative", choices=("exact", "backward"), default="exact",
-                    help="squeeze term of eq 8: exact at every instant (default) or the "
+                    help="squeeze term of eq 8: exact at every instant or the "
                          "paper's backward difference")
     hr.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                     help="processes over h0 values (default: all cores)")
     hr.add_argument("--fields", type=float, nargs="*", default=(), metavar="H0",
                     help="also write the cell fields (VTU/PVD) at these h0 [m]")
-    hr.add_argument("--no-progress", action="store_true")
+    hr.add_argument("--no-progress", action="store_true", help="no progress bar")
     hr.set_defaults(func=_homogenise_run)
     ha = hs.add_parser("average", help="average flow factors over patches (same h0 values)")
     ha.add_argument("inputs", type=Path, nargs="+", help="flow_factors.npz files")
@@ -199,7 +219,7 @@ def _case_command(sub, name, text, output, func):
     """A subcommand on a case file: ``CASE`` (default: the bundled case), ``-o``, progress."""
     c = sub.add_parser(name, help=text)
     c.add_argument("case", nargs="?", type=Path, default=DEFAULT_CASE,
-                   help=f"case file (default: {DEFAULT_CASE})")
+                   help="case file")
     c.add_argument("-o", "--output", type=Path, default=Path(output), help="output folder")
     c.add_argument("--no-progress", action="store_true", help="no progress bars")
     c.set_defaults(func=func)

@@ -27,6 +27,7 @@ from .io.checkpoint import load_or_none
 from .io.files import read_topography, write_topography
 from .io.mesh import grid_mesh, write_vtu
 from .macro import MacroSettings
+from .macro.friction import BOUNDARY_FRICTION
 from .micro import FlowFactors, average, homogenise
 from .micro.homogenisation import prune_checkpoints
 from .micro.estimate import exceeding
@@ -350,6 +351,7 @@ def _sweep_task(args):
 def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
     """The macro solver settings of a case (``method`` overrides ``[macro] method``)."""
     return MacroSettings(e_reduced=case.materials.e_reduced,
+                         boundary_friction=case.tribometer.boundary_friction,
                          method=method or case.macro.method, coupling=case.macro.coupling)
 
 
@@ -373,9 +375,12 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
     if stale:
         log.info("%d stale Stribeck checkpoints removed", len(stale))
     write_stribeck_csv(outdir / "stribeck.csv", curves)
-    labels = [f"{t:g} C, mu_0 = {c.viscosity:g} Pa s" for t, c in zip(lb.temperatures, curves)]
-    plot_stribeck(curves, outdir / "stribeck_speed.png", x="speed", labels=labels)
-    plot_stribeck(curves, outdir / "stribeck_hersey.png", x="hersey", labels=labels)
+    labels = [f"{t:g} °C, $\\mu_0$ = {c.viscosity:g} Pa s"
+              for t, c in zip(lb.temperatures, curves)]
+    cfb = tr.boundary_friction
+    plot_stribeck(curves, outdir / "stribeck_speed.png", x="speed", labels=labels, boundary=cfb)
+    plot_stribeck(curves, outdir / "stribeck_hersey.png", x="hersey", labels=labels,
+                  boundary=cfb)
     for c in curves:
         for u, cf, it, share in zip(c.speed, c.friction_coefficient, c.iterations,
                                     c.contact_load_fraction):
@@ -388,7 +393,7 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
            "files": ["stribeck.csv", "stribeck_speed.png", "stribeck_hersey.png",
                      "fields/"]}
     if len(curves) > 1:
-        out["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves)
+        out["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, cfb)
     if any(case.measured):
         out["validation"] = validate(case, curves, outdir, labels)
     return out
@@ -401,12 +406,13 @@ def validate(case: Case, curves, outdir: Path, labels) -> list:
         if path is None:
             continue
         measured = read_measured_csv(path)
-        dev = deviation_from_measured(curve, measured)
+        dev = deviation_from_measured(curve, measured, case.tribometer.boundary_friction)
         rows += [(curve.viscosity, u, cf, d) for u, cf, d in
                  zip(measured.speed, measured.friction_coefficient, dev)]
         band = None if measured.low is None else (measured.low, measured.high)
         plot_stribeck([curve], outdir / f"validation_mu{curve.viscosity:g}.png", labels=[label],
-                      reference=(measured.speed, measured.friction_coefficient, band))
+                      reference=(measured.speed, measured.friction_coefficient, band),
+                      boundary=case.tribometer.boundary_friction)
         result.append({"viscosity_Pa_s": curve.viscosity, "measured": str(path),
                        "max_abs_cf_dev": float(np.nanmax(np.abs(dev)))})
     with atomic_path(outdir / "validation.csv") as tmp:
@@ -424,13 +430,15 @@ def run_sweeps(common: dict, lubricants, executor=None, progress: bool = True):
     return [f.result() for f in tqdm(futures, desc="Stribeck sweeps", disable=not progress)]
 
 
-def hersey_collapse(curves) -> float:
-    """max |C_f,dev| (eq 35) between the first curve and the others over the Hersey numbers
-    where they overlap (the others' points, interpolated on the first curve)."""
+def hersey_collapse(curves, boundary: float = BOUNDARY_FRICTION) -> float:
+    """max |C_f,dev| (eq 35, relative to ``boundary`` = C_f,b) between the first curve and
+    the others over the Hersey numbers where they overlap (the others' points, interpolated
+    on the first curve)."""
     ref = curves[0]
     devs = []
     for c in curves[1:]:
         cf_ref = ref.at_hersey(c.hersey)
         ok = np.isfinite(cf_ref)
-        devs.extend(np.abs(friction_deviation(c.friction_coefficient[ok], cf_ref[ok])))
+        devs.extend(np.abs(friction_deviation(c.friction_coefficient[ok], cf_ref[ok],
+                                              boundary)))
     return float(max(devs)) if devs else float("nan")

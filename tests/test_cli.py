@@ -494,3 +494,19 @@ def test_a_point_that_does_not_converge_in_a_worker_reports_its_history(tmp_path
     assert main(["run", str(case), "-o", str(tmp_path / "o"), "--no-progress"]) == 3
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert "not converged" in err and "last residuals" in err and "abruptly" not in err
+
+
+def test_boundary_friction_is_set_from_the_case(tmp_path):
+    """Issue 18 item 3: C_f,b of eq 32 from [tribometer] boundary_friction: the boundary
+    friction force is C_f,b times the load carried by p_con (eqs 32-33), at every speed."""
+    text = small_case(tmp_path).read_text()
+    assert "boundary_friction = 0.1924500897" in text
+    (tmp_path / "cfb.toml").write_text(text.replace("boundary_friction = 0.1924500897",
+                                                    "boundary_friction = 0.12"))
+    out = tmp_path / "o"
+    assert main(["run", str(tmp_path / "cfb.toml"), "-o", str(out), "--no-progress"]) == 0
+    rows = list(csv.DictReader(open(out / "stribeck.csv")))
+    share = np.array([float(r["contact_load_fraction"]) for r in rows])
+    force = np.array([float(r["boundary_friction"]) for r in rows])
+    assert share.max() > 0.5
+    assert np.allclose(force, 0.12 * share * 150.0, rtol=1e-6, atol=1e-9)

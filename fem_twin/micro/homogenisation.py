@@ -148,7 +148,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     args = dict(z_low=z_low, z_up=z_up, spacing=spacing, settings=settings,
                 folder=None if folder is None else str(folder), key=key,
                 half_pass=error_estimate)
-    bar = _progress(len(h0), len(done), progress)
+    bar = _progress(len(h0), len(done), progress, patch_id)
     try:
         if executor is None and workers <= 1:
             for chunk in chunks:
@@ -455,7 +455,7 @@ def _load_point(folder, key, h0):
     return load_or_none(_point_path(folder, key, h0), _read_point)
 
 
-def _progress(total, initial, enabled):
+def _progress(total, initial, enabled, patch_id=None):
     from tqdm.auto import tqdm
-    return tqdm(total=total, initial=initial, desc="homogenise h0", unit="h0",
+    return tqdm(total=total, initial=initial, desc=f"homogenise {patch_id or 'h0'}", unit="h0",
                 disable=not enabled or os.environ.get("FEM_TWIN_NO_PROGRESS") == "1")

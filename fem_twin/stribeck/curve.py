@@ -91,27 +91,32 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
     return out
 
 
-def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None) -> Path:
+def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None,
+                  boundary: float = BOUNDARY_FRICTION) -> Path:
     """C_f versus sliding speed (``x="speed"``) or Hersey number (``"hersey"``), log x.
 
-    ``reference``: optional measured curve ``(x values, C_f, optional (low, high) band)``.
+    ``reference``: optional measured curve ``(x values, C_f, optional (low, high) band)``;
+    ``boundary``: C_f,b of eq 32, drawn as the boundary-friction limit.
     """
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
     for i, c in enumerate(curves):
-        label = labels[i] if labels else f"mu_0 = {c.viscosity:g} Pa s"
+        label = labels[i] if labels else f"$\\mu_0$ = {c.viscosity:g} Pa s"
         ax.plot(getattr(c, x), c.friction_coefficient, "o-", ms=3, label=label)
     if reference is not None:
         ax.plot(reference[0], reference[1], "k--", label="measured")
         if len(reference) > 2 and reference[2] is not None:
             ax.fill_between(reference[0], *reference[2], color="0.8", label="scatter")
-    ax.axhline(BOUNDARY_FRICTION, color="0.5", lw=0.8, ls=":")
+    ax.axhline(boundary, color="0.4", lw=1.0, ls=":",
+               label=f"boundary friction $C_{{f,b}}$ = {boundary:g} (eq 32)")
+    ax.set_ylim(0, 1.15 * boundary)
     ax.set_xscale("log")
-    ax.set_xlabel("sliding speed U [m/s]" if x == "speed" else "Hersey number H [-] (eq 46)")
-    ax.set_ylabel("friction coefficient C_f [-]")
-    ax.legend()
+    ax.set_xlabel("sliding speed $U$ [m/s]" if x == "speed" else
+                  "Hersey number $H = \\mu_0 U D / F_N$ [-] (eq 46)")
+    ax.set_ylabel("friction coefficient $C_f$ [-]")
+    ax.legend(fontsize="small", loc="center left")
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     path = Path(path)
@@ -158,7 +163,8 @@ def read_measured_csv(path) -> MeasuredCurve:
                          col("cf_max") if band else None)
 
 
-def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve):
+def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve,
+                            boundary: float = BOUNDARY_FRICTION):
     """C_f,dev (eq 35) of the simulated curve against the measured one, at the measured
     speeds inside the simulated range (PCHIP in log speed); NaN outside it."""
     from scipy.interpolate import PchipInterpolator
@@ -167,4 +173,5 @@ def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve):
     u = np.log(measured.speed)
     inside = (u >= x[0]) & (u <= x[-1])
     sim = PchipInterpolator(x, curve.friction_coefficient[order])(np.clip(u, x[0], x[-1]))
-    return np.where(inside, friction_deviation(sim, measured.friction_coefficient), np.nan)
+    return np.where(inside, friction_deviation(sim, measured.friction_coefficient, boundary),
+                    np.nan)
