@@ -49,8 +49,11 @@ EXIT_CODES = (
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
-                        format="%(levelname)s %(name)s: %(message)s")
+    level = (logging.INFO if args.verbose else logging.ERROR if args.quiet
+             else logging.WARNING)
+    logging.basicConfig(format="%(levelname)s %(name)s: %(message)s")
+    for handler in logging.getLogger().handlers:   # the terminal; run.log keeps everything
+        handler.setLevel(level)
     try:
         return args.func(args) or 0
     except KeyboardInterrupt:
@@ -108,7 +111,9 @@ def build_parser() -> argparse.ArgumentParser:
                     "the whole pipeline of a case file (up to the Stribeck curve). Exit "
                     "codes: README, 'When something goes wrong'.")
     p.add_argument("--version", action="version", version=f"fem-twin {__version__}")
-    p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    p.add_argument("-v", "--verbose", action="store_true",
+                   help="print every logged step (stages, points) on the terminal")
+    p.add_argument("-q", "--quiet", action="store_true", help="print errors only")
     p.add_argument("--debug", action="store_true",
                    help="show the Python traceback of an error (otherwise one line)")
     sub = p.add_subparsers(dest="command", required=True, metavar="STAGE")

@@ -116,7 +116,7 @@ def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None
     ax.set_xlabel("sliding speed $U$ [m/s]" if x == "speed" else
                   "Hersey number $H = \\mu_0 U D / F_N$ [-] (eq 46)")
     ax.set_ylabel("friction coefficient $C_f$ [-]")
-    ax.legend(fontsize="small", loc="center left")
+    ax.legend(fontsize="small", loc="upper right")
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     path = Path(path)
