@@ -133,6 +133,19 @@ def build_parser() -> argparse.ArgumentParser:
                     help="filter FWHMs [px] or resolutions [px] (defaults: 0 3 5 7 9 11; "
                          "64 128 256)")
 
+    va = sub.add_parser("validate", help="compare a finished run with a measured Stribeck "
+                                         "curve: C_f,dev (eq 35) at the measured speeds")
+    va.add_argument("run", type=Path, help="output folder of fem-twin run (its stribeck.csv)")
+    va.add_argument("measured", type=Path, help="CSV with columns speed and "
+                    "friction_coefficient (or cf), optionally cf_min, cf_max")
+    va.add_argument("--viscosity", type=float,
+                    help="mu_0 [Pa s] of the simulated curve to compare (default: the first)")
+    va.add_argument("--rpm", action="store_true",
+                    help="the measured 'speed' column is in rpm: U = 2 pi r n / 60 with the "
+                         "case's sliding radius (or --radius)")
+    va.add_argument("--radius", type=float, help="sliding radius r [m] for --rpm")
+    va.set_defaults(func=_validate)
+
     t = sub.add_parser("topography", help="read and pre-process measured topographies")
     steps = t.add_subparsers(dest="step", required=True, metavar="STEP")
     for name, text in _STEPS.items():
@@ -494,6 +507,64 @@ def _calibrate(args):
                         progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
     return 0
+
+
+def _validate(args):
+    from dataclasses import replace
+
+    from .case import load_case
+    from .macro.friction import BOUNDARY_FRICTION
+    from .stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
+    from .stribeck.curve import read_stribeck_csv
+    csv_path = args.run / "stribeck.csv"
+    if not csv_path.is_file():
+        raise FileNotFoundError(f"{csv_path} not found: give the output folder of fem-twin run")
+    curves = read_stribeck_csv(csv_path)
+    if args.viscosity is None:
+        curve = curves[0]
+    else:
+        match = [c for c in curves if np.isclose(c.viscosity, args.viscosity, rtol=1e-6)]
+        if not match:
+            raise ValueError(f"no curve at mu_0 = {args.viscosity} Pa s in {csv_path} (it has "
+                             f"{[c.viscosity for c in curves]})")
+        curve = match[0]
+    case_file = _run_case_file(args.run)
+    case = load_case(case_file) if case_file else None
+    boundary = case.tribometer.boundary_friction if case else BOUNDARY_FRICTION
+    measured = read_measured_csv(args.measured, unit="rpm" if args.rpm else "m/s")
+    if args.rpm:
+        radius = args.radius or (case.tribometer.sliding_radius if case else None)
+        if radius is None:
+            raise ValueError("--rpm needs the sliding radius: give --radius [m]")
+        measured = replace(measured, speed=measured.speed * 2 * np.pi * radius / 60)
+    dev = deviation_from_measured(curve, measured, boundary)
+    if not np.any(np.isfinite(dev)):
+        raise ValueError(f"the measured speeds ({measured.speed.min():.3g} to "
+                         f"{measured.speed.max():.3g} m/s) lie outside the simulated range")
+    stem = f"validation_{args.measured.stem}"
+    band = None if measured.low is None else (measured.low, measured.high)
+    plot_stribeck([curve], args.run / f"{stem}.png",
+                  labels=[f"simulated, $\\mu_0$ = {curve.viscosity:g} Pa s"],
+                  reference=(measured.speed, measured.friction_coefficient, band),
+                  boundary=boundary)
+    with open(args.run / f"{stem}.csv", "w") as f:
+        f.write("speed,measured_cf,cf_dev\n" + "".join(
+            f"{u:.10g},{c:.10g},{d:.10g}\n"
+            for u, c, d in zip(measured.speed, measured.friction_coefficient, dev)))
+    inside = np.isfinite(dev)
+    print(f"fem-twin validate: mu_0 = {curve.viscosity:g} Pa s against {args.measured.name}: "
+          f"max |C_f,dev| = {np.nanmax(np.abs(dev)):.2%} (eq 35, C_f,b = {boundary:.5g}) at "
+          f"{inside.sum()} of {dev.size} measured speeds; {args.run / stem}.csv, .png")
+    return 0
+
+
+def _run_case_file(run: Path):
+    """The case file recorded in a run's summary.json, if it still exists."""
+    try:
+        path = Path(json.loads((run / "summary.json").read_text())["provenance"]["case_file"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return path if path.is_file() else None
 
 
 def _compare(args):

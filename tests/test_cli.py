@@ -510,3 +510,32 @@ def test_boundary_friction_is_set_from_the_case(tmp_path):
     force = np.array([float(r["boundary_friction"]) for r in rows])
     assert share.max() > 0.5
     assert np.allclose(force, 0.12 * share * 150.0, rtol=1e-6, atol=1e-9)
+
+
+def test_validate_an_existing_run_against_a_measured_curve(tmp_path, capsys):
+    """Issue 18 item 4: fem-twin validate OUT measured.csv, speeds in m/s or rpm with the
+    case's sliding radius: a 'measured' curve 1 % of C_f,b above the simulated one gives
+    C_f,dev = -1 % at every measured speed inside the simulated range."""
+    case = small_case(tmp_path)
+    out = tmp_path / "o"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    rows = [r for r in csv.DictReader(open(out / "stribeck.csv"))
+            if float(r["viscosity"]) == 0.024]
+    cfb = 1 / (3 * 3 ** 0.5)
+    speeds = [float(r["speed"]) for r in rows]
+    (tmp_path / "m.csv").write_text("speed,friction_coefficient\n" + "".join(
+        f"{u!r},{float(r['friction_coefficient']) + 0.01 * cfb!r}\n" for u, r in
+        zip(speeds, rows)))
+    rpm = [u * 60 / (2 * np.pi * 30e-3) for u in speeds]
+    (tmp_path / "rpm.csv").write_text("speed,cf\n" + "".join(
+        f"{n!r},{float(r['friction_coefficient']) + 0.01 * cfb!r}\n" for n, r in
+        zip(rpm, rows)))
+    for name, extra in (("m", []), ("rpm", ["--rpm"])):
+        assert main(["validate", str(out), str(tmp_path / f"{name}.csv"), "--viscosity",
+                     "0.024", *extra]) == 0
+        assert "max |C_f,dev| = 1.00%" in capsys.readouterr().out
+        dev = [float(r["cf_dev"]) for r in csv.DictReader(open(out / f"validation_{name}.csv"))]
+        assert np.allclose(dev, -0.01, atol=1e-8)
+        assert (out / f"validation_{name}.png").stat().st_size > 0
+    assert main(["validate", str(out), str(tmp_path / "rpm.csv")]) == 2     # rpm as m/s
+    assert "--rpm" in capsys.readouterr().err

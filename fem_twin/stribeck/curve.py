@@ -136,9 +136,10 @@ class MeasuredCurve:
     high: np.ndarray | None = None
 
 
-def read_measured_csv(path) -> MeasuredCurve:
-    """CSV with a header: ``speed`` [m/s] and ``friction_coefficient`` (or ``cf``), and
-    optionally ``cf_min``/``cf_max`` (the scatter band of a test set)."""
+def read_measured_csv(path, unit: str = "m/s") -> MeasuredCurve:
+    """CSV with a header: ``speed`` [m/s, or rpm with ``unit="rpm"``, converted by the
+    caller] and ``friction_coefficient`` (or ``cf``), and optionally ``cf_min``/``cf_max``
+    (the scatter band of a test set)."""
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
     if not rows:
@@ -156,8 +157,9 @@ def read_measured_csv(path) -> MeasuredCurve:
             raise ValueError(f"{path}: column {k!r} is not numeric: {err}") from err
 
     speed = col("speed")
-    if np.any(~(speed > 0)) or speed.max() > 100:
-        raise ValueError(f"{path}: speeds must be positive and in m/s (max {speed.max()})")
+    if np.any(~(speed > 0)) or (unit == "m/s" and speed.max() > 100):
+        raise ValueError(f"{path}: speeds must be positive and in m/s (max {speed.max()}; "
+                         "for rpm use --rpm)")
     band = ("cf_min" in cols and "cf_max" in cols)
     return MeasuredCurve(speed, col(cf_key), col("cf_min") if band else None,
                          col("cf_max") if band else None)
