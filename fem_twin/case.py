@@ -88,6 +88,7 @@ class MicroSpec:
     method: str = "fe"
     time_derivative: str = "exact"
     error_tolerance: float = 0.02
+    time_tol: float = 0.0            # > 0: adaptive instants per h0 (homogenise time_tol)
 
 
 @dataclass(frozen=True)
@@ -233,6 +234,9 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
         raise CaseError(f"{where} [micro] method: 'fe' or 'fvm'")
     if micro.time_derivative not in ("exact", "backward"):
         raise CaseError(f"{where} [micro] time_derivative: 'exact' or 'backward' (paper)")
+    if not 0 <= micro.time_tol < 1 or (micro.time_tol and micro.time_derivative != "exact"):
+        raise CaseError(f"{where} [micro] time_tol: 0 (off) or a fraction in (0, 1), with "
+                        "time_derivative = 'exact'")
     if not 0 < micro.error_tolerance < 1:
         raise CaseError(f"{where} [micro] error_tolerance: a fraction in (0, 1), e.g. 0.02")
     if not (0 < micro.h0_min < micro.h0_max < 1e-3) or micro.h0_count < 2 or micro.steps < 1:

@@ -189,6 +189,9 @@ def build_parser() -> argparse.ArgumentParser:
     hr.add_argument("--time-derivative", choices=("exact", "backward"), default="exact",
                     help="squeeze term of eq 8: exact at every instant or the "
                          "paper's backward difference")
+    hr.add_argument("--time-tol", type=float,
+                    help="adaptive instants: add midpoints at an h0 while A11 or b1 change by "
+                         "more than this fraction (exact scheme)")
     hr.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                     help="processes over h0 values (default: all cores)")
     hr.add_argument("--fields", type=float, nargs="*", default=(), metavar="H0",
@@ -361,6 +364,7 @@ def _homogenise_run(args):
         raise ValueError(f"the number of h0 values must be a positive integer, got {n}")
     ff = homogenise(pin, disk, np.geomspace(lo, hi, int(n)), n_steps=args.steps,
                     method=args.method, time_derivative=args.time_derivative,
+                    time_tol=args.time_tol,
                     workers=args.workers,
                     checkpoint=args.output / "checkpoints", progress=not args.no_progress,
                     patch_id=f"{args.pin.stem}/{args.disk.stem}")

@@ -300,7 +300,8 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
                 low, up = resample_cell(low, mc.resolution), resample_cell(up, mc.resolution)
             ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=e_red,
                             hardness=m.hardness, method=mc.method,
-                            time_derivative=mc.time_derivative, executor=executor,
+                            time_derivative=mc.time_derivative,
+                            time_tol=mc.time_tol or None, executor=executor,
                             checkpoint=out.parent / "checkpoints", progress=progress,
                             patch_id=f"patch {i + 1}")
             ff.save(out)

@@ -75,6 +75,7 @@ class CellSettings:
     contact_tol: float = 1e-10
     time_derivative: str = "exact"
     rate_tol: float = 1e-6      # contact-rate CG: tau to 1e-6, far below time and grid errors
+    time_tol: float | None = None   # adaptive instants per h0 (exact scheme), see _refine
 
     def __post_init__(self):
         if int(self.n_steps) != self.n_steps or self.n_steps < 1:
@@ -86,6 +87,10 @@ class CellSettings:
         if self.time_derivative not in ("exact", "backward"):
             raise ValueError("time_derivative must be 'exact' or 'backward' (paper), got "
                              f"{self.time_derivative!r}")
+        if self.time_tol is not None and not (0 < self.time_tol < 1
+                                              and self.time_derivative == "exact"):
+            raise ValueError("time_tol is a relative tolerance in (0, 1), with "
+                             "time_derivative='exact' only")
         if self.first_step not in ("steady", "periodic"):
             raise ValueError(f"first_step must be 'steady' or 'periodic', got {self.first_step!r}")
         if not (self.e_reduced > 0 and self.hardness > 0 and self.gap_floor > 0):
@@ -97,7 +102,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
                method: str = "fe", moving: str = "upper", time_derivative: str = "exact",
                first_step: str = "steady", gap_floor: float = 1e-9, workers: int = 1,
                executor=None, checkpoint=None, progress: bool = False, patch_id=None,
-               error_estimate: bool = True) -> FlowFactors:
+               error_estimate: bool = True, time_tol: float | None = None) -> FlowFactors:
     """Flow factors of a roughness patch pair versus h0 (eqs 11-16).
 
     Parameters
@@ -125,9 +130,14 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     patch_id : recorded in the metadata.
     error_estimate : estimate the time and grid errors (``meta["error_estimate"]``, see
         :mod:`fem_twin.micro.estimate`; about ``3 / (4 len(h0))`` of the run's cost).
+    time_tol : adaptive instants (exact scheme): at each h0 the midpoints are added while
+        A11 or b1 change by more than this relative tolerance from every other instant to
+        all, up to one pixel per step; ``n_steps`` is then the smallest count
+        (``meta["steps_used"]`` per h0).  None: ``n_steps`` everywhere.
     """
     settings = CellSettings(int(n_steps), float(e_reduced), float(hardness), float(gap_floor),
-                            method, moving, first_step, time_derivative=time_derivative)
+                            method, moving, first_step, time_derivative=time_derivative,
+                            time_tol=time_tol)
     z_low, z_up, spacing = _check_patches(pin, disk)
     h0 = DEFAULT_H0 if h0 is None else np.asarray(h0, dtype=float)
     if h0.ndim != 1 or h0.size == 0 or not np.all(np.isfinite(h0)) or np.any(h0 <= 0):
@@ -176,7 +186,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
             "gap_floor": settings.gap_floor, "n_steps": settings.n_steps,
             "method": settings.method, "moving": settings.moving,
             "first_step": settings.first_step, "time_derivative": settings.time_derivative,
-            "version": __version__, "checkpoint_keys": [key],
+            "version": __version__, "checkpoint_keys": [key], "time_tol": settings.time_tol,
+            "steps_used": [int(done[i].get("n_steps", settings.n_steps)) for i in idx],
             "pin": pin.meta.get("sample", pin.meta.get("source")),
             "disk": disk.meta.get("sample", disk.meta.get("source")),
             "seconds": {"contact": sum(done[i].get("seconds_contact", 0.0) for i in todo),
@@ -258,17 +269,20 @@ class SlidingPass:
     um_dt: float
 
 
-def sliding_pass(z_low, z_up, spacing, settings: CellSettings) -> SlidingPass:
+def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | None = None,
+                 offset: float = 0.0) -> SlidingPass:
     """The moving surface shifts by ``s = L_r1 / N_t`` per step (``+s`` for the disk, ``-s``
-    for the pin in the disk's frame); ``u_m dt = (shift_up + shift_low) / 2``."""
+    for the pin in the disk's frame); ``u_m dt = (shift_up + shift_low) / 2``.  The instants
+    are ``(k + offset) s`` for ``k < N_t`` (``offset = 1/2``: the midpoints)."""
     nx = z_low.shape[1]
-    px = nx / settings.n_steps                   # pixels per step
-    n = range(settings.n_steps)
+    n_steps = settings.n_steps if n_steps is None else n_steps
+    px = nx / n_steps                            # pixels per step
+    n = [(k + offset) * px for k in range(n_steps)]
     if settings.moving == "upper":
-        moving = [_shift(z_up, k * px) for k in n]
+        moving = [_shift(z_up, k) for k in n]
         shapes = [m - z_low for m in moving]
         return SlidingPass(shapes, moving, px * spacing[0] / 2)
-    moving = [-_shift(z_low, -k * px) for k in n]
+    moving = [-_shift(z_low, -k) for k in n]
     return SlidingPass([z_up + m for m in moving], moving, -px * spacing[0] / 2)
 
 
@@ -349,7 +363,7 @@ def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=Fa
     """Moments for ``points = [(index, h0), ...]`` in order, warm-starting contact."""
     solver = _cell_solver(z_low.shape, spacing, settings.method)
     sliding = sliding_pass(z_low, z_up, spacing, settings)
-    warm = [None] * settings.n_steps
+    warm, warm_mid = [None] * settings.n_steps, {}
     out = []
     for i, h0 in points:
         if resume and folder is not None:
@@ -357,24 +371,61 @@ def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=Fa
             if m is not None:
                 out.append((i, m))
                 continue
-        t0 = time.perf_counter()
-        contacts = sliding_contacts(sliding.shapes, spacing, settings, h0, warm)
-        squeezes = sliding_squeeze(contacts, sliding, spacing, settings)
-        t1 = time.perf_counter()
-        steps = [cell.moments for cell in
-                 sliding_cells([r.gap for r in contacts], squeezes, solver)]
-        for m, r in zip(steps, contacts):
-            m["p_con"], m["contact_fraction"] = float(r.pressure.mean()), r.contact_fraction
+        contacts, steps, seconds = _instants(sliding, h0, warm, solver, spacing, settings)
+        if settings.time_tol is not None:
+            contacts, steps, more = _refine(contacts, steps, h0, z_low, z_up, solver, spacing,
+                                            settings, warm_mid)
+            seconds = [a + b for a, b in zip(seconds, more)]
         moments = _time_average(steps)
+        moments["n_steps"] = len(steps)
         if half_pass and settings.n_steps % 2 == 0:   # N_t / 2 instants: time-error estimate
             half = _half_pass(steps, contacts, sliding, solver, spacing, settings)
             moments.update({"half_" + k: v for k, v in _time_average(half).items()})
-        moments["seconds_contact"] = t1 - t0
-        moments["seconds_cell"] = time.perf_counter() - t1
+        moments["seconds_contact"], moments["seconds_cell"] = seconds
         if folder is not None:
             _save_point(Path(folder), key, h0, moments)
         out.append((i, moments))
     return out
+
+
+def _instants(sliding, h0, warm, solver, spacing, settings):
+    """Contacts and cell moments at the instants of ``sliding``; (contact, cell) seconds."""
+    t0 = time.perf_counter()
+    contacts = sliding_contacts(sliding.shapes, spacing, settings, h0, warm)
+    squeezes = sliding_squeeze(contacts, sliding, spacing, settings)
+    t1 = time.perf_counter()
+    steps = [cell.moments for cell in
+             sliding_cells([r.gap for r in contacts], squeezes, solver)]
+    for m, r in zip(steps, contacts):
+        m["p_con"], m["contact_fraction"] = float(r.pressure.mean()), r.contact_fraction
+    return contacts, steps, [t1 - t0, time.perf_counter() - t1]
+
+
+def _time_error(steps) -> float:
+    """Relative change of A11 and b1 (eqs 13, 14) from every other instant to all."""
+    def a11_b1(ms):
+        m = _time_average(ms)
+        return np.array([m["h3_grad"][0, 0] / m["h"] ** 3, 1 - m["h3_g1"][0] / m["h"]])
+    full, half = a11_b1(steps), a11_b1(steps[::2])
+    return float(np.max(np.abs(full - half) / np.abs(full)))
+
+
+def _refine(contacts, steps, h0, z_low, z_up, solver, spacing, settings, warm_mid):
+    """Adaptive instants (``settings.time_tol``, exact scheme): while A11 or b1 change by
+    more than the tolerance from every other instant to all, add the midpoints (the time
+    average is then over twice the instants), up to one pixel per step.  In heavy contact
+    the integrand jumps whenever a pixel enters contact, and a fixed N_t samples it
+    unevenly; light contact stops at ``n_steps``."""
+    seconds = [0.0, 0.0]
+    while _time_error(steps) > settings.time_tol and 2 * len(steps) <= z_low.shape[1]:
+        n = len(steps)
+        mid = sliding_pass(z_low, z_up, spacing, settings, n_steps=n, offset=0.5)
+        warm = warm_mid.setdefault(n, [None] * n)
+        c, m, sec = _instants(mid, h0, warm, solver, spacing, settings)
+        contacts = [x for pair in zip(contacts, c) for x in pair]
+        steps = [x for pair in zip(steps, m) for x in pair]
+        seconds = [a + b for a, b in zip(seconds, sec)]
+    return contacts, steps, seconds
 
 
 def _half_pass(steps, contacts, sliding, solver, spacing, settings):
