@@ -20,11 +20,7 @@ def resample(topo: Topography, shape: tuple[int, int], method: str = "linear") -
     """
     if method not in _ORDER:
         raise ValueError(f"method must be one of {sorted(_ORDER)}, got {method!r}")
-    if topo.mask is not None:
-        raise ValueError("resample needs a fully valid topography: call fill_defects first")
-    ny, nx = (int(v) for v in shape)
-    if ny < 2 or nx < 2:
-        raise ValueError(f"target shape must be at least 2 x 2, got {shape}")
+    ny, nx = _target(topo, shape, "resample")
     oy, ox = topo.shape
     # exact rational positions: i (n-1) / (m-1) is an integer whenever the refinement is exact
     pos2 = np.arange(ny) * (oy - 1) / (ny - 1)
@@ -55,14 +51,20 @@ def resample_cell(topo: Topography, shape: tuple[int, int]) -> Topography:
     pixel, refinement by ``k`` keeps every pixel and adds ``k - 1`` between neighbours.
     (:func:`resample` spans the first and last pixels instead, which changes the period.)
     """
-    if topo.mask is not None:
-        raise ValueError("resample_cell needs a fully valid topography: call fill_defects first")
-    ny, nx = (int(v) for v in shape)
-    if ny < 2 or nx < 2:
-        raise ValueError(f"target shape must be at least 2 x 2, got {shape}")
+    ny, nx = _target(topo, shape, "resample_cell")
     oy, ox = topo.shape
     p2, p1 = np.meshgrid(np.arange(ny) * oy / ny, np.arange(nx) * ox / nx, indexing="ij")
     new = ndi.map_coordinates(topo.heights, [p2, p1], order=1, mode="grid-wrap")
     spacing = (topo.spacing[0] * ox / nx, topo.spacing[1] * oy / ny)
     return topo.with_heights(new, spacing=spacing,
                              meta=topo.with_history(f"resample_cell({ny}x{nx})"))
+
+
+def _target(topo: Topography, shape, name: str) -> tuple[int, int]:
+    """The checked target ``(ny, nx)`` of a resampling of a fully valid ``topo``."""
+    if topo.mask is not None:
+        raise ValueError(f"{name} needs a fully valid topography: call fill_defects first")
+    ny, nx = (int(v) for v in shape)
+    if ny < 2 or nx < 2:
+        raise ValueError(f"target shape must be at least 2 x 2, got {shape}")
+    return ny, nx
