@@ -292,8 +292,10 @@ def _topography(args):
     if step == "info":
         ny, nx = topo.shape
         inval = 0 if topo.mask is None else int((~topo.mask).sum())
-        print(json.dumps({"file": str(args.input), "grid": [ny, nx], "spacing_m": topo.spacing,
-                          "size_m": topo.size, "sq_m": topo.rms_height(),
+        print(json.dumps({"file": str(args.input), "pixels_x1_x2": [nx, ny],
+                          "spacing_x1_x2_m": topo.spacing, "size_x1_x2_m": topo.size,
+                          "sq_as_measured_m": topo.rms_height(),
+                          "sq_levelled_m": tp.level(tp.fill_defects(topo)).rms_height(),
                           "invalid_pixels": inval, "meta": topo.meta}, indent=2, default=str))
         return 0
     if step == "convert":

@@ -65,7 +65,7 @@ def test_contact_level_and_average_steps(tmp_path, capsys):
 def test_cli_reports_bad_input_clearly(tmp_path, capsys):
     (tmp_path / "bad.npy").write_bytes(b"nonsense")
     assert main(["topography", "info", str(tmp_path / "bad.npy"), "--spacing", "1e-6"]) == 2
-    assert "cannot read topography" in capsys.readouterr().err
+    assert "not a numeric .npy height map" in capsys.readouterr().err
     assert main(["run", str(tmp_path / "none.toml")]) == 2
 
 
@@ -142,6 +142,16 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     assert prov["case_sha256"] == hashlib.sha256(case.read_bytes()).hexdigest()[:16]
     assert prov["fem_twin_version"] and "git_commit" in prov
     assert "point mu_0 = 0.066 Pa s, U = 2 m/s" in (ref / "run.log").read_text()
+    # ParaView (issue 18 item 7): PVD time = speed [m/s]; gauge pressure beside the absolute
+    import re
+
+    from fem_twin.io.mesh import read_vtu
+    pvd = (ref / "fields" / "stribeck_mu0.066.pvd").read_text()
+    times = sorted(float(t) for t in re.findall(r'timestep="([^"]+)"', pvd))
+    speeds = sorted(float(x["speed"]) for x in rows if float(x["viscosity"]) == 0.066)
+    assert np.allclose(times, speeds, rtol=1e-12)
+    _, fields = read_vtu(ref / "fields" / "mu0.066_000.vtu")
+    assert np.allclose(fields["pressure_gauge"], fields["pressure"] - 1e5)
 
     # validation (paper 3.3): a "measured" curve 1 % of C_f,b above the simulated one
     r66 = [x for x in rows if float(x["viscosity"]) == 0.066]

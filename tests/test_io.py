@@ -88,8 +88,12 @@ def test_bad_files_raise_clear_errors(tmp_path):
 
 @pytest.mark.parametrize("name", ["di_corrupted.di", "nonsense_txt_file.txt", "wrongnpyfile.npy"])
 def test_shared_broken_files_raise(shared_topographies, name):
-    with pytest.raises(TopographyFileError, match=name):
+    with pytest.raises(TopographyFileError, match=name) as err:
         read_topography(shared_topographies / name, spacing=1e-6)
+    # advice a tribologist can act on, not numpy's (issue 18 item 9)
+    assert "allow_pickle" not in str(err.value)
+    if name.endswith(".txt"):
+        assert "not a table of heights" in str(err.value)
 
 
 @pytest.mark.parametrize("name,shape,size,sq", INSTRUMENT_FILES)

@@ -137,7 +137,12 @@ def _read_npz(path: Path, spacing, scale) -> Topography:
 
 
 def _read_npy(path: Path, spacing, scale) -> Topography:
-    h = np.load(path, allow_pickle=False)
+    try:
+        h = np.load(path, allow_pickle=False)
+    except ValueError as err:                     # numpy's hint to unpickle is no advice here
+        raise TopographyFileError(f"{path}: not a numeric .npy height map (it holds Python "
+                                  "objects or is damaged); save the heights with "
+                                  "numpy.save(path, array_of_floats)") from err
     if not np.issubdtype(h.dtype, np.number):
         raise TopographyFileError(f"{path}: .npy holds {h.dtype}, not numbers")
     return Topography(h * scale, _need_spacing(path, spacing), meta={"source": str(path)})
@@ -151,8 +156,12 @@ def _ascii_header(topo: Topography) -> str:
 def _read_ascii(path: Path, spacing, scale) -> Topography:
     text = path.read_text(errors="strict")
     header = re.search(r"spacing = (\S+) (\S+); origin = (\S+) (\S+)", text)
-    data = np.loadtxt(io.StringIO(text), delimiter="," if path.suffix.lower() == ".csv" else None,
-                      ndmin=2)
+    try:
+        data = np.loadtxt(io.StringIO(text), ndmin=2,
+                          delimiter="," if path.suffix.lower() == ".csv" else None)
+    except ValueError as err:
+        raise TopographyFileError(f"{path}: not a table of heights (expected rows of numbers, "
+                                  f"optionally after '#' comment lines): {err}") from err
     if data.size == 0:
         raise TopographyFileError(f"{path}: no numbers in file")
     if path.suffix.lower() == ".xyz":

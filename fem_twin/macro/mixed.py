@@ -169,10 +169,13 @@ class MixedResult:
                        meta=json.loads(str(data["meta"])))
 
     def write_vtu(self, path, origin=(0.0, 0.0)) -> Path:
-        """Fields on the structured grid for ParaView (:func:`fem_twin.io.mesh.write_vtu`)."""
+        """Fields on the structured grid for ParaView (:func:`fem_twin.io.mesh.write_vtu`),
+        SI units; ``pressure`` is absolute (its minimum is p_cav), ``pressure_gauge`` is
+        ``pressure - p_amb``; ``face`` is 1 on the pin face (threshold on it in ParaView)."""
         from ..io.mesh import grid_mesh, write_vtu
         gm = grid_mesh(self.pressure.shape, self.spacing, origin)
-        return write_vtu(path, gm, self.fields())
+        p_amb = self.meta.get("settings", {}).get("ambient_pressure", 0.0)
+        return write_vtu(path, gm, {**self.fields(), "pressure_gauge": self.pressure - p_amb})
 
 
 def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float,

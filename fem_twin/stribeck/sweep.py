@@ -59,7 +59,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         entries = []
         for i, res in enumerate(results):
             vtu = res.write_vtu(fields / f"mu{lubricant.viscosity:g}_{i:03d}.vtu", origin)
-            entries.append((float(np.log10(res.speed)), vtu))
+            entries.append((float(res.speed), vtu))            # ParaView time = U [m/s]
         write_pvd(fields / f"stribeck_mu{lubricant.viscosity:g}.pvd", entries)
     get = lambda name: np.array([getattr(r, name) for r in results])  # noqa: E731
     return StribeckCurve(
