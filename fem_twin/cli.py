@@ -230,6 +230,10 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument("--spacing", type=float, nargs="+", metavar="M")
     m.set_defaults(func=_mesh)
 
+    ex = sub.add_parser("example", help="write the bundled example case and its sample twin "
+                                         "into a folder (works without the repository)")
+    ex.add_argument("folder", type=Path, help="where to write pin_on_disk.toml and meshes/")
+    ex.set_defaults(func=_example)
     g = sub.add_parser("sample", help="regenerate the bundled sample twin (seeded)")
     g.add_argument("-o", "--output", type=Path, default=Path("meshes/sample"))
     g.set_defaults(func=_sample)
@@ -571,6 +575,19 @@ def _run_case_file(run: Path):
     except (OSError, ValueError, KeyError, TypeError):
         return None
     return path if path.is_file() else None
+
+
+def _example(args):
+    from importlib.resources import files
+
+    from .samples import generate
+    args.folder.mkdir(parents=True, exist_ok=True)
+    case = args.folder / "pin_on_disk.toml"
+    case.write_text(files("fem_twin.cases").joinpath("pin_on_disk.toml").read_text())
+    generate(args.folder / "meshes" / "sample")
+    print(f"wrote {case} and {args.folder / 'meshes' / 'sample'}/; run it with\n"
+          f"  fem-twin run {case} -o {args.folder / 'out'}")
+    return 0
 
 
 def _compare(args):

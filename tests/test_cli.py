@@ -549,3 +549,21 @@ def test_validate_an_existing_run_against_a_measured_curve(tmp_path, capsys):
         assert (out / f"validation_{name}.png").stat().st_size > 0
     assert main(["validate", str(out), str(tmp_path / "rpm.csv")]) == 2     # rpm as m/s
     assert "--rpm" in capsys.readouterr().err
+
+
+def test_example_case_ships_with_the_package(tmp_path, capsys):
+    """Issue 18 item 8: `fem-twin example DIR` writes the bundled case (package data, so it
+    is there after a non-editable install, as in CI) and regenerates its sample twin; the
+    case is the repository's example with its paths, and its files are the bundled ones."""
+    from importlib.resources import files
+    shipped = files("fem_twin.cases").joinpath("pin_on_disk.toml").read_text()
+    repo = (ROOT / "examples" / "pin_on_disk.toml").read_text()
+    assert shipped == repo.replace("../meshes/sample/", "meshes/sample/")
+    assert main(["example", str(tmp_path / "ex")]) == 0
+    case = load_case(tmp_path / "ex" / "pin_on_disk.toml")
+    for pair in case.geometry.patches[:1]:
+        for path in pair:
+            a = read_topography(path)
+            b = read_topography(ROOT / "meshes" / "sample" / path.name)
+            assert np.array_equal(a.heights, b.heights)
+    assert "fem-twin run" in capsys.readouterr().out

@@ -1,0 +1,1 @@
+"""Case files shipped with the package (``fem-twin example DIR`` writes them out)."""
