@@ -423,12 +423,31 @@ def validate(case: Case, curves, outdir: Path, labels) -> list:
 
 
 def run_sweeps(common: dict, lubricants, executor=None, progress: bool = True):
-    """Sweeps for several lubricants; serial, or one task per lubricant on ``executor``."""
+    """Sweeps for several lubricants; serial, or one task per lubricant on ``executor``.
+
+    In parallel the bar counts the finished points of all sweeps (their checkpoint files,
+    written as each point finishes in its worker)."""
     if executor is None or len(lubricants) == 1:
         return [_sweep_task((dict(common, progress=progress), lub)) for lub in lubricants]
     futures = [executor.submit(_sweep_task, (dict(common, progress=False), lub))
                for lub in lubricants]
-    return [f.result() for f in tqdm(futures, desc="Stribeck sweeps", disable=not progress)]
+    total = len(lubricants) * len(common["speeds"])
+    with tqdm(total=total, desc="Stribeck points", unit="point", disable=not progress) as bar:
+        while not all(f.done() for f in futures):
+            bar.update(_points_done(common, lubricants) - bar.n)
+            time.sleep(0.5)
+        bar.update(total - bar.n)
+    return [f.result() for f in futures]
+
+
+def _points_done(common: dict, lubricants) -> int:
+    """Finished points of the sweeps of ``common`` (their checkpoint files)."""
+    folder = common.get("checkpoint")
+    if folder is None or common.get("factors_key") is None:
+        return 0
+    keys = {sweep_key(common["gap"], common["spacing"], common["factors_key"], common["load"],
+                      lub, common["settings"], common["face"]) for lub in lubricants}
+    return sum(1 for p in Path(folder).glob("point_*.npz") if p.name.split("_")[1] in keys)
 
 
 def hersey_collapse(curves, boundary: float = BOUNDARY_FRICTION) -> float:

@@ -88,8 +88,9 @@ class FlowFactors:
             raise ValueError(f"{path}: cannot read flow factors ({err})") from err
 
     def write_csv(self, path) -> Path:
-        """Table with one row per h0 (h0 and h_m in um, p_con in MPa as in Figures 4-5)."""
-        cols = {"h0_um": self.h0 * 1e6, "h_m_um": self.h_m * 1e6, "p_con_MPa": self.p_con * 1e-6,
+        """Table with one row per h0, SI units named in the header (h0_m, h_m_m, p_con_Pa;
+        the factors are dimensionless), like the other CSVs of a run."""
+        cols = {"h0_m": self.h0, "h_m_m": self.h_m, "p_con_Pa": self.p_con,
                 "A11": self.A[:, 0, 0], "A12": self.A[:, 0, 1], "A21": self.A[:, 1, 0],
                 "A22": self.A[:, 1, 1], "b1": self.b[:, 0], "b2": self.b[:, 1],
                 "C11": self.C[:, 0, 0], "C12": self.C[:, 0, 1], "C21": self.C[:, 1, 0],
