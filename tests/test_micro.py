@@ -345,7 +345,8 @@ def test_save_load_round_trip(tmp_path, small_factors):
     assert back.meta == json.loads(json.dumps(small_factors.meta))
     assert back.meta["method"] == "fe" and back.meta["patch_id"] == "p1"
     table = np.loadtxt(small_factors.write_csv(tmp_path / "ff.csv"), delimiter=",", skiprows=1)
-    assert np.allclose(table[:, 0], small_factors.h0) and np.allclose(table[:, 2], small_factors.p_con)
+    assert np.allclose(table[:, 0], small_factors.h0)                     # SI: m
+    assert np.allclose(table[:, 2], small_factors.p_con)                  # Pa
     (tmp_path / "bad.npz").write_bytes(b"not a zip")
     with pytest.raises(ValueError, match="cannot read"):
         FlowFactors.load(tmp_path / "bad.npz")
