@@ -26,7 +26,8 @@ from .io.atomic import atomic_path
 from .io.checkpoint import load_or_none
 from .io.files import read_topography, write_topography
 from .io.mesh import grid_mesh, write_vtu
-from .macro import MacroSettings
+from .macro import MacroSettings, MixedResult
+from .macro.figures import plot_point_fields
 from .macro.friction import BOUNDARY_FRICTION
 from .micro import FlowFactors, average, homogenise
 from .micro.homogenisation import prune_checkpoints
@@ -382,6 +383,15 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
     plot_stribeck(curves, outdir / "stribeck_speed.png", x="speed", labels=labels, boundary=cfb)
     plot_stribeck(curves, outdir / "stribeck_hersey.png", x="hersey", labels=labels,
                   boundary=cfb)
+    for lub, c in zip(lb.lubricants(), curves):
+        key = sweep_key(gap, spacing, common["factors_key"], tr.load, lub, common["settings"],
+                        face)
+        points = sorted(common["checkpoint"].glob(f"point_{key}_*.npz"))
+        picked = [points[i] for i in sorted({0, len(points) // 2, len(points) - 1})]
+        results = [MixedResult.load(p) for p in picked]
+        plot_point_fields(results, outdir / f"fields_mu{c.viscosity:g}.png", titles=[
+            f"$\\mu_0$ = {c.viscosity:g} Pa s, U = {r.speed:.3g} m/s, "
+            f"$C_f$ = {r.friction_coefficient:.4f}" for r in results])
     for c in curves:
         for u, cf, it, share in zip(c.speed, c.friction_coefficient, c.iterations,
                                     c.contact_load_fraction):
@@ -392,7 +402,7 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                                                       float(c.friction_coefficient.max())]}
                       for c in curves],
            "files": ["stribeck.csv", "stribeck_speed.png", "stribeck_hersey.png",
-                     "fields/"]}
+                     "fields/", *(f"fields_mu{c.viscosity:g}.png" for c in curves)]}
     if len(curves) > 1:
         out["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, cfb)
     if any(case.measured):

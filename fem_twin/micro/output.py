@@ -25,7 +25,7 @@ def plot_flow_factors(factors, path, labels=None) -> Path:
     fig, ax = plt.subplots(2, 2, figsize=(10, 8), constrained_layout=True)
     for f, label in zip(factors, labels):
         x = f.h0 * 1e6
-        ax[0, 0].plot(x, f.h_m * 1e6, label=label)
+        ax[0, 0].plot(x, (f.h_m - f.h0) * 1e9, label=label)
         ax[0, 1].semilogy(x, np.where(f.p_con > 0, f.p_con * 1e-6, np.nan), ".-", label=label)
         ax[1, 0].plot(x, f.A[:, 0, 0], label=label)
     last = factors[-1]
@@ -34,20 +34,36 @@ def plot_flow_factors(factors, path, labels=None) -> Path:
         ax[1, 1].plot(x, last.A[:, i, j], style, label=f"$A_{{{i + 1}{j + 1}}}$")
     ax[1, 1].plot(x, last.b[:, 0], "-", marker=".", markevery=10, label="$b_1$")
     ax[1, 1].plot(x, last.b[:, 1], "--", marker=".", markevery=10, label="$b_2$")
-    names = [("$h_m$ [µm]", "(a) mean gap, eq 12"), ("$p_{con}$ [MPa]", "(b) contact pressure, eq 11"),
+    names = [("$h_m - h_0$ [nm]", "(a) mean gap above $h_0$, eq 12"),
+             ("$p_{con}$ [MPa]", "(b) contact pressure, eq 11"),
              ("$A_{11}$ [-]", "(c) pressure flow factor, eq 13"),
              ("factor [-]", f"(d) A and b of {labels[-1]}")]
+    sq = composite_sq(last)
     for a, (ylabel, title) in zip(ax.ravel(), names):
         a.set_xlabel("$h_0$ [µm]")
         a.set_ylabel(ylabel)
         a.set_title(title)
         a.grid(True, alpha=0.3)
         a.legend(fontsize="small")
+        if sq:                                    # the separation in roughness units
+            top = a.secondary_xaxis("top", functions=(lambda u: u * 1e-6 / sq,
+                                                      lambda r: r * sq * 1e6))
+            top.set_xlabel(f"$h_0 / S_q$ [-] ($S_q$ = {sq * 1e9:.0f} nm)", fontsize="small")
     path = Path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=120)
     plt.close(fig)
     return path
+
+
+def composite_sq(factors: FlowFactors) -> float | None:
+    """Sq of the patch pair, sqrt(Sq_pin^2 + Sq_disk^2) [m] (Table 5), from the metadata;
+    the mean over the patches of an average; None if unknown."""
+    meta = factors.meta
+    if "sq" in meta:
+        return meta["sq"]
+    members = [m.get("sq") for m in meta.get("average_of", [])]
+    return float(np.mean(members)) if members and all(members) else None
 
 
 def cell_fields(pin, disk, h0: float, *, n_steps: int = 32, method: str = "fe",

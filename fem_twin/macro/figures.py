@@ -1,0 +1,46 @@
+"""Pictures of operating points: pressure, cavity fraction and contact pressure on the pin
+face (the fields of eqs 17-30), one row per point, as PNG."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..io.atomic import atomic_path
+
+#: (field, colour-bar label, scale to the plotted unit)
+PANELS = (("pressure_gauge", "hydrodynamic pressure $p - p_{amb}$ [MPa]", 1e-6),
+          ("cavity_fraction", r"cavity fraction $\theta$ [-]", 1.0),
+          ("contact_pressure", "contact pressure $p_{con}$ [MPa]", 1e-6))
+
+
+def plot_point_fields(results, path, titles=None) -> Path:
+    """One row per :class:`MixedResult`: the three fields on the pin face (the holder is
+    blank), x1 (sliding) to the right, in mm; written atomically."""
+    import matplotlib
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+    results = list(results)
+    fig, ax = plt.subplots(len(results), 3, figsize=(12, 3.4 * len(results)),
+                           squeeze=False, constrained_layout=True)
+    for row, res in enumerate(results):
+        ny, nx = res.pressure.shape
+        extent = (0, nx * res.spacing[0] * 1e3, 0, ny * res.spacing[1] * 1e3)
+        p_amb = res.meta.get("settings", {}).get("ambient_pressure", 0.0)
+        fields = {"pressure_gauge": res.pressure - p_amb,
+                  "cavity_fraction": res.cavity_fraction,
+                  "contact_pressure": res.contact_pressure}
+        for col, (name, label, scale) in enumerate(PANELS):
+            shown = np.where(res.face, fields[name] * scale, np.nan)
+            im = ax[row, col].imshow(shown, origin="lower", extent=extent, cmap="viridis")
+            fig.colorbar(im, ax=ax[row, col], shrink=0.85, label=label)
+            ax[row, col].set_xlabel("$x_1$ (sliding) [mm]")
+            ax[row, col].set_ylabel("$x_2$ [mm]")
+        title = titles[row] if titles else f"U = {res.speed:g} m/s"
+        ax[row, 0].set_title(title, loc="left", fontsize="medium")
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=100)
+    plt.close(fig)
+    return path
