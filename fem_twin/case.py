@@ -102,11 +102,15 @@ class MacroSpec:
 
 @dataclass(frozen=True)
 class SweepSpec:
-    """Speeds from ``speed_max`` down to ``speed_min`` [m/s], ``count`` log-spaced."""
+    """Speeds from ``speed_max`` down to ``speed_min`` [m/s], ``count`` log-spaced, then
+    ``refine`` passes that add the geometric midpoints where C_f jumps by more than
+    ``refine_step`` C_f,b (the transition from full film to boundary friction)."""
 
     speed_max: float = 2.0
     speed_min: float = 0.01
     count: int = 25
+    refine: int = 1             # passes adding midpoints where C_f jumps (0: off)
+    refine_step: float = 0.1    # ... by more than this fraction of C_f,b
 
     @property
     def speeds(self):
@@ -150,7 +154,8 @@ class Case:
         res = self.macro_geometry.resolution or (256, 256)
         point = ((res[0] * res[1]) / 128 ** 2) ** 1.2
         n_mu = len(self.lubricant.viscosities)
-        macro = point * self.sweep.count * n_mu / max(1, min(cores, n_mu))
+        points = self.sweep.count * (1 + 0.5 * self.sweep.refine)   # refinement: ~+50 %
+        macro = point * points * n_mu / max(1, min(cores, n_mu))
         return micro + macro
 
 
@@ -248,7 +253,10 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if macro.pin != "average" and not (isinstance(macro.pin, int)
                                        and 1 <= macro.pin <= len(geometry.pins)):
         raise CaseError(f"{where} [macro] pin: 'average' or a pin number 1..{len(geometry.pins)}")
-    sweep = _section(data, "sweep", SweepSpec, where, positive=True)
+    sweep = _section(data, "sweep", SweepSpec, where, positive=True, zero_ok=("refine",))
+    if not 0 <= sweep.refine <= 4 or not 0 < sweep.refine_step < 1:
+        raise CaseError(f"{where} [sweep]: refine is 0-4 passes, refine_step a fraction of "
+                        "C_f,b in (0, 1)")
     if sweep.speed_min > sweep.speed_max or sweep.count < 1:
         raise CaseError(f"{where} [sweep]: need speed_min <= speed_max [m/s] and count >= 1")
     run = _section(data, "run", RunSpec, where)
@@ -274,7 +282,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
                 sweep=sweep, run=run, measured=measured, source=source, defaulted=defaulted)
 
 
-def _section(data, name, cls, where, positive=False):
+def _section(data, name, cls, where, positive=False, zero_ok=()):
     """A table of scalars/lists into the dataclass ``cls`` (lists become tuples)."""
     table = data.get(name, {})
     _only(table, {f.name for f in fields(cls)}, f"{where} [{name}]")
@@ -301,7 +309,7 @@ def _section(data, name, cls, where, positive=False):
                 raise CaseError(f"{where} [{name}] {f.name}: expected a number (SI units)")
             if not math.isfinite(v):
                 raise CaseError(f"{where} [{name}] {f.name}: must be a finite number, got {v}")
-            if positive and v <= 0:
+            if positive and (v < 0 if f.name in zero_ok else v <= 0):
                 raise CaseError(f"{where} [{name}] {f.name}: must be positive (SI units)")
             v = type(default)(v) if isinstance(default, float) else v
         values[f.name] = v

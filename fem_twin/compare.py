@@ -106,7 +106,8 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
             lubricant=lub, diameter=case.tribometer.pin_diameter, face=face,
             settings=macro_settings(case, method),
             checkpoint=ckpt, progress=progress)
-        points[method] = [MixedResult.load(p) for p in sorted(ckpt.glob("point_*.npz"))]
+        points[method] = sorted((MixedResult.load(p) for p in ckpt.glob("point_*.npz")),
+                                key=lambda r: -r.speed)            # as the curve: fast first
     dev = friction_deviation(curves["fe"].friction_coefficient,
                              curves["fvm"].friction_coefficient)
     fields = [field_differences(a, b) for a, b in zip(points["fe"], points["fvm"])]

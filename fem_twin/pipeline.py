@@ -367,7 +367,15 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                   settings=macro_settings(case),
                   checkpoint=outdir / "stribeck" / "checkpoints", fields=outdir / "fields",
                   origin=origin, factors_key=stage_keys(case)["micro"])
-    curves = run_sweeps(common, lb.lubricants(), executor, progress)
+    speeds = case.sweep.speeds
+    for level in range(case.sweep.refine + 1):
+        curves = run_sweeps(dict(common, speeds=speeds), lb.lubricants(), executor, progress)
+        extra = transition_speeds(curves, case.sweep.refine_step * tr.boundary_friction)
+        if level == case.sweep.refine or extra.size == 0:
+            break
+        log.info("sweep refinement %d: %d speeds added where C_f changes by more than "
+                 "%.3g", level + 1, extra.size, case.sweep.refine_step * tr.boundary_friction)
+        speeds = np.unique(np.r_[speeds, extra])[::-1]
     keep = {sweep_key(gap, spacing, common["factors_key"], tr.load, lub, common["settings"],
                       face) for lub in lb.lubricants()}
     stale = [p for p in common["checkpoint"].glob("point_*.npz")
@@ -386,9 +394,9 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
     for lub, c in zip(lb.lubricants(), curves):
         key = sweep_key(gap, spacing, common["factors_key"], tr.load, lub, common["settings"],
                         face)
-        points = sorted(common["checkpoint"].glob(f"point_{key}_*.npz"))
-        picked = [points[i] for i in sorted({0, len(points) // 2, len(points) - 1})]
-        results = [MixedResult.load(p) for p in picked]
+        points = sorted((MixedResult.load(p) for p in
+                         common["checkpoint"].glob(f"point_{key}_*.npz")), key=lambda r: -r.speed)
+        results = [points[i] for i in sorted({0, len(points) // 2, len(points) - 1})]
         plot_point_fields(results, outdir / f"fields_mu{c.viscosity:g}.png", titles=[
             f"$\\mu_0$ = {c.viscosity:g} Pa s, U = {r.speed:.3g} m/s, "
             f"$C_f$ = {r.friction_coefficient:.4f}" for r in results])
@@ -448,6 +456,18 @@ def run_sweeps(common: dict, lubricants, executor=None, progress: bool = True):
             time.sleep(0.5)
         bar.update(total - bar.n)
     return [f.result() for f in futures]
+
+
+def transition_speeds(curves, step: float) -> np.ndarray:
+    """Geometric midpoints of neighbouring speeds between which C_f of any curve changes by
+    more than ``step`` (where the Stribeck curve turns, from full film to boundary)."""
+    extra = []
+    for c in curves:
+        order = np.argsort(c.speed)
+        u, cf = c.speed[order], c.friction_coefficient[order]
+        jump = np.abs(np.diff(cf)) > step
+        extra.extend(np.sqrt(u[:-1] * u[1:])[jump])
+    return np.unique(np.round(extra, 12))
 
 
 def _points_done(common: dict, lubricants) -> int:

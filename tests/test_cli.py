@@ -105,6 +105,7 @@ def small_case(tmp_path, workers=1):
                      ("resolution = [128, 128]      # patches", "resolution = [16, 16] #"),
                      ("h0_count = 16", "h0_count = 6"), ("steps = 16", "steps = 4"),
                      ("count = 12", "count = 5"), ("speed_min = 0.005", "speed_min = 0.01"),
+                     ("refine = 1 ", "refine = 0 "),
                      ("workers = 0", f"workers = {workers}")):
         assert old in text
         text = text.replace(old, new)
@@ -568,3 +569,24 @@ def test_example_case_ships_with_the_package(tmp_path, capsys):
             b = read_topography(ROOT / "meshes" / "sample" / path.name)
             assert np.array_equal(a.heights, b.heights)
     assert "fem-twin run" in capsys.readouterr().out
+
+
+def test_sweep_refinement_adds_speeds_where_the_curve_turns(tmp_path):
+    """Issue 18 item 5: [sweep] refine adds the geometric midpoints of neighbouring speeds
+    between which C_f jumps by more than refine_step C_f,b; a rerun recomputes nothing."""
+    from fem_twin.pipeline import transition_speeds
+    from fem_twin.stribeck.curve import read_stribeck_csv
+    text = small_case(tmp_path).read_text().replace("refine = 0 ", "refine = 1 ")
+    (tmp_path / "r.toml").write_text(text)
+    base, out = tmp_path / "base", tmp_path / "out"
+    assert main(["run", str(small_case(tmp_path)), "-o", str(base), "--no-progress"]) == 0
+    assert main(["run", str(tmp_path / "r.toml"), "-o", str(out), "--no-progress"]) == 0
+    coarse, fine = read_stribeck_csv(base / "stribeck.csv"), read_stribeck_csv(out / "stribeck.csv")
+    added = transition_speeds(coarse, 0.1 / (3 * 3 ** 0.5))
+    assert added.size > 0
+    for c, f in zip(coarse, fine):
+        assert np.allclose(np.sort(f.speed), np.sort(np.r_[c.speed, added]))
+        assert np.all(np.diff(f.speed) < 0)                          # fast to slow
+    stamps = {p: p.stat().st_mtime_ns for p in (out / "stribeck" / "checkpoints").iterdir()}
+    assert main(["run", str(tmp_path / "r.toml"), "-o", str(out), "--no-progress"]) == 0
+    assert {p: p.stat().st_mtime_ns for p in stamps} == stamps

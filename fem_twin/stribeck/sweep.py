@@ -43,7 +43,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     results, previous = [], None
     for i, speed in enumerate(tqdm(speeds, desc=f"Stribeck mu0={lubricant.viscosity:g}",
                                    disable=not progress, unit="speed")):
-        path = None if folder is None else folder / f"point_{key}_{i:03d}_{speed:.6e}.npz"
+        path = None if folder is None else folder / f"point_{key}_{speed:.9e}.npz"
         res = None if path is None else load_or_none(path, MixedResult.load)
         if res is None:
             res = solve_mixed(gap, spacing, factors, load=load, speed=float(speed),
