@@ -143,7 +143,7 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
 
     history = []
     t = np.zeros_like(s)
-    g_old, delta = 1.0, 0.0
+    g_old, delta, was_wrong = 1.0, 0.0, np.zeros(s.shape, bool)
     h0 = 0.0 if separation is None else float(separation)
     for it in range(1, max_iter + 1):
         u = op(p)
@@ -168,12 +168,16 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
         wrong &= ~free
         delta = 0.0 if wrong.any() else 1.0
         if wrong.any():
-            # pressure that closes a uniform overlap on the wrong set, no larger than the CG
-            # step: the set's joint stiffness, not one point's, limits it (else points
-            # released from and pressed back to the cap can cycle forever)
-            step = 1.0 / op(wrong.astype(float)).max()
-            step = min(step, tau) if tau > 0 else step
+            # pressure that closes a uniform overlap on the wrong set: the CG step; when the
+            # same points are wrong again, no larger than the set's joint stiffness allows
+            # (one point's step made points released from and pressed back to the cap cycle
+            # forever; the extra FFT pair is paid only then)
+            step = tau
+            if tau <= 0 or (wrong & was_wrong).any():
+                joint = 1.0 / op(wrong.astype(float)).max()
+                step = min(joint, tau) if tau > 0 else joint
             p[wrong] = np.clip(p[wrong] - step * g[wrong], p_min, hardness)
+        was_wrong = wrong
         if load is not None:
             p = _enforce_load(p, load / area, p_min, hardness)
         # relative change, with a floor of 1e-14 E' per point (no contact: nothing to resolve)
