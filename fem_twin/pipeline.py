@@ -294,7 +294,8 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
     factors = []
     for i in range(len(case.geometry.patches)):
         out = folder / f"patch_{i + 1}" / "flow_factors.npz"
-        if load_or_none(out, FlowFactors.load) is None:
+        ff = load_or_none(out, FlowFactors.load)
+        if ff is None:
             low = read_topography(geo / f"patch_{i + 1}_low.npz")
             up = read_topography(geo / f"patch_{i + 1}_up.npz")
             if low.shape != tuple(mc.resolution):
@@ -309,7 +310,7 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
             stale = prune_checkpoints(out.parent / "checkpoints", ff.meta["checkpoint_keys"])
             if stale:
                 log.info("patch %d: %d stale h0 checkpoints removed", i + 1, stale)
-        factors.append(FlowFactors.load(out))
+        factors.append(ff)
     mean = average(factors)
     mean.save(folder / "flow_factors.npz")
     mean.write_csv(folder.parent / "flow_factors.csv")
@@ -376,10 +377,8 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
         log.info("sweep refinement %d: %d speeds added where C_f changes by more than "
                  "%.3g", level + 1, extra.size, case.sweep.refine_step * tr.boundary_friction)
         speeds = np.unique(np.r_[speeds, extra])[::-1]
-    keep = {sweep_key(gap, spacing, common["factors_key"], tr.load, lub, common["settings"],
-                      face) for lub in lb.lubricants()}
-    stale = [p for p in common["checkpoint"].glob("point_*.npz")
-             if p.name.split("_")[1] not in keep]
+    keys = _sweep_keys(common, lb.lubricants())
+    stale = [p for p in common["checkpoint"].glob("point_*.npz") if _point_key(p) not in keys]
     for p in stale:
         p.unlink()
     if stale:
@@ -391,12 +390,11 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
     plot_stribeck(curves, outdir / "stribeck_speed.png", x="speed", labels=labels, boundary=cfb)
     plot_stribeck(curves, outdir / "stribeck_hersey.png", x="hersey", labels=labels,
                   boundary=cfb)
-    for lub, c in zip(lb.lubricants(), curves):
-        key = sweep_key(gap, spacing, common["factors_key"], tr.load, lub, common["settings"],
-                        face)
-        points = sorted((MixedResult.load(p) for p in
-                         common["checkpoint"].glob(f"point_{key}_*.npz")), key=lambda r: -r.speed)
-        results = [points[i] for i in sorted({0, len(points) // 2, len(points) - 1})]
+    for key, c in zip(keys, curves):
+        points = sorted(common["checkpoint"].glob(f"point_{key}_*.npz"), key=_point_speed,
+                        reverse=True)                                   # fast to slow
+        results = [MixedResult.load(points[i])
+                   for i in sorted({0, len(points) // 2, len(points) - 1})]
         plot_point_fields(results, outdir / f"fields_mu{c.viscosity:g}.png", titles=[
             f"$\\mu_0$ = {c.viscosity:g} Pa s, U = {r.speed:.3g} m/s, "
             f"$C_f$ = {r.friction_coefficient:.4f}" for r in results])
@@ -450,9 +448,13 @@ def run_sweeps(common: dict, lubricants, executor=None, progress: bool = True):
     futures = [executor.submit(_sweep_task, (dict(common, progress=False), lub))
                for lub in lubricants]
     total = len(lubricants) * len(common["speeds"])
+    keys = _sweep_keys(common, lubricants) if common.get("factors_key") else []
+    folder = common.get("checkpoint")
     with tqdm(total=total, desc="Stribeck points", unit="point", disable=not progress) as bar:
         while not all(f.done() for f in futures):
-            bar.update(_points_done(common, lubricants) - bar.n)
+            if folder is not None and keys:                   # points finished so far
+                bar.update(sum(_point_key(p) in keys for p in Path(folder).glob("point_*.npz"))
+                           - bar.n)
             time.sleep(0.5)
         bar.update(total - bar.n)
     return [f.result() for f in futures]
@@ -470,14 +472,18 @@ def transition_speeds(curves, step: float) -> np.ndarray:
     return np.unique(np.round(extra, 12))
 
 
-def _points_done(common: dict, lubricants) -> int:
-    """Finished points of the sweeps of ``common`` (their checkpoint files)."""
-    folder = common.get("checkpoint")
-    if folder is None or common.get("factors_key") is None:
-        return 0
-    keys = {sweep_key(common["gap"], common["spacing"], common["factors_key"], common["load"],
-                      lub, common["settings"], common["face"]) for lub in lubricants}
-    return sum(1 for p in Path(folder).glob("point_*.npz") if p.name.split("_")[1] in keys)
+def _sweep_keys(common: dict, lubricants) -> list[str]:
+    """Checkpoint key of each lubricant's sweep (``point_KEY_SPEED.npz``)."""
+    return [sweep_key(common["gap"], common["spacing"], common["factors_key"], common["load"],
+                      lub, common["settings"], common["face"]) for lub in lubricants]
+
+
+def _point_key(path: Path) -> str:
+    return path.name.split("_")[1]
+
+
+def _point_speed(path: Path) -> float:
+    return float(path.stem.split("_")[2])
 
 
 def hersey_collapse(curves, boundary: float = BOUNDARY_FRICTION) -> float:

@@ -10,9 +10,10 @@ sampling alone would not see it.  ``|f_N - f_{N/2}|`` estimates the error of ``f
 it falls at first order in ``1 / N_t`` and bounds it when faster.
 
 Grid: the same problem on the cell coarsened by two (every other pixel, exact for a
-periodic cell) at a few separations; the flow factors converge at first order in the pixel
-size (the contact edges and the 1 nm floor cut the gap's smoothness; measured on the bundled
-patches), so ``|f_h - f_{2h}|`` estimates the error of ``f_h``.
+periodic cell) at a few separations.  Coarsening a measured patch also drops its shortest
+wavelengths, and the flow factors then change at first order in the pixel size (measured on
+the bundled patches), so ``|f_h - f_{2h}|`` estimates the error of ``f_h``; where they
+converge at second order (a smooth or fully resolved surface) it is 3x the error.
 
 Each estimate is normwise per quantity: the largest difference over the separations
 relative to the largest magnitude over the range (``max |f - g| / max |f|``), so a factor

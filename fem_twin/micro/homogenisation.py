@@ -263,11 +263,14 @@ class SlidingPass:
     moving : the moving surface's part of that geometry at each instant (``z_up`` shifted
         for the disk, ``-z_low`` shifted for the pin in the disk's frame) [m]
     um_dt : ``u_m dt`` between instants [m], ``+s/2`` (disk moving) or ``-s/2`` (pin)
+    rigid_rate : ``-2 d(moving)/dx1`` at each instant, the rigid part of the squeeze term
+        of eq 8 (central difference, the discrete derivative of the Couette flux) [-]
     """
 
     shapes: list
     moving: list
     um_dt: float
+    rigid_rate: list
 
 
 def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | None = None,
@@ -281,10 +284,11 @@ def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | No
     n = [(k + offset) * px for k in range(n_steps)]
     if settings.moving == "upper":
         moving = [_shift(z_up, k) for k in n]
-        shapes = [m - z_low for m in moving]
-        return SlidingPass(shapes, moving, px * spacing[0] / 2)
-    moving = [-_shift(z_low, -k) for k in n]
-    return SlidingPass([z_up + m for m in moving], moving, -px * spacing[0] / 2)
+        shapes, um_dt = [m - z_low for m in moving], px * spacing[0] / 2
+    else:
+        moving = [-_shift(z_low, -k) for k in n]
+        shapes, um_dt = [z_up + m for m in moving], -px * spacing[0] / 2
+    return SlidingPass(shapes, moving, um_dt, [-2.0 * _d_dx1(m, spacing[0]) for m in moving])
 
 
 def _shift(z, px):
@@ -330,8 +334,8 @@ def sliding_squeeze(contacts, sliding: SlidingPass, spacing, settings: CellSetti
     """The squeeze term ``tau = (1/u_m) dh/dt`` of eq 8 at each instant (None: steady).
 
     ``"exact"``: the moving surface translates at ``V = 2 u_m``, so the rate of the rigid
-    geometry is ``-2 d(moving)/dx1`` exactly at every instant (central difference, the
-    discrete derivative of the Couette flux); the contact deformation adds ``K p'`` from
+    geometry is ``sliding.rigid_rate`` exactly at every instant; the contact deformation
+    adds ``K p'`` from
     :func:`fem_twin.contact.contact_rate`; ``tau = 0`` where the gap sits at the floor.
     No time-step error: the time average of eqs 11-16 over the ``N_t`` instants is then the
     trapezoidal rule of a periodic function.
@@ -344,8 +348,7 @@ def sliding_squeeze(contacts, sliding: SlidingPass, spacing, settings: CellSetti
         return [None if (n == 0 and steady) else (h - gaps[n - 1]) / sliding.um_dt
                 for n, h in enumerate(gaps)]
     out = []
-    for r, m in zip(contacts, sliding.moving):
-        rigid = -2.0 * _d_dx1(m, spacing[0])
+    for r, rigid in zip(contacts, sliding.rigid_rate):
         _, elastic = contact_rate(r, rigid, spacing, settings.e_reduced,
                                   hardness=settings.hardness, periodic=True,
                                   tol=settings.rate_tol)
@@ -364,7 +367,7 @@ def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=Fa
     """Moments for ``points = [(index, h0), ...]`` in order, warm-starting contact."""
     solver = _cell_solver(z_low.shape, spacing, settings.method)
     sliding = sliding_pass(z_low, z_up, spacing, settings)
-    warm, warm_mid = [None] * settings.n_steps, {}
+    warm, midpoints = [None] * settings.n_steps, {}
     out = []
     for i, h0 in points:
         if resume and folder is not None:
@@ -375,7 +378,7 @@ def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=Fa
         contacts, steps, seconds = _instants(sliding, h0, warm, solver, spacing, settings)
         if settings.time_tol is not None:
             contacts, steps, more = _refine(contacts, steps, h0, z_low, z_up, solver, spacing,
-                                            settings, warm_mid)
+                                            settings, midpoints)
             seconds = [a + b for a, b in zip(seconds, more)]
         moments = _time_average(steps)
         moments["n_steps"] = len(steps)
@@ -411,17 +414,20 @@ def _time_error(steps) -> float:
     return float(np.max(np.abs(full - half) / np.abs(full)))
 
 
-def _refine(contacts, steps, h0, z_low, z_up, solver, spacing, settings, warm_mid):
+def _refine(contacts, steps, h0, z_low, z_up, solver, spacing, settings, midpoints):
     """Adaptive instants (``settings.time_tol``, exact scheme): while A11 or b1 change by
     more than the tolerance from every other instant to all, add the midpoints (the time
     average is then over twice the instants), up to one pixel per step.  In heavy contact
     the integrand jumps whenever a pixel enters contact, and a fixed N_t samples it
-    unevenly; light contact stops at ``n_steps``."""
+    unevenly; light contact stops at ``n_steps``.  ``midpoints`` keeps each level's pass and
+    warm starts across the separations of a chunk."""
     seconds = [0.0, 0.0]
     while _time_error(steps) > settings.time_tol and 2 * len(steps) <= z_low.shape[1]:
         n = len(steps)
-        mid = sliding_pass(z_low, z_up, spacing, settings, n_steps=n, offset=0.5)
-        warm = warm_mid.setdefault(n, [None] * n)
+        if n not in midpoints:
+            midpoints[n] = (sliding_pass(z_low, z_up, spacing, settings, n_steps=n,
+                                         offset=0.5), [None] * n)
+        mid, warm = midpoints[n]
         c, m, sec = _instants(mid, h0, warm, solver, spacing, settings)
         contacts = [x for pair in zip(contacts, c) for x in pair]
         steps = [x for pair in zip(steps, m) for x in pair]
@@ -434,7 +440,8 @@ def _half_pass(steps, contacts, sliding, solver, spacing, settings):
     difference quotient is redone over the doubled step (its error is not in the sampling)."""
     if settings.time_derivative == "exact":
         return steps[::2]
-    half = SlidingPass(sliding.shapes[::2], sliding.moving[::2], 2 * sliding.um_dt)
+    half = SlidingPass(sliding.shapes[::2], sliding.moving[::2], 2 * sliding.um_dt,
+                       sliding.rigid_rate[::2])
     squeezes = sliding_squeeze(contacts[::2], half, spacing, settings)
     out = [cell.moments for cell in
            sliding_cells([r.gap for r in contacts[::2]], squeezes, solver)]
