@@ -106,8 +106,6 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
 
 
 def _plot_deviation(path, speed, dev, ref_label, study):
-    import matplotlib
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6, 4))
     for label, d in dev.items():

@@ -120,10 +120,13 @@ class SweepSpec:
 
 @dataclass(frozen=True)
 class RunSpec:
-    """Where independent work runs: local processes, or a Dask scheduler address."""
+    """Where independent work runs: local processes, or a Dask scheduler address; whether
+    the main job adds the patch scatter band (one Stribeck sweep per patch's flow factors
+    beside the patch average, min/max C_f per speed)."""
 
     workers: int = 0                 # 0: all cores
     scheduler: str | None = None     # e.g. "tcp://10.0.0.1:8786"
+    patch_band: bool = True          # one sweep per patch: the scatter band (Figure 13)
 
 
 @dataclass(frozen=True)
@@ -147,7 +150,8 @@ class Case:
     def estimated_seconds(self, cores: int = 2) -> float:
         """Rough wall time of ``fem-twin run`` on ``cores`` cores [s], from the costs measured
         on this project's 2-core machine: ~3 us per cell pixel and time step of the micro
-        stage on one core, ~1 s per Stribeck point at 128^2 growing as N^1.2 (pixels)."""
+        stage on one core, ~1 s per Stribeck point at 128^2 growing as N^1.2 (pixels), one sweep
+        per viscosity and, with ``[run] patch_band``, one more per patch."""
         patches = len(self.geometry.patches)
         micro = (3e-6 * self.micro.resolution[0] * self.micro.resolution[1] * self.micro.steps
                  * self.micro.h0_count * patches / max(cores, 1))
@@ -155,7 +159,8 @@ class Case:
         point = ((res[0] * res[1]) / 128 ** 2) ** 1.2
         n_mu = len(self.lubricant.viscosities)
         points = self.sweep.count * (1 + 0.5 * self.sweep.refine)   # refinement: ~+50 %
-        macro = point * points * n_mu / max(1, min(cores, n_mu))
+        sweeps = n_mu * (1 + (patches if self.run.patch_band and patches > 1 else 0))
+        macro = point * points * sweeps / max(1, min(cores, sweeps))
         return micro + macro
 
 
@@ -301,7 +306,10 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
                 raise CaseError(f"{where} [{name}] {f.name}: values must be finite numbers")
             if positive and any(x <= 0 for x in v):
                 raise CaseError(f"{where} [{name}] {f.name}: values must be positive (SI units)")
-        elif isinstance(default, bool) or default is None or isinstance(default, str):
+        elif isinstance(default, bool):
+            if not isinstance(v, bool):
+                raise CaseError(f"{where} [{name}] {f.name}: expected true or false")
+        elif default is None or isinstance(default, str):
             if not isinstance(v, (str, int)) or isinstance(v, bool):
                 raise CaseError(f"{where} [{name}] {f.name}: expected a string")
         elif isinstance(default, (int, float)):

@@ -144,8 +144,6 @@ def _write_csv(path, columns: dict):
 
 
 def _plot(path, ffd, curves, dev):
-    import matplotlib
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(1, 3, figsize=(13, 3.8))
     for k in ("A", "b", "C", "h_m", "p_con"):

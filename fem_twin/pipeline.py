@@ -359,7 +359,8 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
 
 
 def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = True) -> dict:
-    """One Stribeck sweep per viscosity (in parallel on ``executor``); CSV, plots, fields."""
+    """One Stribeck sweep per viscosity (in parallel on ``executor``), the patch scatter band
+    (``[run] patch_band``); CSV, plots, fields, ``results.nc`` and ``fields.nc``."""
     gap, spacing, face, origin = macro_geometry(case, outdir)
     factors = FlowFactors.load(outdir / "micro" / "flow_factors.npz")
     lb, tr = case.lubricant, case.tribometer
@@ -368,52 +369,124 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                   settings=macro_settings(case),
                   checkpoint=outdir / "stribeck" / "checkpoints", fields=outdir / "fields",
                   origin=origin, factors_key=stage_keys(case)["micro"])
+    lubricants = lb.lubricants()
     speeds = case.sweep.speeds
     for level in range(case.sweep.refine + 1):
-        curves = run_sweeps(dict(common, speeds=speeds), lb.lubricants(), executor, progress)
+        curves = run_sweeps([(dict(common, speeds=speeds), lub) for lub in lubricants],
+                            executor, progress)
         extra = transition_speeds(curves, case.sweep.refine_step * tr.boundary_friction)
         if level == case.sweep.refine or extra.size == 0:
             break
         log.info("sweep refinement %d: %d speeds added where C_f changes by more than "
                  "%.3g", level + 1, extra.size, case.sweep.refine_step * tr.boundary_friction)
         speeds = np.unique(np.r_[speeds, extra])[::-1]
-    keys = _sweep_keys(common, lb.lubricants())
-    stale = [p for p in common["checkpoint"].glob("point_*.npz") if _point_key(p) not in keys]
-    for p in stale:
-        p.unlink()
-    if stale:
-        log.info("%d stale Stribeck checkpoints removed", len(stale))
-    write_stribeck_csv(outdir / "stribeck.csv", curves)
-    labels = [f"{t:g} °C, $\\mu_0$ = {c.viscosity:g} Pa s"
-              for t, c in zip(lb.temperatures, curves)]
-    cfb = tr.boundary_friction
-    plot_stribeck(curves, outdir / "stribeck_speed.png", x="speed", labels=labels, boundary=cfb)
-    plot_stribeck(curves, outdir / "stribeck_hersey.png", x="hersey", labels=labels,
-                  boundary=cfb)
-    for key, c in zip(keys, curves):
-        points = sorted(common["checkpoint"].glob(f"point_{key}_*.npz"), key=_point_speed,
-                        reverse=True)                                   # fast to slow
-        results = [MixedResult.load(points[i])
-                   for i in sorted({0, len(points) // 2, len(points) - 1})]
-        plot_point_fields(results, outdir / f"fields_mu{c.viscosity:g}.png", titles=[
-            f"$\\mu_0$ = {c.viscosity:g} Pa s, U = {r.speed:.3g} m/s, "
-            f"$C_f$ = {r.friction_coefficient:.4f}" for r in results])
-    for c in curves:
-        for u, cf, it, share in zip(c.speed, c.friction_coefficient, c.iterations,
-                                    c.contact_load_fraction):
-            log.info("point mu_0 = %g Pa s, U = %.4g m/s: C_f = %.5f, contact share %.3f, "
-                     "%d iterations", c.viscosity, u, cf, share, it)
+    tasks = [(dict(common, speeds=speeds), lub) for lub in lubricants]
+    band_tasks = band_sweeps(case, outdir, dict(common, speeds=speeds)) if case.run.patch_band \
+        else []
+    patch_curves = run_sweeps([(kw, lub) for kw in band_tasks for lub in lubricants],
+                              executor, progress, desc="patch band points")
+    patch_curves = [patch_curves[i:i + len(lubricants)]
+                    for i in range(0, len(patch_curves), len(lubricants))]
+    band = patch_band(patch_curves) if patch_curves else None
+    _prune_points(common["checkpoint"], tasks + [(kw, lub) for kw in band_tasks
+                                                   for lub in lubricants])
+    write_stribeck_csv(outdir / "stribeck.csv", curves, band)
     out = {"curves": [{"viscosity_Pa_s": c.viscosity,
                        "friction_coefficient_range": [float(c.friction_coefficient.min()),
                                                       float(c.friction_coefficient.max())]}
                       for c in curves],
            "files": ["stribeck.csv", "stribeck_speed.png", "stribeck_hersey.png",
-                     "fields/", *(f"fields_mu{c.viscosity:g}.png" for c in curves)]}
+                     "results.nc", "fields.nc", "fields/",
+                     *(f"fields_mu{c.viscosity:g}.png" for c in curves)]}
+    if band is not None:
+        out["patch_band_max_width"] = float(max(np.max(hi - lo) for lo, hi in band))
+    plot_curves(case, curves, band, outdir)
+    keys = {_sweep_key(kw, lub): lub.viscosity for kw, lub in tasks}
+    for mu, by_speed in sweep_points(common["checkpoint"], keys).items():
+        u = sorted(by_speed, reverse=True)                                # fast to slow
+        res = [MixedResult.load(by_speed[u[i]]) for i in sorted({0, len(u) // 2, len(u) - 1})]
+        plot_point_fields(res, outdir / f"fields_mu{mu:g}.png", titles=[
+            f"$\\mu_0$ = {mu:g} Pa s, U = {r.speed:.3g} m/s, "
+            f"$C_f$ = {r.friction_coefficient:.4f}" for r in res])
+    for c in curves:
+        for u, cf, it, share in zip(c.speed, c.friction_coefficient, c.iterations,
+                                    c.contact_load_fraction):
+            log.info("point mu_0 = %g Pa s, U = %.4g m/s: C_f = %.5f, contact share %.3f, "
+                     "%d iterations", c.viscosity, u, cf, share, it)
     if len(curves) > 1:
-        out["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, cfb)
+        out["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, tr.boundary_friction)
     if any(case.measured):
-        out["validation"] = validate(case, curves, outdir, labels)
+        out["validation"] = validate(case, curves, outdir, curve_labels(case, curves))
+    write_run_results(case, outdir, curves, patch_curves, tasks, origin)
     return out
+
+
+def band_sweeps(case: Case, outdir: Path, common: dict) -> list[dict]:
+    """Sweep arguments of every single patch's flow factors (the scatter band, Figure 13)."""
+    n = len(case.geometry.patches)
+    if n < 2:
+        return []
+    return [dict(common, factors=FlowFactors.load(outdir / "micro" / f"patch_{i + 1}"
+                                                  / "flow_factors.npz"),
+                 factors_key=f"{common['factors_key']}-patch{i + 1}", fields=None)
+            for i in range(n)]
+
+
+def patch_band(patch_curves) -> list:
+    """(cf_min, cf_max) per lubricant over single-patch curves [patch][lubricant]."""
+    cf = np.array([[c.friction_coefficient for c in per_mu] for per_mu in patch_curves])
+    return [(cf[:, k].min(axis=0), cf[:, k].max(axis=0)) for k in range(cf.shape[1])]
+
+
+def curve_labels(case: Case, curves) -> list[str]:
+    return [f"{t:g} °C, $\\mu_0$ = {c.viscosity:g} Pa s"
+            for t, c in zip(case.lubricant.temperatures, curves)]
+
+
+def plot_curves(case: Case, curves, band, outdir: Path) -> None:
+    """C_f versus speed and versus Hersey number, with the band and measured curves."""
+    measured = [read_measured_csv(m) if m is not None else None for m in case.measured]
+    measured += [None] * (len(curves) - len(measured))
+    tr = case.tribometer
+    for x in ("speed", "hersey"):
+        plot_stribeck(curves, outdir / f"stribeck_{x}.png", x=x,
+                      labels=curve_labels(case, curves), boundary=tr.boundary_friction,
+                      bands=band, measured=measured, diameter=tr.pin_diameter, load=tr.load)
+
+
+def sweep_points(folder: Path, task_keys: dict) -> dict:
+    """{viscosity: {speed: checkpoint path}} of the sweeps ``task_keys`` {key: viscosity}."""
+    out = {}
+    for key, mu in task_keys.items():
+        out[mu] = {_point_speed(p): p for p in folder.glob(f"point_{key}_*.npz")}
+    return out
+
+
+def write_run_results(case: Case, outdir: Path, curves, patch_curves, tasks, origin) -> None:
+    """``results.nc`` (flow factors per patch and average, Stribeck curves with the band,
+    settings and error estimates) and ``fields.nc`` (every point's macro fields)."""
+    from dataclasses import asdict
+
+    from .results import fields_dataset, flow_factor_dataset, stribeck_dataset, write_netcdf
+    micro = outdir / "micro"
+    n = len(case.geometry.patches)
+    factors = [FlowFactors.load(micro / f"patch_{i + 1}" / "flow_factors.npz")
+               for i in range(n)] + [FlowFactors.load(micro / "flow_factors.npz")]
+    attrs = {"case": json.dumps(asdict(case), default=str), "case_name": case.name,
+             "provenance": json.dumps(provenance(case))}
+    write_netcdf(outdir / "results.nc",
+                 {"flow_factors": flow_factor_dataset(factors, [str(i + 1) for i in range(n)]
+                                                      + ["average"]),
+                  "stribeck": stribeck_dataset(
+                      curves, patch_band(patch_curves) if patch_curves else None,
+                      patch_curves)}, attrs)
+    keys = {_sweep_key(kw, lub): lub.viscosity for kw, lub in tasks}
+    points = {}
+    for mu, by_speed in sweep_points(tasks[0][0]["checkpoint"], keys).items():
+        for path in by_speed.values():
+            res = MixedResult.load(path)
+            points[mu, res.speed] = res
+    write_netcdf(outdir / "fields.nc", {None: fields_dataset(points, origin)}, attrs)
 
 
 def validate(case: Case, curves, outdir: Path, labels) -> list:
@@ -438,19 +511,20 @@ def validate(case: Case, curves, outdir: Path, labels) -> list:
     return result
 
 
-def run_sweeps(common: dict, lubricants, executor=None, progress: bool = True):
-    """Sweeps for several lubricants; serial, or one task per lubricant on ``executor``.
+def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points"):
+    """Sweeps ``tasks`` [(sweep kwargs, lubricant)]: serial, or one process task each on
+    ``executor``.
 
     In parallel the bar counts the finished points of all sweeps (their checkpoint files,
     written as each point finishes in its worker)."""
-    if executor is None or len(lubricants) == 1:
-        return [_sweep_task((dict(common, progress=progress), lub)) for lub in lubricants]
-    futures = [executor.submit(_sweep_task, (dict(common, progress=False), lub))
-               for lub in lubricants]
-    total = len(lubricants) * len(common["speeds"])
-    keys = _sweep_keys(common, lubricants) if common.get("factors_key") else []
-    folder = common.get("checkpoint")
-    with tqdm(total=total, desc="Stribeck points", unit="point", disable=not progress) as bar:
+    if executor is None or len(tasks) == 1:
+        return [_sweep_task((dict(kw, progress=progress), lub)) for kw, lub in tasks]
+    futures = [executor.submit(_sweep_task, (dict(kw, progress=False), lub))
+               for kw, lub in tasks]
+    total = sum(len(kw["speeds"]) for kw, _ in tasks)
+    keys = {_sweep_key(kw, lub) for kw, lub in tasks if kw.get("factors_key")}
+    folder = tasks[0][0].get("checkpoint")
+    with tqdm(total=total, desc=desc, unit="point", disable=not progress) as bar:
         while not all(f.done() for f in futures):
             if folder is not None and keys:                   # points finished so far
                 bar.update(sum(_point_key(p) in keys for p in Path(folder).glob("point_*.npz"))
@@ -472,10 +546,20 @@ def transition_speeds(curves, step: float) -> np.ndarray:
     return np.unique(np.round(extra, 12))
 
 
-def _sweep_keys(common: dict, lubricants) -> list[str]:
-    """Checkpoint key of each lubricant's sweep (``point_KEY_SPEED.npz``)."""
-    return [sweep_key(common["gap"], common["spacing"], common["factors_key"], common["load"],
-                      lub, common["settings"], common["face"]) for lub in lubricants]
+def _sweep_key(kwargs: dict, lubricant) -> str:
+    """Checkpoint key of one sweep task (``point_KEY_SPEED.npz``)."""
+    return sweep_key(kwargs["gap"], kwargs["spacing"], kwargs["factors_key"], kwargs["load"],
+                     lubricant, kwargs["settings"], kwargs["face"])
+
+
+def _prune_points(folder: Path, tasks) -> None:
+    """Remove the Stribeck checkpoints of no current sweep (changed inputs)."""
+    keys = {_sweep_key(kw, lub) for kw, lub in tasks}
+    stale = [p for p in folder.glob("point_*.npz") if _point_key(p) not in keys]
+    for p in stale:
+        p.unlink()
+    if stale:
+        log.info("%d stale Stribeck checkpoints removed", len(stale))
 
 
 def _point_key(path: Path) -> str:

@@ -96,9 +96,10 @@ def test_case_validation(tmp_path):
             load_case(tmp_path / name)
 
 
-def small_case(tmp_path, workers=1):
+def small_case(tmp_path, workers=1, band=False):
     """The bundled case with reduced settings (48^2 macro, 16^2 x 6 h0 x 4 steps micro,
-    2 patches, 5 speeds) so the whole pipeline runs in seconds."""
+    2 patches, 5 speeds, no patch band unless ``band``) so the whole pipeline runs in
+    seconds."""
     text = (ROOT / "examples" / "pin_on_disk.toml").read_text()
     text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
     for old, new in (("resolution = [128, 128]      # reduced", "resolution = [48, 48] #"),
@@ -106,7 +107,8 @@ def small_case(tmp_path, workers=1):
                      ("h0_count = 16", "h0_count = 6"), ("steps = 16", "steps = 4"),
                      ("count = 12", "count = 5"), ("speed_min = 0.005", "speed_min = 0.01"),
                      ("refine = 1 ", "refine = 0 "),
-                     ("workers = 0", f"workers = {workers}")):
+                     ("workers = 0", f"workers = {workers}"),
+                     ("patch_band = true", f"patch_band = {str(band).lower()}")):
         assert old in text
         text = text.replace(old, new)
     lines = [ln for ln in text.splitlines() if "patch_3" not in ln and "patch_4" not in ln
@@ -590,3 +592,45 @@ def test_sweep_refinement_adds_speeds_where_the_curve_turns(tmp_path):
     stamps = {p: p.stat().st_mtime_ns for p in (out / "stribeck" / "checkpoints").iterdir()}
     assert main(["run", str(tmp_path / "r.toml"), "-o", str(out), "--no-progress"]) == 0
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps
+
+
+def test_results_as_data_and_the_patch_scatter_band(tmp_path):
+    """Issue 16 items 1-2: open_run gives the numbers of the CSVs (to their 10 digits) and of
+    the checkpoints (exactly); the band is the min/max of the single-patch sweeps."""
+    from fem_twin.macro import MixedResult
+    from fem_twin.results import open_run
+    out = tmp_path / "out"
+    assert main(["run", str(small_case(tmp_path, band=True)), "-o", str(out),
+                 "--no-progress"]) == 0
+    run = open_run(out)
+    st, ff = run.stribeck, run.flow_factors
+    rows = list(csv.DictReader(open(out / "stribeck.csv")))
+    assert len(rows) == 10 and {"cf_min", "cf_max"} <= set(rows[0])
+    for r in rows:
+        point = st.sel(viscosity=float(r["viscosity"]), speed=float(r["speed"]),
+                       method="nearest")
+        for k in ("hersey", "friction_coefficient", "hydrodynamic_friction",
+                  "boundary_friction", "contact_load_fraction", "h_d", "iterations", "cf_min",
+                  "cf_max"):
+            assert float(point[k]) == pytest.approx(float(r[k]), rel=1e-9, abs=1e-300), k
+        patches = point["patch_friction_coefficient"].values
+        assert patches.shape == (2,) and float(point.cf_min) == patches.min()
+        assert float(point.cf_max) == patches.max()
+    assert st.friction_coefficient.attrs["units"] == "1" and st.speed.attrs["units"] == "m/s"
+    csv_ff = np.loadtxt(out / "flow_factors.csv", delimiter=",", skiprows=1)
+    avg = ff.sel(patch="average")
+    assert np.allclose(avg.A11, csv_ff[:, 3], rtol=1e-9) and ff.h0.attrs["units"] == "m"
+    assert np.allclose(avg.p_con, csv_ff[:, 2], rtol=1e-9)
+    assert list(ff.patch.values) == ["1", "2", "average"]
+    assert json.loads(ff.attrs["error_estimate"]).keys() >= {"grid", "time"}
+    points = [MixedResult.load(p) for p in (out / "stribeck" / "checkpoints").glob("*.npz")]
+    assert len(points) == 10 + 2 * 10                       # average + one sweep per patch
+    fields = run.fields.pressure
+    assert fields.shape == (2, 5, 48, 48)
+    for mu in fields.viscosity.values:
+        for u in fields.speed.values:                        # every field is a checkpoint's
+            assert sum(np.array_equal(fields.sel(viscosity=mu, speed=u).values, r.pressure)
+                       for r in points if r.speed == u) == 1
+    assert run.summary["stages"]["stribeck"]["patch_band_max_width"] > 0
+    assert (out / "stribeck_speed.png").is_file()
+    run.fields.close()

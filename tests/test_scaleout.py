@@ -32,11 +32,12 @@ def test_dask_local_cluster_gives_the_serial_numbers(tmp_path):
     distributed = pytest.importorskip("distributed")
     common = small_sweep()
     lubricants = [Lubricant(0.066), Lubricant(0.024)]
-    serial = run_sweeps(common, lubricants, None, progress=False)
+    tasks = [(common, lub) for lub in lubricants]
+    serial = run_sweeps(tasks, None, progress=False)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
-        remote = run_sweeps(common, lubricants, client.get_executor(), progress=False)
+        remote = run_sweeps(tasks, client.get_executor(), progress=False)
     for a, b in zip(serial, remote):
         assert a.viscosity == b.viscosity
         assert np.array_equal(a.friction_coefficient, b.friction_coefficient)

@@ -18,8 +18,6 @@ PANELS = (("pressure_gauge", "hydrodynamic pressure $p - p_{amb}$ [MPa]", 1e-6),
 def plot_point_fields(results, path, titles=None) -> Path:
     """One row per :class:`MixedResult`: the three fields on the pin face (the holder is
     blank), x1 (sliding) to the right, in mm; written atomically."""
-    import matplotlib
-    matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
     results = list(results)
     fig, ax = plt.subplots(len(results), 3, figsize=(12, 3.4 * len(results)),

@@ -16,8 +16,6 @@ from .homogenisation import (CellSettings, _cell_solver, _check_patches, sliding
 def plot_flow_factors(factors, path, labels=None) -> Path:
     """Figures 4-5: h_m, p_con, A11 of each patch pair (and their average if given last),
     and all components of A and b of the last entry, versus h0 [um].  Written atomically."""
-    import matplotlib
-    matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
     factors = [factors] if isinstance(factors, FlowFactors) else list(factors)

@@ -63,15 +63,18 @@ class StribeckCurve:
         return np.where(inside, PchipInterpolator(x, y)(np.clip(h, x[0], x[-1])), np.nan)
 
 
-def write_stribeck_csv(path, curves) -> Path:
-    """All curves into one CSV (columns :data:`COLUMNS`, SI units), atomically."""
+def write_stribeck_csv(path, curves, band=None) -> Path:
+    """All curves into one CSV (columns :data:`COLUMNS`, SI units), atomically; ``band``:
+    optional ``(cf_min, cf_max)`` per curve (the patch scatter band), two more columns."""
     path = Path(path)
     with atomic_path(path) as tmp:
         with open(tmp, "w", newline="") as f:
             w = csv.writer(f)
-            w.writerow(COLUMNS)
-            for c in curves:
-                for row in c.rows():
+            w.writerow(COLUMNS + (("cf_min", "cf_max") if band is not None else ()))
+            for k, c in enumerate(curves):
+                for i, row in enumerate(c.rows()):
+                    if band is not None:
+                        row += [float(band[k][0][i]), float(band[k][1][i])]
                     w.writerow([f"{v:.10g}" if isinstance(v, float) else v for v in row])
     return path
 
@@ -92,19 +95,29 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
 
 
 def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None,
-                  boundary: float = BOUNDARY_FRICTION) -> Path:
+                  boundary: float = BOUNDARY_FRICTION, bands=None, measured=None,
+                  diameter: float = 8e-3, load: float = 150.0) -> Path:
     """C_f versus sliding speed (``x="speed"``) or Hersey number (``"hersey"``), log x.
 
     ``reference``: optional measured curve ``(x values, C_f, optional (low, high) band)``;
-    ``boundary``: C_f,b of eq 32, drawn as the boundary-friction limit.
+    ``boundary``: C_f,b of eq 32, drawn as the boundary-friction limit; ``bands``: optional
+    ``(cf_min, cf_max)`` per curve, drawn as a shaded band (the patch scatter, Figure 13);
+    ``measured``: optional :class:`MeasuredCurve` (or None) per curve, drawn on top in the
+    curve's colour (on the Hersey axis with ``diameter`` [m] and ``load`` [N] of eq 46).
     """
-    import matplotlib
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     for i, c in enumerate(curves):
         label = labels[i] if labels else f"$\\mu_0$ = {c.viscosity:g} Pa s"
-        ax.plot(getattr(c, x), c.friction_coefficient, "o-", ms=3, label=label)
+        line, = ax.plot(getattr(c, x), c.friction_coefficient, "o-", ms=3, label=label)
+        if bands is not None and bands[i] is not None:
+            ax.fill_between(getattr(c, x), *bands[i], color=line.get_color(), alpha=0.2, lw=0,
+                            label="patch scatter" if i == 0 else None)
+        m = measured[i] if measured is not None else None
+        if m is not None:
+            mx = m.speed if x == "speed" else hersey_number(c.viscosity, m.speed, diameter, load)
+            ax.plot(mx, m.friction_coefficient, "s", mfc="none", color=line.get_color(),
+                    label=f"measured, {label}")
     if reference is not None:
         ax.plot(reference[0], reference[1], "k--", label="measured")
         if len(reference) > 2 and reference[2] is not None:

@@ -1,0 +1,159 @@
+"""A run's results as data: xarray Datasets with coordinates and units, in NetCDF files.
+
+``fem-twin run`` writes ``OUT/results.nc`` (groups ``flow_factors`` and ``stribeck``, the run's
+settings and error estimates in attributes) and ``OUT/fields.nc`` (the macro fields of every
+Stribeck point over (viscosity, speed, x2, x1)); :func:`open_run` reads them back.  Engine:
+h5netcdf (NetCDF-4 on h5py, BSD-3; groups and compression without the netCDF-C library).
+Units are in each variable's ``units`` attribute, SI throughout.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .io.atomic import atomic_path
+
+ENGINE = "h5netcdf"
+FIELD_UNITS = {"pressure": "Pa", "contact_pressure": "Pa", "cavity_fraction": "1", "h0": "m",
+               "mean_gap": "m", "elastic_deformation": "m", "local_viscosity": "Pa s",
+               "density_ratio": "1", "shear_stress": "Pa", "face": "1"}
+STRIBECK_UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
+                  "friction_coefficient": ("1", "C_f (eq 34)"),
+                  "hydrodynamic_friction": ("N", "hydrodynamic part of F_T (eq 33)"),
+                  "boundary_friction": ("N", "boundary part of F_T (eq 33)"),
+                  "contact_load_fraction": ("1", "share of F_N carried by p_con"),
+                  "h_d": ("m", "rigid-body separation h_d"),
+                  "iterations": ("1", "macro solver iterations"),
+                  "cf_min": ("1", "lowest C_f of the single-patch sweeps"),
+                  "cf_max": ("1", "highest C_f of the single-patch sweeps")}
+
+
+@dataclass(frozen=True)
+class RunResults:
+    """What :func:`open_run` returns: ``flow_factors`` over (patch, h0), ``stribeck`` over
+    (viscosity, speed), ``fields`` over (viscosity, speed, x2, x1) (None when the run kept no
+    fields), ``summary`` (the run's ``summary.json``: settings, timings, error estimates)."""
+
+    flow_factors: object
+    stribeck: object
+    fields: object
+    summary: dict
+
+
+def flow_factor_dataset(factors, labels):
+    """Flow factors of several patches (same h0) as a Dataset over (patch, h0); A, b, C, d
+    split into named components (A11, A12, ..., d2)."""
+    import xarray as xr
+    h0 = factors[0].h0
+    if any(f.h0.shape != h0.shape or not np.allclose(f.h0, h0, rtol=1e-12) for f in factors):
+        raise ValueError("flow factors of a run must share their h0 samples")
+    stack = lambda name: np.stack([getattr(f, name) for f in factors])  # noqa: E731
+    data = {"h_m": (stack("h_m"), "m", "mean gap (eq 12)"),
+            "p_con": (stack("p_con"), "Pa", "mean contact pressure (eq 11)"),
+            "contact_fraction": (stack("contact_fraction"), "1", "pixels in contact")}
+    for name, eq in (("A", 13), ("C", 15)):
+        for i in range(2):
+            for j in range(2):
+                data[f"{name}{i + 1}{j + 1}"] = (stack(name)[:, :, i, j], "1", f"eq {eq}")
+    for name, eq in (("b", 14), ("d", 16)):
+        for i in range(2):
+            data[f"{name}{i + 1}"] = (stack(name)[:, :, i], "1", f"eq {eq}")
+    ds = xr.Dataset({k: (("patch", "h0"), v, {"units": u, "long_name": n})
+                     for k, (v, u, n) in data.items()},
+                    coords={"patch": list(labels), "h0": ("h0", h0, {"units": "m"})})
+    ds.attrs["error_estimate"] = json.dumps(factors[-1].meta.get("error_estimate", {}))
+    return ds
+
+
+def stribeck_dataset(curves, band=None, patch_curves=None):
+    """Stribeck curves as a Dataset over (viscosity, speed) (NaN where a curve has no point);
+    ``band``: optional (cf_min, cf_max) arrays per curve, the patch scatter band;
+    ``patch_curves``: optional single-patch curves [patch][viscosity] (same speeds), as
+    ``patch_friction_coefficient`` over (patch, viscosity, speed)."""
+    import xarray as xr
+    speed = np.unique(np.concatenate([c.speed for c in curves]))
+    mu = np.array([c.viscosity for c in curves])
+    out = {k: np.full((mu.size, speed.size), np.nan) for k in STRIBECK_UNITS}
+    for i, c in enumerate(curves):
+        at = np.searchsorted(speed, c.speed)
+        for k in STRIBECK_UNITS:
+            if k in ("cf_min", "cf_max"):
+                if band is not None:
+                    out[k][i, at] = band[i][k == "cf_max"]
+            else:
+                out[k][i, at] = getattr(c, k)
+    if band is None:
+        del out["cf_min"], out["cf_max"]
+    ds = xr.Dataset({k: (("viscosity", "speed"), v, {"units": STRIBECK_UNITS[k][0],
+                                                     "long_name": STRIBECK_UNITS[k][1]})
+                     for k, v in out.items()},
+                    coords={"viscosity": ("viscosity", mu, {"units": "Pa s"}),
+                            "speed": ("speed", speed, {"units": "m/s"})})
+    if patch_curves:
+        cf = np.full((len(patch_curves), mu.size, speed.size), np.nan)
+        for p, per_mu in enumerate(patch_curves):
+            for i, c in enumerate(per_mu):
+                cf[p, i, np.searchsorted(speed, c.speed)] = c.friction_coefficient
+        ds["patch_friction_coefficient"] = (("patch", "viscosity", "speed"), cf, {
+            "units": "1", "long_name": "C_f with one patch's flow factors"})
+        ds = ds.assign_coords(patch=[str(p + 1) for p in range(len(patch_curves))])
+    return ds
+
+
+def fields_dataset(points, origin=(0.0, 0.0)):
+    """Macro fields of ``points`` {(viscosity, speed): MixedResult} as a Dataset over
+    (viscosity, speed, x2, x1); the coordinate ``viscosity`` is mu_0 of the sweep, the
+    field ``local_viscosity`` the piezoviscous mu(p) of eq 23."""
+    import xarray as xr
+    mus = np.unique([k[0] for k in points])
+    speeds = np.unique([k[1] for k in points])
+    first = next(iter(points.values()))
+    ny, nx = first.pressure.shape
+    dx1, dx2 = first.spacing
+    fields = {k: np.full((mus.size, speeds.size, ny, nx), np.nan) for k in FIELD_UNITS}
+    for (mu, u), res in points.items():
+        i, j = np.searchsorted(mus, mu), np.searchsorted(speeds, u)
+        for k, v in res.fields().items():
+            fields["local_viscosity" if k == "viscosity" else k][i, j] = v
+    coords = {"viscosity": ("viscosity", mus, {"units": "Pa s"}),
+              "speed": ("speed", speeds, {"units": "m/s"}),
+              "x2": ("x2", origin[1] + dx2 * np.arange(ny), {"units": "m"}),
+              "x1": ("x1", origin[0] + dx1 * np.arange(nx), {"units": "m"})}
+    return xr.Dataset({k: (("viscosity", "speed", "x2", "x1"), v, {"units": FIELD_UNITS[k]})
+                       for k, v in fields.items()}, coords=coords)
+
+
+def write_netcdf(path, groups: dict, attrs: dict | None = None) -> Path:
+    """Datasets {group: Dataset} into one NetCDF-4 file, atomically (zlib-compressed); the
+    group None is the file's root."""
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        mode = "w"
+        for name, ds in groups.items():
+            ds = ds.copy()
+            ds.attrs.update(attrs or {})
+            enc = {v: {"zlib": True, "complevel": 4} for v in ds.data_vars}
+            ds.to_netcdf(tmp, mode=mode, group=name, engine=ENGINE, encoding=enc)
+            mode = "a"
+    return path
+
+
+def open_run(outdir) -> RunResults:
+    """The results of ``fem-twin run ... -o OUTDIR`` as xarray Datasets (loaded in memory;
+    the fields lazily)."""
+    import xarray as xr
+    outdir = Path(outdir)
+    path = outdir / "results.nc"
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no results; run `fem-twin run CASE -o {outdir}` "
+                                "first")
+    load = lambda group: xr.load_dataset(path, group=group, engine=ENGINE)  # noqa: E731
+    fields = (xr.open_dataset(outdir / "fields.nc", engine=ENGINE)
+              if (outdir / "fields.nc").is_file() else None)
+    summary = (json.loads((outdir / "summary.json").read_text())
+               if (outdir / "summary.json").is_file() else {})
+    return RunResults(load("flow_factors"), load("stribeck"), fields, summary)
