@@ -146,6 +146,16 @@ def build_parser() -> argparse.ArgumentParser:
     va.add_argument("--radius", type=float, help="sliding radius r [m] for --rpm")
     va.set_defaults(func=_validate)
 
+    rp = sub.add_parser("report", help="one self-contained HTML page with the paper's figures "
+                                       "of a finished run (3D geometry, levelled pins, flow "
+                                       "factors, Stribeck curves with the patch band, "
+                                       "errors, settings, timings)")
+    rp.add_argument("run", type=Path, help="output folder of fem-twin run")
+    rp.add_argument("-o", "--output", type=Path, help="HTML file (default: RUN/report.html)")
+    rp.add_argument("--no-3d", action="store_true",
+                    help="skip the pyvista 3D views (Figures 2 and 6)")
+    rp.set_defaults(func=_report)
+
     t = sub.add_parser("topography", help="read and pre-process measured topographies")
     steps = t.add_subparsers(dest="step", required=True, metavar="STEP")
     for name, text in _STEPS.items():
@@ -516,6 +526,13 @@ def _calibrate(args):
     summary = calibrate(load_case(args.case), args.study, args.output, values=args.values,
                         progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
+    return 0
+
+
+def _report(args):
+    from .report import write_report
+    path = write_report(args.run, args.output, render=not args.no_3d)
+    print(f"report: {path}")
     return 0
 
 

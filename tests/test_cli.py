@@ -634,3 +634,19 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
     assert run.summary["stages"]["stribeck"]["patch_band_max_width"] > 0
     assert (out / "stribeck_speed.png").is_file()
     run.fields.close()
+    # issue 16 item 3: the report page, every image embedded and a valid PNG
+    import base64
+    import re
+    assert main(["report", str(out)]) == 0
+    page = (out / "report.html").read_text()
+    images = re.findall(r'src="data:image/png;base64,([^"]+)"', page)
+    assert len(images) >= 6 and "src=\"http" not in page and "<img" in page
+    for data in images:
+        png = base64.b64decode(data)
+        assert png[:8] == b"\x89PNG\r\n\x1a\n"
+        plt_img = __import__("matplotlib.image", fromlist=["imread"]).imread(
+            __import__("io").BytesIO(png), format="png")
+        assert plt_img.ndim == 3 and min(plt_img.shape[:2]) > 100
+    for title in ("Figure 3", "Figures 4-5", "Figure 14", "Timings", "Case file"):
+        assert title in page, title
+    assert ("Figure 2: virtual pin 1" in page) or ("no 3D view" in page)   # GL or a note

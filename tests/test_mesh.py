@@ -94,3 +94,11 @@ def test_vtu_opens_in_vtk_like_paraview(tmp_path):
     assert np.array_equal(data, gm.to_nodes(f))
     text = (tmp_path / "series.pvd").read_text()
     assert 'file="p.vtu"' in text and 'type="Collection"' in text
+
+
+def test_3d_views_render_in_a_child_process_or_say_why_not(tmp_path):
+    """pyvista segfaults without an OpenGL backend: a failed render (here: a missing file in
+    the child) costs a note, never the calling process."""
+    from fem_twin.io.render import render_views
+    made, note = render_views([(tmp_path / "missing.vtu", tmp_path / "x.png", "t")])
+    assert made == [] and "no 3D view" in note and "libegl1" in note

@@ -1,0 +1,185 @@
+"""``fem-twin report OUT``: one self-contained HTML page with the paper's figures for a run.
+
+Figures (images embedded as base64 PNG): the 3D virtual geometry of pin and disk and of one
+roughness patch (Figures 2 and 6; pyvista in a child process, skipped with a note when no
+OpenGL backend exists), the levelled pin centre lines (Figure 3), the flow factors
+(Figures 4-5), the Stribeck curves versus speed and Hersey number with the patch scatter band
+and measured curves (Figure 14), the macro fields, validation and calibration deviations
+(Figures 9-13) when the run folder has them; then the error estimates, settings and timings.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+from pathlib import Path
+
+import numpy as np
+
+from .io.atomic import atomic_path
+from .io.files import read_topography
+from .io.render import render_views
+
+
+def write_report(outdir, path=None, *, render: bool = True) -> Path:
+    """Write ``OUT/report.html`` (or ``path``) for the run in ``outdir``; return its path."""
+    outdir = Path(outdir)
+    summary_path = outdir / "summary.json"
+    if not summary_path.is_file():
+        raise FileNotFoundError(f"{summary_path} not found: give the output folder of a "
+                                "finished fem-twin run")
+    summary = json.loads(summary_path.read_text())
+    work = outdir / "report"
+    work.mkdir(exist_ok=True)
+    sections = [geometry_section(outdir, work, render), levelling_section(outdir, work),
+                figure_section("Flow factors (Figures 4-5)", [outdir / "flow_factors.png"],
+                               "Patch pairs and their average versus the separation h0."),
+                stribeck_section(outdir), calibration_section(outdir),
+                tables_section(summary)]
+    page = _PAGE.format(title=html.escape(f"fem_twin report: {summary.get('case', '')}"),
+                        body="\n".join(s for s in sections if s))
+    path = Path(path) if path is not None else outdir / "report.html"
+    with atomic_path(path) as tmp:
+        tmp.write_text(page)
+    return path
+
+
+def geometry_section(outdir: Path, work: Path, render: bool) -> str:
+    geo = outdir / "geometry"
+    jobs = [(geo / "macro_1.vtu", work / "geometry_pin.png",
+             "Figure 2: virtual pin 1 and disk 1"),
+            (geo / "patch_1.vtu", work / "geometry_patch.png",
+             "Figure 6: roughness patch pair 1")]
+    jobs = [j for j in jobs if j[0].is_file()]
+    if not render:
+        return section("Virtual geometry (Figures 2 and 6)", "<p>3D views not rendered "
+                       "(--no-3d).</p>")
+    made, note = render_views(jobs)
+    titles = {png: title for _, png, title in jobs}
+    body = "".join(_figure(p, titles[p]) for p in made)
+    if note:
+        body += f'<p class="note">{html.escape(note)}</p>'
+    return section("Virtual geometry (Figures 2 and 6)", body)
+
+
+def levelling_section(outdir: Path, work: Path) -> str:
+    lev = outdir / "levelling"
+    files = sorted(lev.glob("pin_*.npz"))
+    if not files:
+        return ""
+    png = plot_centre_lines(files, work / "pin_centre_lines.png")
+    return figure_section("Levelled pins (Figure 3)", [png], "Centre lines along the sliding "
+                          "direction x1 of the levelled pins and their set average (pin face "
+                          "only).")
+
+
+def plot_centre_lines(files, path) -> Path:
+    """Figure 3: x3_low along x1 through the centre of each levelled pin [um over mm]."""
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 3.8))
+    for f in files:
+        pin = read_topography(f)
+        row = pin.heights[pin.shape[0] // 2]
+        x1 = pin.origin[0] + pin.spacing[0] * np.arange(pin.shape[1])
+        face = row > -20e-6
+        ax.plot(x1 * 1e3, np.where(face, row * 1e6, np.nan),
+                lw=2.0 if "average" in f.stem else 1.0, label=f.stem.replace("_", " "))
+    ax.set_xlabel("$x_1$ [mm]")
+    ax.set_ylabel("$x_{3,low}$ [µm]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def stribeck_section(outdir: Path) -> str:
+    pngs = [outdir / "stribeck_speed.png", outdir / "stribeck_hersey.png"]
+    text = ("Friction coefficient (eq 34) of the patch-average flow factors; the shaded band "
+            "spans the single-patch curves (Figure 13), squares are measured curves.")
+    body = figure_section("Stribeck curves (Figure 14)", pngs, text)
+    fields = sorted(outdir.glob("fields_mu*.png"))
+    val = sorted(outdir.glob("validation_mu*.png"))
+    return (body + figure_section("Macro fields", fields, "Fastest, middle and slowest "
+                                  "point of each sweep.")
+            + figure_section("Validation against measured curves (eq 35)", val, ""))
+
+
+def calibration_section(outdir: Path) -> str:
+    pngs = sorted(outdir.glob("**/cf_dev.png"))
+    return figure_section("Calibration studies (Figures 9-13)", pngs,
+                          "C_f,dev (eq 35) of each variant against its reference.")
+
+
+def tables_section(summary: dict) -> str:
+    stages = summary.get("stages", {})
+    micro = stages.get("micro", {})
+    rows = [("wall time", f"{summary.get('wall_time_s', float('nan')):.1f} s")]
+    rows += [(f"stage {k}", f"{v:.1f} s") for k, v in summary.get("seconds", {}).items()]
+    timing = _table(["", "time"], rows)
+    est = micro.get("error_estimate", {})
+    qs = sorted({q for kind in est.values() if isinstance(kind, dict) for q in kind
+                 if isinstance(kind[q], float)})
+    errors = _table(["estimate", *qs], [(k, *(f"{v.get(q, float('nan')):.2%}" for q in qs))
+                                       for k, v in est.items() if isinstance(v, dict)])
+    tol = micro.get("error_tolerance")
+    body = (f"<h3>Timings</h3>{timing}<h3>Estimated flow-factor errors (relative, largest "
+            f"over h0; tolerance {tol})</h3>{errors}")
+    stribeck = stages.get("stribeck", {})
+    if "patch_band_max_width" in stribeck:
+        body += (f"<p>Widest patch scatter band: ΔC_f = {stribeck['patch_band_max_width']:.4f}"
+                 "</p>")
+    if "hersey_collapse_max_abs_cf_dev" in stribeck:
+        body += (f"<p>Hersey collapse between viscosities: max |C_f,dev| = "
+                 f"{stribeck['hersey_collapse_max_abs_cf_dev']:.2%} (eq 35)</p>")
+    body += ("<h3>Settings and provenance</h3><pre>"
+             + html.escape(json.dumps({"provenance": summary.get("provenance"),
+                                       "stages": stages}, indent=1, default=str)) + "</pre>")
+    case_file = (summary.get("provenance") or {}).get("case_file")
+    if case_file and Path(case_file).is_file():
+        body += f"<h3>Case file</h3><pre>{html.escape(Path(case_file).read_text())}</pre>"
+    return section("Error estimates, settings, timings", body)
+
+
+def figure_section(title: str, pngs, text: str) -> str:
+    pngs = [p for p in pngs if Path(p).is_file()]
+    if not pngs:
+        return ""
+    return section(title, (f"<p>{html.escape(text)}</p>" if text else "")
+                   + "".join(_figure(p, Path(p).stem.replace("_", " ")) for p in pngs))
+
+
+def section(title: str, body: str) -> str:
+    return f"<section><h2>{html.escape(title)}</h2>{body}</section>"
+
+
+def _figure(png, caption: str) -> str:
+    data = base64.b64encode(Path(png).read_bytes()).decode()
+    return (f'<figure><img alt="{html.escape(caption)}" src="data:image/png;base64,{data}">'
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+
+def _table(header, rows) -> str:
+    head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
+                   for r in rows)
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+_PAGE = """<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{title}</title>
+<style>
+body {{ font-family: sans-serif; max-width: 1100px; margin: 2em auto; color: #222; }}
+figure {{ display: inline-block; margin: 0.5em; max-width: 100%; vertical-align: top; }}
+img {{ max-width: 100%; border: 1px solid #ddd; }}
+figcaption {{ font-size: 0.9em; color: #555; }}
+table {{ border-collapse: collapse; margin: 0.5em 0; }}
+td, th {{ border: 1px solid #ccc; padding: 0.2em 0.6em; text-align: right; }}
+pre {{ background: #f6f6f6; padding: 0.6em; overflow-x: auto; font-size: 0.8em; }}
+.note {{ color: #a60; }}
+</style></head><body><h1>{title}</h1>
+{body}
+</body></html>
+"""
