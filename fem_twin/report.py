@@ -125,7 +125,8 @@ def tables_section(summary: dict) -> str:
     errors = _table(["estimate", *qs], [(k, *(f"{v.get(q, float('nan')):.2%}" for q in qs))
                                        for k, v in est.items() if isinstance(v, dict)])
     tol = micro.get("error_tolerance")
-    body = (f"<h3>Timings</h3>{timing}<h3>Estimated flow-factor errors (relative, largest "
+    body = (f"<h3>Timings</h3><p>Of the last <code>fem-twin run</code> of this folder: stages "
+            f"reused from its checkpoints take seconds.</p>{timing}<h3>Estimated flow-factor errors (relative, largest "
             f"over h0; tolerance {tol})</h3>{errors}")
     stribeck = stages.get("stribeck", {})
     if "patch_band_max_width" in stribeck:
@@ -148,7 +149,24 @@ def figure_section(title: str, pngs, text: str) -> str:
     if not pngs:
         return ""
     return section(title, (f"<p>{html.escape(text)}</p>" if text else "")
-                   + "".join(_figure(p, Path(p).stem.replace("_", " ")) for p in pngs))
+                   + "".join(_figure(p, caption(Path(p))) for p in pngs))
+
+
+def caption(png: Path) -> str:
+    """A reader's caption for a figure file of the run folder."""
+    stem = png.stem
+    fixed = {"stribeck_speed": "C_f versus sliding speed U [m/s]",
+             "stribeck_hersey": "C_f versus Hersey number (eq 46)",
+             "flow_factors": "flow factors versus h0", "pin_centre_lines": "pin centre lines",
+             "cf_dev": f"C_f,dev of the {png.parent.name} study"}
+    if stem in fixed:
+        return fixed[stem]
+    for prefix, text in (("fields_mu", "pressure, cavity fraction and contact pressure at "
+                          "mu_0 = {} Pa s"), ("validation_mu", "measured against simulated "
+                                              "at mu_0 = {} Pa s")):
+        if stem.startswith(prefix):
+            return text.format(stem[len(prefix):])
+    return stem.replace("_", " ")
 
 
 def section(title: str, body: str) -> str:

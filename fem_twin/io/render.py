@@ -41,8 +41,8 @@ def render_pair(vtu, png, *, title: str = "") -> Path:
     for s, name, cmap in zip(surfaces, ("x3_low", "x3_up"), ("viridis", "cividis")):
         p.add_mesh(s, scalars=f"{name} [um]", cmap=cmap, scalar_bar_args={
             "title": f"{'pin' if name == 'x3_low' else 'disk'} {name} [um]",
-            "vertical": False, "width": 0.4, "position_y": 0.03,
-            "position_x": 0.05 if name == "x3_low" else 0.55})
+            "vertical": False, "width": 0.36, "position_y": 0.03,
+            "position_x": 0.05 if name == "x3_low" else 0.58})
     p.add_text(f"{title}\nlower: pin, upper: disk; heights x{scale:.3g}, "
                f"width {extent * 1e3:.3g} mm", font_size=10)
     p.camera_position = "iso"
