@@ -517,7 +517,7 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
 
     In parallel the bar counts the finished points of all sweeps (their checkpoint files,
     written as each point finishes in its worker)."""
-    if executor is None or len(tasks) == 1:
+    if executor is None or len(tasks) <= 1:
         return [_sweep_task((dict(kw, progress=progress), lub)) for kw, lub in tasks]
     futures = [executor.submit(_sweep_task, (dict(kw, progress=False), lub))
                for kw, lub in tasks]

@@ -1,6 +1,6 @@
 """FE against FVM flow factors on the bundled roughness patches at full resolution (issue 6).
 
-    python examples/fe_fvm_flow_factors.py [OUT] [--steps N] [--workers W]
+    python examples/03_fe_fvm_flow_factors.py [OUT] [--steps N] [--workers W] [--quick]
 
 Homogenises each of the six bundled patch pairs (256 x 256 px cut, as the bundled case)
 with both methods at h0 = 0.1, 0.15, 0.3, 0.6, 1 um and N sliding steps (default 8), and
@@ -26,6 +26,7 @@ import csv
 import time
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import numpy as np
 
 from fem_twin.compare import flow_factor_differences
@@ -40,9 +41,11 @@ SAMPLE = Path(__file__).resolve().parent.parent / "meshes" / "sample"
 H0 = np.array([0.1e-6, 0.15e-6, 0.3e-6, 0.6e-6, 1e-6])
 
 
-def patch_pair(k, shape=(256, 256)):
+def patch_pair(k, shape=(256, 256), resolution=None):
     pin = prepare_patch(read_topography(SAMPLE / f"patch_{k}_pin.npz"), shape)
     disk = prepare_patch(read_topography(SAMPLE / f"patch_{k}_disk.npz"), shape, upper=True)
+    if resolution:
+        pin, disk = resample_cell(pin, resolution), resample_cell(disk, resolution)
     return pin, disk
 
 
@@ -90,17 +93,20 @@ def main():
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--reference-patches", type=int, nargs="*", default=[1, 3],
                         help="patches also computed at 512^2 with twice the steps")
+    parser.add_argument("--quick", action="store_true", help="smoke-test size")
     args = parser.parse_args()
+    if args.quick:
+        args.steps, args.reference_patches = 2, []
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows, worst, patches = [], {}, {"fe": [], "fvm": []}
     print(f"{'patch':>7} {'h0 [um]':>8} {'A':>8} {'b':>8} {'C':>8} {'|dd|':>8} {'h_m':>8}"
           f" {'FE/FVM time':>11}")
-    for k in [*range(1, 7), "average"]:
+    for k in ([1, "average"] if args.quick else [*range(1, 7), "average"]):
         if k == "average":
             fe, fv, ratio = average(patches["fe"]), average(patches["fvm"]), float("nan")
         else:
-            pin, disk = patch_pair(k)
+            pin, disk = patch_pair(k, resolution=(32, 32) if args.quick else None)
             seconds = {}
             for method in ("fe", "fvm"):
                 path = out / f"patch_{k}_{method}_{args.steps}steps.npz"
@@ -131,8 +137,28 @@ def main():
         writer.writerows(rows)
     print("worst: " + ", ".join(f"{k} {v * (1 if k == 'd' else 100):.3f}"
                                 + ("" if k == "d" else " %") for k, v in worst.items()))
-    against_reference(out, args, patches)
-    refinement_study()
+    plot(rows, out / "fe_fvm_flow_factors.png")
+    if not args.quick:
+        against_reference(out, args, patches)
+        refinement_study()
+
+
+def plot(rows, path):
+    """FE-FVM differences of A, b (relative) and d (absolute) versus h0, one line a patch."""
+    fig, axes = plt.subplots(1, 3, figsize=(11, 3.6), constrained_layout=True)
+    for ax, key, label in zip(axes, ("A", "b", "d"), ("max |ΔA| / max |A|",
+                                                      "max |Δb| / max |b|", "|Δd|")):
+        for k in dict.fromkeys(r["patch"] for r in rows):
+            sel = [r for r in rows if r["patch"] == k]
+            ax.semilogy([r["h0"] * 1e6 for r in sel], [max(r[key], 1e-12) for r in sel],
+                        "o-" if k == "average" else ".-", lw=2 if k == "average" else 1,
+                        label=f"patch {k}")
+        ax.set_xlabel("$h_0$ [µm]")
+        ax.set_title(f"FE - FVM: {label}")
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(fontsize="small")
+    fig.savefig(path, dpi=110)
+    print(f"wrote {path}")
 
 
 def against_reference(out, args, patches):

@@ -1,24 +1,25 @@
 """Reconstruct the virtual macroscopic pins of the sample twin and plot their centre lines
 (like the paper's Figure 3), using the Python API step by step.
 
-    python examples/topography_pipeline.py [OUT.png]
+    python examples/01_topography_pipeline.py [OUT.png] [--quick]
+
+``--quick`` resamples to 64 x 64 instead of 256 x 256 (the gallery's smoke test).
 """
 
 import sys
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-import fem_twin  # noqa: E402
-from fem_twin import topography as tp  # noqa: E402
-from fem_twin.topography.prepare import pin_face_guess  # noqa: E402
+import fem_twin
+from fem_twin import topography as tp
+from fem_twin.topography.prepare import pin_face_guess
 
 SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "sample"
-out = Path(sys.argv[1] if len(sys.argv) > 1 else "pin_centre_lines.png")
+args = [a for a in sys.argv[1:] if a != "--quick"]
+n = 64 if "--quick" in sys.argv else 256
+out = Path(args[0] if args else "pin_centre_lines.png")
 
 fig, ax = plt.subplots(figsize=(7, 4))
 for k in (1, 2, 3):
@@ -27,7 +28,7 @@ for k in (1, 2, 3):
     topo = tp.level(topo, pin_face_guess(topo))                  # mean plane of the face
     topo = tp.clip_heights(topo, -20e-6, 20e-6)                  # +-20 um
     topo = tp.gaussian_filter(topo, fwhm_px=9)                   # 9 px FWHM
-    topo = tp.resample(topo, (256, 256))                         # 256 x 256
+    topo = tp.resample(topo, (n, n))                             # 256 x 256
     face = topo.heights > -20e-6
     topo = tp.centre_on(topo, tp.pin_centre(topo, face))         # origin at the pin centre
     topo = tp.level(topo, tp.radial_mask(topo, 3e-3) & face)     # mean plane within 3 mm
