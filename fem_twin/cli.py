@@ -154,7 +154,7 @@ def build_parser() -> argparse.ArgumentParser:
     rp.add_argument("-o", "--output", type=Path, help="HTML file (default: RUN/report.html)")
     rp.add_argument("--no-3d", action="store_true",
                     help="skip the pyvista 3D views (Figures 2 and 6)")
-    rp.set_defaults(func=_report)
+    rp.set_defaults(func=_html_report)
 
     t = sub.add_parser("topography", help="read and pre-process measured topographies")
     steps = t.add_subparsers(dest="step", required=True, metavar="STEP")
@@ -529,7 +529,7 @@ def _calibrate(args):
     return 0
 
 
-def _report(args):
+def _html_report(args):
     from .report import write_report
     path = write_report(args.run, args.output, render=not args.no_3d)
     print(f"report: {path}")

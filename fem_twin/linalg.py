@@ -67,17 +67,25 @@ class SPDSolver:
 
     The pattern is that of the full symmetric matrix, column indices sorted in each row.
     ``factor(values)`` takes the values in that CSR order; ``solve(rhs)`` solves for one or
-    more right-hand sides (columns).
+    more right-hand sides (columns).  ``symmetric=False``: general square matrices (LU;
+    PARDISO matrix type 11 with pivot perturbation, whose count after ``factor`` is
+    ``perturbed``: a caller that needs an exact step checks it).
     """
 
-    def __init__(self, indptr, indices, backend: str | None = None):
+    def __init__(self, indptr, indices, backend: str | None = None, symmetric: bool = True):
         self.backend = default_backend() if backend is None else backend
         if self.backend not in BACKENDS:
             raise ValueError(f"backend must be one of {BACKENDS}, got {self.backend!r}")
         self._indptr = np.asarray(indptr)
         self._indices = np.asarray(indices)
         self.n = self._indptr.size - 1
-        if self.backend == "pardiso":
+        self.symmetric = symmetric
+        self.perturbed = 0
+        if self.backend == "pardiso" and not symmetric:
+            self._upper = slice(None)
+            self._ia = self._indptr.astype(np.int32)
+            self._ja = self._indices.astype(np.int32)
+        elif self.backend == "pardiso":
             if _mkl_rt() is None:
                 raise ImportError("the 'pardiso' backend needs MKL: pip install "
                                   "'fem-twin[pardiso]' (or use backend='superlu')")
@@ -106,8 +114,10 @@ class SPDSolver:
     def factor(self, values) -> "SPDSolver":
         values = np.asarray(values, dtype=float)
         if self.backend == "superlu":
+            # the CSR pattern read as CSC is the transpose: the same matrix when symmetric
             K = sp.csc_matrix((values, self._indices, self._indptr), shape=(self.n, self.n))
-            self._lu = spla.splu(K, permc_spec="NATURAL", diag_pivot_thresh=0.0,
+            self._lu = spla.splu(K if self.symmetric else K.T.tocsc(), permc_spec="NATURAL",
+                                 diag_pivot_thresh=0.0 if self.symmetric else 0.1,
                                  options={"SymmetricMode": True})
             return self
         self._a = np.ascontiguousarray(values[self._upper])
@@ -129,10 +139,14 @@ class SPDSolver:
         return self._pardiso(33, b).reshape(rhs.shape)
 
     def _pardiso(self, phase, b):
-        """One call of MKL's ``pardiso`` (zero-based indices, Cholesky, METIS ordering)."""
+        """One call of MKL's ``pardiso`` (zero-based indices, METIS ordering; Cholesky, or LU
+        with pivot perturbation 1e-13 and up to 2 refinement steps for general matrices)."""
         lib = _mkl_rt()
         iparm = np.zeros(64, dtype=np.int32)
         iparm[[0, 1, 9, 34]] = 1, 2, 8, 1           # own settings, METIS, eps 1e-8, 0-based
+        if not self.symmetric:
+            iparm[[7, 9]] = 2, 13
+        mtype = 2 if self.symmetric else 11
         x = np.zeros_like(b, order="F")
         a = self._a if self._a is not None else np.zeros(self._ja.size)
         error = ctypes.c_int32(0)
@@ -142,7 +156,7 @@ class SPDSolver:
             return ctypes.byref(ctypes.c_int32(v))
 
         lib.pardiso(self._pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), ref(1), ref(1),
-                    ref(2), ref(phase), ref(self.n), a.ctypes.data_as(ctypes.c_void_p),
+                    ref(mtype), ref(phase), ref(self.n), a.ctypes.data_as(ctypes.c_void_p),
                     self._ia.ctypes.data_as(i32), self._ja.ctypes.data_as(i32),
                     np.zeros(self.n, dtype=np.int32).ctypes.data_as(i32), ref(b.shape[1]),
                     iparm.ctypes.data_as(i32), ref(0), b.ctypes.data_as(ctypes.c_void_p),
@@ -152,4 +166,6 @@ class SPDSolver:
                                         "(zero or negative pivot)")
         if error.value != 0:
             raise RuntimeError(f"PARDISO phase {phase} failed with error {error.value}")
+        if phase == 22:
+            self.perturbed = int(iparm[13])
         return x
