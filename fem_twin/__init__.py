@@ -16,5 +16,9 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 from .topography import Topography  # noqa: E402
 from .io.files import read_topography, write_topography  # noqa: E402
 
-__version__ = "0.1.0"
+try:
+    from importlib.metadata import PackageNotFoundError, version as _version
+    __version__ = _version("fem-twin")                  # one source: pyproject.toml
+except PackageNotFoundError:                            # a source tree never installed
+    __version__ = "0.0.0+unknown"
 __all__ = ["Topography", "read_topography", "write_topography", "__version__"]

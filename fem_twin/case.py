@@ -7,10 +7,11 @@ import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
+from .errors import InputError
 from .topography.prepare import MacroOptions
 
 
-class CaseError(ValueError):
+class CaseError(InputError):
     """A case file that is missing, malformed or inconsistent."""
 
 

@@ -1,11 +1,21 @@
-"""Errors shared by the solvers."""
+"""fem_twin's exceptions: one root, :class:`FemTwinError`, that every error of the package
+derives from (bad input also derives from ``ValueError``, solver failures from
+``RuntimeError``), so ``except FemTwinError`` catches exactly what fem_twin raises."""
 
 from __future__ import annotations
 
 import numpy as np
 
 
-class NotConverged(RuntimeError):
+class FemTwinError(Exception):
+    """Root of fem_twin's exceptions."""
+
+
+class InputError(FemTwinError, ValueError):
+    """Bad input (a case file, a topography file, an argument), found before work starts."""
+
+
+class NotConverged(FemTwinError, RuntimeError):
     """An iterative solver missed its tolerance; ``history`` holds its residuals."""
 
     def __init__(self, message, history):
@@ -18,9 +28,9 @@ class NotConverged(RuntimeError):
         return type(self), (self.message, self.history)
 
 
-class RunLocked(RuntimeError):
+class RunLocked(FemTwinError, RuntimeError):
     """Another process holds the output folder of a run."""
 
 
-class SchedulerUnreachable(RuntimeError):
+class SchedulerUnreachable(FemTwinError, RuntimeError):
     """The Dask scheduler of ``[run] scheduler`` could not be reached."""

@@ -140,12 +140,13 @@ class SPDSolver:
 
     def _pardiso(self, phase, b):
         """One call of MKL's ``pardiso`` (zero-based indices, METIS ordering; Cholesky, or LU
-        with pivot perturbation 1e-13 and up to 2 refinement steps for general matrices)."""
+        with pivot perturbation 1e-13 for general matrices; no refinement steps: callers
+        check the residual)."""
         lib = _mkl_rt()
         iparm = np.zeros(64, dtype=np.int32)
         iparm[[0, 1, 9, 34]] = 1, 2, 8, 1           # own settings, METIS, eps 1e-8, 0-based
         if not self.symmetric:
-            iparm[[7, 9]] = 2, 13
+            iparm[9] = 13                            # pivot perturbation 1e-13
         mtype = 2 if self.symmetric else 11
         x = np.zeros_like(b, order="F")
         a = self._a if self._a is not None else np.zeros(self._ja.size)

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError
 from ..topography.core import Topography
 from .atomic import atomic_path
 
@@ -30,7 +31,7 @@ UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9,
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 
 
-class TopographyFileError(ValueError):
+class TopographyFileError(InputError):
     """A file that cannot be read as a topography (unknown format, corrupt, no data)."""
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from .core import Topography
 
 #: roughness patch: Sq [m] refused outside, warned outside the inner range
@@ -23,7 +24,7 @@ PATCH_SDQ, PATCH_SDQ_USUAL = 10.0, 1.0
 PATCH_PITCH = (1e-9, 1e-4)
 
 
-class ImplausibleTopography(ValueError):
+class ImplausibleTopography(InputError):
     """A map whose heights or pitch cannot be those of a tribometer surface (units?)."""
 
 
