@@ -91,6 +91,70 @@ def bench_contact(sizes=(256, 512, 1024)):
     return base, rows
 
 
+def bench_contact_pk(sizes=(256, 1024)):
+    """fem_twin.contact against the shared plain-numpy Polonsky-Keer (``../shared/baselines/
+    pk_numpy.py``, one thread) on the periodic rough surface of ``contact``: load control
+    (100 MPa), gap control (the separation of that state), gap + hardness (a cap of 0.6 x the
+    elastic peak, so points are plastic) and load + hardness.  Both at tol 1e-8 (each its own
+    criterion); accuracy: L2 of the pressure against a tol 1e-12 reference (fem_twin), bar
+    1e-6.  FFT pairs per iteration counted in both.  Baseline: one rfft2+irfft2 pair."""
+    shared = os.path.join(HERE, "..", "..", "shared", "baselines")
+    if not os.path.isfile(os.path.join(shared, "pk_numpy.py")):
+        return 1.0, [("pk_numpy.py absent (../shared/baselines): nothing to compare", 0.0, "")]
+    sys.path.insert(0, shared)
+    import pk_numpy
+
+    from fem_twin import contact
+    from fem_twin.contact import elastic
+    from fem_twin.topography.synthetic import self_affine
+
+    calls = {"n": 0}
+    plain = elastic.ElasticOperator.__call__
+
+    def counted(self, p):
+        calls["n"] += 1
+        return plain(self, p)
+
+    elastic.ElasticOperator.__call__ = counted
+    e_red = contact.reduced_modulus(210e9, 0.3, 210e9, 0.3)
+    rows, base = [], None
+    try:
+        for n in sizes:
+            dx = 85e-6 / n
+            shape = -self_affine((n, n), dx, 0.8, 150e-9, rng=1).heights
+            z = np.random.default_rng(0).random((n, n))
+            t_fft, _ = best_of(lambda: np.fft.irfft2(np.fft.rfft2(z), s=z.shape), 5)
+            base = base or t_fft
+            load = 100e6 * 85e-6 ** 2
+            el = contact.solve(shape, dx, e_red, load=load, periodic=True, tol=1e-12)
+            cap = 0.6 * el.pressure.max()
+            cases = {"load": dict(load=load), "gap": dict(separation=el.separation),
+                     "gap + hardness": dict(separation=el.separation, hardness=cap),
+                     "load + hardness": dict(load=load, hardness=cap)}
+            K = pk_numpy.Periodic((n, n), (85e-6, 85e-6), e_red / 2, workers=1)
+            for name, kw in cases.items():
+                ref = contact.solve(shape, dx, e_red, periodic=True, tol=1e-12, **kw).pressure
+                pk_kw = dict(hardness=kw.get("hardness", np.inf), tol=1e-8)
+                if "load" in kw:
+                    pk_kw["pmean"] = 100e6
+                else:
+                    pk_kw["offset"] = kw["separation"]
+                K.nfft = 0
+                t_pk, out = best_of(lambda: pk_numpy.solve(K, -shape, **pk_kw), 1)
+                calls["n"] = 0
+                t_ft, res = best_of(lambda: contact.solve(shape, dx, e_red, periodic=True,
+                                                          tol=1e-8, **kw), 1)
+                l2 = lambda p: np.linalg.norm(p - ref) / np.linalg.norm(ref)  # noqa: E731
+                rows += [(f"{n}^2 {name}: pk_numpy", t_pk, f"{out['it']} it, "
+                          f"{out['nfft'] / 2 / out['it']:.2f} FFT pairs/it, L2 {l2(out['p']):.1e}"),
+                         (f"{n}^2 {name}: fem_twin", t_ft, f"{res.iterations} it, "
+                          f"{calls['n'] / res.iterations:.2f} FFT pairs/it, "
+                          f"L2 {l2(res.pressure):.1e}; pk_numpy / fem_twin = {t_pk / t_ft:.2f}")]
+    finally:
+        elastic.ElasticOperator.__call__ = plain
+    return base, rows
+
+
 def _warm_patch_sweep(e_red):
     """The micro stage's contact use: sample patch 3 at 256^2, 8 sliding instants, h0 from
     0.4 to 0.1 um, each warm-started from the same instant at the previous h0 (hardness
@@ -311,7 +375,7 @@ def bench_newton():
 
 
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
-          "macro": bench_macro, "newton": bench_newton, "stribeck": bench_stribeck,
+          "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "stribeck": bench_stribeck,
           "micro-full": lambda: bench_micro(full=True)}
 
 
