@@ -158,31 +158,40 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
     g_old, delta, was_wrong = 1.0, 0.0, np.zeros(s.shape, bool)
     h0 = 0.0 if separation is None else float(separation)
     u, fresh = None, 0
+    dot = lambda a, b: float(np.dot(a.ravel(), b.ravel()))  # noqa: E731  (BLAS, no copies)
     for it in range(1, max_iter + 1):
         if u is None or fresh >= _REFRESH:
             u, fresh = op(p), 0
-        g = s + u + (0.0 if separation is None else h0)
+        g = s + u
         free = (p > p_min) & (p < hardness)
-        if load is not None:
-            if free.any():
-                h0 = -g[free].mean()
-            g = g + h0
-        gg = np.dot(g[free], g[free])
-        t = np.where(free, g + delta * (gg / g_old) * t, 0.0)
+        m = free.astype(float)                     # free-set mask as numbers: masked sums
+        n_free = dot(m, m)                         # are dot products, without index copies
+        if load is not None and n_free:
+            h0 = -dot(g, m) / n_free
+        g += h0
+        gm = g * m
+        gg = dot(gm, gm)
+        t *= delta * (gg / g_old)
+        t += g
+        t *= m
         g_old = gg if gg > 0 else 1.0
         kt = op(t)
-        r = kt - kt[free].mean() if load is not None and free.any() else kt
-        rt = np.dot(r[free], t[free])
-        tau = np.dot(g[free], t[free]) / rt if rt > 0 else 0.0
+        r = kt - dot(kt, m) / n_free if load is not None and n_free else kt
+        rt = dot(r, t)
+        tau = dot(g, t) / rt if rt > 0 else 0.0
         p_old = p
-        trial = p - tau * t
-        p = np.clip(trial, p_min, hardness)
-        linear = np.array_equal(p, trial)          # no bound hit: K p = u - tau K t exactly
+        p = p - tau * t
+        linear = p.min() >= p_min and p.max() <= hardness   # no bound hit: K p = u - tau K t
+        if not linear:
+            np.clip(p, p_min, hardness, out=p)
         # points off the free set whose gap asks to move: p_min with overlap, H with gap open
-        wrong = ((p_old <= p_min) & (g < 0)) | ((p_old >= hardness) & (g > 0))
+        wrong = (p_old <= p_min) & (g < 0)
+        if np.isfinite(hardness):
+            wrong |= (p_old >= hardness) & (g > 0)
         wrong &= ~free
-        delta = 0.0 if wrong.any() else 1.0
-        if wrong.any():
+        any_wrong = wrong.any()
+        delta = 0.0 if any_wrong else 1.0
+        if any_wrong:
             # pressure that closes a uniform overlap on the wrong set: the CG step; when the
             # same points are wrong again, no larger than the set's joint stiffness allows
             # (one point's step made points released from and pressed back to the cap cycle
@@ -193,19 +202,19 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
                 step = min(joint, tau) if tau > 0 else joint
             p[wrong] = np.clip(p[wrong] - step * g[wrong], p_min, hardness)
         was_wrong = wrong
+        factor = 1.0
         if load is not None:
             p, factor = _enforce_load(p, load / area, p_min, hardness)
             linear &= factor is not None and (factor == 1.0 or p_min == 0.0)
-        else:
-            factor = 1.0
         # the next deformation from this iteration's K t (one FFT pair per iteration instead
         # of two) while no bound was hit; recomputed every _REFRESH iterations against drift
-        if linear and not wrong.any():
+        if linear and not any_wrong:
             u, fresh = factor * (u - tau * kt), fresh + 1
         else:
             u = None
         # relative change, with a floor of 1e-14 E' per point (no contact: nothing to resolve)
-        scale = max(np.abs(p).sum(), np.abs(p_old).sum(), 1e-14 * e_reduced * p.size)
+        size = (lambda q: q.sum()) if p_min >= 0 else (lambda q: np.abs(q).sum())
+        scale = max(size(p), size(p_old), 1e-14 * e_reduced * p.size)
         change = np.abs(p - p_old).sum() / scale
         history.append(change)
         if change < tol:
