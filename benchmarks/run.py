@@ -374,8 +374,59 @@ def bench_newton():
     return base, rows
 
 
+def bench_paper():
+    """A reduced paper case and the whole-twin extrapolation (examples/paper.toml: 6 patch
+    pairs at 256^2 x 100 h0 x 32 steps, 2 viscosities x 25 speeds (+ refinement, ~37 points)
+    at 256^2, patch band: 12 more sweeps; 2 cores).  Measured here: one patch pair at 10 of
+    the 100 h0 (every 10th, 32 steps, exact squeeze term, one process) and one warm-started
+    sweep of 6 speeds at 256^2 with the patch-average flow factors of that pair.  Baseline:
+    the measured micro time of one h0."""
+    from fem_twin.case import load_case
+    from fem_twin.macro import Lubricant
+    from fem_twin.micro import DEFAULT_H0, homogenise
+    from fem_twin.stribeck import stribeck_sweep
+    from fem_twin.topography.prepare import MacroOptions, prepare_disk
+
+    case = load_case(os.path.join(HERE, "..", "examples", "paper.toml"))
+    pin, disk = _patch_pair()
+    h0 = DEFAULT_H0[::10]
+    t0 = time.perf_counter()
+    ff = homogenise(pin, disk, h0, workers=1, error_estimate=False)
+    t_micro = time.perf_counter() - t0
+    per_h0 = t_micro / h0.size
+    opts = MacroOptions(resolution=(256, 256))
+    mpin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
+    mdisk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
+    gap, face = mdisk.heights - mpin.heights, mpin.heights > opts.holder_height / 2
+    speeds = np.geomspace(2.0, 0.01, 6)
+    t0 = time.perf_counter()
+    curve = stribeck_sweep(gap, mpin.spacing, ff, speeds, load=150.0,
+                           lubricant=Lubricant(0.066), face=face)
+    per_point = (time.perf_counter() - t0) / speeds.size
+    cores, patches, n_mu = 2, len(case.geometry.patches), len(case.lubricant.viscosities)
+    micro = per_h0 * case.micro.h0_count * patches / cores
+    points = case.sweep.count * 1.5                      # refinement adds ~50 % (bundled)
+    sweeps = n_mu * (1 + patches)
+    macro_avg = per_point * points * n_mu / cores
+    macro_band = per_point * points * patches * n_mu / cores
+    return per_h0, [
+        ("micro: one h0 (32 steps, 256^2), measured", per_h0, f"{h0.size} h0 in {t_micro:.0f} s"),
+        ("macro: one 256^2 point of a warm sweep, measured", per_point,
+         f"{int(curve.iterations.sum())} coupling iterations over {speeds.size} speeds"),
+        ("paper twin, micro stage (extrapolated)", micro,
+         f"{case.micro.h0_count} h0 x {patches} pairs / {cores} cores"),
+        ("paper twin, Stribeck sweeps (extrapolated)", macro_avg,
+         f"{points:.0f} points x {n_mu} viscosities / {cores} cores"),
+        ("paper twin, patch band (extrapolated)", macro_band,
+         f"{sweeps - n_mu} single-patch sweeps / {cores} cores"),
+        ("paper twin, whole (extrapolated)", micro + macro_avg + macro_band,
+         f"{(micro + macro_avg + macro_band) / 60:.0f} min; {(micro + macro_avg) / 60:.0f} min "
+         "without the band"),
+    ]
+
+
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
-          "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "stribeck": bench_stribeck,
+          "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "paper": bench_paper, "stribeck": bench_stribeck,
           "micro-full": lambda: bench_micro(full=True)}
 
 
