@@ -55,7 +55,7 @@ def variant(case, n, quick, patches=None):
         case.geometry, patches=tuple(patches), patch_shape=(n, n))
     geometry = replace(geometry, patches=geometry.patches[:2])
     micro = replace(case.micro, resolution=(n, n), h0_max=2e-6,
-                    **(dict(steps=4, h0_count=8) if quick else dict(h0_count=20)))
+                    **(dict(steps=4, h0_count=14) if quick else dict(h0_count=20)))
     sweep = replace(case.sweep, **(dict(count=5, speed_min=0.01, refine=0) if quick else {}))
     macro_geometry = replace(case.macro_geometry, resolution=(48, 48) if quick else (128, 128))
     lubricant = replace(case.lubricant, viscosities=(0.066,), temperatures=(24.0,))

@@ -169,7 +169,8 @@ def _lock(outdir: Path):
 @contextmanager
 def executor_for(case: Case):
     """Local process pool (``[run] workers``, 0 = all cores) or a Dask cluster's executor
-    (``[run] scheduler`` address); None for one worker."""
+    (``[run] scheduler`` address); None for one worker.  ``executor.n_workers``: how many
+    processes serve it (the micro stage cuts its h0 values into 4 tasks per worker)."""
     if case.run.scheduler:
         from distributed import Client
         try:
@@ -178,7 +179,9 @@ def executor_for(case: Case):
             raise SchedulerUnreachable(f"could not reach the Dask scheduler "
                                        f"{case.run.scheduler} ([run] scheduler): {err}") from err
         with client:
-            yield client.get_executor()
+            executor = client.get_executor()
+            executor.n_workers = max(1, len(client.scheduler_info()["workers"]))
+            yield executor
         return
     workers = case.run.workers or os.cpu_count() or 1
     if workers <= 1:
@@ -186,6 +189,7 @@ def executor_for(case: Case):
         return
     from concurrent.futures import ProcessPoolExecutor
     with ProcessPoolExecutor(workers) as pool:
+        pool.n_workers = workers
         yield pool
 
 
@@ -304,6 +308,7 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
                             hardness=m.hardness, method=mc.method,
                             time_derivative=mc.time_derivative,
                             time_tol=mc.time_tol or None, executor=executor,
+                            workers=getattr(executor, "n_workers", 1),
                             checkpoint=out.parent / "checkpoints", progress=progress,
                             patch_id=f"patch {i + 1}")
             ff.save(out)

@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from fem_twin import Topography
 from fem_twin.io.files import read_topography
 from fem_twin.macro import Lubricant
 from fem_twin.micro import homogenise
@@ -42,3 +43,28 @@ def test_dask_local_cluster_gives_the_serial_numbers(tmp_path):
         assert a.viscosity == b.viscosity
         assert np.array_equal(a.friction_coefficient, b.friction_coefficient)
         assert np.array_equal(a.h_d, b.h_d)
+
+
+def test_micro_tasks_follow_the_cluster_size():
+    """Issue 17 item 5: with an executor served by W processes the h0 values go out as 4 W
+    tasks (at most one per h0), so a large Dask cluster is not left idle."""
+    from concurrent.futures import Executor, Future
+
+    class Recorder(Executor):                 # runs each task here, remembers its size
+        sizes = []
+
+        def submit(self, fn, points, **kw):
+            self.sizes.append(len(points))
+            f = Future()
+            f.set_result(fn(points, **kw))
+            return f
+
+    rng = np.random.default_rng(3)
+    low = Topography(rng.normal(0, 1e-7, (8, 8)), (1e-6, 1e-6))
+    up = Topography(rng.normal(0, 1e-7, (8, 8)), (1e-6, 1e-6))
+    h0 = np.geomspace(2e-7, 1e-6, 40)
+    for workers, tasks in ((2, 8), (16, 40)):
+        Recorder.sizes = []
+        homogenise(low, up, h0, n_steps=2, executor=Recorder(), workers=workers,
+                   error_estimate=False)
+        assert len(Recorder.sizes) == tasks and sum(Recorder.sizes) == h0.size

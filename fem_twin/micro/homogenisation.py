@@ -124,7 +124,10 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     first_step : with ``"backward"`` only: ``"steady"`` (paper: no time term at the first
         step) or ``"periodic"`` (the last configuration precedes the first).
     workers : processes for the h0 values (1: in this process); ``executor``: any
-        ``concurrent.futures``-style executor instead (e.g. ``dask.distributed``'s).
+        ``concurrent.futures``-style executor instead (e.g. ``dask.distributed``'s), with
+        ``workers`` the processes serving it.  The h0 values go out as ``4 workers`` tasks
+        (each warm-starts along its own h0 values), so a 64-worker cluster gets 100 tasks
+        of one h0 from the paper's 100 values.
     checkpoint : folder that keeps one file per finished h0; a rerun resumes from it.
     progress : show a progress bar.
     patch_id : recorded in the metadata.
