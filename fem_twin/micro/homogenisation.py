@@ -172,7 +172,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
             own = executor is None
             pool = ProcessPoolExecutor(workers) if own else executor
             try:
-                futures = [pool.submit(_run_chunk, [(i, h0[i]) for i in c], **args)
+                futures = [pool.submit(_chunk_task, ([(i, h0[i]) for i in c], args))
                            for c in chunks]
                 for fut in as_completed(futures):
                     for i, m in fut.result():
@@ -363,6 +363,13 @@ def sliding_cells(gaps, squeezes, solver):
     """Cell solutions of each step for its gap and squeeze term."""
     for h, tau in zip(gaps, squeezes):
         yield solver.solve(h, tau)
+
+
+def _chunk_task(job):
+    """``_run_chunk`` as one positional argument: executors may own keywords (Dask's
+    ``submit`` takes ``key`` for itself)."""
+    points, args = job
+    return _run_chunk(points, **args)
 
 
 def _run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=False,
