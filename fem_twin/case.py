@@ -7,6 +7,7 @@ import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
+from . import tables as T
 from .errors import InputError
 from .topography.prepare import MacroOptions
 
@@ -32,10 +33,10 @@ class Tribometer:
     radius [m] (recorded; speeds are given in m/s), boundary friction coefficient C_f,b of
     eq 32 [-]."""
 
-    load: float = 150.0
+    load: float = T.LOAD
     pin_diameter: float = 8e-3
     sliding_radius: float = 30e-3
-    boundary_friction: float = 1.0 / (3.0 * 3.0 ** 0.5)   # the paper's C_f,b, eq 32
+    boundary_friction: float = T.BOUNDARY_FRICTION        # the paper's C_f,b, eq 32
 
 
 @dataclass(frozen=True)
@@ -44,11 +45,11 @@ class LubricantSpec:
 
     viscosities: tuple[float, ...] = (0.066, 0.024)
     temperatures: tuple[float, ...] = (24.0, 50.0)
-    density: float = 850.0
-    roelands_alpha: float = 22e-9
-    roelands_p0: float = 1.96e8
-    dh_c1: float = 5.9e8
-    dh_c2: float = 1.34
+    density: float = T.DENSITY
+    roelands_alpha: float = T.ROELANDS_ALPHA
+    roelands_p0: float = T.ROELANDS_P0
+    dh_c1: float = T.DH_C1
+    dh_c2: float = T.DH_C2
 
     def lubricants(self) -> list:
         """One :class:`fem_twin.macro.Lubricant` per viscosity."""
@@ -62,11 +63,11 @@ class LubricantSpec:
 class Materials:
     """Elastic constants of pin and disk (Table 4) and the hardness cap [Pa]."""
 
-    e_pin: float = 210e9
-    nu_pin: float = 0.3
-    e_disk: float = 210e9
-    nu_disk: float = 0.3
-    hardness: float = 6.99e9
+    e_pin: float = T.E_STEEL
+    nu_pin: float = T.NU_STEEL
+    e_disk: float = T.E_STEEL
+    nu_disk: float = T.NU_STEEL
+    hardness: float = T.HARDNESS
 
     @property
     def e_reduced(self) -> float:

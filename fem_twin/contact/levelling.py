@@ -13,15 +13,15 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.ndimage as ndi
 
+from .. import tables as T
 from ..topography.core import Topography
 from ..topography.geometry import pin_face
 from ..topography.levelling import level, radial_mask
-from .elastic import reduced_modulus
 from .solver import ContactNotConverged, ContactResult, solve
 
 #: Table 4 of the paper.
-TABLE4 = {"load": 50.0, "e_reduced": reduced_modulus(210e9, 0.3, 210e9, 0.3),
-          "hardness": 6.99e9, "gains": (3e-6, 6e-6, 3.75e-7)}
+TABLE4 = {"load": T.LEVELLING_LOAD, "e_reduced": T.E_REDUCED, "hardness": T.HARDNESS,
+          "gains": T.LEVELLING_GAINS}
 
 
 @dataclass(frozen=True, eq=False)

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import tables as T
+
 #: Boundary friction coefficient C_f,b of eq 32 (Bowden and Tabor, pure shearing).
-BOUNDARY_FRICTION = 1.0 / (3.0 * np.sqrt(3.0))
+BOUNDARY_FRICTION = T.BOUNDARY_FRICTION
 
 
 def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, C, d, spacing,

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import tables as T
+
 
 @dataclass(frozen=True)
 class Lubricant:
@@ -23,11 +25,11 @@ class Lubricant:
     """
 
     viscosity: float
-    density: float = 850.0
-    roelands_alpha: float = 22e-9
-    roelands_p0: float = 1.96e8
-    dh_c1: float = 5.9e8
-    dh_c2: float = 1.34
+    density: float = T.DENSITY
+    roelands_alpha: float = T.ROELANDS_ALPHA
+    roelands_p0: float = T.ROELANDS_P0
+    dh_c1: float = T.DH_C1
+    dh_c2: float = T.DH_C2
 
     def __post_init__(self):
         for name in ("viscosity", "density", "roelands_p0", "dh_c1", "dh_c2"):

@@ -41,7 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..contact.elastic import elastic_operator, reduced_modulus
+from .. import tables as T
+from ..contact.elastic import elastic_operator
 from ..errors import NotConverged
 from ..io.atomic import atomic_path
 from ..micro.flow_factors import FlowFactors
@@ -67,16 +68,16 @@ class MixedNotConverged(NotConverged):
 class MacroSettings:
     """Settings of the macro solver (Table 6 defaults, SI units)."""
 
-    ambient_pressure: float = 1e5
-    cavitation_pressure: float = 8e4
-    e_reduced: float = reduced_modulus(210e9, 0.3, 210e9, 0.3)
+    ambient_pressure: float = T.AMBIENT_PRESSURE
+    cavitation_pressure: float = T.CAVITATION_PRESSURE
+    e_reduced: float = T.E_REDUCED
     boundary_friction: float = BOUNDARY_FRICTION
     method: str = "fe"                       # Poiseuille term: "fe" or "fvm"
     coupling: str = "anderson"               # or "pid" (the paper's)
     complementarity: str = "switch"          # or "fb" (the paper's FBNS; slower)
-    relaxation_pcon: float = 0.05            # alpha_pcon of eq 26 ("pid")
+    relaxation_pcon: float = T.RELAXATION_PCON   # alpha_pcon of eq 26 ("pid")
     relaxation_elastic: float = 0.1          # under-relaxation of h_el ("pid")
-    gains: tuple = (1.2e-2, 2.4e-2, 1.5e-3)  # K_P, K_I, K_D of eq 29 ("pid")
+    gains: tuple = T.MACRO_GAINS             # K_P, K_I, K_D of eq 29 ("pid")
     anderson_depth: int = 8
     p_ref: float = 100e6
     h_ref: float = 1e-6
