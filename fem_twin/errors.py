@@ -34,3 +34,7 @@ class RunLocked(FemTwinError, RuntimeError):
 
 class SchedulerUnreachable(FemTwinError, RuntimeError):
     """The Dask scheduler of ``[run] scheduler`` could not be reached."""
+
+
+class ReynoldsNotConverged(NotConverged):
+    """The complementarity Newton loop failed; ``history`` holds the residuals."""

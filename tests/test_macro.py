@@ -9,7 +9,7 @@ couplings agree to about 1e-5 (two independent 1e-6 stops); exact invariances ho
 import numpy as np
 import pytest
 
-from fem_twin.fvm.reynolds import fvm_poiseuille
+from fem_twin.fvm import fvm_poiseuille
 from fem_twin.io.files import read_topography
 from fem_twin.macro import (BOUNDARY_FRICTION, Lubricant, MacroSettings, MixedNotConverged,
                             MixedResult, solve_mixed, solve_reynolds)

@@ -1,5 +1,12 @@
-"""FVM reference twin of the FE solvers: the paper's own discretisation (issue 6)."""
+"""The paper's finite volumes, the reference twin of the FE solvers (one import for all).
 
-from .cell import CellSolverFV
+They live beside their FE counterparts: the cell problems in :mod:`fem_twin.micro.cell_fv`,
+the Poiseuille operator in :mod:`fem_twin.macro.reynolds_fv`, the FBNS complementarity solver
+in :mod:`fem_twin.macro.fbns`; ``method="fvm"`` selects them in the solvers.
+"""
 
-__all__ = ["CellSolverFV"]
+from ..macro.fbns import solve_complementarity_fb
+from ..macro.reynolds_fv import fvm_poiseuille
+from ..micro.cell_fv import CellSolverFV
+
+__all__ = ["CellSolverFV", "fvm_poiseuille", "solve_complementarity_fb"]

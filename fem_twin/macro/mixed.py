@@ -48,6 +48,7 @@ from ..io.atomic import atomic_path
 from ..micro.flow_factors import FlowFactors
 from .friction import BOUNDARY_FRICTION, boundary_shear, hydrodynamic_shear
 from .lubricant import Lubricant
+from .reynolds_fv import fvm_poiseuille
 from .reynolds import (ReynoldsNotConverged, complementarity_solver, fe_poiseuille,
                        trapezoid_weights, upwind_couette)
 
@@ -224,7 +225,6 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
     def poiseuille(g, A):
         if s.method == "fe":
             return fe_poiseuille(g, dx, A)
-        from ..fvm.reynolds import fvm_poiseuille
         return fvm_poiseuille(g, dx, A)
 
     if initial is None and min(h_g.shape) >= 2 * COARSE_START:

@@ -32,19 +32,17 @@ import scipy.sparse.linalg as spla
 import skfem
 from skfem.helpers import dot, grad
 
-from ..errors import NotConverged
+from ..errors import ReynoldsNotConverged
 from ..assembly import FixedPattern, element_entries, unit_element
 from ..io.mesh import grid_mesh
 from ..linalg import SPDSolver, default_backend
 from ..ordering import nested_dissection
+from .fbns import solve_complementarity_fb
+from .reynolds_fv import fvm_poiseuille
 
 
 #: relative mass residual at which Newton steps can no longer improve the solution
 ROUND_OFF = 1e3 * np.finfo(float).eps
-
-
-class ReynoldsNotConverged(NotConverged):
-    """The complementarity Newton loop failed; ``history`` holds the residuals."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,7 +107,6 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     if method == "fe":
         K = fe_poiseuille(g, dx)
     elif method == "fvm":
-        from ..fvm.reynolds import fvm_poiseuille
         K = fvm_poiseuille(g, dx)
     else:
         raise ValueError(f"method must be 'fe' or 'fvm', got {method!r}")
@@ -236,7 +233,6 @@ def complementarity_solver(name: str):
     if name == "switch":
         return solve_complementarity
     if name == "fb":
-        from ..fvm.fbns import solve_complementarity_fb
         return solve_complementarity_fb
     raise ValueError(f"complementarity must be 'switch' or 'fb', got {name!r}")
 

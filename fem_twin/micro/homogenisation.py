@@ -54,6 +54,7 @@ from ..contact.levelling import TABLE4
 from ..io.atomic import atomic_path
 from ..io.checkpoint import load_or_none
 from ..topography import Topography
+from .cell_fv import CellSolverFV
 from .estimate import discrepancy, grid_separations
 from .flow_factors import FlowFactors
 
@@ -314,7 +315,6 @@ def _cell_solver(shape, spacing, method):
     if method == "fe":
         from .cell import CellSolver
         return CellSolver(shape, spacing)
-    from ..fvm.cell import CellSolverFV
     return CellSolverFV(shape, spacing)
 
 

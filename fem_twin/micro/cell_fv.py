@@ -29,9 +29,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..micro.cell import CellSolution
 from ..assembly import FixedPattern, periodic_unknowns
 from ..linalg import SPDSolver
+from .cell import CellSolution
 
 
 def _cube_mean(a, b):

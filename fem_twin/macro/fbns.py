@@ -20,7 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..macro.reynolds import ReynoldsNotConverged
+from ..errors import ReynoldsNotConverged
 
 
 def solve_complementarity_fb(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=1e-10,

@@ -1,0 +1,52 @@
+"""The layout: imports run down the pipeline, with no cycle between fem_twin's modules."""
+
+import ast
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[1] / "fem_twin"
+
+
+def _module(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _imports(path: Path) -> set:
+    """fem_twin modules imported anywhere in ``path`` (also inside functions)."""
+    name = _module(path)
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[:len(base) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            for alias in node.names:            # "from . import tables" names a module
+                sub = f"{target}.{alias.name}"
+                out.add(sub if (PACKAGE.parent / (sub.replace(".", "/") + ".py")).exists()
+                        else target)
+        elif isinstance(node, ast.Import):
+            out.update(a.name for a in node.names)
+    return {m for m in out if m == "fem_twin" or m.startswith("fem_twin.")} - {name}
+
+
+def test_no_import_cycle_between_modules():
+    graph = {_module(p): _imports(p) for p in PACKAGE.rglob("*.py")}
+    graph = {m: {d for d in deps if d in graph and d != "fem_twin"} for m, deps in graph.items()}
+    state = {}
+
+    def visit(m, path):
+        state[m] = "open"
+        for d in graph[m]:
+            if state.get(d) == "open":
+                raise AssertionError("import cycle: " + " -> ".join(path + [m, d]))
+            if d not in state:
+                visit(d, path + [m])
+        state[m] = "done"
+
+    for m in sorted(graph):
+        if m not in state:
+            visit(m, [])
