@@ -36,6 +36,7 @@ from .micro.output import plot_flow_factors
 from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)
 from .stribeck.sweep import sweep_key
+from .threads import one_thread
 from .topography import resample_cell
 from .topography.plausibility import check_patch, check_pin
 from .topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
@@ -43,6 +44,7 @@ from .topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_
 log = logging.getLogger("fem_twin")
 
 
+@one_thread
 def run(case: Case, outdir, *, progress: bool = True) -> dict:
     """Run the whole pipeline of ``case`` into ``outdir``; return the summary."""
     outdir = Path(outdir)
@@ -350,6 +352,7 @@ def macro_geometry(case: Case, outdir: Path):
     return disk.heights - pin.heights, pin.spacing, face, pin.origin
 
 
+@one_thread
 def _sweep_task(args):
     """One viscosity's sweep (a picklable unit of work for process pools and Dask)."""
     kwargs, lub = args

@@ -90,3 +90,23 @@ def test_cell_moments_do_not_depend_on_the_backend(solver):
     for key in a.moments:
         assert np.allclose(a.moments[key], b.moments[key], rtol=1e-9,
                            atol=1e-12 * np.abs(a.moments[key]).max()), key
+
+
+def test_one_thread_while_computing_and_restored_after(monkeypatch):
+    """BLAS/OpenMP pools hold one thread inside fem_twin's entry points (FEM_TWIN_THREADS
+    raises it) and get their previous sizes back afterwards: importing changes nothing."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    from fem_twin.threads import one_thread
+
+    inside = one_thread(lambda: {p["internal_api"]: p["num_threads"] for p in threadpool_info()})
+    with threadpool_limits(limits=2):
+        before = {p["internal_api"]: p["num_threads"] for p in threadpool_info()}
+        assert set(inside().values()) <= {1}
+        monkeypatch.setenv("FEM_TWIN_THREADS", "2")
+        assert set(inside().values()) <= {1, 2}
+        after = {p["internal_api"]: p["num_threads"] for p in threadpool_info()}
+    assert after == before
+    monkeypatch.setenv("FEM_TWIN_THREADS", "two")
+    with pytest.raises(ValueError, match="FEM_TWIN_THREADS"):
+        inside()

@@ -46,6 +46,7 @@ from ..contact.elastic import elastic_operator
 from ..errors import NotConverged
 from ..io.atomic import atomic_path
 from ..micro.flow_factors import FlowFactors
+from ..threads import one_thread
 from .friction import BOUNDARY_FRICTION, boundary_shear, hydrodynamic_shear
 from .lubricant import Lubricant
 from .reynolds_fv import fvm_poiseuille
@@ -180,6 +181,7 @@ class MixedResult:
         return write_vtu(path, gm, {**self.fields(), "pressure_gauge": self.pressure - p_amb})
 
 
+@one_thread
 def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float,
                 lubricant: Lubricant, face=None, settings: MacroSettings = MacroSettings(),
                 initial: MixedResult | None = None, progress=None) -> MixedResult:

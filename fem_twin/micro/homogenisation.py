@@ -53,6 +53,7 @@ from ..contact import solve as contact_solve
 from ..contact.levelling import TABLE4
 from ..io.atomic import atomic_path
 from ..io.checkpoint import load_or_none
+from ..threads import one_thread
 from ..topography import Topography
 from .cell_fv import CellSolverFV
 from .estimate import discrepancy, grid_separations
@@ -98,6 +99,7 @@ class CellSettings:
             raise ValueError("e_reduced, hardness and gap_floor must be positive (Pa, Pa, m)")
 
 
+@one_thread
 def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
                e_reduced: float = TABLE4["e_reduced"], hardness: float = TABLE4["hardness"],
                method: str = "fe", moving: str = "upper", time_derivative: str = "exact",
@@ -365,6 +367,7 @@ def sliding_cells(gaps, squeezes, solver):
         yield solver.solve(h, tau)
 
 
+@one_thread
 def _chunk_task(job):
     """``_run_chunk`` as one positional argument: executors may own keywords (Dask's
     ``submit`` takes ``key`` for itself)."""

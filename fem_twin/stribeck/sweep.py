@@ -13,9 +13,11 @@ from ..io.checkpoint import load_or_none
 from ..io.mesh import write_pvd
 from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
 from ..micro.flow_factors import FlowFactors
+from ..threads import one_thread
 from .curve import StribeckCurve, hersey_number
 
 
+@one_thread
 def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    lubricant: Lubricant, diameter: float = 8e-3, face=None,
                    settings: MacroSettings = MacroSettings(), checkpoint=None, fields=None,
