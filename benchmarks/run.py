@@ -379,8 +379,8 @@ def bench_paper():
     pairs at 256^2 x 100 h0 x 32 steps, 2 viscosities x 25 speeds (+ refinement, ~37 points)
     at 256^2, patch band: 12 more sweeps; 2 cores).  Measured here: one patch pair at 10 of
     the 100 h0 (every 10th, 32 steps, exact squeeze term, one process) and one warm-started
-    sweep of 6 speeds at 256^2 with the patch-average flow factors of that pair.  Baseline:
-    the measured micro time of one h0."""
+    sweep of 6 speeds at 256^2 with flow factors of that pair at 64^2 (30 h0 x 8 steps, as in
+    the macro groups).  Baseline: the measured micro time of one h0."""
     from fem_twin.case import load_case
     from fem_twin.macro import Lubricant
     from fem_twin.micro import DEFAULT_H0, homogenise
@@ -399,6 +399,9 @@ def bench_paper():
     mdisk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
     gap, face = mdisk.heights - mpin.heights, mpin.heights > opts.holder_height / 2
     speeds = np.geomspace(2.0, 0.01, 6)
+    # the sweep with smooth factors (30 h0, as the other macro groups): 10 h0 kink p_con
+    ff = homogenise(tp.resample_cell(pin, (64, 64)), tp.resample_cell(disk, (64, 64)),
+                    np.geomspace(2e-8, 1e-6, 30), n_steps=8)
     t0 = time.perf_counter()
     curve = stribeck_sweep(gap, mpin.spacing, ff, speeds, load=150.0,
                            lubricant=Lubricant(0.066), face=face)

@@ -36,7 +36,7 @@ from .micro.output import plot_flow_factors
 from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)
 from .stribeck.sweep import sweep_key
-from .threads import one_thread
+from .threads import one_thread, worker_heap
 from .topography import resample_cell
 from .topography.plausibility import check_patch, check_pin
 from .topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
@@ -355,6 +355,7 @@ def macro_geometry(case: Case, outdir: Path):
 @one_thread
 def _sweep_task(args):
     """One viscosity's sweep (a picklable unit of work for process pools and Dask)."""
+    worker_heap()
     kwargs, lub = args
     return stribeck_sweep(lubricant=lub, **kwargs)
 

@@ -53,7 +53,7 @@ from ..contact import solve as contact_solve
 from ..contact.levelling import TABLE4
 from ..io.atomic import atomic_path
 from ..io.checkpoint import load_or_none
-from ..threads import one_thread
+from ..threads import one_thread, worker_heap
 from ..topography import Topography
 from .cell_fv import CellSolverFV
 from .estimate import discrepancy, grid_separations
@@ -371,6 +371,7 @@ def sliding_cells(gaps, squeezes, solver):
 def _chunk_task(job):
     """``_run_chunk`` as one positional argument: executors may own keywords (Dask's
     ``submit`` takes ``key`` for itself)."""
+    worker_heap()
     points, args = job
     return _run_chunk(points, **args)
 
