@@ -238,6 +238,26 @@ def bench_micro(full=False):
     return base, rows
 
 
+def _macro_factors():
+    """Flow factors of sample patch 1 at 64^2, 30 h0 x 8 steps: the macro groups' input."""
+    from fem_twin.micro import homogenise
+    from fem_twin.topography.prepare import prepare_patch
+    low = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
+                           (64, 64))
+    up = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
+                                        upper=True), (64, 64))
+    return homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), n_steps=8)
+
+
+def _macro_gap(n):
+    """Gap, spacing and pin face of sample pin 1 on disk 1 at n^2."""
+    from fem_twin.topography.prepare import MacroOptions, prepare_disk
+    opts = MacroOptions(resolution=(n, n))
+    pin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
+    disk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
+    return disk.heights - pin.heights, pin.spacing, pin.heights > opts.holder_height / 2
+
+
 def bench_macro():
     """One operating point (150 N, 0.066 Pa s, 0.1 and 1 m/s), cold start, FE and FVM.
 
@@ -246,25 +266,16 @@ def bench_macro():
     Goal: a converged 256^2 point in under 20 s.
     """
     from fem_twin.macro import Lubricant, MacroSettings, solve_mixed
-    from fem_twin.micro import homogenise
-    from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch
 
-    low = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
-                      (64, 64))
-    up = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
-                                   upper=True), (64, 64))
-    ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), n_steps=8)
+    ff = _macro_factors()
     rows, base = [], None
     for n in (128, 256):
-        opts = MacroOptions(resolution=(n, n))
-        pin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
-        disk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
-        gap, face = disk.heights - pin.heights, pin.heights > opts.holder_height / 2
+        gap, spacing, face = _macro_gap(n)
         for speed in (1.0, 0.1):
             cf = {}
             for method in ("fvm", "fe"):
                 t0 = time.perf_counter()
-                r = solve_mixed(gap, pin.spacing, ff, load=150.0, speed=speed, face=face,
+                r = solve_mixed(gap, spacing, ff, load=150.0, speed=speed, face=face,
                                 lubricant=Lubricant(0.066), settings=MacroSettings(method=method))
                 t = time.perf_counter() - t0
                 base = base or t
@@ -275,7 +286,7 @@ def bench_macro():
             rows.append(("  FE / FVM time; |C_f,dev|", rows[-1][1] / rows[-2][1],
                          f"{abs(cf['fe'] - cf['fvm']) / 0.19245:.2e}"))
             t0 = time.perf_counter()
-            r = solve_mixed(gap, pin.spacing, ff, load=150.0, speed=speed, face=face,
+            r = solve_mixed(gap, spacing, ff, load=150.0, speed=speed, face=face,
                             lubricant=Lubricant(0.066),
                             settings=MacroSettings(method="fvm", complementarity="fb"))
             rows.append((f"FVM + FBNS (paper's inner solver) {n}^2, U = {speed}",
@@ -295,9 +306,7 @@ def bench_stribeck():
     import tempfile
 
     from fem_twin.macro import Lubricant, solve_mixed
-    from fem_twin.micro import homogenise
     from fem_twin.stribeck import stribeck_sweep
-    from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch
 
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -307,24 +316,17 @@ def bench_stribeck():
                         "--no-progress"], check=True, capture_output=True)
         wall = time.perf_counter() - t0
         sec = json.loads(open(os.path.join(tmp, "summary.json")).read())["seconds"]
-    low = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
-                      (64, 64))
-    up = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
-                                   upper=True), (64, 64))
-    ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), n_steps=8)
-    opts = MacroOptions(resolution=(256, 256))
-    pin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
-    disk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
-    gap, face = disk.heights - pin.heights, pin.heights > opts.holder_height / 2
+    ff = _macro_factors()
+    gap, spacing, face = _macro_gap(256)
     t0 = time.perf_counter()
-    solve_mixed(gap, pin.spacing, ff, load=150.0, speed=2.0, face=face,
+    solve_mixed(gap, spacing, ff, load=150.0, speed=2.0, face=face,
                 lubricant=Lubricant(0.066))
     base = time.perf_counter() - t0
     rows.append(("baseline: cold 256^2 point at 2 m/s", base, ""))
     rows.append(("bundled case, fem-twin run (2 viscosities)", wall,
                  ", ".join(f"{k} {v:.0f} s" for k, v in sec.items())))
     t0 = time.perf_counter()
-    curve = stribeck_sweep(gap, pin.spacing, ff, np.geomspace(2.0, 0.01, 25), load=150.0,
+    curve = stribeck_sweep(gap, spacing, ff, np.geomspace(2.0, 0.01, 25), load=150.0,
                            lubricant=Lubricant(0.066), face=face)
     t = time.perf_counter() - t0
     rows.append(("paper-grade curve: 25 speeds at 256^2", t,
@@ -340,27 +342,18 @@ def bench_newton():
     Baseline: the SuperLU sweep at 128^2.  Goal of the paper-grade issue: 2x at 256^2."""
     from fem_twin.linalg import _mkl_rt
     from fem_twin.macro import Lubricant
-    from fem_twin.micro import homogenise
     from fem_twin.stribeck import stribeck_sweep
-    from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch
 
-    low = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
-                           (64, 64))
-    up = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
-                                        upper=True), (64, 64))
-    ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), n_steps=8)
+    ff = _macro_factors()
     backends = ("superlu", "pardiso") if _mkl_rt() is not None else ("superlu",)
     rows, base = [], None
     for n in (128, 256):
-        opts = MacroOptions(resolution=(n, n))
-        pin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
-        disk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
-        gap, face = disk.heights - pin.heights, pin.heights > opts.holder_height / 2
+        gap, spacing, face = _macro_gap(n)
         times, cf = {}, {}
         for backend in backends:
             os.environ["FEM_TWIN_SPARSE"] = backend
             t0 = time.perf_counter()
-            c = stribeck_sweep(gap, pin.spacing, ff, np.geomspace(2.0, 0.01, 8), load=150.0,
+            c = stribeck_sweep(gap, spacing, ff, np.geomspace(2.0, 0.01, 8), load=150.0,
                                lubricant=Lubricant(0.066), face=face)
             times[backend], cf[backend] = time.perf_counter() - t0, c.friction_coefficient
             base = base or times[backend]
@@ -379,13 +372,11 @@ def bench_paper():
     pairs at 256^2 x 100 h0 x 32 steps, 2 viscosities x 25 speeds (+ refinement, ~37 points)
     at 256^2, patch band: 12 more sweeps; 2 cores).  Measured here: one patch pair at 10 of
     the 100 h0 (every 10th, 32 steps, exact squeeze term, one process) and one warm-started
-    sweep of 6 speeds at 256^2 with flow factors of that pair at 64^2 (30 h0 x 8 steps, as in
-    the macro groups).  Baseline: the measured micro time of one h0."""
+    sweep of 6 speeds at 256^2 with the macro groups' flow factors (patch 1 at 64^2, 30 h0).  Baseline: the measured micro time of one h0."""
     from fem_twin.case import load_case
     from fem_twin.macro import Lubricant
     from fem_twin.micro import DEFAULT_H0, homogenise
     from fem_twin.stribeck import stribeck_sweep
-    from fem_twin.topography.prepare import MacroOptions, prepare_disk
 
     case = load_case(os.path.join(HERE, "..", "examples", "paper.toml"))
     pin, disk = _patch_pair()
@@ -394,16 +385,11 @@ def bench_paper():
     ff = homogenise(pin, disk, h0, workers=1, error_estimate=False)
     t_micro = time.perf_counter() - t0
     per_h0 = t_micro / h0.size
-    opts = MacroOptions(resolution=(256, 256))
-    mpin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
-    mdisk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
-    gap, face = mdisk.heights - mpin.heights, mpin.heights > opts.holder_height / 2
+    gap, spacing, face = _macro_gap(256)
     speeds = np.geomspace(2.0, 0.01, 6)
-    # the sweep with smooth factors (30 h0, as the other macro groups): 10 h0 kink p_con
-    ff = homogenise(tp.resample_cell(pin, (64, 64)), tp.resample_cell(disk, (64, 64)),
-                    np.geomspace(2e-8, 1e-6, 30), n_steps=8)
+    ff = _macro_factors()          # smooth factors (30 h0): 10 h0 kink p_con, the sweep stalls
     t0 = time.perf_counter()
-    curve = stribeck_sweep(gap, mpin.spacing, ff, speeds, load=150.0,
+    curve = stribeck_sweep(gap, spacing, ff, speeds, load=150.0,
                            lubricant=Lubricant(0.066), face=face)
     per_point = (time.perf_counter() - t0) / speeds.size
     cores, patches, n_mu = 2, len(case.geometry.patches), len(case.lubricant.viscosities)
