@@ -110,3 +110,30 @@ def test_one_thread_while_computing_and_restored_after(monkeypatch):
     monkeypatch.setenv("FEM_TWIN_THREADS", "two")
     with pytest.raises(ValueError, match="FEM_TWIN_THREADS"):
         inside()
+
+
+def test_anderson_mixing_is_gmres_on_a_linear_map():
+    """x = G x + c with a slow contraction (spectral radius 0.95): Anderson with memory >=
+    the dimension n reaches the fixed point in at most n + 1 steps (GMRES equivalence),
+    where the plain iteration needs hundreds; depth 0 is the plain iteration."""
+    from fem_twin.anderson import Anderson
+    rng = np.random.default_rng(5)
+    n = 6
+    Q = np.linalg.qr(rng.normal(size=(n, n)))[0]
+    G = Q @ np.diag(np.linspace(-0.95, 0.95, n)) @ Q.T
+    c = rng.normal(size=n)
+    exact = np.linalg.solve(np.eye(n) - G, c)
+
+    def solve(depth, steps):
+        mixer, x = Anderson(depth), np.zeros(n)
+        for _ in range(steps):
+            x = mixer.step(x, G @ x + c - x)
+        return np.linalg.norm(x - exact) / np.linalg.norm(exact)
+
+    assert solve(depth=8, steps=n + 1) < 1e-9
+    plain = solve(depth=0, steps=n + 1)
+    x = np.zeros(n)
+    for _ in range(n + 1):
+        x = G @ x + c
+    assert plain == pytest.approx(np.linalg.norm(x - exact) / np.linalg.norm(exact), rel=1e-12)
+    assert plain > 0.5

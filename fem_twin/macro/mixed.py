@@ -42,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import tables as T
+from ..anderson import Anderson
 from ..contact.elastic import elastic_operator
 from ..errors import NotConverged
 from ..io.atomic import atomic_path
@@ -287,7 +288,7 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
         p_con = factors.contact_pressure(np.maximum(h_d + h_g, s.gap_floor))
     history = []
     r_prev = [0.0, 0.0]
-    mixer = _Anderson(s.anderson_depth)
+    mixer = Anderson(s.anderson_depth)
     p_con_prev = p_con
     good, retries, best, stall = None, 0, np.inf, 0
     for it in range(1, s.max_iter + 1):
@@ -301,7 +302,7 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
                                         history) from err
             h_el, h_d = (h_el + good[0]) / 2, (h_d + good[1]) / 2
             state["phi"], state["p"] = good[2], good[3]
-            mixer = _Anderson(s.anderson_depth)
+            mixer = Anderson(s.anderson_depth)
             history.append((it, np.nan, np.nan, np.nan, np.nan, h_d, -1))
             continue
         retries = 0
@@ -325,7 +326,7 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
         if res < 0.5 * best:
             best, stall = res, 0
         elif stall > 25:                   # Anderson mixing stagnates: restart its history
-            mixer, best, stall = _Anderson(s.anderson_depth), res, 0
+            mixer, best, stall = Anderson(s.anderson_depth), res, 0
         if s.coupling == "pid":
             p_con = p_con + s.relaxation_pcon * delta               # eq 26
             kp, ki, kd = s.gains
@@ -473,27 +474,3 @@ def _load_stiffness(factors, ev, area, s):
     h_char = float(np.average(h0[loaded], weights=ev["p"][loaded] + 1e-30))
     k_hd = 2 * max(ev["F_hd"], 0.0) / max(h_char, s.gap_floor)
     return max(k_con + k_hd, 1e-3 * abs(ev["F"]) / s.h_ref + 1e-300)
-
-
-class _Anderson:
-    """Anderson mixing (type II, Walker and Ni 2011) for ``x = x + f(x)``, depth ``m``."""
-
-    def __init__(self, depth: int):
-        self.depth = depth
-        self.dx, self.df = [], []
-        self.x_old = self.f_old = None
-
-    def step(self, x, f):
-        if self.x_old is not None:
-            self.dx.append(x - self.x_old)
-            self.df.append(f - self.f_old)
-            if len(self.dx) > self.depth:
-                self.dx.pop(0)
-                self.df.pop(0)
-        self.x_old, self.f_old = x.copy(), f.copy()
-        if not self.dx:
-            return x + f
-        DF = np.array(self.df).T
-        DX = np.array(self.dx).T
-        gamma = np.linalg.lstsq(DF, f, rcond=1e-10)[0]
-        return x + f - (DX + DF) @ gamma
