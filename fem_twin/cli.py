@@ -516,7 +516,9 @@ def _short_summary(summary: dict, out: Path) -> str:
         if kind in est:
             lines.append(f"  flow factors, estimated {kind} error: " + ", ".join(
                 f"{q} {e:.1%}" for q, e in est[kind].items() if q in ("A11", "b1", "p_con")))
-    lines.append(f"results in {out}/ (stribeck.csv, plots, fields/, summary.json, run.log)")
+    lines.append(f"results in {out}/ (stribeck.csv, plots, results.nc and fields.nc for "
+                 f"fem_twin.results.open_run, fields/ for ParaView, summary.json, run.log); "
+                 f"the figures on one page: fem-twin report {out}")
     return "\n".join(lines)
 
 
