@@ -352,7 +352,6 @@ def macro_geometry(case: Case, outdir: Path):
     return disk.heights - pin.heights, pin.spacing, face, pin.origin
 
 
-@one_thread
 def _sweep_task(args):
     """One viscosity's sweep (a picklable unit of work for process pools and Dask)."""
     worker_heap()
@@ -390,15 +389,13 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                  "%.3g", level + 1, extra.size, case.sweep.refine_step * tr.boundary_friction)
         speeds = np.unique(np.r_[speeds, extra])[::-1]
     tasks = [(dict(common, speeds=speeds), lub) for lub in lubricants]
-    band_tasks = band_sweeps(case, outdir, dict(common, speeds=speeds)) if case.run.patch_band \
-        else []
-    patch_curves = run_sweeps([(kw, lub) for kw in band_tasks for lub in lubricants],
-                              executor, progress, desc="patch band points")
+    band_tasks = [(kw, lub) for kw in band_sweeps(case, outdir, dict(common, speeds=speeds))
+                  for lub in lubricants] if case.run.patch_band else []
+    patch_curves = run_sweeps(band_tasks, executor, progress, desc="patch band points")
     patch_curves = [patch_curves[i:i + len(lubricants)]
                     for i in range(0, len(patch_curves), len(lubricants))]
     band = patch_band(patch_curves) if patch_curves else None
-    _prune_points(common["checkpoint"], tasks + [(kw, lub) for kw in band_tasks
-                                                   for lub in lubricants])
+    _prune_points(common["checkpoint"], tasks + band_tasks)
     write_stribeck_csv(outdir / "stribeck.csv", curves, band)
     out = {"curves": [{"viscosity_Pa_s": c.viscosity,
                        "friction_coefficient_range": [float(c.friction_coefficient.min()),
@@ -410,10 +407,10 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
     if band is not None:
         out["patch_band_max_width"] = float(max(np.max(hi - lo) for lo, hi in band))
     plot_curves(case, curves, band, outdir)
-    keys = {_sweep_key(kw, lub): lub.viscosity for kw, lub in tasks}
-    for mu, by_speed in sweep_points(common["checkpoint"], keys).items():
-        u = sorted(by_speed, reverse=True)                                # fast to slow
-        res = [MixedResult.load(by_speed[u[i]]) for i in sorted({0, len(u) // 2, len(u) - 1})]
+    points = sweep_points(common["checkpoint"], tasks)
+    for mu in lb.viscosities:
+        u = sorted((v for m, v in points if m == mu), reverse=True)      # fast to slow
+        res = [points[mu, u[i]] for i in sorted({0, len(u) // 2, len(u) - 1})]
         plot_point_fields(res, outdir / f"fields_mu{mu:g}.png", titles=[
             f"$\\mu_0$ = {mu:g} Pa s, U = {r.speed:.3g} m/s, "
             f"$C_f$ = {r.friction_coefficient:.4f}" for r in res])
@@ -426,7 +423,7 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
         out["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, tr.boundary_friction)
     if any(case.measured):
         out["validation"] = validate(case, curves, outdir, curve_labels(case, curves))
-    write_run_results(case, outdir, curves, patch_curves, tasks, origin)
+    write_run_results(case, outdir, curves, patch_curves, points, origin)
     return out
 
 
@@ -463,17 +460,19 @@ def plot_curves(case: Case, curves, band, outdir: Path) -> None:
                       bands=band, measured=measured, diameter=tr.pin_diameter, load=tr.load)
 
 
-def sweep_points(folder: Path, task_keys: dict) -> dict:
-    """{viscosity: {speed: checkpoint path}} of the sweeps ``task_keys`` {key: viscosity}."""
-    out = {}
-    for key, mu in task_keys.items():
-        out[mu] = {_point_speed(p): p for p in folder.glob(f"point_{key}_*.npz")}
-    return out
+def sweep_points(folder: Path, tasks) -> dict:
+    """{(viscosity, speed): MixedResult} of the checkpoints of the sweeps ``tasks``."""
+    points = {}
+    for kw, lub in tasks:
+        for path in folder.glob(f"point_{_sweep_key(kw, lub)}_*.npz"):
+            res = MixedResult.load(path)
+            points[lub.viscosity, res.speed] = res
+    return points
 
 
-def write_run_results(case: Case, outdir: Path, curves, patch_curves, tasks, origin) -> None:
+def write_run_results(case: Case, outdir: Path, curves, patch_curves, points, origin) -> None:
     """``results.nc`` (flow factors per patch and average, Stribeck curves with the band,
-    settings and error estimates) and ``fields.nc`` (every point's macro fields)."""
+    settings and error estimates) and ``fields.nc`` (the macro fields of ``points``)."""
     from dataclasses import asdict
 
     from .results import fields_dataset, flow_factor_dataset, stribeck_dataset, write_netcdf
@@ -486,15 +485,7 @@ def write_run_results(case: Case, outdir: Path, curves, patch_curves, tasks, ori
     write_netcdf(outdir / "results.nc",
                  {"flow_factors": flow_factor_dataset(factors, [str(i + 1) for i in range(n)]
                                                       + ["average"]),
-                  "stribeck": stribeck_dataset(
-                      curves, patch_band(patch_curves) if patch_curves else None,
-                      patch_curves)}, attrs)
-    keys = {_sweep_key(kw, lub): lub.viscosity for kw, lub in tasks}
-    points = {}
-    for mu, by_speed in sweep_points(tasks[0][0]["checkpoint"], keys).items():
-        for path in by_speed.values():
-            res = MixedResult.load(path)
-            points[mu, res.speed] = res
+                  "stribeck": stribeck_dataset(curves, patch_curves)}, attrs)
     write_netcdf(outdir / "fields.nc", {None: fields_dataset(points, origin)}, attrs)
 
 
@@ -573,10 +564,6 @@ def _prune_points(folder: Path, tasks) -> None:
 
 def _point_key(path: Path) -> str:
     return path.name.split("_")[1]
-
-
-def _point_speed(path: Path) -> float:
-    return float(path.stem.split("_")[2])
 
 
 def hersey_collapse(curves, boundary: float = BOUNDARY_FRICTION) -> float:

@@ -69,38 +69,35 @@ def flow_factor_dataset(factors, labels):
     return ds
 
 
-def stribeck_dataset(curves, band=None, patch_curves=None):
+def stribeck_dataset(curves, patch_curves=None):
     """Stribeck curves as a Dataset over (viscosity, speed) (NaN where a curve has no point);
-    ``band``: optional (cf_min, cf_max) arrays per curve, the patch scatter band;
     ``patch_curves``: optional single-patch curves [patch][viscosity] (same speeds), as
-    ``patch_friction_coefficient`` over (patch, viscosity, speed)."""
+    ``patch_friction_coefficient`` over (patch, viscosity, speed) and its band, ``cf_min``
+    and ``cf_max`` over the patches."""
     import xarray as xr
     speed = np.unique(np.concatenate([c.speed for c in curves]))
     mu = np.array([c.viscosity for c in curves])
-    out = {k: np.full((mu.size, speed.size), np.nan) for k in STRIBECK_UNITS}
-    for i, c in enumerate(curves):
-        at = np.searchsorted(speed, c.speed)
-        for k in STRIBECK_UNITS:
-            if k in ("cf_min", "cf_max"):
-                if band is not None:
-                    out[k][i, at] = band[i][k == "cf_max"]
-            else:
-                out[k][i, at] = getattr(c, k)
-    if band is None:
-        del out["cf_min"], out["cf_max"]
-    ds = xr.Dataset({k: (("viscosity", "speed"), v, {"units": STRIBECK_UNITS[k][0],
-                                                     "long_name": STRIBECK_UNITS[k][1]})
-                     for k, v in out.items()},
-                    coords={"viscosity": ("viscosity", mu, {"units": "Pa s"}),
-                            "speed": ("speed", speed, {"units": "m/s"})})
+    out = {}
+    for k in STRIBECK_UNITS:
+        if k not in ("cf_min", "cf_max"):
+            out[k] = np.full((mu.size, speed.size), np.nan)
+            for i, c in enumerate(curves):
+                out[k][i, np.searchsorted(speed, c.speed)] = getattr(c, k)
+    coords = {"viscosity": ("viscosity", mu, {"units": "Pa s"}),
+              "speed": ("speed", speed, {"units": "m/s"})}
     if patch_curves:
         cf = np.full((len(patch_curves), mu.size, speed.size), np.nan)
         for p, per_mu in enumerate(patch_curves):
             for i, c in enumerate(per_mu):
                 cf[p, i, np.searchsorted(speed, c.speed)] = c.friction_coefficient
+        out["cf_min"], out["cf_max"] = cf.min(axis=0), cf.max(axis=0)
+        coords["patch"] = [str(p + 1) for p in range(len(patch_curves))]
+    ds = xr.Dataset({k: (("viscosity", "speed"), v, {"units": STRIBECK_UNITS[k][0],
+                                                     "long_name": STRIBECK_UNITS[k][1]})
+                     for k, v in out.items()}, coords=coords)
+    if patch_curves:
         ds["patch_friction_coefficient"] = (("patch", "viscosity", "speed"), cf, {
             "units": "1", "long_name": "C_f with one patch's flow factors"})
-        ds = ds.assign_coords(patch=[str(p + 1) for p in range(len(patch_curves))])
     return ds
 
 

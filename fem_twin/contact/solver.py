@@ -159,6 +159,7 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
     h0 = 0.0 if separation is None else float(separation)
     u, fresh = None, 0
     dot = lambda a, b: float(np.dot(a.ravel(), b.ravel()))  # noqa: E731  (BLAS, no copies)
+    size = (lambda q: q.sum()) if p_min >= 0 else (lambda q: np.abs(q).sum())  # noqa: E731
     for it in range(1, max_iter + 1):
         if u is None or fresh >= _REFRESH:
             u, fresh = op(p), 0
@@ -213,7 +214,6 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
         else:
             u = None
         # relative change, with a floor of 1e-14 E' per point (no contact: nothing to resolve)
-        size = (lambda q: q.sum()) if p_min >= 0 else (lambda q: np.abs(q).sum())
         scale = max(size(p), size(p_old), 1e-14 * e_reduced * p.size)
         change = np.abs(p - p_old).sum() / scale
         history.append(change)

@@ -317,9 +317,9 @@ def _newton_solver(shape, dirichlet, interior, K, B):
     parts = []
     for M in (K, B):
         M = M[interior][:, interior].tocoo()
-        at = np.searchsorted(keys, M.row.astype(np.int64) * n + M.col)
-        if not np.array_equal(keys[np.minimum(at, keys.size - 1)],
-                              M.row.astype(np.int64) * n + M.col):
+        entries = M.row.astype(np.int64) * n + M.col
+        at = np.searchsorted(keys, entries)
+        if not np.array_equal(keys[np.minimum(at, keys.size - 1)], entries):
             return None                           # not a stencil matrix: the general path
         parts.append((at, M.data, M.col))
 
