@@ -36,5 +36,9 @@ class SchedulerUnreachable(FemTwinError, RuntimeError):
     """The Dask scheduler of ``[run] scheduler`` could not be reached."""
 
 
+class MixedNotConverged(NotConverged):
+    """The coupled macro iteration failed; ``history`` holds the residual rows."""
+
+
 class ReynoldsNotConverged(NotConverged):
     """The complementarity Newton loop failed; ``history`` holds the residuals."""

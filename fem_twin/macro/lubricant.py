@@ -63,3 +63,18 @@ class Lubricant:
         """rho_l / rho_0 of eq 24 at relative pressure ``p = p_hd - p_cav >= 0`` [-]."""
         p = np.maximum(np.asarray(pressure, float), 0.0)
         return (self.dh_c1 + self.dh_c2 * p) / (self.dh_c1 + p)
+
+    def viscosity_log_slope(self, pressure):
+        """``d ln(mu_l) / dp`` of eq 23 [1/Pa] (zero below p = 0, like eq 23's clipping)."""
+        p = np.asarray(pressure, float)
+        x = 1.0 + np.maximum(p, 0.0) / self.roelands_p0
+        slope = ((np.log(self.viscosity) + 9.67) * self.roelands_z
+                 * x ** (self.roelands_z - 1) / self.roelands_p0)
+        return np.where(p > 0, slope, 0.0)
+
+    def density_log_slope(self, pressure):
+        """``d ln(rho_l) / dp`` of eq 24 [1/Pa] (zero below p = 0)."""
+        p = np.maximum(np.asarray(pressure, float), 0.0)
+        c1, c2 = self.dh_c1, self.dh_c2
+        slope = c1 * (c2 - 1) / ((c1 + p) * (c1 + c2 * p))
+        return np.where(np.asarray(pressure, float) > 0, slope, 0.0)

@@ -44,13 +44,15 @@ import numpy as np
 from .. import tables as T
 from ..anderson import Anderson
 from ..contact.elastic import elastic_operator
-from ..errors import NotConverged
+from ..errors import MixedNotConverged
 from ..io.atomic import atomic_path
 from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from .friction import BOUNDARY_FRICTION, boundary_shear, hydrodynamic_shear
+from . import newton
 from .lubricant import Lubricant
 from .reynolds_fv import fvm_poiseuille
+from .start import dry_separation, rigid_separation
 from .reynolds import (ReynoldsNotConverged, complementarity_solver, fe_poiseuille,
                        trapezoid_weights, upwind_couette)
 
@@ -59,12 +61,11 @@ from .reynolds import (ReynoldsNotConverged, complementarity_solver, fe_poiseuil
 #: clipped before eqs 23-24 are evaluated, so that the Roelands exponential stays finite.
 MAX_COEFFICIENT_PRESSURE = 1e10
 
+#: Newton iterations per load of the ``"newton"`` coupling (it converges in 5-20)
+NEWTON_MAX_ITER = 60
+
 #: Cold starts on grids of at least twice this size begin with a solve on the coarser grid.
 COARSE_START = 48
-
-
-class MixedNotConverged(NotConverged):
-    """The coupled macro iteration failed; ``history`` holds the residual rows."""
 
 
 @dataclass(frozen=True)
@@ -91,8 +92,9 @@ class MacroSettings:
     def __post_init__(self):
         if self.method not in ("fe", "fvm"):
             raise ValueError(f"method must be 'fe' or 'fvm', got {self.method!r}")
-        if self.coupling not in ("anderson", "pid"):
-            raise ValueError(f"coupling must be 'anderson' or 'pid', got {self.coupling!r}")
+        if self.coupling not in ("anderson", "pid", "newton"):
+            raise ValueError("coupling must be 'anderson', 'pid' or 'newton', got "
+                             f"{self.coupling!r}")
         if self.ambient_pressure < self.cavitation_pressure:
             raise ValueError("ambient pressure must not be below the cavitation pressure [Pa]")
         if self.complementarity not in ("switch", "fb"):
@@ -236,10 +238,14 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
         initial = solve_mixed(h_g[::2, ::2], (2 * dx[0], 2 * dx[1]), factors, load=load,
                               speed=speed, lubricant=lubricant, face=face[::2, ::2],
                               settings=coarse)
+    if initial is not None:
+        initial = _on_grid(initial, h_g.shape, dx)
+    if s.coupling == "newton":
+        return _solve_newton(h_g, dx, factors, load, speed, lubricant, face, area, s, op,
+                             poiseuille, boundary, initial, progress, t0)
     state = {"phi": None, "p": np.full(h_g.shape, p_amb_rel), "newton": 0}
     solver = complementarity_solver(s.complementarity)
     if initial is not None:
-        initial = _on_grid(initial, h_g.shape, dx)
         state["p"] = initial.pressure - s.cavitation_pressure
         theta0 = initial.cavity_fraction
         state["phi"] = np.where(theta0 > 0, -theta0 * scale, np.maximum(state["p"], 0)).ravel()
@@ -282,7 +288,7 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
             return evaluate(h_el, hd)["F"] - load
 
         h_free = float(factors.h0[-1]) - float(h_g[face].min())
-        h_d = _rigid_separation(excess, h_free, _dry_separation(factors, h_g, area, load, s),
+        h_d = rigid_separation(excess, h_free, dry_separation(factors, h_g, area, load, s),
                                 float(factors.h0[-1]))
         state["p"] = np.full(h_g.shape, p_amb_rel)
         p_con = factors.contact_pressure(np.maximum(h_d + h_g, s.gap_floor))
@@ -355,6 +361,22 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
                    time.perf_counter() - t0)
 
 
+def _solve_newton(h_g, dx, factors, load, speed, lubricant, face, area, s, op, poiseuille,
+                  boundary, initial, progress, t0):
+    """The ``"newton"`` coupling (:mod:`.newton`): warm from ``initial``, else by load
+    continuation from the rigid film."""
+    P = newton.Problem(h_g, dx, factors, lubricant, s, poiseuille, op, area,
+                       np.flatnonzero(~boundary.ravel()), speed)
+    if initial is None:
+        x, ev, it, history = newton.continuation(P, load, tol=s.tol, max_iter=NEWTON_MAX_ITER,
+                                                 progress=progress)
+    else:
+        x, ev, it, history = newton.solve(P, newton.state_from(initial, s), load, tol=s.tol,
+                                          max_iter=NEWTON_MAX_ITER, progress=progress)
+    return _result(ev, x.w, x.h_d, speed, load, dx, face, area, lubricant, s, it, history,
+                   time.perf_counter() - t0)
+
+
 def _result(ev, h_el, h_d, speed, load, dx, face, area, lubricant, s, it, history, seconds):
     loc = ev["loc"]
     p_hd = ev["p"] + s.cavitation_pressure
@@ -393,75 +415,6 @@ def _on_grid(result: MixedResult, shape, dx) -> MixedResult:
     return replace(result, spacing=tuple(dx), **{k: interp(getattr(result, k))
                                                  for k in _FIELDS if k != "face"},
                    face=interp(result.face) > 0.5)
-
-
-def _dry_separation(factors, h_g, area, load, s):
-    """h_d at which the rigid contact alone carries the load (bisection), or at which the
-    surfaces touch (``h0 = gap_floor``) if the contact pressure cannot carry it."""
-    def excess(h_d):
-        p = factors.contact_pressure(np.maximum(h_d + h_g, s.gap_floor))
-        return float(np.sum(area * p)) - load
-
-    touch = s.gap_floor - float(h_g.min())
-    hi = float(factors.h0[-1]) - float(h_g.min())       # first contact at h0_max
-    if excess(hi) >= 0:
-        return hi
-    if excess(touch) < 0:
-        return touch
-    lo = touch
-    for _ in range(60):
-        mid = (lo + hi) / 2
-        lo, hi = (mid, hi) if excess(mid) > 0 else (lo, mid)
-    return hi
-
-
-def _rigid_separation(excess, h_free, h_dry, step, rtol=1e-3):
-    """h_d at which the rigid, isoviscous film and contact carry the load: the start.
-
-    ``excess(h_d) = F_N - F_N,imp`` decreases with ``h_d``.  The search starts at
-    ``h_free`` (first asperity contact) and brackets the root by doubling steps upward (a
-    lifting film) or by halving the distance to the dry separation ``h_dry`` (mixed
-    regime), then refines it by regula falsi (Illinois).
-    """
-    f_free = excess(h_free)
-    if f_free > 0:
-        lo, f_lo = h_free, f_free
-        hi, f_hi = lo + step, excess(lo + step)
-        while f_hi > 0:
-            lo, f_lo = hi, f_hi
-            step *= 2
-            if step > 1e-3:
-                raise MixedNotConverged("no separation below 1 mm balances the load", [])
-            hi, f_hi = lo + step, excess(lo + step)
-    else:
-        hi, f_hi = h_free, f_free
-        lo = h_dry
-        for _ in range(30):                      # approach the dry state from above
-            mid = (hi + lo) / 2
-            f_mid = excess(mid)
-            if f_mid > 0:
-                lo, f_lo = mid, f_mid
-                break
-            hi, f_hi = mid, f_mid
-        else:
-            lo, f_lo = h_dry, excess(h_dry)
-    side, mid = 0, hi
-    for _ in range(100):
-        mid = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-        f_mid = excess(mid)
-        if f_mid > 0:
-            lo, f_lo = mid, f_mid
-            if side == 1:
-                f_hi /= 2
-            side = 1
-        else:
-            hi, f_hi = mid, f_mid
-            if side == -1:
-                f_lo /= 2
-            side = -1
-        if hi - lo < rtol * max(abs(mid), step) or f_mid == 0:
-            break
-    return mid
 
 
 def _load_stiffness(factors, ev, area, s):

@@ -210,22 +210,41 @@ def upwind_couette(q1, q2, spacing) -> sp.csr_matrix:
     between two neighbours is ``dx_perp * q_up * (1 - theta_up)`` from the upstream node
     (the sign of the face mean of q decides).
     """
-    ny, nx = q1.shape
-    idx = np.arange(ny * nx).reshape(ny, nx)
     rows, cols, vals = [], [], []
-    for q, a, b, width in ((q1, idx[:, :-1], idx[:, 1:], spacing[1]),
-                           (q2, idx[:-1, :], idx[1:, :], spacing[0])):
-        a, b = a.ravel(), b.ravel()
-        qf = (q.ravel()[a] + q.ravel()[b]) / 2
-        up = np.where(qf >= 0, a, b)
-        f = width * q.ravel()[up]
+    for a, b, up, width, q in _upwind_faces(q1, q2, spacing):
+        f = width * q[up]
         # flux f leaves node a and enters node b (negative f: the other way)
         rows += [a, b]
         cols += [up, up]
         vals += [f, -f]
-    n = ny * nx
+    n = q1.size
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                          shape=(n, n))
+
+
+def couette_parts(q1, q2, spacing):
+    """``(B1, B2)`` with ``upwind_couette(q1, q2) = B1 diag(q1) + B2 diag(q2)``: the upwind
+    Couette operator per unit flow, upwinded by the signs of ``q``.  Its derivative with
+    respect to ``q`` at fixed upwinding is ``B1 diag(1 - theta)`` (macro Newton coupling)."""
+    n = q1.size
+    parts = []
+    for a, b, up, width, _ in _upwind_faces(q1, q2, spacing):
+        w = np.full(a.size, float(width))
+        parts.append(sp.csr_matrix((np.r_[w, -w], (np.r_[a, b], np.r_[up, up])),
+                                   shape=(n, n)))
+    return tuple(parts)
+
+
+def _upwind_faces(q1, q2, spacing):
+    """Per direction: the faces' two nodes ``a -> b``, the upwind node, the face width and
+    the flow component (flattened)."""
+    ny, nx = q1.shape
+    idx = np.arange(ny * nx).reshape(ny, nx)
+    for q, a, b, width in ((q1, idx[:, :-1], idx[:, 1:], spacing[1]),
+                           (q2, idx[:-1, :], idx[1:, :], spacing[0])):
+        a, b, q = a.ravel(), b.ravel(), np.asarray(q, float).ravel()
+        up = np.where((q[a] + q[b]) / 2 >= 0, a, b)
+        yield a, b, up, width, q
 
 
 def complementarity_solver(name: str):

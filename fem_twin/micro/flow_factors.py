@@ -64,6 +64,26 @@ class FlowFactors:
     def __len__(self) -> int:
         return self.h0.size
 
+    @classmethod
+    def smooth(cls, h0_range=(1e-10, 1e-2)) -> "FlowFactors":
+        """Factors of two perfectly smooth surfaces (the smooth limit of eqs 11-16):
+        ``h_m = h0``, ``p_con = 0``, ``A = C = I``, ``b = e1``, ``d = 0`` at every ``h0``
+        [m] (tabulated at the two ends of ``h0_range``; exact in between and above, and
+        below down to the 1 nm floor of :meth:`at`).  What a smooth EHL contact uses."""
+        h0 = np.asarray(h0_range, float)
+        n = h0.size
+        return cls(h0=h0, h_m=h0.copy(), p_con=np.zeros(n), A=np.tile(np.eye(2), (n, 1, 1)),
+                   b=np.tile([1.0, 0.0], (n, 1)), C=np.tile(np.eye(2), (n, 1, 1)),
+                   d=np.zeros((n, 2)), contact_fraction=np.zeros(n), meta={"smooth": True})
+
+    def slopes(self, h0, rel_step: float = 1e-6):
+        """``(dh_m/dh0, dp_con/dh0)`` at ``h0`` [-, Pa/m], central differences of
+        :meth:`at`'s rules with a relative step (the Jacobian of the macro Newton coupling)."""
+        x = np.asarray(h0, float)
+        eps = rel_step * x
+        lo, hi = self.at(x - eps), self.at(x + eps)
+        return (hi.h_m - lo.h_m) / (2 * eps), (hi.p_con - lo.p_con) / (2 * eps)
+
     # -- files ---------------------------------------------------------------------------
     def save(self, path) -> Path:
         """Write ``.npz`` (arrays + ``meta`` as JSON) atomically."""

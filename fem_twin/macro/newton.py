@@ -1,0 +1,431 @@
+"""Monolithic Newton coupling of the macro problem, for elastically dominated contacts.
+
+When the elastic deformation is much larger than the film (a ball on a disk: ~1.5 um of
+deformation over a 0.2 um film) no fixed point on ``h_el`` converges; the paper's EHL-FBNS
+puts the elastic operator into its Newton system, and so does this module.  The unknowns
+are ``phi`` (the p-theta switch of :mod:`.reynolds`, interior nodes), the elastic
+deformation ``w = h_el`` (all nodes) and ``h_d``; the equations, all fully implicit:
+
+* ``R = K(g) p + B(q) (1 - theta) = 0`` on the interior (eqs 17-18), with
+  ``g = rho h_m^3 / (12 mu)`` and ``q = rho h_m u_m`` at ``p`` and
+  ``h0 = h_d + h_g + w`` (eq 19), Roelands (23) and Dowson-Higginson (24);
+* ``G = w - E (p + p_cav + p_con(h0) - p_amb) = 0`` (eqs 20-22, ``E`` the FFT half-space);
+* ``L = sum(a (p + p_cav + p_con - p_amb)) - F_N,imp = 0`` (eq 28).
+
+The Jacobian is exact except for the ``h0``-dependence of the flow factor tensors ``A, b``
+(held at the step's values: smooth surfaces have none).  Each Newton step is solved by
+right-preconditioned GMRES with the exact Jacobian action (``E`` by FFT); the preconditioner
+is the Jacobian with the elastic coupling kept, as a dense block, on the set ``S`` of nodes
+where it outweighs the pressure flow (the loaded zone of the contact), and dropped
+elsewhere; ``S`` is eliminated by a Schur complement on a sparse LU of the rest.  Steps are
+limited so no film thins by more than half, then backtracked on the scaled residual.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.fft as fft
+import scipy.linalg as la
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..errors import MixedNotConverged
+from .reynolds import couette_parts
+
+#: pressures above this [Pa] are clipped before eqs 23-24 (finite Roelands exponential)
+MAX_COEFFICIENT_PRESSURE = 1e10
+#: a node joins the dense elastic block when its elastic coupling exceeds this fraction of
+#: its pressure-flow coupling
+DENSE_THRESHOLD = 0.02
+#: most nodes in the dense block (a 4000^2 LU takes about 2 s here)
+MAX_DENSE = 4000
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """The grid, the physics and the load of one operating point (SI units)."""
+
+    gap: np.ndarray            # rigid gap h_g (ny, nx) [m]
+    spacing: tuple             # (dx1, dx2) [m]
+    factors: object            # FlowFactors
+    lubricant: object          # Lubricant
+    settings: object           # MacroSettings
+    poiseuille: object         # (g, A) -> sparse K
+    elastic: object            # ElasticOperator
+    area: np.ndarray           # trapezoid weights [m^2]
+    interior: np.ndarray       # flat indices of the interior nodes
+    speed: float               # U [m/s]
+
+    @property
+    def shape(self):
+        return self.gap.shape
+
+    def kernel(self):
+        """The influence kernel on the padded grid (real space, [m/Pa])."""
+        ny, nx = self.shape
+        cache = self.__dict__.setdefault("_kernel", [])
+        if not cache:
+            cache.append(fft.irfft2(self.elastic.kernel_hat, s=(2 * ny, 2 * nx)))
+        return cache[0]
+
+    def dense_elastic(self, nodes) -> np.ndarray:
+        """``E[nodes, nodes]``: deformation at node i per pressure at node j [m/Pa]."""
+        ny, nx = self.shape
+        r, c = np.divmod(nodes, nx)
+        return self.kernel()[(r[:, None] - r[None, :]) % (2 * ny),
+                             (c[:, None] - c[None, :]) % (2 * nx)]
+
+
+@dataclass(frozen=True, eq=False)
+class State:
+    phi: np.ndarray            # (n,) p-theta switch, boundary nodes at p_amb - p_cav [Pa]
+    w: np.ndarray              # (ny, nx) elastic deformation h_el [m]
+    h_d: float                 # rigid-body separation [m]
+
+
+def evaluate(P: Problem, x: State, load: float) -> dict:
+    """Residuals ``R, G, L`` and every field the Jacobian and the result need."""
+    s, lub = P.settings, P.lubricant
+    shape = P.shape
+    p = np.maximum(x.phi, 0).reshape(shape)
+    theta = (np.maximum(-x.phi, 0) / s.p_ref).reshape(shape)
+    h_raw = x.h_d + P.gap + x.w
+    h0 = np.maximum(h_raw, s.gap_floor)
+    loc = P.factors.at(h0)
+    p_coef = np.minimum(p, MAX_COEFFICIENT_PRESSURE)
+    mu, rho = lub.viscosity_at(p_coef), lub.density_ratio(p_coef)
+    g = rho * loc.h_m ** 3 / (12 * mu)
+    q = rho * loc.h_m * P.speed / 2
+    K = P.poiseuille(g, loc.A)
+    q1, q2 = (q * loc.b[..., 0]).ravel(), (q * loc.b[..., 1]).ravel()
+    B1, B2 = couette_parts(q1.reshape(shape), q2.reshape(shape), P.spacing)
+    open_ = 1 - theta.ravel()
+    flux = K @ p.ravel() + B1 @ (q1 * open_) + B2 @ (q2 * open_)
+    size = abs(K) @ p.ravel() + abs(B1) @ np.abs(q1) + abs(B2) @ np.abs(q2)
+    p_tot = p + s.cavitation_pressure + loc.p_con - s.ambient_pressure
+    return dict(p=p, theta=theta, h0=h0, touching=h_raw <= s.gap_floor, loc=loc, mu=mu,
+                rho=rho, g=g, q=q, K=K, B=(B1, B2), q12=(q1, q2), p_con=loc.p_con,
+                R=flux[P.interior], size=size[P.interior] + 1e-300,
+                G=x.w - P.elastic(p_tot), F=float(np.sum(P.area * p_tot)),
+                F_hd=float(np.sum(P.area * (p + s.cavitation_pressure - s.ambient_pressure))),
+                L=float(np.sum(P.area * p_tot)) - load)
+
+
+def _probe(P: Problem, g_A, p) -> sp.csr_matrix:
+    """``Kg`` with ``K(dg, A) p = Kg dg`` (K is linear in g), probed with nine colourings of
+    the grid (the 3 x 3 stencil of a node's coefficient never overlaps its colour mates)."""
+    ny, nx = P.shape
+    A = g_A
+    i, j = np.divmod(np.arange(ny * nx), nx)
+    rows, cols, vals = [], [], []
+    for ci in range(3):
+        for cj in range(3):
+            colour = ((i % 3 == ci) & (j % 3 == cj)).astype(float).reshape(ny, nx)
+            v = P.poiseuille(colour, A) @ p
+            # the node of this colour in each row's 3 x 3 neighbourhood
+            ni = i + (ci - i) % 3 - np.where((ci - i) % 3 == 2, 3, 0)
+            nj = j + (cj - j) % 3 - np.where((cj - j) % 3 == 2, 3, 0)
+            ok = (ni >= 0) & (ni < ny) & (nj >= 0) & (nj < nx) & (v != 0)
+            rows.append(np.flatnonzero(ok))
+            cols.append((ni * nx + nj)[ok])
+            vals.append(v[ok])
+    n = ny * nx
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(n, n))
+
+
+def jacobian(P: Problem, ev: dict) -> dict:
+    """The sparse blocks of the Jacobian: ``J_pp = dR/dphi`` (interior x interior),
+    ``J_ph = dR/dh0`` (interior x all), ``pos`` (dp/dphi) and ``dpc = dp_con/dh0``."""
+    s, lub = P.settings, P.lubricant
+    I = P.interior
+    phi_pos = ev["p"].ravel() > 0
+    p_coef = np.minimum(ev["p"], MAX_COEFFICIENT_PRESSURE)
+    unclipped = (ev["p"] < MAX_COEFFICIENT_PRESSURE)
+    dlnrho = lub.density_log_slope(p_coef) * unclipped
+    dlnmu = lub.viscosity_log_slope(p_coef) * unclipped
+    dhm, dpc = P.factors.slopes(ev["h0"])
+    free = ~ev["touching"]
+    dhm, dpc = dhm * free, dpc * free
+    g, q, loc = ev["g"], ev["q"], ev["loc"]
+    Kg = _probe(P, loc.A, ev["p"].ravel())
+    B1, B2 = ev["B"]
+    open_ = 1 - ev["theta"].ravel()
+    Bq = B1 @ sp.diags(loc.b[..., 0].ravel() * open_) + B2 @ sp.diags(loc.b[..., 1].ravel()
+                                                                       * open_)
+    dg_dp, dq_dp = (g * (dlnrho - dlnmu)).ravel(), (q * dlnrho).ravel()
+    dg_dh, dq_dh = (3 * g * dhm / loc.h_m).ravel(), (q * dhm / loc.h_m).ravel()
+    q1, q2 = ev["q12"]
+    dtheta = np.where(phi_pos, 0.0, 1.0 / s.p_ref)
+    Bfull = B1 @ sp.diags(q1) + B2 @ sp.diags(q2)
+    J_p = (ev["K"] @ sp.diags(phi_pos * 1.0) + Bfull @ sp.diags(dtheta)
+           + (Kg @ sp.diags(dg_dp) + Bq @ sp.diags(dq_dp)) @ sp.diags(phi_pos * 1.0))
+    J_h = Kg @ sp.diags(dg_dh) + Bq @ sp.diags(dq_dh)
+    J_p, J_h = J_p.tocsr()[I], J_h.tocsr()[I]
+    return dict(J_pp=J_p[:, I].tocsc(), J_ph=J_h.tocsr(), pos=phi_pos, dpc=dpc.ravel())
+
+
+class Preconditioner:
+    """Approximate inverse of the Newton matrix: the Jacobian with ``E`` kept on ``S x S``.
+
+    Outside ``S`` the deformation update is the elastic residual alone; on ``S`` it is
+    eliminated exactly (``dw_S = M_S (r_G + E_SS (D dphi + p_con' dh))``,
+    ``M_S = (I - E_SS p_con')^-1``), which leaves the pressure system ``J_pp + J_ph[:, S] W``
+    bordered by the load row; that is solved with a sparse LU outside ``S`` and a dense LU of
+    the Schur complement on ``S``.
+    """
+
+    def __init__(self, P: Problem, ev: dict, jac: dict, dense=None):
+        I, n = P.interior, P.gap.size
+        J_pp, J_ph, pos, dpc = jac["J_pp"], jac["J_ph"], jac["pos"], jac["dpc"]
+        sI = dense_set(P, jac) if dense is None else dense
+        S = I[sI]
+        self.P, self.jac, self.sI, self.S = P, jac, sI, S
+        E = P.dense_elastic(S)
+        M = np.eye(S.size) if not np.any(dpc[S]) else la.inv(np.eye(S.size) - E * dpc[S])
+        self.ME = M @ E                                   # M_S E_SS
+        self.M = M
+        W = self.ME * pos[S]                              # M_S E_SS D_S
+        self.JphS = J_ph[:, S].tocsr()
+        a = P.area.ravel()
+        self.v = M.T @ (a[S] * dpc[S])
+        l = a[I] * pos[I]
+        l[sI] += pos[S] * (E.T @ self.v)
+        self.l = l
+        self.delta = float(a @ dpc + self.v @ (E @ dpc[S]))
+        self._factor(J_pp, W)
+        c = J_ph @ np.ones(n) + self.JphS @ (self.ME @ dpc[S])
+        self.y2 = self.solve_pressure(c)
+
+    def _factor(self, J_pp, W):
+        nI = J_pp.shape[0]
+        sI = self.sI
+        O = np.setdiff1d(np.arange(nI), sI)
+        self.O = O
+        J = J_pp.tocsr()
+        self.lu = spla.splu(J[O][:, O].tocsc())
+        if sI.size == 0:
+            return
+        JOS = J[O][:, sI]
+        CsO = self.JphS[O]
+        ring = np.flatnonzero(np.asarray(abs(JOS).sum(axis=1)).ravel()
+                              + np.asarray(abs(CsO).sum(axis=1)).ravel())
+        self.ring = ring
+        self.B_ring = JOS[ring].toarray() + CsO[ring] @ W
+        unit = np.zeros((O.size, ring.size))
+        unit[ring, np.arange(ring.size)] = 1.0
+        self.Z = self.lu.solve(unit)
+        self.C = J[sI][:, O].tocsr()
+        D = J[sI][:, sI].toarray() + self.JphS[sI] @ W
+        self.schur = la.lu_factor(D - (self.C @ self.Z) @ self.B_ring)
+
+    def solve_pressure(self, r):
+        """``(J_pp + J_ph[:, S] W)^-1 r`` by the block elimination."""
+        x = np.empty_like(r)
+        yO = self.lu.solve(r[self.O])
+        if self.sI.size == 0:
+            x[self.O] = yO
+            return x
+        xS = la.lu_solve(self.schur, r[self.sI] - self.C @ yO)
+        x[self.O] = yO - self.Z @ (self.B_ring @ xS)
+        x[self.sI] = xS
+        return x
+
+    def __call__(self, r_R, r_G, r_L):
+        S, sI = self.S, self.sI
+        dpc = self.jac["dpc"]
+        a = self.P.area.ravel()
+        r_GO = r_G.copy()
+        r_GO[S] = 0.0
+        MrS = self.M @ r_G[S]
+        r_t = r_R - self.jac["J_ph"] @ r_GO - self.JphS @ MrS
+        r_tL = r_L - float(np.sum(a * dpc * r_GO)) - float(self.v @ r_G[S])
+        y1 = self.solve_pressure(r_t)
+        dhd = (r_tL - self.l @ y1) / (self.delta - self.l @ self.y2)
+        dphi = y1 - self.y2 * dhd
+        dw = r_GO
+        dw[S] = MrS + self.ME @ (self.jac["pos"][S] * dphi[sI] + dpc[S] * dhd)
+        return dphi, dw, dhd
+
+
+def dense_set(P: Problem, jac: dict) -> np.ndarray:
+    """Interior positions where the elastic coupling of a node's own deformation outweighs
+    ``DENSE_THRESHOLD`` of its pressure coupling (or of its contact stiffness), grown by two
+    nodes; at most ``MAX_DENSE``, the strongest first."""
+    from scipy.ndimage import maximum_filter
+    e0 = float(P.kernel()[0, 0])
+    I = P.interior
+    diag = np.abs(jac["J_pp"].diagonal())
+    row = np.asarray(abs(jac["J_ph"]).sum(axis=1)).ravel()
+    score = np.zeros(P.gap.size)
+    score[I] = e0 * row / np.maximum(diag, 1e-300 + 1e-12 * diag.max())
+    score = np.maximum(score, e0 * np.abs(jac["dpc"]))
+    score = maximum_filter(score.reshape(P.shape), size=5, mode="constant").ravel()[I]
+    chosen = np.flatnonzero(score > DENSE_THRESHOLD)
+    if chosen.size > MAX_DENSE:
+        chosen = np.sort(chosen[np.argsort(score[chosen])[-MAX_DENSE:]])
+    return chosen
+
+
+def apply_jacobian(P: Problem, jac: dict, dphi, dw, dhd):
+    """The exact Jacobian action (``E`` by FFT) on an update ``(dphi, dw, dhd)``."""
+    dp = np.zeros(P.gap.size)
+    dp[P.interior] = jac["pos"][P.interior] * dphi
+    dh = dw + dhd
+    dpt = dp + jac["dpc"] * dh
+    return (jac["J_pp"] @ dphi + jac["J_ph"] @ dh,
+            dw - P.elastic(dpt.reshape(P.shape)).ravel(), float(P.area.ravel() @ dpt))
+
+
+def newton_step(P: Problem, ev: dict, load: float, rtol: float):
+    """The Newton update ``(dphi, dw, dhd)``, the GMRES iteration count and the size of
+    the dense block; GMRES runs on the system scaled by the residuals' natural sizes (each
+    node's flux magnitude, h_ref, the load) to the relative tolerance ``rtol``."""
+    s = P.settings
+    jac = jacobian(P, ev)
+    pre = Preconditioner(P, ev, jac)
+    nI, n = P.interior.size, P.gap.size
+    row = np.r_[1 / ev["size"], np.full(n, 1 / s.h_ref), 1 / load]      # residual scales
+
+    def split(v):
+        return v[:nI], v[nI:nI + n], v[-1]
+
+    def precondition(y):
+        r = y / row
+        dphi, dw, dhd = pre(*split(r))
+        return np.r_[dphi, dw, dhd]
+
+    def matvec(y):
+        return _stack(apply_jacobian(P, jac, *split(precondition(y)))) * row
+
+    b = -_stack((ev["R"], ev["G"].ravel(), ev["L"])) * row
+    op = spla.LinearOperator((b.size, b.size), matvec=matvec)
+    count = [0]
+    y, info = spla.gmres(op, b, rtol=rtol, atol=0.0, restart=60, maxiter=4,
+                         callback=lambda _: count.__setitem__(0, count[0] + 1),
+                         callback_type="pr_norm")
+    return split(precondition(y)), count[0], pre.sI.size
+
+
+def _stack(parts):
+    return np.concatenate([np.atleast_1d(np.asarray(v, float)).ravel() for v in parts])
+
+
+def merit(ev: dict, s, load: float) -> float:
+    """Scaled residual norm: rms of the nodes' relative mass residuals, of ``G / h_ref``
+    and the relative load error, the largest of the three."""
+    return max(float(np.sqrt(np.mean((ev["R"] / ev["size"]) ** 2))),
+               float(np.sqrt(np.mean(ev["G"] ** 2))) / s.h_ref, abs(ev["L"]) / load)
+
+
+def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progress=None):
+    """Newton iterations from ``x`` to ``tol``; returns ``(x, ev, iterations, history)``.
+
+    A step is first shortened so that no film thins by more than half, then halved until
+    the merit function decreases.  Converged when a full step changes ``h_el`` by less than
+    ``tol h_ref``, ``p`` and ``p_con`` by less than ``tol p_ref``, the load error is below
+    ``tol`` and the rms mass residual below ``tol``; :class:`MixedNotConverged` otherwise.
+    """
+    s = P.settings
+    ev = evaluate(P, x, load)
+    f = merit(ev, s, load)
+    history = []
+    I = P.interior
+    for it in range(1, max_iter + 1):
+        (dphi, dw, dhd), gm, _ = newton_step(P, ev, load, rtol=min(1e-3, max(1e-8, 0.1 * f)))
+        dh = (dw + dhd).reshape(P.shape)
+        thinning = (dh < 0) & ~ev["touching"]
+        alpha = min(1.0, float(np.min(0.5 * ev["h0"][thinning] / -dh[thinning],
+                                      initial=np.inf)))
+        for _ in range(30):
+            phi = x.phi.copy()
+            phi[I] += alpha * dphi
+            trial = State(phi, x.w + alpha * dw.reshape(P.shape), x.h_d + alpha * dhd)
+            ev_t = evaluate(P, trial, load)
+            f_t = merit(ev_t, s, load)
+            if np.isfinite(f_t) and f_t <= (1 - 1e-4 * alpha) * f:
+                break
+            alpha /= 2
+        else:
+            raise MixedNotConverged(f"Newton coupling: no decrease of the residual along "
+                                    f"the step at iteration {it}", history)
+        changes = (float(np.abs(alpha * dw).max() / s.h_ref),
+                   float(np.abs(ev_t["p_con"] - ev["p_con"]).max() / s.p_ref),
+                   float(np.abs(ev_t["p"] - ev["p"]).max() / s.p_ref), ev_t["L"] / load)
+        history.append((it, *changes, trial.h_d, gm))
+        x, ev, f = trial, ev_t, f_t
+        if progress is not None:
+            progress(it, f)
+        if alpha == 1.0 and max(max(map(abs, changes)), f) < tol:
+            return x, ev, it, history
+    raise MixedNotConverged(f"Newton coupling did not reach {tol} in {max_iter} iterations "
+                            f"(merit {f:.2e})", history)
+
+
+def state_from(result, settings) -> State:
+    """The Newton state of a converged :class:`MixedResult` (a warm start)."""
+    p = (result.pressure - settings.cavitation_pressure).ravel()
+    theta = result.cavity_fraction.ravel()
+    phi = np.where(theta > 0, -theta * settings.p_ref, np.maximum(p, 0))
+    return State(phi, np.asarray(result.elastic_deformation, float).copy(), float(result.h_d))
+
+
+def rigid_start(P: Problem, load: float, ratio: float):
+    """The cold start: the rigid (``w = 0``), isoviscous film at the largest separation
+    (halving ``h_d - h_touch`` from the first-contact separation) whose load reaches
+    ``load`` or whose elastic deformation reaches ``ratio`` of its thinnest loaded film.
+    Returns the state and the load it carries (at most ``load``)."""
+    from .reynolds import solve_complementarity, upwind_couette
+    s = P.settings
+    boundary = np.ones(P.shape, bool)
+    boundary.ravel()[P.interior] = False
+    rho0 = P.lubricant.density_ratio(0.0)
+    touch = s.gap_floor - float(P.gap.min())
+    t = float(P.factors.h0[-1]) - float(P.gap.min()) - touch
+    for _ in range(80):
+        h_d = touch + t
+        loc = P.factors.at(np.maximum(h_d + P.gap, s.gap_floor))
+        g = rho0 * loc.h_m ** 3 / (12 * P.lubricant.viscosity)
+        q = rho0 * loc.h_m * P.speed / 2
+        B = upwind_couette(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing)
+        phi, _, _ = solve_complementarity(P.poiseuille(g, loc.A), B, boundary,
+                                          s.ambient_pressure - s.cavitation_pressure, s.p_ref)
+        x = State(phi, np.zeros(P.shape), h_d)
+        ev = evaluate(P, x, load)
+        loaded = ev["p"] > 0
+        if ev["F"] >= load or (loaded.any() and np.abs(ev["G"]).max()
+                               >= ratio * float(ev["h0"][loaded].min())):
+            break
+        t /= 2
+    return x, min(ev["F"], load)
+
+
+def continuation(P: Problem, load: float, *, tol: float, max_iter: int, progress=None,
+                 ratio: float = 0.3):
+    """Cold start by load continuation: the rigid film of :func:`rigid_start`, then Newton solves at loads growing
+    by a factor (x4, halved in log after a failure, doubled after a success) up to
+    ``load``.  Returns what :func:`solve` returns, with the iterations of every stage."""
+    x, F = rigid_start(P, load, ratio)
+    total, history, factor, target = 0, [], 4.0, F
+    while True:
+        last = target == load
+        try:
+            x, ev, its, hist = solve(P, x, target, tol=tol if last else max(tol, 1e-4),
+                                     max_iter=max_iter, progress=progress)
+        except MixedNotConverged as err:
+            history += err.history
+            factor = np.sqrt(factor)
+            if factor < 1.02 or target == F:
+                raise MixedNotConverged("load continuation of the Newton coupling stalled "
+                                        f"at {F:.3g} N of {load:.3g} N", history) from err
+            target = min(load, F * factor)
+            continue
+        total += its
+        history += hist
+        F = target
+        if last:
+            return x, ev, total, history
+        factor = min(factor ** 2, 100.0)
+        target = min(load, F * factor)

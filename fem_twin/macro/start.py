@@ -1,0 +1,105 @@
+"""Cold starts of the macro iteration: the rigid separations that begin it (eqs 28-30).
+
+Before any elastic deformation is known the load balance is solved on the rigid gap:
+:func:`dry_separation` (contact alone), :func:`rigid_separation` (film and contact, the
+Anderson and PID couplings) and :func:`film_separation` (film alone on a log scale, the
+Newton coupling's load continuation).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..errors import MixedNotConverged
+
+
+def dry_separation(factors, h_g, area, load, s):
+    """h_d at which the rigid contact alone carries the load (bisection), or at which the
+    surfaces touch (``h0 = gap_floor``) if the contact pressure cannot carry it."""
+    def excess(h_d):
+        p = factors.contact_pressure(np.maximum(h_d + h_g, s.gap_floor))
+        return float(np.sum(area * p)) - load
+
+    touch = s.gap_floor - float(h_g.min())
+    hi = float(factors.h0[-1]) - float(h_g.min())       # first contact at h0_max
+    if excess(hi) >= 0:
+        return hi
+    if excess(touch) < 0:
+        return touch
+    lo = touch
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if excess(mid) > 0 else (lo, mid)
+    return hi
+
+
+def rigid_separation(excess, h_free, h_dry, step, rtol=1e-3):
+    """h_d at which the rigid, isoviscous film and contact carry the load: the start.
+
+    ``excess(h_d) = F_N - F_N,imp`` decreases with ``h_d``.  The search starts at
+    ``h_free`` (first asperity contact) and brackets the root by doubling steps upward (a
+    lifting film) or by halving the distance to the dry separation ``h_dry`` (mixed
+    regime), then refines it by regula falsi (Illinois).
+    """
+    f_free = excess(h_free)
+    if f_free > 0:
+        lo, f_lo = h_free, f_free
+        hi, f_hi = lo + step, excess(lo + step)
+        while f_hi > 0:
+            lo, f_lo = hi, f_hi
+            step *= 2
+            if step > 1e-3:
+                raise MixedNotConverged("no separation below 1 mm balances the load", [])
+            hi, f_hi = lo + step, excess(lo + step)
+    else:
+        hi, f_hi = h_free, f_free
+        lo = h_dry
+        for _ in range(30):                      # approach the dry state from above
+            mid = (hi + lo) / 2
+            f_mid = excess(mid)
+            if f_mid > 0:
+                lo, f_lo = mid, f_mid
+                break
+            hi, f_hi = mid, f_mid
+        else:
+            lo, f_lo = h_dry, excess(h_dry)
+    side, mid = 0, hi
+    for _ in range(100):
+        mid = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+        f_mid = excess(mid)
+        if f_mid > 0:
+            lo, f_lo = mid, f_mid
+            if side == 1:
+                f_hi /= 2
+            side = 1
+        else:
+            hi, f_hi = mid, f_mid
+            if side == -1:
+                f_lo /= 2
+            side = -1
+        if hi - lo < rtol * max(abs(mid), step) or f_mid == 0:
+            break
+    return mid
+
+
+def film_separation(excess, h_touch, h_free, rtol=1e-3):
+    """h_d in ``(h_touch, h_free]`` at which ``excess(h_d) = F_N - F_N,imp`` (decreasing in
+    ``h_d``) vanishes: bracketed by halving ``h_d - h_touch`` from ``h_free`` (a film's load
+    grows like a power of ``1/h``), then ``brentq`` in ``log(h_d - h_touch)`` [m]."""
+    def f(log_t):
+        return excess(h_touch + np.exp(log_t))
+
+    hi = np.log(h_free - h_touch)
+    f_hi = f(hi)
+    if f_hi > 0:
+        raise MixedNotConverged("the film carries more than the load even at the largest "
+                           "separation of the flow factors", [(h_free, f_hi)])
+    lo = hi
+    for _ in range(80):
+        lo -= np.log(2.0)
+        if f(lo) > 0:
+            break
+    else:
+        raise MixedNotConverged("no film separation carries the load", [(h_free, f_hi)])
+    return h_touch + np.exp(brentq(f, lo, lo + np.log(2.0), rtol=rtol * 1e-2))
