@@ -39,6 +39,8 @@ MAX_COEFFICIENT_PRESSURE = 1e10
 #: a node joins the dense elastic block when its elastic coupling exceeds this fraction of
 #: its pressure-flow coupling
 DENSE_THRESHOLD = 0.02
+#: the preconditioner is kept from step to step until GMRES needs more iterations than this
+REBUILD_AFTER = 6
 #: most nodes in the dense block (a 4000^2 LU takes about 2 s here)
 MAX_DENSE = 4000
 
@@ -184,13 +186,15 @@ class Preconditioner:
         S = I[sI]
         self.P, self.jac, self.sI, self.S = P, jac, sI, S
         E = P.dense_elastic(S)
-        M = np.eye(S.size) if not np.any(dpc[S]) else la.inv(np.eye(S.size) - E * dpc[S])
-        self.ME = M @ E                                   # M_S E_SS
-        self.M = M
+        if np.any(dpc[S]):                                # contact stiffness on S
+            self.M = la.inv(np.eye(S.size) - E * dpc[S])
+            self.ME = self.M @ E                          # M_S E_SS
+        else:
+            self.M, self.ME = None, E
         W = self.ME * pos[S]                              # M_S E_SS D_S
         self.JphS = J_ph[:, S].tocsr()
         a = P.area.ravel()
-        self.v = M.T @ (a[S] * dpc[S])
+        self.v = self._M(a[S] * dpc[S], transpose=True)
         l = a[I] * pos[I]
         l[sI] += pos[S] * (E.T @ self.v)
         self.l = l
@@ -221,6 +225,11 @@ class Preconditioner:
         D = J[sI][:, sI].toarray() + self.JphS[sI] @ W
         self.schur = la.lu_factor(D - (self.C @ self.Z) @ self.B_ring)
 
+    def _M(self, r, transpose=False):
+        if self.M is None:
+            return r
+        return (self.M.T if transpose else self.M) @ r
+
     def solve_pressure(self, r):
         """``(J_pp + J_ph[:, S] W)^-1 r`` by the block elimination."""
         x = np.empty_like(r)
@@ -239,7 +248,7 @@ class Preconditioner:
         a = self.P.area.ravel()
         r_GO = r_G.copy()
         r_GO[S] = 0.0
-        MrS = self.M @ r_G[S]
+        MrS = self._M(r_G[S])
         r_t = r_R - self.jac["J_ph"] @ r_GO - self.JphS @ MrS
         r_tL = r_L - float(np.sum(a * dpc * r_GO)) - float(self.v @ r_G[S])
         y1 = self.solve_pressure(r_t)
@@ -279,13 +288,13 @@ def apply_jacobian(P: Problem, jac: dict, dphi, dw, dhd):
             dw - P.elastic(dpt.reshape(P.shape)).ravel(), float(P.area.ravel() @ dpt))
 
 
-def newton_step(P: Problem, ev: dict, load: float, rtol: float):
-    """The Newton update ``(dphi, dw, dhd)``, the GMRES iteration count and the size of
-    the dense block; GMRES runs on the system scaled by the residuals' natural sizes (each
+def newton_step(P: Problem, ev: dict, load: float, rtol: float, pre=None):
+    """The Newton update ``(dphi, dw, dhd)``, the GMRES iteration count and the
+    preconditioner (built from this step's Jacobian unless ``pre`` is given); GMRES runs on the system scaled by the residuals' natural sizes (each
     node's flux magnitude, h_ref, the load) to the relative tolerance ``rtol``."""
     s = P.settings
     jac = jacobian(P, ev)
-    pre = Preconditioner(P, ev, jac)
+    pre = Preconditioner(P, ev, jac) if pre is None else pre
     nI, n = P.interior.size, P.gap.size
     row = np.r_[1 / ev["size"], np.full(n, 1 / s.h_ref), 1 / load]      # residual scales
 
@@ -306,7 +315,7 @@ def newton_step(P: Problem, ev: dict, load: float, rtol: float):
     y, info = spla.gmres(op, b, rtol=rtol, atol=0.0, restart=60, maxiter=4,
                          callback=lambda _: count.__setitem__(0, count[0] + 1),
                          callback_type="pr_norm")
-    return split(precondition(y)), count[0], pre.sI.size
+    return split(precondition(y)), count[0], pre
 
 
 def _stack(parts):
@@ -333,8 +342,12 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
     f = merit(ev, s, load)
     history = []
     I = P.interior
+    pre = None
     for it in range(1, max_iter + 1):
-        (dphi, dw, dhd), gm, _ = newton_step(P, ev, load, rtol=min(1e-3, max(1e-8, 0.1 * f)))
+        (dphi, dw, dhd), gm, pre = newton_step(P, ev, load, pre=pre,
+                                               rtol=min(1e-3, max(1e-8, 0.1 * f)))
+        if gm > REBUILD_AFTER:
+            pre = None
         dh = (dw + dhd).reshape(P.shape)
         thinning = (dh < 0) & ~ev["touching"]
         alpha = min(1.0, float(np.min(0.5 * ev["h0"][thinning] / -dh[thinning],
