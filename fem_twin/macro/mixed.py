@@ -61,6 +61,10 @@ from .reynolds import (ReynoldsNotConverged, complementarity_solver, fe_poiseuil
 #: clipped before eqs 23-24 are evaluated, so that the Roelands exponential stays finite.
 MAX_COEFFICIENT_PRESSURE = 1e10
 
+#: ``coupling="auto"`` takes the Newton coupling when the first iterate's elastic
+#: deformation exceeds this multiple of the thinnest loaded film
+ELASTIC_RATIO = 100.0
+
 #: Newton iterations per load of the ``"newton"`` coupling (it converges in 5-20)
 NEWTON_MAX_ITER = 60
 
@@ -77,7 +81,7 @@ class MacroSettings:
     e_reduced: float = T.E_REDUCED
     boundary_friction: float = BOUNDARY_FRICTION
     method: str = "fe"                       # Poiseuille term: "fe" or "fvm"
-    coupling: str = "anderson"               # or "pid" (the paper's)
+    coupling: str = "auto"                   # "anderson", "newton" or "pid" (the paper's)
     complementarity: str = "switch"          # or "fb" (the paper's FBNS; slower)
     relaxation_pcon: float = T.RELAXATION_PCON   # alpha_pcon of eq 26 ("pid")
     relaxation_elastic: float = 0.1          # under-relaxation of h_el ("pid")
@@ -92,8 +96,8 @@ class MacroSettings:
     def __post_init__(self):
         if self.method not in ("fe", "fvm"):
             raise ValueError(f"method must be 'fe' or 'fvm', got {self.method!r}")
-        if self.coupling not in ("anderson", "pid", "newton"):
-            raise ValueError("coupling must be 'anderson', 'pid' or 'newton', got "
+        if self.coupling not in ("auto", "anderson", "pid", "newton"):
+            raise ValueError("coupling must be 'auto', 'anderson', 'pid' or 'newton', got "
                              f"{self.coupling!r}")
         if self.ambient_pressure < self.cavitation_pressure:
             raise ValueError("ambient pressure must not be below the cavitation pressure [Pa]")
@@ -240,7 +244,8 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
                               settings=coarse)
     if initial is not None:
         initial = _on_grid(initial, h_g.shape, dx)
-    if s.coupling == "newton":
+    if s.coupling == "newton" or (s.coupling == "auto" and initial is not None
+                                  and initial.meta.get("coupling") == "newton"):
         return _solve_newton(h_g, dx, factors, load, speed, lubricant, face, area, s, op,
                              poiseuille, boundary, initial, progress, t0)
     state = {"phi": None, "p": np.full(h_g.shape, p_amb_rel), "newton": 0}
@@ -312,6 +317,9 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
             history.append((it, np.nan, np.nan, np.nan, np.nan, h_d, -1))
             continue
         retries = 0
+        if it == 1 and s.coupling == "auto" and elastic_ratio(ev, op, s) > ELASTIC_RATIO:
+            return _solve_newton(h_g, dx, factors, load, speed, lubricant, face, area, s, op,
+                                 poiseuille, boundary, initial, progress, t0)
         good = (h_el, h_d, state["phi"], ev["p_prev"])
         stall += 1
         r_F = (ev["F"] - load) / load
@@ -374,10 +382,26 @@ def _solve_newton(h_g, dx, factors, load, speed, lubricant, face, area, s, op, p
         x, ev, it, history = newton.solve(P, newton.state_from(initial, s), load, tol=s.tol,
                                           max_iter=NEWTON_MAX_ITER, progress=progress)
     return _result(ev, x.w, x.h_d, speed, load, dx, face, area, lubricant, s, it, history,
-                   time.perf_counter() - t0)
+                   time.perf_counter() - t0, coupling="newton")
 
 
-def _result(ev, h_el, h_d, speed, load, dx, face, area, lubricant, s, it, history, seconds):
+def elastic_ratio(ev, op, s) -> float:
+    """Largest elastic deformation by the film pressure over the thinnest film under
+    pressure, at the first iterate: large for a concentrated contact (a ball: 10-100),
+    small for a conformal pin."""
+    import os
+    p_gauge = ev["p"] + s.cavitation_pressure - s.ambient_pressure
+    loaded = p_gauge > 0
+    if not loaded.any():
+        return 0.0
+    r = float(np.abs(op(np.maximum(p_gauge, 0))).max()) / float(ev["h0"][loaded].min())
+    if os.environ.get("FT_DEBUG"):
+        print("elastic ratio", r)
+    return r
+
+
+def _result(ev, h_el, h_d, speed, load, dx, face, area, lubricant, s, it, history, seconds,
+            coupling=None):
     loc = ev["loc"]
     p_hd = ev["p"] + s.cavitation_pressure
     tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev["theta"], ev["mu"], loc.C, loc.d, dx, speed)
@@ -397,7 +421,8 @@ def _result(ev, h_el, h_d, speed, load, dx, face, area, lubricant, s, it, histor
         face=face, iterations=it, history=np.array(history),
         meta={"settings": {k: (list(v) if isinstance(v, tuple) else v)
                            for k, v in s.__dict__.items()},
-              "lubricant": lubricant.__dict__.copy(), "seconds": seconds})
+              "lubricant": lubricant.__dict__.copy(), "seconds": seconds,
+              "coupling": coupling or ("anderson" if s.coupling == "auto" else s.coupling)})
 
 
 def _on_grid(result: MixedResult, shape, dx) -> MixedResult:

@@ -296,7 +296,8 @@ def newton_step(P: Problem, ev: dict, load: float, rtol: float, pre=None):
     jac = jacobian(P, ev)
     pre = Preconditioner(P, ev, jac) if pre is None else pre
     nI, n = P.interior.size, P.gap.size
-    row = np.r_[1 / ev["size"], np.full(n, 1 / s.h_ref), 1 / load]      # residual scales
+    size, h_s, _ = scales(ev, s, load)
+    row = np.r_[1 / size, np.full(n, 1 / h_s), 1 / load]                 # residual scales
 
     def split(v):
         return v[:nI], v[nI:nI + n], v[-1]
@@ -322,11 +323,19 @@ def _stack(parts):
     return np.concatenate([np.atleast_1d(np.asarray(v, float)).ravel() for v in parts])
 
 
-def merit(ev: dict, s, load: float) -> float:
-    """Scaled residual norm: rms of the nodes' relative mass residuals, of ``G / h_ref``
-    and the relative load error, the largest of the three."""
-    return max(float(np.sqrt(np.mean((ev["R"] / ev["size"]) ** 2))),
-               float(np.sqrt(np.mean(ev["G"] ** 2))) / s.h_ref, abs(ev["L"]) / load)
+def scales(ev: dict, s, load: float) -> tuple:
+    """Natural sizes of the residuals ``(R, G, L)``: each node's flux magnitude, the
+    thinnest loaded film (at most h_ref) and the load."""
+    loaded = ev["p"] > 0
+    film = float(ev["h0"][loaded].min()) if loaded.any() else s.h_ref
+    return ev["size"], min(s.h_ref, max(film, 10 * s.gap_floor)), load
+
+
+def merit(ev: dict, sizes: tuple) -> float:
+    """Scaled residual norm: root of the summed mean squares of ``R``, ``G`` and ``L``, each
+    divided by its size from :func:`scales` (held fixed over a line search)."""
+    return float(np.sqrt(np.mean((ev["R"] / sizes[0]) ** 2)
+                         + np.mean((ev["G"] / sizes[1]) ** 2) + (ev["L"] / sizes[2]) ** 2))
 
 
 def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progress=None):
@@ -339,11 +348,12 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
     """
     s = P.settings
     ev = evaluate(P, x, load)
-    f = merit(ev, s, load)
     history = []
     I = P.interior
     pre = None
     for it in range(1, max_iter + 1):
+        sizes = scales(ev, s, load)
+        f = merit(ev, sizes)
         (dphi, dw, dhd), gm, pre = newton_step(P, ev, load, pre=pre,
                                                rtol=min(1e-3, max(1e-8, 0.1 * f)))
         if gm > REBUILD_AFTER:
@@ -357,7 +367,7 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
             phi[I] += alpha * dphi
             trial = State(phi, x.w + alpha * dw.reshape(P.shape), x.h_d + alpha * dhd)
             ev_t = evaluate(P, trial, load)
-            f_t = merit(ev_t, s, load)
+            f_t = merit(ev_t, sizes)
             if np.isfinite(f_t) and f_t <= (1 - 1e-4 * alpha) * f:
                 break
             alpha /= 2
@@ -368,13 +378,13 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
                    float(np.abs(ev_t["p_con"] - ev["p_con"]).max() / s.p_ref),
                    float(np.abs(ev_t["p"] - ev["p"]).max() / s.p_ref), ev_t["L"] / load)
         history.append((it, *changes, trial.h_d, gm))
-        x, ev, f = trial, ev_t, f_t
+        x, ev = trial, ev_t
         if progress is not None:
-            progress(it, f)
-        if alpha == 1.0 and max(max(map(abs, changes)), f) < tol:
+            progress(it, f_t)
+        if alpha == 1.0 and max(max(map(abs, changes)), f_t) < tol:
             return x, ev, it, history
     raise MixedNotConverged(f"Newton coupling did not reach {tol} in {max_iter} iterations "
-                            f"(merit {f:.2e})", history)
+                            f"(merit {f_t:.2e})", history)
 
 
 def state_from(result, settings) -> State:

@@ -1,0 +1,106 @@
+"""Concentrated (ball-on-disk) contacts: Hertz, Moes parameters, Hamrock-Dowson films.
+
+The smooth elastohydrodynamic point contact is the reference case of the concentrated
+contacts: a sphere of radius ``R`` on a flat, reduced modulus ``E'`` (eq 22), normal load
+``F``, mean entrainment speed ``u_m = (u_1 + u_2)/2``, lubricant ``mu_0`` and pressure-viscosity
+coefficient ``alpha``.
+
+* Hertz: ``a = (3 F R / (2 E'))^(1/3)``, ``p_H = 3 F / (2 pi a^2)``, approach ``a^2 / R``.
+* Dimensionless groups (Hamrock and Dowson 1977): ``U = mu_0 u_m / (E' R)``,
+  ``W = F / (E' R^2)``, ``G = alpha E'``; Moes: ``M = W (2U)^(-3/4)``, ``L = G (2U)^(1/4)``.
+* Hamrock-Dowson fits for a circular contact (ellipticity k = 1):
+  ``h_c / R = 2.69 U^0.67 G^0.53 W^-0.067 (1 - 0.61 e^(-0.73 k))`` and
+  ``h_min / R = 3.63 U^0.68 G^0.49 W^-0.073 (1 - e^(-0.68 k))``.
+
+In :func:`fem_twin.macro.solve_mixed` the disk slides at ``U_s`` under a stationary pin
+(``u_m = U_s / 2``); a rolling contact with entrainment speed ``u_m`` is given as
+``speed = 2 u_m`` (eq 17 only sees ``u_m``; the shear of eq 31 sees the sliding speed).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class PointContact:
+    """A smooth circular EHL contact (SI units)."""
+
+    radius: float              # R [m]
+    load: float                # F [N]
+    e_reduced: float           # E' [Pa]
+    viscosity: float           # mu_0 [Pa s]
+    alpha: float               # pressure-viscosity coefficient [1/Pa]
+    entrainment: float         # u_m [m/s]
+
+    def __post_init__(self):
+        for name in ("radius", "load", "e_reduced", "viscosity", "entrainment"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"PointContact.{name} must be positive and finite, got {v}")
+        if not (np.isfinite(self.alpha) and self.alpha >= 0):
+            raise ValueError(f"PointContact.alpha must be >= 0 [1/Pa], got {self.alpha}")
+
+    @classmethod
+    def from_moes(cls, M: float, L: float, *, radius=12.5e-3, e_reduced=110e9,
+                  viscosity=0.25, alpha=22e-9) -> "PointContact":
+        """The contact with Moes parameters ``M, L`` for the given R, E', mu_0 and alpha
+        (``u_m`` from ``L``, then ``F`` from ``M``)."""
+        G = alpha * e_reduced
+        if not (M > 0 and L > 0 and G > 0):
+            raise ValueError("M, L and alpha E' must be positive")
+        U = (L / G) ** 4 / 2
+        W = M * (2 * U) ** 0.75
+        return cls(radius, W * e_reduced * radius ** 2, e_reduced, viscosity, alpha,
+                   U * e_reduced * radius / viscosity)
+
+    @property
+    def hertz_radius(self) -> float:
+        """a [m]."""
+        return (3 * self.load * self.radius / (2 * self.e_reduced)) ** (1 / 3)
+
+    @property
+    def hertz_pressure(self) -> float:
+        """p_H [Pa]."""
+        return 3 * self.load / (2 * np.pi * self.hertz_radius ** 2)
+
+    @property
+    def groups(self) -> tuple:
+        """Hamrock-Dowson ``(U, W, G)``."""
+        E, R = self.e_reduced, self.radius
+        return (self.viscosity * self.entrainment / (E * R), self.load / (E * R ** 2),
+                self.alpha * E)
+
+    @property
+    def moes(self) -> tuple:
+        """``(M, L)``."""
+        U, W, G = self.groups
+        return W * (2 * U) ** -0.75, G * (2 * U) ** 0.25
+
+    def hamrock_dowson(self) -> tuple:
+        """``(h_c, h_min)`` [m] of the Hamrock-Dowson fits (k = 1)."""
+        U, W, G = self.groups
+        k = 1.0
+        h_c = 2.69 * U ** 0.67 * G ** 0.53 * W ** -0.067 * (1 - 0.61 * np.exp(-0.73 * k))
+        h_min = 3.63 * U ** 0.68 * G ** 0.49 * W ** -0.073 * (1 - np.exp(-0.68 * k))
+        return h_c * self.radius, h_min * self.radius
+
+    def grid(self, n: int, extent=((-4.0, 2.0), (-3.0, 3.0))):
+        """The rigid gap ``x1^2/(2R) + x2^2/(2R)`` [m] on ``n x n`` nodes over ``extent``
+        (in Hertz radii, x1 the entrainment direction), its spacing and node coordinates.
+        ``n - 1`` divisible by the extents' lengths puts a node on the centre."""
+        a = self.hertz_radius
+        x1 = np.linspace(*extent[0], n) * a
+        x2 = np.linspace(*extent[1], n) * a
+        gap = (x1[None, :] ** 2 + x2[:, None] ** 2) / (2 * self.radius)
+        return gap, (x1[1] - x1[0], x2[1] - x2[0]), x1, x2
+
+
+def film_thickness(result, x1, x2) -> tuple:
+    """``(h_c, h_min)`` [m] of a solved point contact: the film at the centre (bilinear
+    interpolation of ``result.h0`` at x = 0) and its minimum over the grid."""
+    from scipy.interpolate import RegularGridInterpolator
+    h = RegularGridInterpolator((x2, x1), result.h0)([[0.0, 0.0]])[0]
+    return float(h), float(result.h0.min())
