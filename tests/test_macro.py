@@ -6,6 +6,8 @@ Tolerances: the coupled solver converges to 1e-6 in every residual, so states re
 couplings agree to about 1e-5 (two independent 1e-6 stops); exact invariances hold to that.
 """
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -127,6 +129,21 @@ def test_paper_pid_coupling_reaches_the_same_state(case32, factors):
     assert pid.friction_coefficient == pytest.approx(fast.friction_coefficient, rel=1e-4)
 
 
+@pytest.mark.parametrize("speed", [1.0, 0.003])
+def test_newton_coupling_reaches_the_same_state_on_the_pin(case32, factors, speed):
+    """The monolithic Newton coupling of concentrated contacts on the conformal pin, full
+    film and boundary (p_con carries ~90 % of the load): the Anderson state to 1e-5."""
+    gap, spacing, face = case32
+    kw = dict(load=150.0, speed=speed, lubricant=Lubricant(0.066), face=face)
+    fixed = solve_mixed(gap, spacing, factors, **kw,
+                        settings=MacroSettings(coupling="anderson"))
+    newton = solve_mixed(gap, spacing, factors, **kw, settings=MacroSettings(coupling="newton"))
+    assert newton.meta["coupling"] == "newton" and newton.iterations < 30
+    assert newton.h_d == pytest.approx(fixed.h_d, rel=1e-5)
+    assert newton.friction_coefficient == pytest.approx(fixed.friction_coefficient, rel=1e-5)
+    assert newton.contact_load == pytest.approx(fixed.contact_load, rel=1e-5, abs=1e-9)
+
+
 def test_hersey_invariance_and_stribeck_limits(case32, factors):
     """Isoviscous: the state depends on mu_0 U only, so C_f is a function of the Hersey
     number (eq 46); C_f rises toward C_f,b at low speed and falls with speed when the film
@@ -185,10 +202,13 @@ def test_bad_input_and_non_convergence(case32, factors):
         solve_mixed(gap, spacing, factors, load=-1, speed=1, lubricant=lub)
     with pytest.raises(ValueError, match="Pa s"):
         Lubricant(66.0)
-    with pytest.raises(MixedNotConverged) as err:
-        solve_mixed(gap, spacing, factors, load=150, speed=0.03, lubricant=lub,
-                    settings=MacroSettings(max_iter=2))
-    assert len(err.value.history) == 2
+    for coupling in ("anderson", "newton"):
+        with pytest.raises(MixedNotConverged) as err:
+            solve_mixed(gap, spacing, factors, load=150, speed=0.03, lubricant=lub,
+                        settings=MacroSettings(max_iter=2, coupling=coupling))
+        assert len(err.value.history) >= 2
+        again = pickle.loads(pickle.dumps(err.value))          # crosses to worker processes
+        assert again.history == err.value.history
 
 
 def test_roelands_and_dowson_higginson():
