@@ -22,6 +22,8 @@ class Lubricant:
     density : rho_0 at ambient pressure [kg/m^3] (cancels from eq 17; kept for output)
     roelands_alpha, roelands_p0 : alpha_R [1/Pa] and p_0,R [Pa] of eq 23
     dh_c1, dh_c2 : C_1 [Pa] and C_2 [-] of eq 24
+    piezoviscosity : ``"roelands"`` (eq 23) or ``"barus"`` (``mu_0 exp(alpha p)`` with
+        ``alpha = roelands_alpha``, the law of the Hamrock-Dowson fits and of many EHL papers)
     """
 
     viscosity: float
@@ -30,8 +32,12 @@ class Lubricant:
     roelands_p0: float = T.ROELANDS_P0
     dh_c1: float = T.DH_C1
     dh_c2: float = T.DH_C2
+    piezoviscosity: str = "roelands"
 
     def __post_init__(self):
+        if self.piezoviscosity not in ("roelands", "barus"):
+            raise ValueError("Lubricant.piezoviscosity must be 'roelands' or 'barus', got "
+                             f"{self.piezoviscosity!r}")
         for name in ("viscosity", "density", "roelands_p0", "dh_c1", "dh_c2"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
@@ -53,9 +59,11 @@ class Lubricant:
         return self.roelands_alpha * self.roelands_p0 / (np.log(self.viscosity) + 9.67)
 
     def viscosity_at(self, pressure):
-        """mu_l of eq 23 at relative pressure ``p = p_hd - p_cav >= 0`` [Pa s]."""
+        """mu_l of eq 23 (or Barus) at relative pressure ``p = p_hd - p_cav >= 0`` [Pa s]."""
         p = np.maximum(np.asarray(pressure, float), 0.0)
         mu0 = self.viscosity
+        if self.piezoviscosity == "barus":
+            return mu0 * np.exp(self.roelands_alpha * p)
         return mu0 * np.exp((np.log(mu0) + 9.67)
                             * (-1.0 + (1.0 + p / self.roelands_p0) ** self.roelands_z))
 
@@ -65,8 +73,11 @@ class Lubricant:
         return (self.dh_c1 + self.dh_c2 * p) / (self.dh_c1 + p)
 
     def viscosity_log_slope(self, pressure):
-        """``d ln(mu_l) / dp`` of eq 23 [1/Pa] (zero below p = 0, like eq 23's clipping)."""
+        """``d ln(mu_l) / dp`` of eq 23 (or Barus) [1/Pa] (zero below p = 0, like the
+        clipping of :meth:`viscosity_at`)."""
         p = np.asarray(pressure, float)
+        if self.piezoviscosity == "barus":
+            return np.where(p > 0, self.roelands_alpha, 0.0)
         x = 1.0 + np.maximum(p, 0.0) / self.roelands_p0
         slope = ((np.log(self.viscosity) + 9.67) * self.roelands_z
                  * x ** (self.roelands_z - 1) / self.roelands_p0)

@@ -38,6 +38,7 @@ from ..io.mesh import grid_mesh
 from ..linalg import SPDSolver, default_backend
 from ..ordering import nested_dissection
 from .fbns import solve_complementarity_fb
+from .lubricant import Lubricant
 from .reynolds_fv import fvm_poiseuille
 
 
@@ -86,7 +87,10 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     gap : (ny, nx) film thickness h [m], x1 (sliding) along the columns
     spacing : (dx1, dx2) [m]
     speed : sliding speed U [m/s] of one surface along +x1 (u_m = U / 2); may be negative
-    viscosity : mu [Pa s]
+    viscosity : mu [Pa s], or a :class:`~fem_twin.macro.Lubricant` for a piezoviscous
+        (eq 23 or Barus) and compressible (eq 24) film: its coefficients are then iterated
+        with the pressure (Picard, warm-started) until the pressure changes by less than
+        ``tol`` of its maximum
     ambient_pressure, cavitation_pressure : p_amb on the four edges and p_cav [Pa]
     method : ``"fe"`` (Q1 Poiseuille) or ``"fvm"`` (5-point Poiseuille)
     complementarity : ``"switch"`` (p-theta semismooth Newton) or ``"fb"`` (the paper's
@@ -97,27 +101,39 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
         raise ValueError(f"gap must be a 2D field of at least 3 x 3 nodes, got shape {h.shape}")
     if not np.all(np.isfinite(h)) or h.min() <= 0:
         raise ValueError("gap must be finite and positive everywhere [m]")
-    if not viscosity > 0:
+    lubricant = viscosity if isinstance(viscosity, Lubricant) else None
+    mu0 = lubricant.viscosity if lubricant is not None else viscosity
+    if not mu0 > 0:
         raise ValueError(f"viscosity must be positive [Pa s], got {viscosity}")
     if ambient_pressure < cavitation_pressure:
         raise ValueError("ambient pressure must not be below the cavitation pressure [Pa]")
-    dx = tuple(float(s) for s in np.broadcast_to(np.asarray(spacing, float), (2,)))
-    g = h ** 3 / (12 * viscosity)
-    q1 = h * speed / 2
-    if method == "fe":
-        K = fe_poiseuille(g, dx)
-    elif method == "fvm":
-        K = fvm_poiseuille(g, dx)
-    else:
+    if method not in ("fe", "fvm"):
         raise ValueError(f"method must be 'fe' or 'fvm', got {method!r}")
-    B = upwind_couette(q1, np.zeros_like(q1), dx)
+    dx = tuple(float(s) for s in np.broadcast_to(np.asarray(spacing, float), (2,)))
     boundary = np.zeros(h.shape, bool)
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
-    scale = 12 * viscosity * max(abs(speed), 1e-30) / 2 * float(np.mean(dx)) / np.mean(h) ** 2
-    phi, its, history = complementarity_solver(complementarity)(K, B, boundary,
-                                              ambient_pressure - cavitation_pressure, scale,
-                                              tol=tol, max_iter=max_iter)
-    p = np.maximum(phi, 0).reshape(h.shape)
+    scale = 12 * mu0 * max(abs(speed), 1e-30) / 2 * float(np.mean(dx)) / np.mean(h) ** 2
+    solver = complementarity_solver(complementarity)
+    assemble = fe_poiseuille if method == "fe" else fvm_poiseuille
+    mu, rho, phi, p_old, outer = mu0, 1.0, None, None, []
+    for _ in range(max_iter if lubricant is not None else 1):
+        g = rho * h ** 3 / (12 * mu)
+        q1 = rho * h * speed / 2
+        phi, its, history = solver(assemble(g, dx), upwind_couette(q1, np.zeros_like(q1), dx),
+                                   boundary, ambient_pressure - cavitation_pressure, scale,
+                                   phi0=phi, tol=tol, max_iter=max_iter)
+        p = np.maximum(phi, 0).reshape(h.shape)
+        if lubricant is None:
+            break
+        change = np.inf if p_old is None else float(np.abs(p - p_old).max())
+        outer.append(change / max(float(p.max()), 1e-300))
+        if outer[-1] < tol:
+            break
+        p_old = p
+        mu, rho = lubricant.viscosity_at(p), lubricant.density_ratio(p)
+    else:
+        raise ReynoldsNotConverged("piezoviscous Reynolds: the coefficient iteration did not "
+                                   f"settle in {max_iter} solves", outer)
     theta = (np.maximum(-phi, 0) / scale).reshape(h.shape)
     p_hd = p + cavitation_pressure
     load = float(np.sum(trapezoid_weights(h.shape, dx) * (p_hd - ambient_pressure)))
