@@ -150,3 +150,17 @@ def test_dimpled_slider_pressure_matches_bertocchi(pocket, width, column, peak_t
     dry = (published < 0.05e6) & (ref[:, 0] > 0.2) & (ref[:, 0] < 0.5)
     theta = np.interp(ref[:, 0] * 20e-3, x1, res.cavity_fraction[32])
     assert dry.any() and np.all(theta[dry] > 0)
+
+
+def test_film_depends_on_entrainment_not_on_sliding():
+    """Isothermal Newtonian film: at one entrainment speed u_m the film and pressure do not
+    depend on the slide-to-roll ratio (eq 17 sees u_m only), while the shear of eq 31 does."""
+    gap, spacing, _, _ = MOURIER.grid(49)
+    kw = dict(load=15.0, lubricant=Lubricant(0.25, roelands_alpha=22e-9), settings=POINT)
+    sliding = solve_mixed(gap, spacing, FlowFactors.smooth(), speed=0.18, **kw)   # SRR 2
+    rolling = solve_mixed(gap, spacing, FlowFactors.smooth(), speed=0.045,
+                          entrainment=0.09, **kw)                                 # SRR 0.5
+    assert np.abs(rolling.h0 - sliding.h0).max() < 1e-6 * sliding.h0.min()
+    assert np.abs(rolling.pressure - sliding.pressure).max() < 1e-6 * sliding.pressure.max()
+    assert rolling.meta["entrainment"] == 0.09
+    assert rolling.friction_force < sliding.friction_force

@@ -11,14 +11,15 @@ BOUNDARY_FRICTION = T.BOUNDARY_FRICTION
 
 
 def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, C, d, spacing,
-                       speed) -> np.ndarray:
-    """tau_hd,31 of eq 31 on the stationary pin [Pa], disk sliding at ``speed`` along +x1.
+                       speed, entrainment=None) -> np.ndarray:
+    """tau_hd,31 of eq 31 on the lower surface [Pa], sliding speed ``speed`` along +x1.
 
     ``tau = -(h_m/2) (C grad p)_1 + (mu / h_m) (-6 u_m d_1 + u_r) (1 - theta)`` with
-    ``u_m = U/2``, ``u_r = U``; ``grad p`` by second-order central differences on the grid.
+    ``u_r = U`` and ``u_m = U/2`` (a stationary pin) or ``entrainment`` (a ball on a disk);
+    ``grad p`` by second-order central differences on the grid.
     """
     dp2, dp1 = np.gradient(np.asarray(pressure, float), spacing[1], spacing[0])
-    u_m = speed / 2
+    u_m = speed / 2 if entrainment is None else entrainment
     poiseuille = -mean_gap / 2 * (C[..., 0, 0] * dp1 + C[..., 0, 1] * dp2)
     couette = viscosity / mean_gap * (-6 * u_m * d[..., 0] + speed) * (1 - cavity_fraction)
     return poiseuille + couette

@@ -192,6 +192,7 @@ class MixedResult:
 
 @one_thread
 def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float,
+                entrainment: float | None = None,
                 lubricant: Lubricant, face=None, settings: MacroSettings = MacroSettings(),
                 initial: MixedResult | None = None, progress=None) -> MixedResult:
     """Solve one operating point of the homogenised mixed-EHL problem.
@@ -203,7 +204,10 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
     spacing : (dx1, dx2) [m]
     factors : flow factors of the micro scale (patch average)
     load : imposed normal load F_N,imp [N]
-    speed : sliding speed U of the disk [m/s] (``u_m = U/2``, ``u_r = U``)
+    speed : sliding speed U of the disk [m/s] (``u_r = U``; ``u_m = U/2`` on a pin)
+    entrainment : mean speed ``u_m`` of the surfaces [m/s] when it is not ``U/2``: a ball on
+        a disk at slide-to-roll ratio ``SRR = u_r / u_m`` has ``speed = SRR u_m`` (eq 17 takes
+        u_m, the shear of eq 31 both); a pure rolling contact is approached with a small SRR
     lubricant : mu_0 and the constants of eqs 23-24
     face : (ny, nx) bool, the pin face for the friction integral (eq 33); all if None
     initial : a result to warm-start from (e.g. the neighbouring speed of a sweep)
@@ -218,6 +222,9 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
         raise ValueError(f"load must be a positive force [N], got {load}")
     if not (speed > 0 and np.isfinite(speed)):
         raise ValueError(f"speed must be positive [m/s], got {speed}")
+    u_m = speed / 2 if entrainment is None else float(entrainment)
+    if not (u_m > 0 and np.isfinite(u_m)):
+        raise ValueError(f"entrainment speed must be positive [m/s], got {entrainment}")
     dx = tuple(float(v) for v in np.broadcast_to(np.asarray(spacing, float), (2,)))
     face = np.ones(h_g.shape, bool) if face is None else np.asarray(face, bool)
     if face.shape != h_g.shape:
@@ -239,14 +246,15 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
         coarse = replace(s, tol=max(s.tol, 1e-4))
         try:
             initial = solve_mixed(h_g[::2, ::2], (2 * dx[0], 2 * dx[1]), factors, load=load,
-                                  speed=speed, lubricant=lubricant, face=face[::2, ::2],
+                                  speed=speed, entrainment=entrainment,
+                                  lubricant=lubricant, face=face[::2, ::2],
                                   settings=coarse)
         except MixedNotConverged:
             initial = None          # too coarse to resolve the contact: start on this grid
     if initial is not None:
         initial = _on_grid(initial, h_g.shape, dx)
     P = newton.Problem(h_g, dx, factors, lubricant, s, poiseuille, op, area,
-                       np.flatnonzero(~boundary.ravel()), speed)
+                       np.flatnonzero(~boundary.ravel()), speed, u_m)
     if s.coupling == "newton" or (s.coupling == "auto" and initial is not None
                                   and initial.meta.get("coupling") == "newton"):
         return _solve_newton(P, load, face, initial, progress, t0)
@@ -265,10 +273,10 @@ class _Concentrated(Exception):
 def _solve_fixed_point(P, load, face, initial, progress, t0):
     """The ``"anderson"`` and ``"pid"`` couplings (see the module docstring)."""
     h_g, dx, factors, lubricant, s = P.gap, P.spacing, P.factors, P.lubricant, P.settings
-    op, poiseuille, area, speed = P.elastic, P.poiseuille, P.area, P.speed
+    op, poiseuille, area = P.elastic, P.poiseuille, P.area
     boundary = np.ones(h_g.shape, bool)
     boundary.ravel()[P.interior] = False
-    u_m = speed / 2
+    u_m = P.entrainment
     p_amb_rel = s.ambient_pressure - s.cavitation_pressure
     scale = s.p_ref                                     # theta = -phi / scale in cavities
     state = {"phi": None, "p": np.full(h_g.shape, p_amb_rel), "newton": 0}
@@ -387,7 +395,7 @@ def _solve_fixed_point(P, load, face, initial, progress, t0):
             f"macro iteration ({s.coupling}) did not reach residuals below {s.tol} in "
             f"{s.max_iter} iterations (last: h_el {r_hel:.2e}, p_con {r_pcon:.2e}, "
             f"p {r_p:.2e}, load {r_F:.2e})", history)
-    return _result(ev, h_el, h_d, speed, load, dx, face, area, lubricant, s, it, history,
+    return _result(ev, h_el, h_d, P, load, face, it, history,
                    time.perf_counter() - t0)
 
 
@@ -402,30 +410,27 @@ def _solve_newton(P, load, face, initial, progress, t0):
     else:
         x, ev, it, history = newton.solve(P, newton.state_from(initial, s), load, tol=s.tol,
                                           max_iter=max_iter, progress=progress)
-    return _result(ev, x.w, x.h_d, P.speed, load, P.spacing, face, P.area, P.lubricant, s, it,
-                   history, time.perf_counter() - t0, coupling="newton")
+    return _result(ev, x.w, x.h_d, P, load, face, it, history, time.perf_counter() - t0,
+                   coupling="newton")
 
 
 def elastic_ratio(ev, op, s) -> float:
     """Largest elastic deformation by the film pressure over the thinnest film under
     pressure, at the first iterate: large for a concentrated contact (a ball: 10-100),
     small for a conformal pin."""
-    import os
     p_gauge = ev["p"] + s.cavitation_pressure - s.ambient_pressure
     loaded = p_gauge > 0
     if not loaded.any():
         return 0.0
-    r = float(np.abs(op(np.maximum(p_gauge, 0))).max()) / float(ev["h0"][loaded].min())
-    if os.environ.get("FT_DEBUG"):
-        print("elastic ratio", r)
-    return r
+    return float(np.abs(op(np.maximum(p_gauge, 0))).max()) / float(ev["h0"][loaded].min())
 
 
-def _result(ev, h_el, h_d, speed, load, dx, face, area, lubricant, s, it, history, seconds,
-            coupling=None):
+def _result(ev, h_el, h_d, P, load, face, it, history, seconds, coupling=None):
+    s, dx, area, speed, lubricant = P.settings, P.spacing, P.area, P.speed, P.lubricant
     loc = ev["loc"]
     p_hd = ev["p"] + s.cavitation_pressure
-    tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev["theta"], ev["mu"], loc.C, loc.d, dx, speed)
+    tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev["theta"], ev["mu"], loc.C, loc.d, dx, speed,
+                                entrainment=P.entrainment)
     tau_con = boundary_shear(ev["p_con"], s.boundary_friction)
     cell = dx[0] * dx[1]
     F_hd = float(tau_hd[face].sum() * cell)
@@ -443,7 +448,8 @@ def _result(ev, h_el, h_d, speed, load, dx, face, area, lubricant, s, it, histor
         meta={"settings": {k: (list(v) if isinstance(v, tuple) else v)
                            for k, v in s.__dict__.items()},
               "lubricant": lubricant.__dict__.copy(), "seconds": seconds,
-              "coupling": coupling or ("anderson" if s.coupling == "auto" else s.coupling)})
+              "coupling": coupling or ("anderson" if s.coupling == "auto" else s.coupling),
+              "entrainment": P.entrainment})
 
 
 def _on_grid(result: MixedResult, shape, dx) -> MixedResult:

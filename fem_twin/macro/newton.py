@@ -58,7 +58,8 @@ class Problem:
     elastic: object            # ElasticOperator
     area: np.ndarray           # trapezoid weights [m^2]
     interior: np.ndarray       # flat indices of the interior nodes
-    speed: float               # U [m/s]
+    speed: float               # sliding speed u_r [m/s]
+    entrainment: float         # mean (entrainment) speed u_m [m/s]
 
     @property
     def shape(self):
@@ -99,7 +100,7 @@ def evaluate(P: Problem, x: State, load: float) -> dict:
     p_coef = np.minimum(p, MAX_COEFFICIENT_PRESSURE)
     mu, rho = lub.viscosity_at(p_coef), lub.density_ratio(p_coef)
     g = rho * loc.h_m ** 3 / (12 * mu)
-    q = rho * loc.h_m * P.speed / 2
+    q = rho * loc.h_m * P.entrainment
     K = P.poiseuille(g, loc.A)
     q1, q2 = (q * loc.b[..., 0]).ravel(), (q * loc.b[..., 1]).ravel()
     B1, B2 = couette_parts(q1.reshape(shape), q2.reshape(shape), P.spacing)
@@ -411,7 +412,7 @@ def rigid_start(P: Problem, load: float, ratio: float):
         h_d = touch + t
         loc = P.factors.at(np.maximum(h_d + P.gap, s.gap_floor))
         g = rho0 * loc.h_m ** 3 / (12 * P.lubricant.viscosity)
-        q = rho0 * loc.h_m * P.speed / 2
+        q = rho0 * loc.h_m * P.entrainment
         B = upwind_couette(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing)
         phi, _, _ = solve_complementarity(P.poiseuille(g, loc.A), B, boundary,
                                           s.ambient_pressure - s.cavitation_pressure, s.p_ref)
