@@ -31,12 +31,22 @@ class Geometry:
 class Tribometer:
     """Operating conditions (Tables 1 and 6): imposed load [N], pin diameter [m], sliding
     radius [m] (recorded; speeds are given in m/s), boundary friction coefficient C_f,b of
-    eq 32 [-]."""
+    eq 32 [-].  ``kind = "ball-on-disk"``: a ball of ``ball_radius`` [m] on the disk at
+    ``slide_to_roll`` = u_r / u_m (MTM convention, in (0, 2]; the sweep's speeds are then
+    entrainment speeds u_m), on a track of ``track_radius`` [m] (recorded)."""
 
     load: float = T.LOAD
     pin_diameter: float = 8e-3
     sliding_radius: float = 30e-3
     boundary_friction: float = T.BOUNDARY_FRICTION        # the paper's C_f,b, eq 32
+    kind: str = "pin-on-disk"                             # or "ball-on-disk"
+    ball_radius: float = 12.5e-3
+    slide_to_roll: float = 0.5
+    track_radius: float = 20e-3
+
+    @property
+    def ball(self) -> bool:
+        return self.kind == "ball-on-disk"
 
 
 @dataclass(frozen=True)
@@ -50,12 +60,14 @@ class LubricantSpec:
     roelands_p0: float = T.ROELANDS_P0
     dh_c1: float = T.DH_C1
     dh_c2: float = T.DH_C2
+    eyring_stress: float = 0.0       # tau_0 [Pa] of Eyring shear thinning (0: Newtonian)
 
     def lubricants(self) -> list:
         """One :class:`fem_twin.macro.Lubricant` per viscosity."""
         from .macro.lubricant import Lubricant
         return [Lubricant(mu, density=self.density, roelands_alpha=self.roelands_alpha,
-                          roelands_p0=self.roelands_p0, dh_c1=self.dh_c1, dh_c2=self.dh_c2)
+                          roelands_p0=self.roelands_p0, dh_c1=self.dh_c1, dh_c2=self.dh_c2,
+                          eyring_stress=self.eyring_stress or None)
                 for mu in self.viscosities]
 
 
@@ -95,11 +107,15 @@ class MicroSpec:
 
 @dataclass(frozen=True)
 class MacroSpec:
-    """Macro scale: which pin ("average" of the set or 1-based index), FE/FVM, coupling."""
+    """Macro scale: which pin ("average" of the set or 1-based index), FE/FVM, coupling
+    (``auto``: Anderson on conformal pins, Newton on concentrated contacts), and the nodes
+    per side of a ball's grid over [-4a, 2a] x [-3a, 3a] (``grid - 1`` divisible by 6 puts
+    a node on the contact centre)."""
 
     pin: str | int = "average"
     method: str = "fe"
-    coupling: str = "anderson"
+    coupling: str = "auto"
+    grid: int = 97
 
 
 @dataclass(frozen=True)
@@ -158,7 +174,8 @@ class Case:
         patches = len(self.geometry.patches)
         micro = (3e-6 * self.micro.resolution[0] * self.micro.resolution[1] * self.micro.steps
                  * self.micro.h0_count * patches / max(cores, 1))
-        res = self.macro_geometry.resolution or (256, 256)
+        res = ((self.macro.grid,) * 2 if self.tribometer.ball
+               else self.macro_geometry.resolution or (256, 256))
         point = 2.0 * ((res[0] * res[1]) / 128 ** 2) ** 1.2
         n_mu = len(self.lubricant.viscosities)
         points = self.sweep.count * (1 + 0.5 * self.sweep.refine)   # refinement: ~+50 %
@@ -198,13 +215,17 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
                 raise CaseError(f"{where} [geometry] {key}: file not found: {p}")
         return out
 
-    if "pins" not in g or not g["pins"]:
+    tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
+    if tribometer.kind not in ("pin-on-disk", "ball-on-disk"):
+        raise CaseError(f"{where} [tribometer] kind: 'pin-on-disk' or 'ball-on-disk', got "
+                        f"{tribometer.kind!r}")
+    if not tribometer.ball and ("pins" not in g or not g["pins"]):
         raise CaseError(f"{where} [geometry]: at least one pin file is required in 'pins'")
     patches = g.get("patches", [])
     if not isinstance(patches, list) or not all(isinstance(p, list) and len(p) == 2 for p in patches):
         raise CaseError(f"{where} [geometry] patches: expected a list of [pin, disk] file pairs")
     geometry = Geometry(
-        pins=files("pins", g["pins"]), disks=files("disks", g.get("disks", [])),
+        pins=files("pins", g.get("pins", [])), disks=files("disks", g.get("disks", [])),
         patches=tuple(files("patches", p) for p in patches),
         patch_shape=_int_pair(g.get("patch_shape", [256, 256]), f"{where} [geometry] patch_shape"),
         patch_start=_int_pair(g.get("patch_start", [0, 0]), f"{where} [geometry] patch_start", 0))
@@ -233,8 +254,8 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
                         f"{opts['sliding_direction']!r}")
     if opts.get("fwhm_px", 0) < 0:
         raise CaseError(f"{where} [preprocessing] fwhm_px must be >= 0 pixels")
-    tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
-    lubricant = _section(data, "lubricant", LubricantSpec, where, positive=True)
+    lubricant = _section(data, "lubricant", LubricantSpec, where, positive=True,
+                         zero_ok=("eyring_stress",))
     if not lubricant.viscosities:
         raise CaseError(f"{where} [lubricant] viscosities: give at least one mu_0 [Pa s]")
     if len(lubricant.temperatures) != len(lubricant.viscosities):
@@ -256,9 +277,14 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
         raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
                         "h0_count >= 2 and steps >= 1")
     macro = _section(data, "macro", MacroSpec, where)
-    if macro.method not in ("fe", "fvm") or macro.coupling not in ("anderson", "pid"):
-        raise CaseError(f"{where} [macro]: method 'fe'|'fvm', coupling 'anderson'|'pid'")
-    if macro.pin != "average" and not (isinstance(macro.pin, int)
+    if macro.method not in ("fe", "fvm") or macro.coupling not in ("auto", "anderson",
+                                                                    "newton", "pid"):
+        raise CaseError(f"{where} [macro]: method 'fe'|'fvm', coupling "
+                        "'auto'|'anderson'|'newton'|'pid'")
+    if not 9 <= macro.grid <= 1025:
+        raise CaseError(f"{where} [macro] grid: nodes per side of the ball's grid, 9 to 1025 "
+                        f"(e.g. 97), got {macro.grid}")
+    if macro.pin != "average" and not tribometer.ball and not (isinstance(macro.pin, int)
                                        and 1 <= macro.pin <= len(geometry.pins)):
         raise CaseError(f"{where} [macro] pin: 'average' or a pin number 1..{len(geometry.pins)}")
     sweep = _section(data, "sweep", SweepSpec, where, positive=True, zero_ok=("refine",))
@@ -333,9 +359,13 @@ PLAUSIBLE = {
     ("tribometer", "pin_diameter"): (1e-4, 0.1, "m (8 mm is 8e-3)"),
     ("tribometer", "sliding_radius"): (1e-3, 1.0, "m (30 mm is 30e-3)"),
     ("tribometer", "boundary_friction"): (1e-3, 1.0, "(a friction coefficient)"),
+    ("tribometer", "ball_radius"): (1e-4, 1.0, "m (12.7 mm is 12.7e-3)"),
+    ("tribometer", "slide_to_roll"): (1e-3, 2.0, "u_r / u_m, in (0, 2] (50 % is 0.5)"),
+    ("tribometer", "track_radius"): (1e-3, 1.0, "m (20 mm is 20e-3)"),
     ("lubricant", "viscosities"): (1e-5, 10.0, "Pa s (66 mPa s is 0.066)"),
     ("lubricant", "density"): (100.0, 2e4, "kg/m^3"),
     ("lubricant", "roelands_alpha"): (0.0, 1e-7, "1/Pa (22 GPa^-1 is 22e-9)"),
+    ("lubricant", "eyring_stress"): (0.0, 1e9, "Pa (5 MPa is 5e6; 0: Newtonian)"),
     ("materials", "e_pin"): (1e8, 2e12, "Pa (210 GPa is 210e9)"),
     ("materials", "e_disk"): (1e8, 2e12, "Pa (210 GPa is 210e9)"),
     ("materials", "nu_pin"): (0.0, 0.4999, "Poisson ratio in [0, 0.5)"),

@@ -511,6 +511,12 @@ def _short_summary(summary: dict, out: Path) -> str:
     if "hersey_collapse_max_abs_cf_dev" in stages["stribeck"]:
         lines.append("  Hersey collapse: max |C_f,dev| = "
                      f"{stages['stribeck']['hersey_collapse_max_abs_cf_dev']:.2%} (eq 35)")
+    film = stages["stribeck"].get("ehl_film")
+    if film:
+        lines.append(f"  EHL film at u_m = {film['entrainment_m_s']:g} m/s: h_c "
+                     f"{film['h_c_m'] * 1e9:.0f} nm, h_min {film['h_min_m'] * 1e9:.0f} nm "
+                     f"(Hamrock-Dowson, smooth: {film['hamrock_dowson_h_c_m'] * 1e9:.0f} nm, "
+                     f"{film['hamrock_dowson_h_min_m'] * 1e9:.0f} nm)")
     est = stages["micro"].get("error_estimate", {})
     for kind in ("time", "grid"):
         if kind in est:

@@ -14,6 +14,7 @@ import logging
 import os
 import time
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +30,7 @@ from .io.mesh import grid_mesh, write_vtu
 from .macro import MacroSettings, MixedResult
 from .macro.figures import plot_point_fields
 from .macro.friction import BOUNDARY_FRICTION
+from .macro.point_contact import PointContact, film_thickness
 from .micro import FlowFactors, average, homogenise
 from .micro.homogenisation import prune_checkpoints
 from .micro.estimate import exceeding
@@ -198,7 +200,7 @@ def executor_for(case: Case):
 def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dict:
     """Prepare every pin (with its disk, or a flat one) and patch pair; write npz + VTU."""
     opts = case.macro_geometry
-    jobs = [("pin", i) for i in range(len(case.geometry.pins))]
+    jobs = [] if case.tribometer.ball else [("pin", i) for i in range(len(case.geometry.pins))]
     jobs += [("patch", i) for i in range(len(case.geometry.patches))]
     result = {"pins": [], "patches": []}
     for kind, i in tqdm(jobs, desc="geometry", disable=not progress, unit="surface"):
@@ -254,6 +256,8 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
 def level_pins(case: Case, outdir: Path, progress: bool = True) -> dict:
     """Level every pin against its disk (torque balance, Table 4 at 50 N); average the
     levelled set and level the average (paper 2.2.1).  Writes ``levelling/``."""
+    if case.tribometer.ball:
+        return {"skipped": "ball-on-disk: the macro gap is the ball's sphere"}
     folder = outdir / "levelling"
     folder.mkdir(parents=True, exist_ok=True)
     geo = outdir / "geometry"
@@ -340,7 +344,11 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
 
 
 def macro_geometry(case: Case, outdir: Path):
-    """Gap ``h_g = x3_up - x3_low``, spacing, pin-face mask and origin of the macro pin."""
+    """Gap ``h_g = x3_up - x3_low``, spacing, pin-face mask and origin of the macro pin, or
+    of the ball's sphere over [-4a, 2a] x [-3a, 3a] (a the Hertz radius; face: all)."""
+    if case.tribometer.ball:
+        gap, spacing, x1, x2 = ball_contact(case).grid(case.macro.grid)
+        return gap, spacing, np.ones(gap.shape, bool), (float(x1[0]), float(x2[0]))
     lev = outdir / "levelling"
     pin_file = (lev / "pin_average.npz" if case.macro.pin == "average"
                 and (lev / "pin_average.npz").exists()
@@ -352,6 +360,14 @@ def macro_geometry(case: Case, outdir: Path):
     return disk.heights - pin.heights, pin.spacing, face, pin.origin
 
 
+def ball_contact(case: Case) -> PointContact:
+    """The smooth ball of a ball-on-disk case (Hertz radius, Hamrock-Dowson films) at the
+    first viscosity and the sweep's fastest entrainment speed."""
+    tr, lb = case.tribometer, case.lubricant
+    return PointContact(tr.ball_radius, tr.load, case.materials.e_reduced, lb.viscosities[0],
+                        lb.roelands_alpha, case.sweep.speed_max)
+
+
 def _sweep_task(args):
     """One viscosity's sweep (a picklable unit of work for process pools and Dask)."""
     worker_heap()
@@ -360,10 +376,17 @@ def _sweep_task(args):
 
 
 def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
-    """The macro solver settings of a case (``method`` overrides ``[macro] method``)."""
-    return MacroSettings(e_reduced=case.materials.e_reduced,
-                         boundary_friction=case.tribometer.boundary_friction,
-                         method=method or case.macro.method, coupling=case.macro.coupling)
+    """The macro solver settings of a case (``method`` overrides ``[macro] method``).
+
+    A ball's contact cavitates at the ambient pressure: the 0.2 bar between p_amb and p_cav
+    of Table 6 is nothing beside its GPa, and the thin pressurised layer it forces along
+    the sides of the outlet cavity makes the Newton coupling cycle between two states."""
+    settings = MacroSettings(e_reduced=case.materials.e_reduced,
+                             boundary_friction=case.tribometer.boundary_friction,
+                             method=method or case.macro.method, coupling=case.macro.coupling)
+    if case.tribometer.ball:
+        settings = replace(settings, cavitation_pressure=settings.ambient_pressure)
+    return settings
 
 
 def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = True) -> dict:
@@ -372,8 +395,9 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
     gap, spacing, face, origin = macro_geometry(case, outdir)
     factors = FlowFactors.load(outdir / "micro" / "flow_factors.npz")
     lb, tr = case.lubricant, case.tribometer
+    ball = dict(slide_to_roll=tr.slide_to_roll) if tr.ball else {}
     common = dict(gap=gap, spacing=spacing, factors=factors, speeds=case.sweep.speeds,
-                  load=tr.load, diameter=tr.pin_diameter, face=face,
+                  load=tr.load, diameter=hersey_length(case), face=face, **ball,
                   settings=macro_settings(case),
                   checkpoint=outdir / "stribeck" / "checkpoints", fields=outdir / "fields",
                   origin=origin, factors_key=stage_keys(case)["micro"])
@@ -421,6 +445,8 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                      "%d iterations", c.viscosity, u, cf, share, it)
     if len(curves) > 1:
         out["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, tr.boundary_friction)
+    if tr.ball:
+        out["ehl_film"] = ehl_film(case, points)
     if any(case.measured):
         out["validation"] = validate(case, curves, outdir, curve_labels(case, curves))
     write_run_results(case, outdir, curves, patch_curves, points, origin)
@@ -449,6 +475,26 @@ def curve_labels(case: Case, curves) -> list[str]:
             for t, c in zip(case.lubricant.temperatures, curves)]
 
 
+def ehl_film(case: Case, points) -> dict:
+    """The film of a ball-on-disk sweep's fastest point (first viscosity) beside the
+    Hamrock-Dowson films of the smooth ball at the same u_m: the full-film end of the curve."""
+    mu = case.lubricant.viscosities[0]
+    u_m = max(u for m, u in points if m == mu)
+    _, _, x1, x2 = ball_contact(case).grid(case.macro.grid)
+    h_c, h_min = film_thickness(points[mu, u_m], x1, x2)
+    hd_c, hd_min = replace(ball_contact(case), viscosity=mu, entrainment=u_m).hamrock_dowson()
+    log.info("EHL film at u_m = %g m/s: h_c %.4g m, h_min %.4g m; Hamrock-Dowson %.4g m, "
+             "%.4g m", u_m, h_c, h_min, hd_c, hd_min)
+    return {"entrainment_m_s": u_m, "h_c_m": h_c, "h_min_m": h_min,
+            "hamrock_dowson_h_c_m": float(hd_c), "hamrock_dowson_h_min_m": float(hd_min)}
+
+
+def hersey_length(case: Case) -> float:
+    """D of the Hersey number (eq 46) [m]: the pin diameter, or a ball's Hertz diameter."""
+    return (2 * ball_contact(case).hertz_radius if case.tribometer.ball
+            else case.tribometer.pin_diameter)
+
+
 def plot_curves(case: Case, curves, band, outdir: Path) -> None:
     """C_f versus speed and versus Hersey number, with the band and measured curves."""
     measured = [read_measured_csv(m) if m is not None else None for m in case.measured]
@@ -457,7 +503,10 @@ def plot_curves(case: Case, curves, band, outdir: Path) -> None:
     for x in ("speed", "hersey"):
         plot_stribeck(curves, outdir / f"stribeck_{x}.png", x=x,
                       labels=curve_labels(case, curves), boundary=tr.boundary_friction,
-                      bands=band, measured=measured, diameter=tr.pin_diameter, load=tr.load)
+                      bands=band, measured=measured, diameter=hersey_length(case),
+                      load=tr.load, speed_label=("entrainment speed $u_m$ [m/s], SRR "
+                                                 f"{tr.slide_to_roll:g}" if tr.ball else
+                                                 "sliding speed $U$ [m/s]"))
 
 
 def sweep_points(folder: Path, tasks) -> dict:
@@ -466,7 +515,8 @@ def sweep_points(folder: Path, tasks) -> dict:
     for kw, lub in tasks:
         for path in folder.glob(f"point_{_sweep_key(kw, lub)}_*.npz"):
             res = MixedResult.load(path)
-            points[lub.viscosity, res.speed] = res
+            speed = res.speed if kw.get("slide_to_roll") is None else res.meta["entrainment"]
+            points[lub.viscosity, speed] = res
     return points
 
 
@@ -549,7 +599,8 @@ def transition_speeds(curves, step: float) -> np.ndarray:
 def _sweep_key(kwargs: dict, lubricant) -> str:
     """Checkpoint key of one sweep task (``point_KEY_SPEED.npz``)."""
     return sweep_key(kwargs["gap"], kwargs["spacing"], kwargs["factors_key"], kwargs["load"],
-                     lubricant, kwargs["settings"], kwargs["face"])
+                     lubricant, kwargs["settings"], kwargs["face"],
+                     kwargs.get("slide_to_roll"))
 
 
 def _prune_points(folder: Path, tasks) -> None:

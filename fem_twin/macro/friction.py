@@ -11,17 +11,20 @@ BOUNDARY_FRICTION = T.BOUNDARY_FRICTION
 
 
 def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, C, d, spacing,
-                       speed, entrainment=None) -> np.ndarray:
+                       speed, entrainment=None, eyring_stress=None) -> np.ndarray:
     """tau_hd,31 of eq 31 on the lower surface [Pa], sliding speed ``speed`` along +x1.
 
     ``tau = -(h_m/2) (C grad p)_1 + (mu / h_m) (-6 u_m d_1 + u_r) (1 - theta)`` with
     ``u_r = U`` and ``u_m = U/2`` (a stationary pin) or ``entrainment`` (a ball on a disk);
-    ``grad p`` by second-order central differences on the grid.
+    ``grad p`` by second-order central differences on the grid.  ``eyring_stress`` tau_0
+    [Pa]: the Couette (shear-driven) part becomes ``tau_0 asinh(tau / tau_0)`` (Eyring).
     """
     dp2, dp1 = np.gradient(np.asarray(pressure, float), spacing[1], spacing[0])
     u_m = speed / 2 if entrainment is None else entrainment
     poiseuille = -mean_gap / 2 * (C[..., 0, 0] * dp1 + C[..., 0, 1] * dp2)
     couette = viscosity / mean_gap * (-6 * u_m * d[..., 0] + speed) * (1 - cavity_fraction)
+    if eyring_stress is not None:
+        couette = eyring_stress * np.arcsinh(couette / eyring_stress)
     return poiseuille + couette
 
 

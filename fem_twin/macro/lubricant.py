@@ -24,6 +24,9 @@ class Lubricant:
     dh_c1, dh_c2 : C_1 [Pa] and C_2 [-] of eq 24
     piezoviscosity : ``"roelands"`` (eq 23) or ``"barus"`` (``mu_0 exp(alpha p)`` with
         ``alpha = roelands_alpha``, the law of the Hamrock-Dowson fits and of many EHL papers)
+    eyring_stress : Eyring stress tau_0 [Pa] of the shear-thinning film: the Couette shear of
+        eq 31 becomes ``tau_0 asinh(tau_Newton / tau_0)`` (None: Newtonian, the paper's; an
+        EHL contact needs it, its Newtonian shear at GPa viscosities is unphysical)
     """
 
     viscosity: float
@@ -33,8 +36,13 @@ class Lubricant:
     dh_c1: float = T.DH_C1
     dh_c2: float = T.DH_C2
     piezoviscosity: str = "roelands"
+    eyring_stress: float | None = None
 
     def __post_init__(self):
+        if self.eyring_stress is not None and not (np.isfinite(self.eyring_stress)
+                                                   and self.eyring_stress > 0):
+            raise ValueError(f"Lubricant.eyring_stress must be positive [Pa] or None, got "
+                             f"{self.eyring_stress}")
         if self.piezoviscosity not in ("roelands", "barus"):
             raise ValueError("Lubricant.piezoviscosity must be 'roelands' or 'barus', got "
                              f"{self.piezoviscosity!r}")

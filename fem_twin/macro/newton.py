@@ -12,8 +12,9 @@ deformation ``w = h_el`` (all nodes) and ``h_d``; the equations, all fully impli
 * ``G = w - E (p + p_cav + p_con(h0) - p_amb) = 0`` (eqs 20-22, ``E`` the FFT half-space);
 * ``L = sum(a (p + p_cav + p_con - p_amb)) - F_N,imp = 0`` (eq 28).
 
-The Jacobian is exact except for the ``h0``-dependence of the flow factor tensors ``A, b``
-(held at the step's values: smooth surfaces have none).  Each Newton step is solved by
+The Jacobian is exact (the ``h0``-derivatives of the flow factors by central differences of
+their interpolation, the Poiseuille operator's coefficient derivatives by probing it with
+nine colourings of the grid).  Each Newton step is solved by
 right-preconditioned GMRES with the exact Jacobian action (``E`` by FFT); the preconditioner
 is the Jacobian with the elastic coupling kept, as a dense block, on the set ``S`` of nodes
 where it outweighs the pressure flow (the loaded zone of the contact), and dropped
@@ -23,7 +24,7 @@ limited so no film thins by more than half, then backtracked on the scaled resid
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.fft as fft
@@ -39,6 +40,10 @@ MAX_COEFFICIENT_PRESSURE = 1e10
 #: a node joins the dense elastic block when its elastic coupling exceeds this fraction of
 #: its pressure-flow coupling
 DENSE_THRESHOLD = 0.02
+#: halvings of a Newton step in its line search
+HALVINGS = 6
+#: Newton steps in a row that may fail to decrease the merit function
+WATCHDOG = 8
 #: the preconditioner is kept from step to step until GMRES needs more iterations than this
 REBUILD_AFTER = 6
 #: most nodes in the dense block (a 4000^2 LU takes about 2 s here)
@@ -116,17 +121,18 @@ def evaluate(P: Problem, x: State, load: float) -> dict:
                 L=float(np.sum(P.area * p_tot)) - load)
 
 
-def _probe(P: Problem, g_A, p) -> sp.csr_matrix:
-    """``Kg`` with ``K(dg, A) p = Kg dg`` (K is linear in g), probed with nine colourings of
-    the grid (the 3 x 3 stencil of a node's coefficient never overlaps its colour mates)."""
+def _probe(P: Problem, coefficients, p) -> sp.csr_matrix:
+    """The matrix ``M`` with ``M[:, k] = K(*coefficients(e_k)) p``, where ``K`` (the
+    Poiseuille operator, bilinear in its nodal coefficient fields) takes the fields that
+    ``coefficients(mask)`` returns for a node mask: probed with nine colourings of the grid
+    (the 3 x 3 stencil of a node's coefficient never overlaps its colour mates)."""
     ny, nx = P.shape
-    A = g_A
     i, j = np.divmod(np.arange(ny * nx), nx)
     rows, cols, vals = [], [], []
     for ci in range(3):
         for cj in range(3):
             colour = ((i % 3 == ci) & (j % 3 == cj)).astype(float).reshape(ny, nx)
-            v = P.poiseuille(colour, A) @ p
+            v = P.poiseuille(*coefficients(colour)) @ p
             # the node of this colour in each row's 3 x 3 neighbourhood
             ni = i + (ci - i) % 3 - np.where((ci - i) % 3 == 2, 3, 0)
             nj = j + (cj - j) % 3 - np.where((cj - j) % 3 == 2, 3, 0)
@@ -141,33 +147,37 @@ def _probe(P: Problem, g_A, p) -> sp.csr_matrix:
 
 def jacobian(P: Problem, ev: dict) -> dict:
     """The sparse blocks of the Jacobian: ``J_pp = dR/dphi`` (interior x interior),
-    ``J_ph = dR/dh0`` (interior x all), ``pos`` (dp/dphi) and ``dpc = dp_con/dh0``."""
-    s, lub = P.settings, P.lubricant
-    I = P.interior
-    phi_pos = ev["p"].ravel() > 0
+    ``J_ph = dR/dh0`` (interior x all, through h_m, A and b), ``pos`` (dp/dphi) and
+    ``dpc = dp_con/dh0``."""
+    lub, I = P.lubricant, P.interior
+    pos = ev["p"].ravel() > 0
     p_coef = np.minimum(ev["p"], MAX_COEFFICIENT_PRESSURE)
-    unclipped = (ev["p"] < MAX_COEFFICIENT_PRESSURE)
+    unclipped = ev["p"] < MAX_COEFFICIENT_PRESSURE
     dlnrho = lub.density_log_slope(p_coef) * unclipped
     dlnmu = lub.viscosity_log_slope(p_coef) * unclipped
-    dhm, dpc = P.factors.slopes(ev["h0"])
+    d = P.factors.slopes(ev["h0"])
     free = ~ev["touching"]
-    dhm, dpc = dhm * free, dpc * free
-    g, q, loc = ev["g"], ev["q"], ev["loc"]
-    Kg = _probe(P, loc.A, ev["p"].ravel())
+    g, q, loc, p = ev["g"], ev["q"], ev["loc"], ev["p"].ravel()
+    Kg = _probe(P, lambda c: (c, loc.A), p)
+    KA = _probe(P, lambda c: (g, c[..., None, None] * d["A"] * free[..., None, None]), p)
     B1, B2 = ev["B"]
     open_ = 1 - ev["theta"].ravel()
-    Bq = B1 @ sp.diags(loc.b[..., 0].ravel() * open_) + B2 @ sp.diags(loc.b[..., 1].ravel()
-                                                                       * open_)
+    b1, b2 = loc.b[..., 0].ravel(), loc.b[..., 1].ravel()
+    Bq = B1 @ sp.diags(b1 * open_) + B2 @ sp.diags(b2 * open_)
+    Bb = (B1 @ sp.diags(q.ravel() * open_ * d["b"][..., 0].ravel())
+          + B2 @ sp.diags(q.ravel() * open_ * d["b"][..., 1].ravel()))
     dg_dp, dq_dp = (g * (dlnrho - dlnmu)).ravel(), (q * dlnrho).ravel()
+    dhm = d["h_m"] * free
     dg_dh, dq_dh = (3 * g * dhm / loc.h_m).ravel(), (q * dhm / loc.h_m).ravel()
     q1, q2 = ev["q12"]
-    dtheta = np.where(phi_pos, 0.0, 1.0 / s.p_ref)
+    dtheta = np.where(pos, 0.0, 1.0 / P.settings.p_ref)
     Bfull = B1 @ sp.diags(q1) + B2 @ sp.diags(q2)
-    J_p = (ev["K"] @ sp.diags(phi_pos * 1.0) + Bfull @ sp.diags(dtheta)
-           + (Kg @ sp.diags(dg_dp) + Bq @ sp.diags(dq_dp)) @ sp.diags(phi_pos * 1.0))
-    J_h = Kg @ sp.diags(dg_dh) + Bq @ sp.diags(dq_dh)
+    J_p = (ev["K"] @ sp.diags(pos * 1.0) + Bfull @ sp.diags(dtheta)
+           + (Kg @ sp.diags(dg_dp) + Bq @ sp.diags(dq_dp)) @ sp.diags(pos * 1.0))
+    J_h = Kg @ sp.diags(dg_dh) + Bq @ sp.diags(dq_dh) + KA + Bb @ sp.diags(free.ravel() * 1.0)
     J_p, J_h = J_p.tocsr()[I], J_h.tocsr()[I]
-    return dict(J_pp=J_p[:, I].tocsc(), J_ph=J_h.tocsr(), pos=phi_pos, dpc=dpc.ravel())
+    return dict(J_pp=J_p[:, I].tocsc(), J_ph=J_h.tocsr(), pos=pos,
+                dpc=(d["p_con"] * free).ravel())
 
 
 class Preconditioner:
@@ -342,40 +352,30 @@ def merit(ev: dict, sizes: tuple) -> float:
 def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progress=None):
     """Newton iterations from ``x`` to ``tol``; returns ``(x, ev, iterations, history)``.
 
-    A step is first shortened so that no film thins by more than half, then halved until
-    the merit function decreases.  Converged when a full step changes ``h_el`` by less than
-    ``tol h_ref``, ``p`` and ``p_con`` by less than ``tol p_ref``, the load error is below
-    ``tol`` and the rms mass residual below ``tol``; :class:`MixedNotConverged` otherwise.
+    Each step is globalised by :func:`line_search`.  Converged when a full step changes
+    ``h_el`` by less than ``tol h_ref``, ``p`` and ``p_con`` by less than ``tol p_ref``, the
+    load error is below ``tol`` and the merit function below ``tol``;
+    :class:`MixedNotConverged` otherwise, or after ``WATCHDOG`` steps in a row that did not
+    decrease the merit function.
     """
     s = P.settings
     ev = evaluate(P, x, load)
-    history = []
-    I = P.interior
-    pre = None
+    history, pre, uphill = [], None, 0
     for it in range(1, max_iter + 1):
         sizes = scales(ev, s, load)
         f = merit(ev, sizes)
-        (dphi, dw, dhd), gm, pre = newton_step(P, ev, load, pre=pre,
-                                               rtol=min(1e-3, max(1e-8, 0.1 * f)))
+        step, gm, pre = newton_step(P, ev, load, pre=pre, rtol=min(1e-3, max(1e-8, 0.1 * f)))
         if gm > REBUILD_AFTER:
             pre = None
-        dh = (dw + dhd).reshape(P.shape)
-        thinning = (dh < 0) & ~ev["touching"]
-        alpha = min(1.0, float(np.min(0.5 * ev["h0"][thinning] / -dh[thinning],
-                                      initial=np.inf)))
-        for _ in range(30):
-            phi = x.phi.copy()
-            phi[I] += alpha * dphi
-            trial = State(phi, x.w + alpha * dw.reshape(P.shape), x.h_d + alpha * dhd)
-            ev_t = evaluate(P, trial, load)
-            f_t = merit(ev_t, sizes)
-            if np.isfinite(f_t) and f_t <= (1 - 1e-4 * alpha) * f:
-                break
-            alpha /= 2
-        else:
-            raise MixedNotConverged(f"Newton coupling: no decrease of the residual along "
-                                    f"the step at iteration {it}", history)
-        changes = (float(np.abs(alpha * dw).max() / s.h_ref),
+        trial, ev_t, f_t, alpha, downhill = line_search(P, x, ev, step, load, sizes, f)
+        if not downhill:
+            trial, ev_t, f_t, alpha = clamped_step(P, x, step[0], load, sizes)
+            downhill = f_t < f
+        uphill = 0 if downhill else uphill + 1
+        if uphill > WATCHDOG or not np.isfinite(f_t):
+            raise MixedNotConverged(f"Newton coupling: the residual did not decrease in "
+                                    f"{uphill} steps up to iteration {it}", history)
+        changes = (float(np.abs(trial.w - x.w).max() / s.h_ref),
                    float(np.abs(ev_t["p_con"] - ev["p_con"]).max() / s.p_ref),
                    float(np.abs(ev_t["p"] - ev["p"]).max() / s.p_ref), ev_t["L"] / load)
         history.append((it, *changes, trial.h_d, gm))
@@ -386,6 +386,60 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
             return x, ev, it, history
     raise MixedNotConverged(f"Newton coupling did not reach {tol} in {max_iter} iterations "
                             f"(merit {f_t:.2e})", history)
+
+
+def clamped_step(P: Problem, x: State, dphi, load: float, sizes):
+    """The Newton step with the nodes that the step ``dphi`` moves across the p-theta kink
+    held on it (``p = theta = 0``, their own mass balance dropped for this step): where a
+    degenerate node of the solution sits on the kink, the plain step overshoots it back
+    and forth between the two branches.  Returns ``(state, ev, merit, 1.0)``."""
+    I = P.interior
+    crossing = (x.phi[I] + dphi) * x.phi[I] < 0
+    clamped = replace(P, interior=I[~crossing])
+    phi = x.phi.copy()
+    phi[I[crossing]] = 0.0
+    held = State(phi, x.w, x.h_d)
+    ev_c = evaluate(clamped, held, load)
+    (dphi_c, dw, dhd), _, _ = newton_step(clamped, ev_c, load, rtol=1e-6)
+    phi = held.phi.copy()
+    phi[clamped.interior] += dphi_c
+    trial = State(phi, held.w + dw.reshape(P.shape), held.h_d + dhd)
+    ev_t = evaluate(P, trial, load)
+    return trial, ev_t, merit(ev_t, sizes), 1.0
+
+
+def line_search(P: Problem, x: State, ev: dict, step, load: float, sizes, f: float):
+    """The accepted trial ``(state, ev, merit, alpha, decreased)`` along a Newton step.
+
+    The step is first shortened so that no film thins by more than half.  If the merit
+    function does not decrease, the nodes that would cross the p-theta kink stop on it
+    (their Jacobian changes there) and the step is halved until it does (Armijo, at most
+    ``HALVINGS`` times: a shorter step stagnates at a kink); if it never does, the
+    projected full step is taken anyway (semismooth Newton converges
+    without a line search near the solution; :func:`solve`'s watchdog limits such steps).
+    """
+    dphi, dw, dhd = step
+    I = P.interior
+    dh = (dw + dhd).reshape(P.shape)
+    thinning = (dh < 0) & ~ev["touching"]
+    alpha = min(1.0, float(np.min(0.5 * ev["h0"][thinning] / -dh[thinning], initial=np.inf)))
+    fallback = None
+    for trial_no in range(2 + HALVINGS):
+        phi = x.phi.copy()
+        phi[I] += alpha * dphi
+        trial = State(phi, x.w + alpha * dw.reshape(P.shape), x.h_d + alpha * dhd)
+        ev_t = evaluate(P, trial, load)
+        f_t = merit(ev_t, sizes)
+        if np.isfinite(f_t) and f_t <= (1 - 1e-4 * alpha) * f:
+            return trial, ev_t, f_t, alpha, True
+        if trial_no == 0:
+            crossing = (x.phi[I] + alpha * dphi) * x.phi[I] < 0
+            dphi = np.where(crossing, -x.phi[I] / alpha, dphi)
+            continue
+        if fallback is None:
+            fallback = (trial, ev_t, f_t, alpha, False)
+        alpha /= 2
+    return fallback
 
 
 def state_from(result, settings) -> State:

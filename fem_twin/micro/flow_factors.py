@@ -76,13 +76,16 @@ class FlowFactors:
                    b=np.tile([1.0, 0.0], (n, 1)), C=np.tile(np.eye(2), (n, 1, 1)),
                    d=np.zeros((n, 2)), contact_fraction=np.zeros(n), meta={"smooth": True})
 
-    def slopes(self, h0, rel_step: float = 1e-6):
-        """``(dh_m/dh0, dp_con/dh0)`` at ``h0`` [-, Pa/m], central differences of
-        :meth:`at`'s rules with a relative step (the Jacobian of the macro Newton coupling)."""
+    def slopes(self, h0, rel_step: float = 1e-6) -> dict:
+        """Derivatives with respect to ``h0`` of ``h_m`` [-], ``p_con`` [Pa/m], ``A`` and
+        ``b`` [1/m] at ``h0``: central differences of :meth:`at`'s rules with a relative
+        step (the Jacobian of the macro Newton coupling)."""
         x = np.asarray(h0, float)
         eps = rel_step * x
         lo, hi = self.at(x - eps), self.at(x + eps)
-        return (hi.h_m - lo.h_m) / (2 * eps), (hi.p_con - lo.p_con) / (2 * eps)
+        return {name: (getattr(hi, name) - getattr(lo, name))
+                / (2 * eps).reshape(x.shape + (1,) * (getattr(hi, name).ndim - x.ndim))
+                for name in ("h_m", "p_con", "A", "b")}
 
     # -- files ---------------------------------------------------------------------------
     def save(self, path) -> Path:

@@ -96,7 +96,8 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
 
 def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None,
                   boundary: float = BOUNDARY_FRICTION, bands=None, measured=None,
-                  diameter: float = 8e-3, load: float = 150.0) -> Path:
+                  diameter: float = 8e-3, load: float = 150.0,
+                  speed_label: str = "sliding speed $U$ [m/s]") -> Path:
     """C_f versus sliding speed (``x="speed"``) or Hersey number (``"hersey"``), log x.
 
     ``reference``: optional measured curve ``(x values, C_f, optional (low, high) band)``;
@@ -104,6 +105,7 @@ def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None
     ``(cf_min, cf_max)`` per curve, drawn as a shaded band (the patch scatter, Figure 13);
     ``measured``: optional :class:`MeasuredCurve` (or None) per curve, drawn on top in the
     curve's colour (on the Hersey axis with ``diameter`` [m] and ``load`` [N] of eq 46).
+    ``speed_label``: the speed axis (a ball-on-disk sweep is over entrainment speeds).
     """
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
@@ -126,7 +128,7 @@ def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None
                label=f"boundary friction $C_{{f,b}}$ = {boundary:g} (eq 32)")
     ax.set_ylim(0, 1.15 * boundary)
     ax.set_xscale("log")
-    ax.set_xlabel("sliding speed $U$ [m/s]" if x == "speed" else
+    ax.set_xlabel(speed_label if x == "speed" else
                   "Hersey number $H = \\mu_0 U D / F_N$ [-] (eq 46)")
     ax.set_ylabel("friction coefficient $C_f$ [-]")
     ax.legend(fontsize="small", loc="upper right")

@@ -22,7 +22,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    lubricant: Lubricant, diameter: float = 8e-3, face=None,
                    settings: MacroSettings = MacroSettings(), checkpoint=None, fields=None,
                    origin=(0.0, 0.0), progress: bool = False,
-                   factors_key: str | None = None) -> StribeckCurve:
+                   factors_key: str | None = None,
+                   slide_to_roll: float | None = None) -> StribeckCurve:
     """C_f over ``speeds`` [m/s] at one viscosity (paper 3.2: from 2 m/s down to 0.01 m/s).
 
     Each point warm-starts from the previous one (give speeds from fast to slow: the
@@ -32,13 +33,17 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     ``factors_key``: a key of the inputs the flow factors were computed from (the pipeline's
     micro-stage key); the checkpoints then depend on it instead of the factors' bits, so
     recomputing a lost micro checkpoint (same numbers to ~1e-10) keeps the points.
+    ``slide_to_roll``: a rolling-sliding contact (a ball on a disk): ``speeds`` are then the
+    entrainment speeds u_m and each point slides at ``u_r = slide_to_roll * u_m``.
     """
     speeds = np.asarray(speeds, float)
     if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
         raise ValueError("speeds must be a non-empty list of positive values [m/s]")
+    if slide_to_roll is not None and not (0 < slide_to_roll <= 2):
+        raise ValueError(f"slide_to_roll must be in (0, 2], got {slide_to_roll}")
     gap = np.asarray(gap, float)
     key = sweep_key(gap, spacing, factors if factors_key is None else factors_key, load,
-                    lubricant, settings, face)
+                    lubricant, settings, face, slide_to_roll)
     folder = Path(checkpoint) if checkpoint is not None else None
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
@@ -48,7 +53,9 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         path = None if folder is None else folder / f"point_{key}_{speed:.9e}.npz"
         res = None if path is None else load_or_none(path, MixedResult.load)
         if res is None:
-            res = solve_mixed(gap, spacing, factors, load=load, speed=float(speed),
+            sliding = dict(speed=float(speed)) if slide_to_roll is None else dict(
+                speed=float(slide_to_roll * speed), entrainment=float(speed))
+            res = solve_mixed(gap, spacing, factors, load=load, **sliding,
                               lubricant=lubricant, face=face, settings=settings,
                               initial=previous)
             if path is not None:
@@ -74,7 +81,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         iterations=get("iterations"))
 
 
-def sweep_key(gap, spacing, factors, load, lubricant, settings, face) -> str:
+def sweep_key(gap, spacing, factors, load, lubricant, settings, face,
+              slide_to_roll=None) -> str:
     """Key of a sweep's checkpoints (``point_KEY_*.npz``): a hash of all its inputs, with
     ``factors`` a :class:`FlowFactors` or a key string of their inputs."""
     h = hashlib.sha256()
@@ -84,6 +92,8 @@ def sweep_key(gap, spacing, factors, load, lubricant, settings, face) -> str:
     for a in (gap, np.asarray(spacing, float), *flow,
               np.zeros(0) if face is None else np.asarray(face, bool)):
         h.update(np.ascontiguousarray(a).tobytes())
-    h.update(json.dumps([load, lubricant.__dict__, settings.__dict__], sort_keys=True,
-                        default=str).encode())
+    inputs = [load, lubricant.__dict__, settings.__dict__]
+    if slide_to_roll is not None:
+        inputs.append(slide_to_roll)
+    h.update(json.dumps(inputs, sort_keys=True, default=str).encode())
     return h.hexdigest()[:12]
