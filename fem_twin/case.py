@@ -169,14 +169,17 @@ class Case:
         """Rough wall time of ``fem-twin run`` on ``cores`` cores [s], from the costs measured
         on this project's 2-core machine: ~3 us per cell pixel and time step of the micro
         stage on one core, ~2 s per Stribeck point at 128^2 (bundled case: 276 s measured
-        for 288 s estimated) growing as N^1.2 (pixels), one sweep
+        for 288 s estimated) growing as N^1.2 (pixels), ~2.5 s at 73^2 for a ball (67 s
+        measured for examples/ball_on_disk.toml), one sweep
         per viscosity and, with ``[run] patch_band``, one more per patch."""
         patches = len(self.geometry.patches)
         micro = (3e-6 * self.micro.resolution[0] * self.micro.resolution[1] * self.micro.steps
                  * self.micro.h0_count * patches / max(cores, 1))
-        res = ((self.macro.grid,) * 2 if self.tribometer.ball
-               else self.macro_geometry.resolution or (256, 256))
-        point = 2.0 * ((res[0] * res[1]) / 128 ** 2) ** 1.2
+        if self.tribometer.ball:         # Newton coupling: ~2.5 s a point at 73^2 measured
+            point = 2.5 * (self.macro.grid / 73) ** 2.4
+        else:
+            res = self.macro_geometry.resolution or (256, 256)
+            point = 2.0 * ((res[0] * res[1]) / 128 ** 2) ** 1.2
         n_mu = len(self.lubricant.viscosities)
         points = self.sweep.count * (1 + 0.5 * self.sweep.refine)   # refinement: ~+50 %
         sweeps = n_mu * (1 + (patches if self.run.patch_band and patches > 1 else 0))

@@ -1,0 +1,72 @@
+"""The ball-on-disk twin: case keys, and the whole pipeline on a reduced bundled case."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from fem_twin.case import CaseError, load_case
+from fem_twin.cli import main
+from fem_twin.macro import MixedResult
+from fem_twin.pipeline import ball_contact
+
+from conftest import ROOT
+
+
+def small_ball_case(tmp_path):
+    """examples/ball_on_disk.toml reduced (one patch at 32^2 x 8 h0 x 4 steps, a 37^2 ball
+    grid, 6 speeds) so that the whole pipeline runs in seconds."""
+    text = (ROOT / "examples" / "ball_on_disk.toml").read_text()
+    text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
+    for old, new in (("resolution = [128, 128]", "resolution = [32, 32]"),
+                     ("h0_count = 16", "h0_count = 8"), ("steps = 16", "steps = 4"),
+                     ("grid = 73", "grid = 37"), ("count = 12", "count = 6"),
+                     ("refine = 1 ", "refine = 0 "), ("workers = 0", "workers = 1")):
+        assert old in text
+        text = text.replace(old, new)
+    lines = [ln for ln in text.splitlines() if "patch_2" not in ln and "patch_3" not in ln]
+    path = tmp_path / "ball.toml"
+    path.write_text("\n".join(lines))
+    return path
+
+
+def test_ball_on_disk_stribeck_curve_from_ehl_to_boundary(tmp_path):
+    """Full film at the fast end (central film within 10 % of Hamrock-Dowson for the smooth
+    ball: the film is thicker than the roughness there), boundary friction at the slow end
+    (C_f within 2 % of C_f,b, the contact carries the load), through the Newton coupling;
+    the Hersey number uses u_m and the Hertz diameter."""
+    case_file = small_ball_case(tmp_path)
+    out = tmp_path / "out"
+    assert main(["run", str(case_file), "-o", str(out), "--no-progress"]) == 0
+    case = load_case(case_file)
+    rows = list(csv.DictReader(open(out / "stribeck.csv")))
+    cf_b = case.tribometer.boundary_friction
+    two_a = 2 * ball_contact(case).hertz_radius
+    for mu in case.lubricant.viscosities:
+        r = [x for x in rows if float(x["viscosity"]) == mu]
+        u_m = np.array([float(x["speed"]) for x in r])
+        cf = np.array([float(x["friction_coefficient"]) for x in r])
+        share = np.array([float(x["contact_load_fraction"]) for x in r])
+        assert np.allclose([float(x["hersey"]) for x in r], mu * u_m * two_a / case.tribometer.load)
+        assert share[0] < 0.05 and share[-1] > 0.98
+        assert cf[-1] == pytest.approx(cf_b, rel=0.02) and cf[0] < 0.7 * cf_b
+    film = json.loads((out / "summary.json").read_text())["stages"]["stribeck"]["ehl_film"]
+    assert film["h_c_m"] == pytest.approx(film["hamrock_dowson_h_c_m"], rel=0.10)
+    point = MixedResult.load(next((out / "stribeck" / "checkpoints").glob("point_*.npz")))
+    assert point.meta["coupling"] == "newton"
+    assert point.speed == pytest.approx(case.tribometer.slide_to_roll * point.meta["entrainment"])
+
+
+@pytest.mark.parametrize("old, new, key", [
+    ('kind = "ball-on-disk"', 'kind = "ball-in-socket"', "kind"),
+    ("slide_to_roll = 2.0", "slide_to_roll = 5.0", "slide_to_roll"),
+    ("ball_radius = 9.525e-3", "ball_radius = 9.525", "ball_radius"),
+    ("grid = 73", "grid = 5", "grid"),
+    ("eyring_stress = 5e6", "eyring_stress = -5e6", "eyring_stress")])
+def test_ball_case_keys_are_validated_with_units(tmp_path, old, new, key):
+    text = small_ball_case(tmp_path).read_text().replace("grid = 37", "grid = 73")
+    assert old in text
+    (tmp_path / "bad.toml").write_text(text.replace(old, new))
+    with pytest.raises(CaseError, match=key):
+        load_case(tmp_path / "bad.toml")
