@@ -41,7 +41,11 @@ MAX_COEFFICIENT_PRESSURE = 1e10
 #: its pressure-flow coupling
 DENSE_THRESHOLD = 0.02
 #: halvings of a Newton step in its line search
-HALVINGS = 6
+HALVINGS = 30
+#: ``STALL`` line-search steps in a row shorter than ``SHORT_STEP`` (a stall at a kink)
+#: are followed by a clamped step
+SHORT_STEP = 2.0 ** -6
+STALL = 3
 #: Newton steps in a row that may fail to decrease the merit function
 WATCHDOG = 8
 #: the preconditioner is kept from step to step until GMRES needs more iterations than this
@@ -360,7 +364,7 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
     """
     s = P.settings
     ev = evaluate(P, x, load)
-    history, pre, uphill = [], None, 0
+    history, pre, uphill, short = [], None, 0, 0
     for it in range(1, max_iter + 1):
         sizes = scales(ev, s, load)
         f = merit(ev, sizes)
@@ -368,9 +372,11 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
         if gm > REBUILD_AFTER:
             pre = None
         trial, ev_t, f_t, alpha, downhill = line_search(P, x, ev, step, load, sizes, f)
-        if not downhill:
+        short = short + 1 if alpha < SHORT_STEP else 0
+        if not downhill or short >= STALL:
+            # no decrease, or steps so short that the iteration stalls at a kink
             trial, ev_t, f_t, alpha = clamped_step(P, x, step[0], load, sizes)
-            downhill = f_t < f
+            downhill, short = f_t < f, 0
         uphill = 0 if downhill else uphill + 1
         if uphill > WATCHDOG or not np.isfinite(f_t):
             raise MixedNotConverged(f"Newton coupling: the residual did not decrease in "
@@ -414,9 +420,10 @@ def line_search(P: Problem, x: State, ev: dict, step, load: float, sizes, f: flo
     The step is first shortened so that no film thins by more than half.  If the merit
     function does not decrease, the nodes that would cross the p-theta kink stop on it
     (their Jacobian changes there) and the step is halved until it does (Armijo, at most
-    ``HALVINGS`` times: a shorter step stagnates at a kink); if it never does, the
-    projected full step is taken anyway (semismooth Newton converges
-    without a line search near the solution; :func:`solve`'s watchdog limits such steps).
+    ``HALVINGS`` times).  Without a decrease (``decreased`` False: the projected full step
+    is returned), or after ``STALL`` steps shorter than ``SHORT_STEP``, :func:`solve` takes
+    a :func:`clamped_step` instead (its watchdog limits the steps that do not decrease the
+    merit function).
     """
     dphi, dw, dhd = step
     I = P.interior
