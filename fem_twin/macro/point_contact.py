@@ -8,9 +8,13 @@ coefficient ``alpha``.
 * Hertz: ``a = (3 F R / (2 E'))^(1/3)``, ``p_H = 3 F / (2 pi a^2)``, approach ``a^2 / R``.
 * Dimensionless groups (Hamrock and Dowson 1977): ``U = mu_0 u_m / (E' R)``,
   ``W = F / (E' R^2)``, ``G = alpha E'``; Moes: ``M = W (2U)^(-3/4)``, ``L = G (2U)^(1/4)``.
-* Hamrock-Dowson fits for a circular contact (ellipticity k = 1):
+* Hamrock-Dowson fits (R = R_x, ellipticity k = b/a):
   ``h_c / R = 2.69 U^0.67 G^0.53 W^-0.067 (1 - 0.61 e^(-0.73 k))`` and
   ``h_min / R = 3.63 U^0.68 G^0.49 W^-0.073 (1 - e^(-0.68 k))``.
+* An elliptical (line-like) contact has ``radius_y = R_y > R_x`` (the entrainment along x):
+  Hamrock and Brewe's (1983) ``k = 1.0339 (R_y/R_x)^0.636``,
+  ``E = 1.0003 + 0.5968 R_x/R_y``, ``a = (6 E F R' / (pi k E'))^(1/3)``, ``b = k a`` with
+  ``1/R' = 1/R_x + 1/R_y`` (within a few per cent of the exact Hertz ellipse).
 
 In :func:`fem_twin.macro.solve_mixed` the disk slides at ``U_s`` under a stationary pin
 (``u_m = U_s / 2``); a rolling contact with entrainment speed ``u_m`` is given as
@@ -34,6 +38,7 @@ class PointContact:
     viscosity: float           # mu_0 [Pa s]
     alpha: float               # pressure-viscosity coefficient [1/Pa]
     entrainment: float         # u_m [m/s]
+    radius_y: float | None = None   # R_y [m] across the entrainment (None: a sphere)
 
     def __post_init__(self):
         for name in ("radius", "load", "e_reduced", "viscosity", "entrainment"):
@@ -42,6 +47,17 @@ class PointContact:
                 raise ValueError(f"PointContact.{name} must be positive and finite, got {v}")
         if not (np.isfinite(self.alpha) and self.alpha >= 0):
             raise ValueError(f"PointContact.alpha must be >= 0 [1/Pa], got {self.alpha}")
+        if self.radius_y is not None and not (np.isfinite(self.radius_y)
+                                              and self.radius_y >= self.radius):
+            raise ValueError("PointContact.radius_y must be at least the radius R_x [m], got "
+                             f"{self.radius_y}")
+
+    @property
+    def ellipticity(self) -> float:
+        """k = b/a (Hamrock-Brewe; 1 for a sphere)."""
+        if self.radius_y is None or self.radius_y == self.radius:
+            return 1.0
+        return 1.0339 * (self.radius_y / self.radius) ** 0.636
 
     @classmethod
     def from_moes(cls, M: float, L: float, *, radius=12.5e-3, e_reduced=110e9,
@@ -58,13 +74,18 @@ class PointContact:
 
     @property
     def hertz_radius(self) -> float:
-        """a [m]."""
-        return (3 * self.load * self.radius / (2 * self.e_reduced)) ** (1 / 3)
+        """a [m], the contact's half-width along the entrainment."""
+        if self.ellipticity == 1.0:
+            return (3 * self.load * self.radius / (2 * self.e_reduced)) ** (1 / 3)
+        k, rx, ry = self.ellipticity, self.radius, self.radius_y
+        r = 1 / (1 / rx + 1 / ry)
+        e = 1.0003 + 0.5968 * rx / ry
+        return (6 * e * self.load * r / (np.pi * k * self.e_reduced)) ** (1 / 3)
 
     @property
     def hertz_pressure(self) -> float:
         """p_H [Pa]."""
-        return 3 * self.load / (2 * np.pi * self.hertz_radius ** 2)
+        return 3 * self.load / (2 * np.pi * self.ellipticity * self.hertz_radius ** 2)
 
     @property
     def groups(self) -> tuple:
@@ -82,19 +103,21 @@ class PointContact:
     def hamrock_dowson(self) -> tuple:
         """``(h_c, h_min)`` [m] of the Hamrock-Dowson fits (k = 1)."""
         U, W, G = self.groups
-        k = 1.0
+        k = self.ellipticity
         h_c = 2.69 * U ** 0.67 * G ** 0.53 * W ** -0.067 * (1 - 0.61 * np.exp(-0.73 * k))
         h_min = 3.63 * U ** 0.68 * G ** 0.49 * W ** -0.073 * (1 - np.exp(-0.68 * k))
         return h_c * self.radius, h_min * self.radius
 
     def grid(self, n: int, extent=((-4.0, 2.0), (-3.0, 3.0))):
-        """The rigid gap ``x1^2/(2R) + x2^2/(2R)`` [m] on ``n x n`` nodes over ``extent``
-        (in Hertz radii, x1 the entrainment direction), its spacing and node coordinates.
-        ``n - 1`` divisible by the extents' lengths puts a node on the centre."""
+        """The rigid gap ``x1^2/(2R_x) + x2^2/(2R_y)`` [m] on ``n x n`` nodes over ``extent``
+        (in the Hertz half-widths a and b = k a, x1 the entrainment direction), its spacing
+        and node coordinates.  ``n - 1`` divisible by the extents' lengths puts a node on
+        the centre."""
         a = self.hertz_radius
         x1 = np.linspace(*extent[0], n) * a
-        x2 = np.linspace(*extent[1], n) * a
-        gap = (x1[None, :] ** 2 + x2[:, None] ** 2) / (2 * self.radius)
+        x2 = np.linspace(*extent[1], n) * a * self.ellipticity
+        gap = x1[None, :] ** 2 / (2 * self.radius) + x2[:, None] ** 2 / (
+            2 * (self.radius_y or self.radius))
         return gap, (x1[1] - x1[0], x2[1] - x2[0]), x1, x2
 
 
