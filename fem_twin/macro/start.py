@@ -1,15 +1,13 @@
 """Cold starts of the macro iteration: the rigid separations that begin it (eqs 28-30).
 
 Before any elastic deformation is known the load balance is solved on the rigid gap:
-:func:`dry_separation` (contact alone), :func:`rigid_separation` (film and contact, the
-Anderson and PID couplings) and :func:`film_separation` (film alone on a log scale, the
-Newton coupling's load continuation).
+:func:`dry_separation` (contact alone) and :func:`rigid_separation` (film and contact, the
+Anderson and PID couplings; the Newton coupling's start is :func:`.newton.rigid_start`).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import MixedNotConverged
 
@@ -81,25 +79,3 @@ def rigid_separation(excess, h_free, h_dry, step, rtol=1e-3):
         if hi - lo < rtol * max(abs(mid), step) or f_mid == 0:
             break
     return mid
-
-
-def film_separation(excess, h_touch, h_free, rtol=1e-3):
-    """h_d in ``(h_touch, h_free]`` at which ``excess(h_d) = F_N - F_N,imp`` (decreasing in
-    ``h_d``) vanishes: bracketed by halving ``h_d - h_touch`` from ``h_free`` (a film's load
-    grows like a power of ``1/h``), then ``brentq`` in ``log(h_d - h_touch)`` [m]."""
-    def f(log_t):
-        return excess(h_touch + np.exp(log_t))
-
-    hi = np.log(h_free - h_touch)
-    f_hi = f(hi)
-    if f_hi > 0:
-        raise MixedNotConverged("the film carries more than the load even at the largest "
-                           "separation of the flow factors", [(h_free, f_hi)])
-    lo = hi
-    for _ in range(80):
-        lo -= np.log(2.0)
-        if f(lo) > 0:
-            break
-    else:
-        raise MixedNotConverged("no film separation carries the load", [(h_free, f_hi)])
-    return h_touch + np.exp(brentq(f, lo, lo + np.log(2.0), rtol=rtol * 1e-2))
