@@ -62,8 +62,8 @@ from .reynolds import (ReynoldsNotConverged, complementarity_solver, fe_poiseuil
 MAX_COEFFICIENT_PRESSURE = 1e10
 
 #: ``coupling="auto"`` takes the Newton coupling when the first iterate's elastic
-#: deformation exceeds this multiple of the thinnest loaded film (measured: bundled pin
-#: 0.2-6.4 over its sweep; smooth balls 25-4000 for M = 10-1000)
+#: deformation exceeds this multiple of the thinnest loaded film (measured: sample pin at
+#: 32^2 and 128^2, 0.003-1 m/s: 0.2-6.4; smooth balls 25-4000 for M = 10-1000)
 ELASTIC_RATIO = 15.0
 
 #: Newton iterations per load of the ``"newton"`` coupling (it converges in 5-20), at most
