@@ -57,10 +57,6 @@ from .reynolds import (ReynoldsNotConverged, complementarity_solver, fe_poiseuil
                        trapezoid_weights, upwind_couette)
 
 
-#: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
-#: clipped before eqs 23-24 are evaluated, so that the Roelands exponential stays finite.
-MAX_COEFFICIENT_PRESSURE = 1e10
-
 #: ``coupling="auto"`` takes the Newton coupling when the first iterate's elastic
 #: deformation exceeds this multiple of the thinnest loaded film (measured: sample pin at
 #: 32^2 and 128^2, 0.003-1 m/s: 0.2-6.4; smooth balls 25-4000 for M = 10-1000)
@@ -274,8 +270,7 @@ def _solve_fixed_point(P, load, face, initial, progress, t0):
     """The ``"anderson"`` and ``"pid"`` couplings (see the module docstring)."""
     h_g, dx, factors, lubricant, s = P.gap, P.spacing, P.factors, P.lubricant, P.settings
     op, poiseuille, area = P.elastic, P.poiseuille, P.area
-    boundary = np.ones(h_g.shape, bool)
-    boundary.ravel()[P.interior] = False
+    boundary = P.boundary
     u_m = P.entrainment
     p_amb_rel = s.ambient_pressure - s.cavitation_pressure
     scale = s.p_ref                                     # theta = -phi / scale in cavities
@@ -291,7 +286,7 @@ def _solve_fixed_point(P, load, face, initial, progress, t0):
         h0 = np.maximum(h_d + h_g + h_el, s.gap_floor)
         loc = factors.at(h0)
         p_prev = state["p"]
-        p_coef = np.minimum(p_prev, MAX_COEFFICIENT_PRESSURE)
+        p_coef = np.minimum(p_prev, newton.MAX_COEFFICIENT_PRESSURE)
         mu = lubricant.viscosity_at(p_coef)
         rho = lubricant.density_ratio(p_coef)
         g = rho * loc.h_m ** 3 / (12 * mu)
@@ -416,8 +411,8 @@ def _solve_newton(P, load, face, initial, progress, t0):
 
 def elastic_ratio(ev, op, s) -> float:
     """Largest elastic deformation by the film pressure over the thinnest film under
-    pressure, at the first iterate: large for a concentrated contact (a ball: 10-100),
-    small for a conformal pin."""
+    pressure, at the first iterate: large for a concentrated contact (smooth balls:
+    25-4000), small for a conformal pin (0.2-6.4)."""
     p_gauge = ev["p"] + s.cavitation_pressure - s.ambient_pressure
     loaded = p_gauge > 0
     if not loaded.any():

@@ -35,7 +35,9 @@ import scipy.sparse.linalg as spla
 from ..errors import MixedNotConverged
 from .reynolds import couette_parts
 
-#: pressures above this [Pa] are clipped before eqs 23-24 (finite Roelands exponential)
+#: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
+#: clipped before eqs 23-24 are evaluated (both couplings), so that the Roelands
+#: exponential stays finite.
 MAX_COEFFICIENT_PRESSURE = 1e10
 #: a node joins the dense elastic block when its elastic coupling exceeds this fraction of
 #: its pressure-flow coupling
@@ -73,6 +75,13 @@ class Problem:
     @property
     def shape(self):
         return self.gap.shape
+
+    @property
+    def boundary(self) -> np.ndarray:
+        """(ny, nx) bool: the Dirichlet nodes (all but ``interior``)."""
+        mask = np.ones(self.shape, bool)
+        mask.ravel()[self.interior] = False
+        return mask
 
     def kernel(self):
         """The influence kernel on the padded grid (real space, [m/Pa])."""
@@ -117,12 +126,13 @@ def evaluate(P: Problem, x: State, load: float) -> dict:
     flux = K @ p.ravel() + B1 @ (q1 * open_) + B2 @ (q2 * open_)
     size = abs(K) @ p.ravel() + abs(B1) @ np.abs(q1) + abs(B2) @ np.abs(q2)
     p_tot = p + s.cavitation_pressure + loc.p_con - s.ambient_pressure
+    F = float(np.sum(P.area * p_tot))
     return dict(p=p, theta=theta, h0=h0, touching=h_raw <= s.gap_floor, loc=loc, mu=mu,
                 rho=rho, g=g, q=q, K=K, B=(B1, B2), q12=(q1, q2), p_con=loc.p_con,
                 R=flux[P.interior], size=size[P.interior] + 1e-300,
-                G=x.w - P.elastic(p_tot), F=float(np.sum(P.area * p_tot)),
+                G=x.w - P.elastic(p_tot), F=F,
                 F_hd=float(np.sum(P.area * (p + s.cavitation_pressure - s.ambient_pressure))),
-                L=float(np.sum(P.area * p_tot)) - load)
+                L=F - load)
 
 
 def _probe(P: Problem, coefficients, p) -> sp.csr_matrix:
@@ -194,10 +204,10 @@ class Preconditioner:
     the Schur complement on ``S``.
     """
 
-    def __init__(self, P: Problem, ev: dict, jac: dict, dense=None):
+    def __init__(self, P: Problem, jac: dict):
         I, n = P.interior, P.gap.size
         J_pp, J_ph, pos, dpc = jac["J_pp"], jac["J_ph"], jac["pos"], jac["dpc"]
-        sI = dense_set(P, jac) if dense is None else dense
+        sI = dense_set(P, jac)
         S = I[sI]
         self.P, self.jac, self.sI, self.S = P, jac, sI, S
         E = P.dense_elastic(S)
@@ -231,7 +241,6 @@ class Preconditioner:
         CsO = self.JphS[O]
         ring = np.flatnonzero(np.asarray(abs(JOS).sum(axis=1)).ravel()
                               + np.asarray(abs(CsO).sum(axis=1)).ravel())
-        self.ring = ring
         self.B_ring = JOS[ring].toarray() + CsO[ring] @ W
         unit = np.zeros((O.size, ring.size))
         unit[ring, np.arange(ring.size)] = 1.0
@@ -305,11 +314,11 @@ def apply_jacobian(P: Problem, jac: dict, dphi, dw, dhd):
 
 def newton_step(P: Problem, ev: dict, load: float, rtol: float, pre=None):
     """The Newton update ``(dphi, dw, dhd)``, the GMRES iteration count and the
-    preconditioner (built from this step's Jacobian unless ``pre`` is given); GMRES runs on the system scaled by the residuals' natural sizes (each
-    node's flux magnitude, h_ref, the load) to the relative tolerance ``rtol``."""
+    preconditioner (built from this step's Jacobian unless ``pre`` is given).  GMRES runs on
+    the system scaled by the residuals' natural sizes (:func:`scales`) to ``rtol``."""
     s = P.settings
     jac = jacobian(P, ev)
-    pre = Preconditioner(P, ev, jac) if pre is None else pre
+    pre = Preconditioner(P, jac) if pre is None else pre
     nI, n = P.interior.size, P.gap.size
     size, h_s, _ = scales(ev, s, load)
     row = np.r_[1 / size, np.full(n, 1 / h_s), 1 / load]                 # residual scales
@@ -464,8 +473,6 @@ def rigid_start(P: Problem, load: float, ratio: float):
     Returns the state and the load it carries (at most ``load``)."""
     from .reynolds import solve_complementarity, upwind_couette
     s = P.settings
-    boundary = np.ones(P.shape, bool)
-    boundary.ravel()[P.interior] = False
     rho0 = P.lubricant.density_ratio(0.0)
     touch = s.gap_floor - float(P.gap.min())
     t = float(P.factors.h0[-1]) - float(P.gap.min()) - touch
@@ -475,7 +482,7 @@ def rigid_start(P: Problem, load: float, ratio: float):
         g = rho0 * loc.h_m ** 3 / (12 * P.lubricant.viscosity)
         q = rho0 * loc.h_m * P.entrainment
         B = upwind_couette(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing)
-        phi, _, _ = solve_complementarity(P.poiseuille(g, loc.A), B, boundary,
+        phi, _, _ = solve_complementarity(P.poiseuille(g, loc.A), B, P.boundary,
                                           s.ambient_pressure - s.cavitation_pressure, s.p_ref)
         x = State(phi, np.zeros(P.shape), h_d)
         ev = evaluate(P, x, load)
@@ -489,9 +496,9 @@ def rigid_start(P: Problem, load: float, ratio: float):
 
 def continuation(P: Problem, load: float, *, tol: float, max_iter: int, progress=None,
                  ratio: float = 0.3):
-    """Cold start by load continuation: the rigid film of :func:`rigid_start`, then Newton solves at loads growing
-    by a factor (x4, halved in log after a failure, doubled after a success) up to
-    ``load``.  Returns what :func:`solve` returns, with the iterations of every stage."""
+    """Cold start by load continuation: the rigid film of :func:`rigid_start`, then Newton
+    solves at loads growing by a factor (x4, its logarithm halved after a failure and
+    doubled after a success) up to ``load``.  Returns what :func:`solve` returns, with the iterations of every stage."""
     x, F = rigid_start(P, load, ratio)
     total, history, factor, target = 0, [], 4.0, F
     while True:
