@@ -239,19 +239,15 @@ def test_newton_jacobian_is_exact(case32, factors):
     mixed state (p_con carries part of the load), in directions away from the p-theta kink;
     each node's mass residual relative to its flux size (a 1e-13 m change of a 1 mm gap
     beside the pin is round-off): within 1e-6 of the change (measured 1e-11 and below)."""
-    from fem_twin.contact.elastic import elastic_operator
     from fem_twin.macro import newton
-    from fem_twin.macro.reynolds import trapezoid_weights
+    from fem_twin.macro.problem import macro_problem
     gap, spacing, face = case32
     s = MacroSettings(coupling="newton")
     res = solve_mixed(gap, spacing, factors, load=150.0, speed=0.03,
                       lubricant=Lubricant(0.066), face=face, settings=s)
     assert res.contact_load > 10
-    interior = np.flatnonzero(np.pad(np.ones((30, 30), bool), 1).ravel())
-    P = newton.Problem(gap, spacing, factors, Lubricant(0.066), s,
-                       lambda g, A: fe_poiseuille(g, spacing, A),
-                       elastic_operator(gap.shape, spacing, s.e_reduced),
-                       trapezoid_weights(gap.shape, spacing), interior, 0.03, 0.015)
+    P = macro_problem(gap, spacing, factors, Lubricant(0.066), s, 0.03, 0.015)
+    interior = P.interior
     x = newton.state_from(res, s)
     ev = newton.evaluate(P, x, 150.0)
     jac = newton.jacobian(P, ev)
@@ -271,3 +267,38 @@ def test_newton_jacobian_is_exact(case32, factors):
         for k, scale in enumerate((ev["size"], 1.0, 1.0)):
             fd = (np.asarray(sides[0][k]) - np.asarray(sides[1][k])) / 2 / scale
             assert np.abs(exact[k] / scale - fd).max() <= 1e-6 * np.abs(fd).max() + 1e-30
+
+
+def test_start_separations_find_analytic_roots():
+    """The cold start's root finders (macro/start.py) on loads with known roots: a lifting
+    film ``F = W (h*/h)^2`` (bracket by doubling upward), a film plus asperities below first
+    contact (bracket by halving towards the dry state) within their ``rtol`` 1e-3, the
+    dry contact ``p_con = k (h_c - h0)^1.5`` to 1e-12, and a clear error when no
+    separation below 1 mm carries the load."""
+    from types import SimpleNamespace
+
+    from fem_twin.macro.start import dry_separation, rigid_separation
+    W, calls = 100.0, []
+
+    def film(h_star):
+        def excess(h):
+            calls.append(h)
+            return W * (h_star / h) ** 2 - W
+        return excess
+
+    h = rigid_separation(film(0.7e-6), 0.2e-6, 0.01e-6, 0.05e-6)
+    assert abs(h - 0.7e-6) <= 1e-3 * 0.7e-6 and len(calls) < 25
+    calls.clear()
+    h = rigid_separation(film(0.3e-6), 1e-6, 0.1e-6, 0.05e-6)
+    assert abs(h - 0.3e-6) <= 1e-3 * 0.3e-6 and len(calls) < 25
+    with pytest.raises(MixedNotConverged, match="1 mm"):
+        rigid_separation(lambda h: 1.0, 1e-6, 0.1e-6, 1e-6)
+    k, h_c, n = 1e18, 2e-6, 10
+    factors = SimpleNamespace(h0=np.array([1e-9, h_c]),
+                              contact_pressure=lambda h0: k * np.maximum(h_c - h0, 0) ** 1.5)
+    gap, area = np.zeros((n, n)), np.full((n, n), 1e-8)
+    s = SimpleNamespace(gap_floor=1e-9)
+    load = 30.0
+    exact = h_c - (load / (k * area.sum())) ** (2 / 3)
+    assert abs(dry_separation(factors, gap, area, load, s) - exact) <= 1e-12 * h_c
+    assert dry_separation(factors, gap, area, 1e9, s) == s.gap_floor   # cannot carry it

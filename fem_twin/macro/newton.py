@@ -27,18 +27,14 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.fft as fft
 import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import MixedNotConverged
+from .problem import MAX_COEFFICIENT_PRESSURE, Problem
 from .reynolds import couette_parts
 
-#: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
-#: clipped before eqs 23-24 are evaluated (both couplings), so that the Roelands
-#: exponential stays finite.
-MAX_COEFFICIENT_PRESSURE = 1e10
 #: a node joins the dense elastic block when its elastic coupling exceeds this fraction of
 #: its pressure-flow coupling
 DENSE_THRESHOLD = 0.02
@@ -57,49 +53,6 @@ MAX_DENSE = 4000
 
 
 @dataclass(frozen=True, eq=False)
-class Problem:
-    """The grid, the physics and the load of one operating point (SI units)."""
-
-    gap: np.ndarray            # rigid gap h_g (ny, nx) [m]
-    spacing: tuple             # (dx1, dx2) [m]
-    factors: object            # FlowFactors
-    lubricant: object          # Lubricant
-    settings: object           # MacroSettings
-    poiseuille: object         # (g, A) -> sparse K
-    elastic: object            # ElasticOperator
-    area: np.ndarray           # trapezoid weights [m^2]
-    interior: np.ndarray       # flat indices of the interior nodes
-    speed: float               # sliding speed u_r [m/s]
-    entrainment: float         # mean (entrainment) speed u_m [m/s]
-
-    @property
-    def shape(self):
-        return self.gap.shape
-
-    @property
-    def boundary(self) -> np.ndarray:
-        """(ny, nx) bool: the Dirichlet nodes (all but ``interior``)."""
-        mask = np.ones(self.shape, bool)
-        mask.ravel()[self.interior] = False
-        return mask
-
-    def kernel(self):
-        """The influence kernel on the padded grid (real space, [m/Pa])."""
-        ny, nx = self.shape
-        cache = self.__dict__.setdefault("_kernel", [])
-        if not cache:
-            cache.append(fft.irfft2(self.elastic.kernel_hat, s=(2 * ny, 2 * nx)))
-        return cache[0]
-
-    def dense_elastic(self, nodes) -> np.ndarray:
-        """``E[nodes, nodes]``: deformation at node i per pressure at node j [m/Pa]."""
-        ny, nx = self.shape
-        r, c = np.divmod(nodes, nx)
-        return self.kernel()[(r[:, None] - r[None, :]) % (2 * ny),
-                             (c[:, None] - c[None, :]) % (2 * nx)]
-
-
-@dataclass(frozen=True, eq=False)
 class State:
     phi: np.ndarray            # (n,) p-theta switch, boundary nodes at p_amb - p_cav [Pa]
     w: np.ndarray              # (ny, nx) elastic deformation h_el [m]
@@ -108,17 +61,13 @@ class State:
 
 def evaluate(P: Problem, x: State, load: float) -> dict:
     """Residuals ``R, G, L`` and every field the Jacobian and the result need."""
-    s, lub = P.settings, P.lubricant
+    s = P.settings
     shape = P.shape
     p = np.maximum(x.phi, 0).reshape(shape)
     theta = (np.maximum(-x.phi, 0) / s.p_ref).reshape(shape)
     h_raw = x.h_d + P.gap + x.w
     h0 = np.maximum(h_raw, s.gap_floor)
-    loc = P.factors.at(h0)
-    p_coef = np.minimum(p, MAX_COEFFICIENT_PRESSURE)
-    mu, rho = lub.viscosity_at(p_coef), lub.density_ratio(p_coef)
-    g = rho * loc.h_m ** 3 / (12 * mu)
-    q = rho * loc.h_m * P.entrainment
+    loc, mu, rho, g, q = P.coefficients(p, h0)
     K = P.poiseuille(g, loc.A)
     q1, q2 = (q * loc.b[..., 0]).ravel(), (q * loc.b[..., 1]).ravel()
     B1, B2 = couette_parts(q1.reshape(shape), q2.reshape(shape), P.spacing)

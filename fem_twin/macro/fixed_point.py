@@ -1,0 +1,229 @@
+"""The fixed-point couplings of the macro scale: ``"anderson"`` and the paper's ``"pid"``.
+
+Each iteration solves the Reynolds complementarity problem (eqs 17-18) at the coefficients
+of the previous pressure (lagged viscosity and density, warm-started), then updates the
+elastic deformation ``h_el`` (eqs 20-22), the contact pressure ``p_con`` (eqs 25-27) and the
+rigid-body separation ``h_d`` (eqs 28-30):
+
+``"anderson"``
+    the fixed point ``(h_el, h_d) -> (op(p_tot - p_amb), h_d + dF/k)`` with ``p_con``
+    taken at the current ``h0`` (no under-relaxation), accelerated by Anderson mixing
+    (Walker and Ni 2011).  ``k`` is a load-stiffness estimate (contact stiffness from the
+    slope of ``p_con(h0)`` plus ``2 F_hd / h``); Anderson mixing corrects it.
+``"pid"``
+    the paper's scheme: ``p_con`` under-relaxed with ``alpha_pcon`` (eq 26), the
+    incremental PID controller of eq 29 on ``h_d``, and ``h_el`` under-relaxed (the
+    paper's EHL-FBNS solves the elastic coupling inside its Newton system; a plain
+    fixed point on ``h_el`` oscillates here, so it is relaxed with ``relaxation_elastic``).
+
+Converged when, between two iterations, the change of ``h_el`` / h_ref, the update of
+``p_con`` / p_ref (eq 27), the change of ``p`` / p_ref and the load residual (eq 30) are all
+below ``tol``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..anderson import Anderson
+from ..errors import MixedNotConverged
+from .reynolds import ReynoldsNotConverged, complementarity_solver, upwind_couette
+from .start import dry_separation, rigid_separation
+
+#: ``coupling="auto"`` takes the Newton coupling when the first iterate's elastic
+#: deformation exceeds this multiple of the thinnest loaded film (measured: sample pin at
+#: 32^2 and 128^2, 0.003-1 m/s: 0.2-6.4; smooth balls 25-4000 for M = 10-1000)
+ELASTIC_RATIO = 15.0
+#: halvings of an over-long step (the Reynolds solve failed) before giving up
+RETRIES = 12
+#: Anderson iterations without halving the residual before its history is restarted
+STAGNATION = 25
+
+
+class Concentrated(Exception):
+    """The ``"auto"`` coupling's signal: the contact needs the Newton coupling."""
+
+
+def solve_fixed_point(P, load: float, face, initial=None, progress=None):
+    """Iterate the ``P.settings.coupling`` fixed point (``"auto"`` means ``"anderson"``, and
+    raises :class:`Concentrated` at the first iterate of an elastically dominated contact).
+    Returns ``(ev, h_el, h_d, iterations, history)``; raises :class:`MixedNotConverged`."""
+    s = P.settings
+    inner = _Reynolds(P, initial)
+    h_el, h_d, p_con = _start(P, inner, load, face, initial)
+    outer = _Pid(s) if s.coupling == "pid" else _Mixing(P, load, face)
+    history, good, retries, row = [], None, 0, (np.nan,) * 4
+    for it in range(1, s.max_iter + 1):
+        try:
+            ev = inner.evaluate(h_el, h_d, p_con if s.coupling == "pid" else None)
+        except ReynoldsNotConverged as err:     # an over-long step (gap far too thin)
+            retries += 1
+            if good is None or retries > RETRIES:
+                raise MixedNotConverged(f"the Reynolds solve failed at iteration {it}: {err}",
+                                        history) from err
+            h_el, h_d = (h_el + good[0]) / 2, (h_d + good[1]) / 2
+            inner.phi, inner.p = good[2], good[3]
+            outer.restart()
+            history.append((it, np.nan, np.nan, np.nan, np.nan, h_d, -1))
+            continue
+        retries = 0
+        if it == 1 and s.coupling == "auto" and elastic_ratio(ev, P.elastic, s) > ELASTIC_RATIO:
+            raise Concentrated
+        good = (h_el, h_d, inner.phi, ev["p_prev"])
+        row = _changes(ev, h_el, p_con, load, s)
+        res = max(map(abs, row))
+        history.append((it, *row, h_d, inner.newton))
+        if progress is not None:
+            progress(it, res)
+        if res < s.tol and it > 1:
+            return ev, h_el, h_d, it, history
+        h_el, h_d, p_con = outer.update(ev, h_el, h_d, p_con, row, res)
+    raise MixedNotConverged(
+        f"macro iteration ({s.coupling}) did not reach residuals below {s.tol} in "
+        f"{s.max_iter} iterations (last: h_el {row[0]:.2e}, p_con {row[1]:.2e}, "
+        f"p {row[2]:.2e}, load {row[3]:.2e})", history)
+
+
+def _changes(ev, h_el, p_con, load, s) -> tuple:
+    """``(r_hel, r_pcon, r_p, r_F)``: the changes of ``h_el`` / h_ref, ``p_con`` / p_ref
+    (eq 27) and ``p`` / p_ref in this iteration, and the load residual (eq 30)."""
+    return (float(np.abs(ev["h_el_new"] - h_el).max() / s.h_ref),
+            float(np.abs(ev["p_con_target"] - p_con).max() / s.p_ref),
+            float(np.abs(ev["p"] - ev["p_prev"]).max() / s.p_ref),
+            (ev["F"] - load) / load)
+
+
+class _Reynolds:
+    """Reynolds (eqs 17-18) at the coefficients of the previous pressure, warm-started from
+    the previous switch ``phi``: the inner problem of the fixed point."""
+
+    def __init__(self, P, initial):
+        s = P.settings
+        self.P, self.solver = P, complementarity_solver(s.complementarity)
+        self.p_amb_rel = s.ambient_pressure - s.cavitation_pressure
+        self.phi, self.p, self.newton = None, np.full(P.shape, self.p_amb_rel), 0
+        if initial is not None:
+            self.p = initial.pressure - s.cavitation_pressure
+            theta0 = initial.cavity_fraction
+            self.phi = np.where(theta0 > 0, -theta0 * s.p_ref, np.maximum(self.p, 0)).ravel()
+
+    def reset(self):
+        """A cold inner start (the state is far from the last one)."""
+        self.phi, self.p = None, np.full(self.P.shape, self.p_amb_rel)
+
+    def evaluate(self, h_el, h_d, p_con=None) -> dict:
+        """Solve at ``h0 = h_d + h_g + h_el`` (eq 19); ``p_con`` [Pa] is used in the load and
+        the deformation when given (``"pid"``), else ``p_con(h0)``.  Returns every field the
+        updates and the result need."""
+        P, s = self.P, self.P.settings
+        h0 = np.maximum(h_d + P.gap + h_el, s.gap_floor)
+        p_prev = self.p
+        loc, mu, rho, g, q = P.coefficients(p_prev, h0)
+        B = upwind_couette(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing)
+        phi, its, _ = self.solver(P.poiseuille(g, loc.A), B, P.boundary, self.p_amb_rel,
+                                  s.p_ref, phi0=self.phi)
+        self.phi, self.newton = phi, its
+        p = np.maximum(phi, 0).reshape(P.shape)
+        self.p = p
+        p_con_used = loc.p_con if p_con is None else p_con
+        p_tot = p + s.cavitation_pressure + p_con_used
+        return dict(h0=h0, loc=loc, mu=mu, rho=rho, p=p, p_prev=p_prev,
+                    theta=(np.maximum(-phi, 0) / s.p_ref).reshape(P.shape),
+                    p_con_target=loc.p_con, p_con=p_con_used,
+                    F=float(np.sum(P.area * (p_tot - s.ambient_pressure))),
+                    F_hd=float(np.sum(P.area * (p + s.cavitation_pressure
+                                                - s.ambient_pressure))),
+                    h_el_new=P.elastic(p_tot - s.ambient_pressure))
+
+
+def _start(P, inner, load, face, initial):
+    """``(h_el, h_d, p_con)`` to begin with: ``initial``'s, or the rigid film and contact
+    that carry the load (:func:`.start.rigid_separation`)."""
+    if initial is not None:
+        return (initial.elastic_deformation.copy(), float(initial.h_d),
+                initial.contact_pressure.copy())
+    s, factors, h_g = P.settings, P.factors, P.gap
+    h_el = np.zeros(P.shape)
+
+    def excess(h_d):
+        inner.reset()
+        return inner.evaluate(h_el, h_d)["F"] - load
+
+    h_free = float(factors.h0[-1]) - float(h_g[face].min())
+    h_d = rigid_separation(excess, h_free, dry_separation(factors, h_g, P.area, load, s),
+                           float(factors.h0[-1]))
+    inner.p = np.full(P.shape, inner.p_amb_rel)
+    return h_el, h_d, factors.contact_pressure(np.maximum(h_d + h_g, s.gap_floor))
+
+
+class _Pid:
+    """The paper's updates: eq 26 on ``p_con``, the PID controller of eq 29 on ``h_d``,
+    under-relaxation on ``h_el``."""
+
+    def __init__(self, s):
+        self.s, self.r_prev = s, (0.0, 0.0)
+
+    def restart(self):
+        pass
+
+    def update(self, ev, h_el, h_d, p_con, row, res):
+        s, r_F = self.s, row[3]
+        p_con = p_con + s.relaxation_pcon * (ev["p_con_target"] - p_con)       # eq 26
+        kp, ki, kd = s.gains
+        r1, r2 = self.r_prev
+        h_d += (kp * (r_F - r1) + ki * r_F + kd * (r_F - 2 * r1 + r2)) * 1e-6   # eq 29
+        self.r_prev = (r_F, r1)
+        return h_el + s.relaxation_elastic * (ev["h_el_new"] - h_el), h_d, p_con
+
+
+class _Mixing:
+    """Anderson mixing of ``(h_el, h_d)`` with ``p_con`` at the current ``h0``; a trust
+    region keeps every step below half the thinnest film."""
+
+    def __init__(self, P, load, face):
+        self.P, self.load, self.face = P, load, face
+        self.best, self.stall = np.inf, 0
+        self.restart()
+
+    def restart(self):
+        self.mixer = Anderson(self.P.settings.anderson_depth)
+
+    def update(self, ev, h_el, h_d, p_con, row, res):
+        P, s = self.P, self.P.settings
+        self.stall += 1
+        if res < 0.5 * self.best:
+            self.best, self.stall = res, 0
+        elif self.stall > STAGNATION:
+            self.restart()
+            self.best, self.stall = res, 0
+        k = _load_stiffness(P.factors, ev, P.area, s)
+        x = np.r_[h_el.ravel(), h_d] / s.h_ref
+        f = np.r_[ev["h_el_new"].ravel(), h_d + (ev["F"] - self.load) / k] / s.h_ref - x
+        step = self.mixer.step(x, f) - x
+        bound = 0.5 * max(float(ev["h0"][self.face].min()), 1e-8) / s.h_ref
+        step *= min(1.0, bound / max(float(np.abs(step).max()), 1e-300))
+        x = (x + step) * s.h_ref
+        return x[:-1].reshape(P.shape), float(x[-1]), ev["p_con_target"]
+
+
+def elastic_ratio(ev, op, s) -> float:
+    """Largest elastic deformation by the film pressure over the thinnest film under
+    pressure, at the first iterate: large for a concentrated contact (smooth balls:
+    25-4000), small for a conformal pin (0.2-6.4)."""
+    p_gauge = ev["p"] + s.cavitation_pressure - s.ambient_pressure
+    loaded = p_gauge > 0
+    if not loaded.any():
+        return 0.0
+    return float(np.abs(op(np.maximum(p_gauge, 0))).max()) / float(ev["h0"][loaded].min())
+
+
+def _load_stiffness(factors, ev, area, s):
+    """-dF/dh_d estimate [N/m]: contact slope of p_con(h0) plus 2 F_hd / h (hydrodynamic)."""
+    h0 = ev["h0"]
+    eps = 1e-3 * h0
+    dp = (factors.contact_pressure(h0 - eps) - factors.contact_pressure(h0 + eps)) / (2 * eps)
+    k_con = float(np.sum(area * np.maximum(dp, 0)))
+    loaded = ev["p"] > ev["p"].max() * 0.1 if ev["p"].max() > 0 else np.ones(h0.shape, bool)
+    h_char = float(np.average(h0[loaded], weights=ev["p"][loaded] + 1e-30))
+    k_hd = 2 * max(ev["F_hd"], 0.0) / max(h_char, s.gap_floor)
+    return max(k_con + k_hd, 1e-3 * abs(ev["F"]) / s.h_ref + 1e-300)

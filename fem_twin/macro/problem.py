@@ -1,0 +1,102 @@
+"""One operating point of the macro scale as a value: the grid, the physics and the speeds.
+
+:func:`macro_problem` builds the :class:`Problem` that both couplings (:mod:`.fixed_point`
+and :mod:`.newton`) solve; :meth:`Problem.coefficients` evaluates eq 17's homogenised
+Poiseuille and Couette coefficients with Roelands (eq 23) and Dowson-Higginson (eq 24) at a
+pressure and a separation field.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import partial
+
+import numpy as np
+import scipy.fft as fft
+
+from ..contact.elastic import elastic_operator
+from .reynolds import fe_poiseuille, trapezoid_weights
+from .reynolds_fv import fvm_poiseuille
+
+#: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
+#: clipped before eqs 23-24 are evaluated (both couplings), so that the Roelands
+#: exponential stays finite.
+MAX_COEFFICIENT_PRESSURE = 1e10
+
+#: the Poiseuille term of eq 17 by discretisation (``MacroSettings.method``)
+POISEUILLE = {"fe": fe_poiseuille, "fvm": fvm_poiseuille}
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """The grid, the physics and the speeds of one operating point (SI units)."""
+
+    gap: np.ndarray            # rigid gap h_g (ny, nx) [m]
+    spacing: tuple             # (dx1, dx2) [m]
+    factors: object            # FlowFactors
+    lubricant: object          # Lubricant
+    settings: object           # MacroSettings
+    poiseuille: object         # (g, A) -> sparse K
+    elastic: object            # ElasticOperator
+    area: np.ndarray           # trapezoid weights [m^2]
+    interior: np.ndarray       # flat indices of the interior nodes
+    speed: float               # sliding speed u_r [m/s]
+    entrainment: float         # mean (entrainment) speed u_m [m/s]
+
+    @property
+    def shape(self):
+        return self.gap.shape
+
+    @property
+    def boundary(self) -> np.ndarray:
+        """(ny, nx) bool: the Dirichlet nodes (all but ``interior``)."""
+        mask = np.ones(self.shape, bool)
+        mask.ravel()[self.interior] = False
+        return mask
+
+    def coefficients(self, p, h0):
+        """Eq 17's coefficients at the film pressure ``p`` (relative to p_cav) [Pa] and the
+        separation ``h0`` [m]: ``(loc, mu, rho, g, q)`` with ``loc`` the flow factors at
+        ``h0``, ``g = rho h_m^3 / (12 mu)`` [m^3/(Pa s)] and ``q = rho h_m u_m`` [m^2/s]."""
+        loc = self.factors.at(h0)
+        p_coef = np.minimum(p, MAX_COEFFICIENT_PRESSURE)
+        mu = self.lubricant.viscosity_at(p_coef)
+        rho = self.lubricant.density_ratio(p_coef)
+        g = rho * loc.h_m ** 3 / (12 * mu)
+        q = rho * loc.h_m * self.entrainment
+        return loc, mu, rho, g, q
+
+    def kernel(self):
+        """The influence kernel on the padded grid (real space, [m/Pa])."""
+        ny, nx = self.shape
+        cache = self.__dict__.setdefault("_kernel", [])
+        if not cache:
+            cache.append(fft.irfft2(self.elastic.kernel_hat, s=(2 * ny, 2 * nx)))
+        return cache[0]
+
+    def dense_elastic(self, nodes) -> np.ndarray:
+        """``E[nodes, nodes]``: deformation at node i per pressure at node j [m/Pa]."""
+        ny, nx = self.shape
+        r, c = np.divmod(nodes, nx)
+        return self.kernel()[(r[:, None] - r[None, :]) % (2 * ny),
+                             (c[:, None] - c[None, :]) % (2 * nx)]
+
+
+def macro_problem(gap, spacing, factors, lubricant, settings, speed: float,
+                  entrainment: float) -> Problem:
+    """The :class:`Problem` of a validated gap (ny, nx) [m] and spacing (dx1, dx2) [m]:
+    Dirichlet nodes on the grid's edge, the non-periodic FFT half-space of eqs 20-22 and the
+    Poiseuille operator of ``settings.method``."""
+    gap = np.asarray(gap, float)
+    dx = tuple(float(v) for v in spacing)
+    boundary = np.zeros(gap.shape, bool)
+    boundary[[0, -1], :] = boundary[:, [0, -1]] = True
+    return Problem(gap, dx, factors, lubricant, settings,
+                   partial(_poiseuille, POISEUILLE[settings.method], dx),
+                   elastic_operator(gap.shape, dx, settings.e_reduced),
+                   trapezoid_weights(gap.shape, dx), np.flatnonzero(~boundary.ravel()),
+                   float(speed), float(entrainment))
+
+
+def _poiseuille(assemble, dx, g, A):
+    return assemble(g, dx, A)

@@ -1,0 +1,141 @@
+"""The converged operating point of the macro scale: fields, friction (eqs 31-34), files."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..io.atomic import atomic_path
+from .friction import boundary_shear, hydrodynamic_shear
+
+_FIELDS = ("pressure", "contact_pressure", "cavity_fraction", "h0", "mean_gap",
+           "elastic_deformation", "viscosity", "density_ratio", "shear_stress", "face")
+
+
+@dataclass(frozen=True, eq=False)
+class MixedResult:
+    """A converged operating point (SI units).
+
+    Scalars: ``speed`` U [m/s], ``imposed_load`` F_N,imp and ``normal_load`` F_N (eq 28) [N],
+    ``h_d`` [m], ``friction_force`` F_T (eq 33) with its ``hydrodynamic_friction`` and
+    ``boundary_friction`` parts [N], ``friction_coefficient`` C_f (eq 34),
+    ``contact_load`` (integral of p_con) [N].
+    Fields (ny, nx): ``pressure`` p_hd, ``contact_pressure`` p_con [Pa], ``cavity_fraction``,
+    ``h0``, ``mean_gap`` h_m, ``elastic_deformation`` h_el [m], ``viscosity`` [Pa s],
+    ``density_ratio`` rho/rho_0, ``shear_stress`` tau_tot [Pa], ``face`` (pin face mask).
+    ``history``: rows (iteration, r_hel, r_pcon, r_p, r_F, h_d, newton steps).
+    """
+
+    speed: float
+    imposed_load: float
+    normal_load: float
+    h_d: float
+    friction_force: float
+    hydrodynamic_friction: float
+    boundary_friction: float
+    friction_coefficient: float
+    contact_load: float
+    spacing: tuple
+    pressure: np.ndarray
+    contact_pressure: np.ndarray
+    cavity_fraction: np.ndarray
+    h0: np.ndarray
+    mean_gap: np.ndarray
+    elastic_deformation: np.ndarray
+    viscosity: np.ndarray
+    density_ratio: np.ndarray
+    shear_stress: np.ndarray
+    face: np.ndarray
+    iterations: int = 0
+    history: np.ndarray = field(default_factory=lambda: np.zeros((0, 7)))
+    meta: dict = field(default_factory=dict)
+
+    def fields(self) -> dict:
+        """The grid fields by name (for VTU output)."""
+        return {k: np.asarray(getattr(self, k), float) for k in _FIELDS}
+
+    def scalars(self) -> dict:
+        return {f.name: getattr(self, f.name) for f in fields(self)
+                if f.name not in _FIELDS and f.name not in ("history", "meta")}
+
+    def save(self, path) -> Path:
+        """Write ``.npz`` (fields, history, scalars and meta as JSON) atomically."""
+        path = Path(path)
+        with atomic_path(path) as tmp:
+            with open(tmp, "wb") as f:
+                np.savez(f, **self.fields(), history=self.history,
+                         scalars=np.array(json.dumps(self.scalars())),
+                         meta=np.array(json.dumps(self.meta, sort_keys=True)))
+        return path
+
+    @classmethod
+    def load(cls, path) -> "MixedResult":
+        with np.load(path) as data:
+            scalars = json.loads(str(data["scalars"]))
+            scalars["spacing"] = tuple(scalars["spacing"])
+            arrays = {k: data[k] for k in _FIELDS}
+            arrays["face"] = arrays["face"].astype(bool)
+            return cls(**scalars, **arrays, history=data["history"],
+                       meta=json.loads(str(data["meta"])))
+
+    def write_vtu(self, path, origin=(0.0, 0.0)) -> Path:
+        """Fields on the structured grid for ParaView (:func:`fem_twin.io.mesh.write_vtu`),
+        SI units; ``pressure`` is absolute (its minimum is p_cav), ``pressure_gauge`` is
+        ``pressure - p_amb``; ``face`` is 1 on the pin face (threshold on it in ParaView)."""
+        from ..io.mesh import grid_mesh, write_vtu
+        gm = grid_mesh(self.pressure.shape, self.spacing, origin)
+        p_amb = self.meta.get("settings", {}).get("ambient_pressure", 0.0)
+        return write_vtu(path, gm, {**self.fields(), "pressure_gauge": self.pressure - p_amb})
+
+
+
+def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
+                 coupling=None) -> MixedResult:
+    """The :class:`MixedResult` of a converged state of ``P`` (a :class:`.problem.Problem`):
+    ``ev`` its evaluation (``p``, ``theta``, ``loc``, ``mu``, ``rho``, ``h0``, ``p_con``,
+    ``F``), with the friction of eqs 31-34 over the pin ``face``."""
+    s, dx, area, speed, lubricant = P.settings, P.spacing, P.area, P.speed, P.lubricant
+    loc = ev["loc"]
+    p_hd = ev["p"] + s.cavitation_pressure
+    tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev["theta"], ev["mu"], loc.C, loc.d, dx, speed,
+                                entrainment=P.entrainment,
+                                eyring_stress=lubricant.eyring_stress)
+    tau_con = boundary_shear(ev["p_con"], s.boundary_friction)
+    cell = dx[0] * dx[1]
+    F_hd = float(tau_hd[face].sum() * cell)
+    F_con = float(tau_con[face].sum() * cell)
+    F_N = ev["F"]
+    return MixedResult(
+        speed=float(speed), imposed_load=float(load), normal_load=F_N, h_d=float(h_d),
+        friction_force=F_hd + F_con, hydrodynamic_friction=F_hd, boundary_friction=F_con,
+        friction_coefficient=(F_hd + F_con) / F_N,
+        contact_load=float(np.sum(area * ev["p_con"])), spacing=dx,
+        pressure=p_hd, contact_pressure=ev["p_con"], cavity_fraction=ev["theta"],
+        h0=ev["h0"], mean_gap=loc.h_m, elastic_deformation=h_el,
+        viscosity=ev["mu"], density_ratio=ev["rho"], shear_stress=tau_hd + tau_con,
+        face=face, iterations=it, history=np.array(history),
+        meta={"settings": {k: (list(v) if isinstance(v, tuple) else v)
+                           for k, v in s.__dict__.items()},
+              "lubricant": lubricant.__dict__.copy(), "seconds": seconds,
+              "coupling": coupling or ("anderson" if s.coupling == "auto" else s.coupling),
+              "entrainment": P.entrainment})
+
+
+def on_grid(result: MixedResult, shape, dx) -> MixedResult:
+    """``result`` interpolated (linearly, by coordinates from the first node) onto a grid."""
+    if result.pressure.shape == tuple(shape) and np.allclose(result.spacing, dx):
+        return result
+    from scipy.ndimage import map_coordinates
+    rows = np.arange(shape[0]) * dx[1] / result.spacing[1]
+    cols = np.arange(shape[1]) * dx[0] / result.spacing[0]
+    where = np.meshgrid(rows, cols, indexing="ij")
+
+    def interp(f):
+        return map_coordinates(np.asarray(f, float), where, order=1, mode="nearest")
+
+    return replace(result, spacing=tuple(dx), **{k: interp(getattr(result, k))
+                                                 for k in _FIELDS if k != "face"},
+                   face=interp(result.face) > 0.5)
