@@ -22,7 +22,6 @@ rules compare (``face="bilinear"``, the default, against the two-point ``"arithm
 """
 
 import argparse
-import csv
 import time
 from pathlib import Path
 
@@ -32,6 +31,7 @@ import numpy as np
 from fem_twin.compare import flow_factor_differences
 from fem_twin.fvm import CellSolverFV
 from fem_twin.io.files import read_topography
+from fem_twin.io.table import write_csv
 from fem_twin.micro import CellSolver, FlowFactors, average, homogenise
 from fem_twin.micro.homogenisation import CellSettings, sliding_contacts, sliding_pass
 from fem_twin.topography import resample_cell
@@ -131,10 +131,8 @@ def main():
             print(f"{k:>7} {h0 * 1e6:8.2f} " + " ".join(
                 f"{row[key] * (1 if key == 'd' else 100):7.3f}{' ' if key == 'd' else '%'}"
                 for key in ("A", "b", "C", "d", "h_m")) + f" {ratio:11.2f}", flush=True)
-    with open(out / "fe_fvm_flow_factors.csv", "w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
+    write_csv(out / "fe_fvm_flow_factors.csv",
+              {("h0_m" if k == "h0" else k): [r[k] for r in rows] for k in rows[0]})
     print("worst: " + ", ".join(f"{k} {v * (1 if k == 'd' else 100):.3f}"
                                 + ("" if k == "d" else " %") for k, v in worst.items()))
     plot(rows, out / "fe_fvm_flow_factors.png")

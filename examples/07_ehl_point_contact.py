@@ -16,6 +16,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from fem_twin.io.table import write_csv
 from fem_twin.macro import Lubricant, MacroSettings, MixedNotConverged, solve_mixed
 from fem_twin.macro.point_contact import PointContact, film_thickness
 from fem_twin.micro import FlowFactors
@@ -55,8 +56,8 @@ for M in (10, 100) if quick else (10, 100, 1000):
         rows.append((M, L, h_c / hd_c, h_min / hd_min, res.iterations, seconds))
         print(f"{M:6} {L:4} {h_c / hd_c:7.3f} {h_min / hd_min:8.3f} {res.iterations:10d} "
               f"{seconds:8.1f}")
-np.savetxt(out / "ehl_moes.csv", np.array(rows), delimiter=",", fmt="%.6g",
-           header="M,L,h_c_over_HD,h_min_over_HD,iterations,seconds", comments="")
+write_csv(out / "ehl_moes.csv", dict(zip(("M", "L", "h_c_over_HD", "h_min_over_HD", "iterations",
+                                          "seconds_s"), zip(*rows))))
 
 # -- the measured contact, and a grid study of its central film ----------------------------
 mourier = PointContact(12.5e-3, 15.0, 110e9, 0.25, 22e-9, 0.09)

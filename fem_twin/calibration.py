@@ -24,6 +24,7 @@ import numpy as np
 
 from .case import Case
 from .io.atomic import atomic_path
+from .io.figure import save_figure
 from .micro import FlowFactors
 from .stribeck import friction_deviation, plot_stribeck, stribeck_sweep, write_stribeck_csv
 
@@ -116,6 +117,4 @@ def _plot_deviation(path, speed, dev, ref_label, study):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)

@@ -200,13 +200,43 @@ def load_case(path) -> Case:
 
 
 def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -> Case:
-    """Validate a case given as a dict (as read from TOML)."""
+    """Validate a case given as a dict (as read from TOML); file paths relative to ``base``."""
     where = str(source or "case")
     _only(data, {"name", "geometry", "preprocessing", "tribometer", "lubricant", "materials",
                  "micro", "macro", "sweep", "run", "validation"}, where)
     if "geometry" not in data:
         raise CaseError(f"{where}: missing [geometry] section")
-    g = data["geometry"]
+    tribometer = _tribometer(data, where)
+    geometry = _geometry(data["geometry"], base, where, tribometer.ball)
+    macro_geometry = _preprocessing(data.get("preprocessing", {}), where)
+    lubricant = _lubricant(data, where)
+    materials = _section(data, "materials", Materials, where, positive=True)
+    micro = _micro(data, where)
+    macro = _macro(data, where, tribometer, geometry)
+    sweep = _sweep(data, where)
+    run = _section(data, "run", RunSpec, where)
+    if not geometry.patches:
+        raise CaseError(f"{where} [geometry]: at least one roughness patch pair is required")
+    measured = _measured(data.get("validation", {}), base, where, lubricant)
+    defaulted = tuple(name for name in ("preprocessing", "tribometer", "lubricant",
+                                        "materials", "micro", "macro", "sweep", "run")
+                      if name not in data)
+    return Case(name=str(data.get("name", source.stem if source else "case")),
+                geometry=geometry, macro_geometry=macro_geometry, tribometer=tribometer,
+                lubricant=lubricant, materials=materials, micro=micro, macro=macro,
+                sweep=sweep, run=run, measured=measured, source=source, defaulted=defaulted)
+
+
+def _tribometer(data, where) -> Tribometer:
+    tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
+    if tribometer.kind not in ("pin-on-disk", "ball-on-disk"):
+        raise CaseError(f"{where} [tribometer] kind: 'pin-on-disk' or 'ball-on-disk', got "
+                        f"{tribometer.kind!r}")
+    return tribometer
+
+
+def _geometry(g, base, where, ball) -> Geometry:
+    """[geometry]: the instrument files (resolved, existing) and the patch window."""
     _only(g, {"pins", "disks", "patches", "patch_shape", "patch_start"}, f"{where} [geometry]")
 
     def files(key, value):
@@ -218,27 +248,28 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
                 raise CaseError(f"{where} [geometry] {key}: file not found: {p}")
         return out
 
-    tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
-    if tribometer.kind not in ("pin-on-disk", "ball-on-disk"):
-        raise CaseError(f"{where} [tribometer] kind: 'pin-on-disk' or 'ball-on-disk', got "
-                        f"{tribometer.kind!r}")
-    if not tribometer.ball and ("pins" not in g or not g["pins"]):
+    if not ball and ("pins" not in g or not g["pins"]):
         raise CaseError(f"{where} [geometry]: at least one pin file is required in 'pins'")
     patches = g.get("patches", [])
-    if not isinstance(patches, list) or not all(isinstance(p, list) and len(p) == 2 for p in patches):
+    if not isinstance(patches, list) or not all(isinstance(p, list) and len(p) == 2
+                                                for p in patches):
         raise CaseError(f"{where} [geometry] patches: expected a list of [pin, disk] file pairs")
     geometry = Geometry(
         pins=files("pins", g.get("pins", [])), disks=files("disks", g.get("disks", [])),
         patches=tuple(files("patches", p) for p in patches),
-        patch_shape=_int_pair(g.get("patch_shape", [256, 256]), f"{where} [geometry] patch_shape"),
-        patch_start=_int_pair(g.get("patch_start", [0, 0]), f"{where} [geometry] patch_start", 0))
+        patch_shape=_int_pair(g.get("patch_shape", [256, 256]),
+                              f"{where} [geometry] patch_shape"),
+        patch_start=_int_pair(g.get("patch_start", [0, 0]), f"{where} [geometry] patch_start",
+                              0))
     if geometry.disks and len(geometry.disks) != len(geometry.pins):
         raise CaseError(f"{where} [geometry]: {len(geometry.pins)} pins but "
                         f"{len(geometry.disks)} disks (give one disk per pin, or none for flat)")
+    return geometry
 
-    pre = data.get("preprocessing", {})
-    known = {f.name for f in fields(MacroOptions)}
-    _only(pre, known, f"{where} [preprocessing]")
+
+def _preprocessing(pre, where) -> MacroOptions:
+    """[preprocessing]: the macro geometry's options, lengths in metres."""
+    _only(pre, {f.name for f in fields(MacroOptions)}, f"{where} [preprocessing]")
     opts = dict(pre)
     if "resolution" in opts:
         opts["resolution"] = _int_pair(opts["resolution"], f"{where} [preprocessing] resolution")
@@ -257,6 +288,10 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
                         f"{opts['sliding_direction']!r}")
     if opts.get("fwhm_px", 0) < 0:
         raise CaseError(f"{where} [preprocessing] fwhm_px must be >= 0 pixels")
+    return MacroOptions(**opts)
+
+
+def _lubricant(data, where) -> LubricantSpec:
     lubricant = _section(data, "lubricant", LubricantSpec, where, positive=True,
                          zero_ok=("eyring_stress",))
     if not lubricant.viscosities:
@@ -265,7 +300,10 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
         raise CaseError(f"{where} [lubricant]: give one temperature per viscosity")
     if any(v > 10 for v in lubricant.viscosities):
         raise CaseError(f"{where} [lubricant] viscosities: expected Pa s (0.066, not 66 mPa s)")
-    materials = _section(data, "materials", Materials, where, positive=True)
+    return lubricant
+
+
+def _micro(data, where) -> MicroSpec:
     micro = _section(data, "micro", MicroSpec, where)
     if micro.method not in ("fe", "fvm"):
         raise CaseError(f"{where} [micro] method: 'fe' or 'fvm'")
@@ -279,6 +317,10 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if not (0 < micro.h0_min < micro.h0_max < 1e-3) or micro.h0_count < 2 or micro.steps < 1:
         raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
                         "h0_count >= 2 and steps >= 1")
+    return micro
+
+
+def _macro(data, where, tribometer, geometry) -> MacroSpec:
     macro = _section(data, "macro", MacroSpec, where)
     if macro.method not in ("fe", "fvm") or macro.coupling not in ("auto", "anderson",
                                                                     "newton", "pid"):
@@ -290,16 +332,21 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if macro.pin != "average" and not tribometer.ball and not (isinstance(macro.pin, int)
                                        and 1 <= macro.pin <= len(geometry.pins)):
         raise CaseError(f"{where} [macro] pin: 'average' or a pin number 1..{len(geometry.pins)}")
+    return macro
+
+
+def _sweep(data, where) -> SweepSpec:
     sweep = _section(data, "sweep", SweepSpec, where, positive=True, zero_ok=("refine",))
     if not 0 <= sweep.refine <= 4 or not 0 < sweep.refine_step < 1:
         raise CaseError(f"{where} [sweep]: refine is 0-4 passes, refine_step a fraction of "
                         "C_f,b in (0, 1)")
     if sweep.speed_min > sweep.speed_max or sweep.count < 1:
         raise CaseError(f"{where} [sweep]: need speed_min <= speed_max [m/s] and count >= 1")
-    run = _section(data, "run", RunSpec, where)
-    if not geometry.patches:
-        raise CaseError(f"{where} [geometry]: at least one roughness patch pair is required")
-    val = data.get("validation", {})
+    return sweep
+
+
+def _measured(val, base, where, lubricant) -> tuple:
+    """[validation] measured: one CSV file (or "") per viscosity, resolved."""
     _only(val, {"measured"}, f"{where} [validation]")
     measured = val.get("measured", [])
     if (not isinstance(measured, list) or len(measured) > len(lubricant.viscosities)
@@ -310,13 +357,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     for m in measured:
         if m is not None and not m.is_file():
             raise CaseError(f"{where} [validation] measured: file not found: {m}")
-    defaulted = tuple(name for name in ("preprocessing", "tribometer", "lubricant",
-                                        "materials", "micro", "macro", "sweep", "run")
-                      if name not in data)
-    return Case(name=str(data.get("name", source.stem if source else "case")),
-                geometry=geometry, macro_geometry=MacroOptions(**opts), tribometer=tribometer,
-                lubricant=lubricant, materials=materials, micro=micro, macro=macro,
-                sweep=sweep, run=run, measured=measured, source=source, defaulted=defaulted)
+    return measured
 
 
 def _section(data, name, cls, where, positive=False, zero_ok=()):

@@ -118,6 +118,18 @@ def build_parser() -> argparse.ArgumentParser:
                    help="show the Python traceback of an error (otherwise one line)")
     sub = p.add_subparsers(dest="command", required=True, metavar="STAGE")
 
+    _add_case_commands(sub)
+    _add_run_commands(sub)
+    _add_topography(sub)
+    _add_contact(sub)
+    _add_homogenise(sub)
+    _add_macro(sub)
+    _add_utilities(sub)
+    return p
+
+
+def _add_case_commands(sub):
+    """run, compare and calibrate: the commands on a case file."""
     rn = _case_command(sub, "run", "run the pipeline of a case file (TOML) into an output "
                                    "folder", "out", _run)
     rn.add_argument("--yes", action="store_true",
@@ -133,6 +145,9 @@ def build_parser() -> argparse.ArgumentParser:
                     help="filter FWHMs [px] or resolutions [px] (defaults: 0 3 5 7 9 11; "
                          "64 128 256)")
 
+
+def _add_run_commands(sub):
+    """validate and report: the commands on a finished run."""
     va = sub.add_parser("validate", help="compare a finished run with a measured Stribeck "
                                          "curve: C_f,dev (eq 35) at the measured speeds")
     va.add_argument("run", type=Path, help="output folder of fem-twin run (its stribeck.csv)")
@@ -156,6 +171,9 @@ def build_parser() -> argparse.ArgumentParser:
                     help="skip the pyvista 3D views (Figures 2 and 6)")
     rp.set_defaults(func=_html_report)
 
+
+def _add_topography(sub):
+    """topography STEP: one pre-processing step per subcommand."""
     t = sub.add_parser("topography", help="read and pre-process measured topographies")
     steps = t.add_subparsers(dest="step", required=True, metavar="STEP")
     for name, text in _STEPS.items():
@@ -169,6 +187,9 @@ def build_parser() -> argparse.ArgumentParser:
         _step_options(name, s)
         s.set_defaults(func=_topography)
 
+
+def _add_contact(sub):
+    """contact level|average: dry contact of pins."""
     c = sub.add_parser("contact", help="dry contact: pin levelling by torque balance, set averaging")
     cs = c.add_subparsers(dest="step", required=True, metavar="STEP")
     lv = cs.add_parser("level", help="tilt a mounted pin until the 50 N contact torques vanish")
@@ -183,6 +204,9 @@ def build_parser() -> argparse.ArgumentParser:
     av.add_argument("-o", "--output", type=Path, required=True)
     av.set_defaults(func=_contact_average)
 
+
+def _add_homogenise(sub):
+    """homogenise run|average: the micro scale."""
     h = sub.add_parser("homogenise", help="micro scale: flow factors of roughness patch pairs "
                                           "versus h0 (eqs 8-16)")
     hs = h.add_subparsers(dest="step", required=True, metavar="STEP")
@@ -213,6 +237,9 @@ def build_parser() -> argparse.ArgumentParser:
     ha.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     ha.set_defaults(func=_homogenise_average)
 
+
+def _add_macro(sub):
+    """macro point: one operating point."""
     mc = sub.add_parser("macro", help="macro scale: one operating point of the homogenised "
                                       "mixed-EHL solver (eqs 17-34)")
     ms = mc.add_subparsers(dest="step", required=True, metavar="STEP")
@@ -229,9 +256,14 @@ def build_parser() -> argparse.ArgumentParser:
     mp.add_argument("--diameter", type=float, default=8e-3,
                     help="pin diameter D of the Hersey number, eq 46 [m]")
     mp.add_argument("--method", choices=("fe", "fvm"), default="fe")
-    mp.add_argument("--coupling", choices=("anderson", "pid"), default="anderson")
+    mp.add_argument("--coupling", choices=("auto", "anderson", "newton", "pid"),
+                    default="auto", help="macro coupling: Anderson, with Newton for "
+                    "elastically dominated contacts (auto), or one of them; pid is the paper's")
     mp.set_defaults(func=_macro_point)
 
+
+def _add_utilities(sub):
+    """mesh, example and sample."""
     m = sub.add_parser("mesh", help="topography -> structured FE mesh written as VTU for ParaView")
     m.add_argument("input", type=Path)
     m.add_argument("output", type=Path, help="VTU file")
@@ -247,7 +279,6 @@ def build_parser() -> argparse.ArgumentParser:
     g = sub.add_parser("sample", help="regenerate the bundled sample twin (seeded)")
     g.add_argument("-o", "--output", type=Path, default=Path("meshes/sample"))
     g.set_defaults(func=_sample)
-    return p
 
 
 def _case_command(sub, name, text, output, func):
@@ -550,6 +581,7 @@ def _validate(args):
     from .case import load_case
     from .macro.friction import BOUNDARY_FRICTION
     from .stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
+    from .io.table import write_csv
     from .stribeck.curve import read_stribeck_csv
     csv_path = args.run / "stribeck.csv"
     if not csv_path.is_file():
@@ -582,10 +614,9 @@ def _validate(args):
                   labels=[f"simulated, $\\mu_0$ = {curve.viscosity:g} Pa s"],
                   reference=(measured.speed, measured.friction_coefficient, band),
                   boundary=boundary)
-    with open(args.run / f"{stem}.csv", "w") as f:
-        f.write("speed,measured_cf,cf_dev\n" + "".join(
-            f"{u:.10g},{c:.10g},{d:.10g}\n"
-            for u, c, d in zip(measured.speed, measured.friction_coefficient, dev)))
+    write_csv(args.run / f"{stem}.csv", {"speed_m_s": measured.speed,
+                                         "measured_cf": measured.friction_coefficient,
+                                         "cf_dev": dev})
     inside = np.isfinite(dev)
     print(f"fem-twin validate: mu_0 = {curve.viscosity:g} Pa s against {args.measured.name}: "
           f"max |C_f,dev| = {np.nanmax(np.abs(dev)):.2%} (eq 35, C_f,b = {boundary:.5g}) at "

@@ -10,7 +10,6 @@ reference (FE on the cells refined by two with twice the steps, at three h0).
 
 from __future__ import annotations
 
-import csv
 import json
 from dataclasses import replace
 from pathlib import Path
@@ -19,6 +18,8 @@ import numpy as np
 
 from .case import Case
 from .io.atomic import atomic_path
+from .io.figure import save_figure
+from .io.table import write_csv
 from .macro import MixedResult
 from .micro import FlowFactors
 from .micro.estimate import discrepancy, grid_separations
@@ -111,9 +112,10 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     dev = friction_deviation(curves["fe"].friction_coefficient,
                              curves["fvm"].friction_coefficient)
     fields = [field_differences(a, b) for a, b in zip(points["fe"], points["fvm"])]
-    _write_csv(outdir / "compare_flow_factors.csv", ffd)
-    _write_csv(outdir / "compare_stribeck.csv", {
-        "speed": curves["fe"].speed, "cf_fe": curves["fe"].friction_coefficient,
+    write_csv(outdir / "compare_flow_factors.csv", {"h0_m" if k == "h0" else k: v
+                                                     for k, v in ffd.items()})
+    write_csv(outdir / "compare_stribeck.csv", {
+        "speed_m_s": curves["fe"].speed, "cf_fe": curves["fe"].friction_coefficient,
         "cf_fvm": curves["fvm"].friction_coefficient, "cf_dev": dev,
         "pressure_diff": np.array([f["pressure"] for f in fields]),
         "cavity_fraction_diff": np.array([f["cavity_fraction"] for f in fields])})
@@ -132,15 +134,6 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     with atomic_path(outdir / "compare.json") as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     return summary
-
-
-def _write_csv(path, columns: dict):
-    with atomic_path(path) as tmp:
-        with open(tmp, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(list(columns))
-            for row in zip(*columns.values()):
-                w.writerow([f"{v:.10g}" for v in row])
 
 
 def _plot(path, ffd, curves, dev):
@@ -162,6 +155,4 @@ def _plot(path, ffd, curves, dev):
     for a in ax:
         a.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)

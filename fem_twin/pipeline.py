@@ -24,7 +24,7 @@ from .case import Case
 from .contact.levelling import average_pins, level_pin
 from .errors import RunLocked, SchedulerUnreachable
 from .io.atomic import atomic_path
-from .io.checkpoint import load_or_none
+from .io.checkpoint import input_key, load_or_none
 from .io.files import read_topography, write_topography
 from .io.mesh import grid_mesh, write_vtu
 from .macro import MacroSettings, MixedResult
@@ -99,10 +99,8 @@ def provenance(case: Case) -> dict:
 
 def stage_keys(case: Case) -> dict:
     """Hash of the case settings each cached stage depends on."""
-    import hashlib
-
     def key(*parts):
-        return hashlib.sha256(repr(parts).encode()).hexdigest()[:16]
+        return input_key(repr(parts))
 
     g = case.geometry
     files = [(str(p), p.stat().st_mtime_ns, p.stat().st_size)

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .io.atomic import atomic_path
+from .io.figure import save_figure
 from .io.files import read_topography
 from .io.render import render_views
 
@@ -90,9 +91,7 @@ def plot_centre_lines(files, path) -> Path:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return save_figure(fig, path, dpi=110)
 
 
 def stribeck_section(outdir: Path) -> str:

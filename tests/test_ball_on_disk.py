@@ -44,8 +44,8 @@ def test_ball_on_disk_stribeck_curve_from_ehl_to_boundary(tmp_path):
     cf_b = case.tribometer.boundary_friction
     two_a = 2 * ball_contact(case).hertz_radius
     for mu in case.lubricant.viscosities:
-        r = [x for x in rows if float(x["viscosity"]) == mu]
-        u_m = np.array([float(x["speed"]) for x in r])
+        r = [x for x in rows if float(x["viscosity_Pa_s"]) == mu]
+        u_m = np.array([float(x["speed_m_s"]) for x in r])
         cf = np.array([float(x["friction_coefficient"]) for x in r])
         share = np.array([float(x["contact_load_fraction"]) for x in r])
         assert np.allclose([float(x["hersey"]) for x in r], mu * u_m * two_a / case.tribometer.load)

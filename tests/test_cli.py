@@ -127,10 +127,10 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     assert main(["run", str(case), "-o", str(ref), "--no-progress"]) == 0
     rows = list(csv.DictReader(open(ref / "stribeck.csv")))
     assert {"speed", "hersey", "friction_coefficient", "viscosity"} <= set(rows[0])
-    assert len(rows) == 10 and {float(r["viscosity"]) for r in rows} == {0.066, 0.024}
+    assert len(rows) == 10 and {float(r["viscosity_Pa_s"]) for r in rows} == {0.066, 0.024}
     for mu in (0.066, 0.024):
-        r = [x for x in rows if float(x["viscosity"]) == mu]
-        speed = np.array([float(x["speed"]) for x in r])
+        r = [x for x in rows if float(x["viscosity_Pa_s"]) == mu]
+        speed = np.array([float(x["speed_m_s"]) for x in r])
         cf = np.array([float(x["friction_coefficient"]) for x in r])
         assert np.all(np.diff(speed) < 0)
         assert cf[-1] > 10 * cf.min()                      # rises toward boundary friction
@@ -152,13 +152,13 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     from fem_twin.io.mesh import read_vtu
     pvd = (ref / "fields" / "stribeck_mu0.066.pvd").read_text()
     times = sorted(float(t) for t in re.findall(r'timestep="([^"]+)"', pvd))
-    speeds = sorted(float(x["speed"]) for x in rows if float(x["viscosity"]) == 0.066)
+    speeds = sorted(float(x["speed_m_s"]) for x in rows if float(x["viscosity_Pa_s"]) == 0.066)
     assert np.allclose(times, speeds, rtol=1e-12)
     _, fields = read_vtu(ref / "fields" / "mu0.066_000.vtu")
     assert np.allclose(fields["pressure_gauge"], fields["pressure"] - 1e5)
 
     # validation (paper 3.3): a "measured" curve 1 % of C_f,b above the simulated one
-    r66 = [x for x in rows if float(x["viscosity"]) == 0.066]
+    r66 = [x for x in rows if float(x["viscosity_Pa_s"]) == 0.066]
     measured = tmp_path / "measured_24C.csv"
     measured.write_text("speed,friction_coefficient,cf_min,cf_max\n" + "".join(
         f"{x['speed']},{float(x['friction_coefficient']) + 0.01 / (3 * 3 ** 0.5)!r},0,1\n"
@@ -521,7 +521,7 @@ def test_boundary_friction_is_set_from_the_case(tmp_path):
     assert main(["run", str(tmp_path / "cfb.toml"), "-o", str(out), "--no-progress"]) == 0
     rows = list(csv.DictReader(open(out / "stribeck.csv")))
     share = np.array([float(r["contact_load_fraction"]) for r in rows])
-    force = np.array([float(r["boundary_friction"]) for r in rows])
+    force = np.array([float(r["boundary_friction_N"]) for r in rows])
     assert share.max() > 0.5
     assert np.allclose(force, 0.12 * share * 150.0, rtol=1e-6, atol=1e-9)
 
@@ -534,9 +534,9 @@ def test_validate_an_existing_run_against_a_measured_curve(tmp_path, capsys):
     out = tmp_path / "o"
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
     rows = [r for r in csv.DictReader(open(out / "stribeck.csv"))
-            if float(r["viscosity"]) == 0.024]
+            if float(r["viscosity_Pa_s"]) == 0.024]
     cfb = 1 / (3 * 3 ** 0.5)
-    speeds = [float(r["speed"]) for r in rows]
+    speeds = [float(r["speed_m_s"]) for r in rows]
     (tmp_path / "m.csv").write_text("speed,friction_coefficient\n" + "".join(
         f"{u!r},{float(r['friction_coefficient']) + 0.01 * cfb!r}\n" for u, r in
         zip(speeds, rows)))
@@ -599,6 +599,7 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
     the checkpoints (exactly); the band is the min/max of the single-patch sweeps."""
     from fem_twin.macro import MixedResult
     from fem_twin.results import open_run
+    from fem_twin.stribeck.curve import HEADERS
     out = tmp_path / "out"
     assert main(["run", str(small_case(tmp_path, band=True)), "-o", str(out),
                  "--no-progress"]) == 0
@@ -607,12 +608,13 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
     rows = list(csv.DictReader(open(out / "stribeck.csv")))
     assert len(rows) == 10 and {"cf_min", "cf_max"} <= set(rows[0])
     for r in rows:
-        point = st.sel(viscosity=float(r["viscosity"]), speed=float(r["speed"]),
+        point = st.sel(viscosity=float(r["viscosity_Pa_s"]), speed=float(r["speed_m_s"]),
                        method="nearest")
         for k in ("hersey", "friction_coefficient", "hydrodynamic_friction",
                   "boundary_friction", "contact_load_fraction", "h_d", "iterations", "cf_min",
                   "cf_max"):
-            assert float(point[k]) == pytest.approx(float(r[k]), rel=1e-9, abs=1e-300), k
+            assert float(point[k]) == pytest.approx(float(r[HEADERS.get(k, k)]), rel=1e-9,
+                                                    abs=1e-300), k
         patches = point["patch_friction_coefficient"].values
         assert patches.shape == (2,) and float(point.cf_min) == patches.min()
         assert float(point.cf_max) == patches.max()

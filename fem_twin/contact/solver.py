@@ -135,22 +135,15 @@ def _solve_load_by_separation(shape, spacing, e_reduced, load, initial_pressure,
 
 def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_min, gap_floor,
         initial_pressure, tol, max_iter) -> ContactResult:
-    """Polonsky-Keer CG (load) or its separation-controlled variant, pressure in [p_min, H]."""
+    """Polonsky-Keer CG (load) or its separation-controlled variant, pressure in [p_min, H].
+
+    One loop of about 60 lines: the CG state (direction, free set, the deformation carried
+    from ``K t``) is shared by every line of an iteration, so it is not split further."""
     s = np.asarray(shape, dtype=float)
-    if s.ndim != 2 or not np.all(np.isfinite(s)):
-        raise ValueError("shape must be a finite 2D array [m]")
-    if (load is None) == (separation is None):
-        raise ValueError("give exactly one of load [N] or separation [m]")
-    if not hardness > p_min:
-        raise ValueError(f"hardness {hardness} must exceed p_min {p_min}")
     dx1, dx2 = np.broadcast_to(np.asarray(spacing, float), (2,))
     area = dx1 * dx2
+    _check(s, area, load, separation, hardness, p_min)
     op = elastic_operator(s.shape, (dx1, dx2), e_reduced, periodic)
-    if load is not None:
-        if not load > p_min * s.size * area:
-            raise ValueError(f"load {load} N must exceed the floor load p_min * area")
-        if load >= hardness * s.size * area:
-            raise ValueError(f"load {load} N exceeds what the hardness can carry on this grid")
     p = _initial(s, area, load, separation, hardness, p_min, initial_pressure)
 
     history = []
@@ -186,22 +179,9 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
         if not linear:
             np.clip(p, p_min, hardness, out=p)
         # points off the free set whose gap asks to move: p_min with overlap, H with gap open
-        wrong = (p_old <= p_min) & (g < 0)
-        if np.isfinite(hardness):
-            wrong |= (p_old >= hardness) & (g > 0)
-        wrong &= ~free
+        wrong = _wrong_set(p, p_old, g, free, was_wrong, tau, op, p_min, hardness)
         any_wrong = wrong.any()
         delta = 0.0 if any_wrong else 1.0
-        if any_wrong:
-            # pressure that closes a uniform overlap on the wrong set: the CG step; when the
-            # same points are wrong again, no larger than the set's joint stiffness allows
-            # (one point's step made points released from and pressed back to the cap cycle
-            # forever; the extra FFT pair is paid only then)
-            step = tau
-            if tau <= 0 or (wrong & was_wrong).any():
-                joint = 1.0 / op(wrong.astype(float)).max()
-                step = min(joint, tau) if tau > 0 else joint
-            p[wrong] = np.clip(p[wrong] - step * g[wrong], p_min, hardness)
         was_wrong = wrong
         factor = 1.0
         if load is not None:
@@ -222,8 +202,50 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
     else:
         raise ContactNotConverged(f"contact did not converge in {max_iter} iterations "
                                   f"(tol {tol})", history)
-    u = op(p)
+    return _result(s, op(p), p, h0, load is not None, area, p_min, hardness, gap_floor, it,
+                   history)
+
+
+def _check(s, area, load, separation, hardness, p_min):
+    """Clear errors before the work: shape, one control, bounds, a load the grid carries."""
+    if s.ndim != 2 or not np.all(np.isfinite(s)):
+        raise ValueError("shape must be a finite 2D array [m]")
+    if (load is None) == (separation is None):
+        raise ValueError("give exactly one of load [N] or separation [m]")
+    if not hardness > p_min:
+        raise ValueError(f"hardness {hardness} must exceed p_min {p_min}")
     if load is not None:
+        if not load > p_min * s.size * area:
+            raise ValueError(f"load {load} N must exceed the floor load p_min * area")
+        if load >= hardness * s.size * area:
+            raise ValueError(f"load {load} N exceeds what the hardness can carry on this grid")
+
+
+def _wrong_set(p, p_old, g, free, was_wrong, tau, op, p_min, hardness):
+    """Points off the free set whose gap asks to move (p_min with overlap, H with the gap
+    open), moved in place in ``p``; returns their mask.
+
+    They get the pressure that closes a uniform overlap on the wrong set: the CG step; when
+    the same points are wrong again, no larger than the set's joint stiffness allows (one
+    point's step made points released from and pressed back to the cap cycle forever; the
+    extra FFT pair is paid only then)."""
+    wrong = (p_old <= p_min) & (g < 0)
+    if np.isfinite(hardness):
+        wrong |= (p_old >= hardness) & (g > 0)
+    wrong &= ~free
+    if wrong.any():
+        step = tau
+        if tau <= 0 or (wrong & was_wrong).any():
+            joint = 1.0 / op(wrong.astype(float)).max()
+            step = min(joint, tau) if tau > 0 else joint
+        p[wrong] = np.clip(p[wrong] - step * g[wrong], p_min, hardness)
+    return wrong
+
+
+def _result(s, u, p, h0, by_load, area, p_min, hardness, gap_floor, it, history):
+    """The :class:`ContactResult` of the converged pressure; under a load the separation is
+    the mean over the free set (where the gap closes)."""
+    if by_load:
         free = (p > p_min) & (p < hardness)
         pts = free if free.any() else p > p_min
         h0 = -(s + u)[pts].mean() if pts.any() else -(s + u).min()

@@ -1,6 +1,10 @@
-"""Results read back from an output folder: what cannot be read is set aside and recomputed.
+"""The store of a run: keys of cached results, and results read back from an output folder.
 
-Every stage writes atomically, so a file is either complete or absent after a crash; a file
+Every cached result (a micro h0 point, a Stribeck point, a pipeline stage) is filed under
+:func:`input_key`, a hash of all its inputs and the fem_twin version: a change of any input
+or of the code's version makes a new key, so a stale file is never read (callers prune the
+files of keys they no longer use).  Every stage writes atomically
+(:func:`fem_twin.io.atomic.atomic_path`), so a file is either complete or absent after a crash; a file
 that still cannot be read (a disk error, a truncated copy, a hand edit) must not stop every
 later run.  :func:`load_or_none` returns the loaded result, or None after moving the bad file
 to ``NAME.corrupt`` with a warning in the log, and the caller recomputes it.
@@ -8,10 +12,16 @@ to ``NAME.corrupt`` with a warning in the log, and the caller recomputes it.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import logging
 import os
 import zipfile
 from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
 
 log = logging.getLogger("fem_twin")
 
@@ -32,3 +42,17 @@ def load_or_none(path, loader):
         log.warning("unreadable result %s (%s: %s): moved to %s, recomputing", path,
                     type(err).__name__, err, aside.name)
         return None
+
+
+def input_key(*parts, length: int = 16) -> str:
+    """Hex key of ``parts`` and the fem_twin version: arrays by dtype, shape and bytes,
+    anything else by its JSON form (``str`` for what JSON cannot hold, e.g. dataclasses)."""
+    h = hashlib.sha256()
+    for part in (*parts, __version__):
+        if isinstance(part, np.ndarray):
+            a = np.ascontiguousarray(part)
+            h.update(f"{a.dtype.str}{a.shape}".encode())
+            h.update(a.tobytes())
+        else:
+            h.update(json.dumps(part, sort_keys=True, default=str).encode())
+    return h.hexdigest()[:length]

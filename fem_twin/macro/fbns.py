@@ -69,23 +69,7 @@ def solve_complementarity_fb(K, B, dirichlet, p_boundary, scale, *, phi0=None, t
             phi = np.full(n, float(p_boundary))
             phi[interior] = np.where(p >= s * theta, p, -theta * scale)
             return phi, it, history
-        t = s * theta
-        r = np.hypot(p, t)
-        safe = np.where(r > 0, r, 1.0)
-        dp = np.where(r > 0, 1 - p / safe, 1 - 1 / np.sqrt(2))
-        dt = np.where(r > 0, 1 - t / safe, 1 - 1 / np.sqrt(2))
-        P = dt >= dp                                       # eliminate dt here, dp elsewhere
-        a = np.where(P, 1.0, -dt / np.where(P, 1.0, dp))
-        b = np.where(P, dp / np.where(P, dt, 1.0), -1.0)
-        M = (KI @ sp.diags(a) + BI @ sp.diags(b / s)).tocsc()
-        rhs = -f1 - BI @ np.where(P, f2 / np.where(P, dt, 1.0), 0.0) / s \
-            + KI @ np.where(P, 0.0, f2 / np.where(P, 1.0, dp))
-        try:
-            y = spla.splu(M).solve(rhs)
-        except RuntimeError as err:
-            raise ReynoldsNotConverged(f"singular FBNS Schur complement: {err}", history) from err
-        d_p = np.where(P, y, (-f2 - dt * y) / np.where(P, 1.0, dp))
-        d_theta = np.where(P, (-f2 - dp * y) / np.where(P, dt, 1.0), y) / s
+        d_p, d_theta = _newton_direction(KI, BI, p, theta, s, f1, f2, history)
         merit, lam = norm(f1, f2, s), 1.0
         while True:
             p_new, theta_new = p + lam * d_p, theta + lam * d_theta
@@ -95,3 +79,27 @@ def solve_complementarity_fb(K, B, dirichlet, p_boundary, scale, *, phi0=None, t
         p, theta = p_new, theta_new
     raise ReynoldsNotConverged(f"FBNS: no convergence in {max_iter} Newton steps (tol {tol})",
                                history)
+
+
+def _newton_direction(KI, BI, p, theta, s, f1, f2, history):
+    """The semismooth Newton direction ``(d_p, d_theta)`` of ``(F1, phi_FB(p, s theta))``:
+    per node the larger of the two Fischer-Burmeister slopes is eliminated, leaving one
+    sparse system in ``p`` or ``theta`` (SuperLU)."""
+    t = s * theta
+    r = np.hypot(p, t)
+    safe = np.where(r > 0, r, 1.0)
+    dp = np.where(r > 0, 1 - p / safe, 1 - 1 / np.sqrt(2))
+    dt = np.where(r > 0, 1 - t / safe, 1 - 1 / np.sqrt(2))
+    P = dt >= dp                                       # eliminate dt here, dp elsewhere
+    a = np.where(P, 1.0, -dt / np.where(P, 1.0, dp))
+    b = np.where(P, dp / np.where(P, dt, 1.0), -1.0)
+    M = (KI @ sp.diags(a) + BI @ sp.diags(b / s)).tocsc()
+    rhs = -f1 - BI @ np.where(P, f2 / np.where(P, dt, 1.0), 0.0) / s \
+        + KI @ np.where(P, 0.0, f2 / np.where(P, 1.0, dp))
+    try:
+        y = spla.splu(M).solve(rhs)
+    except RuntimeError as err:
+        raise ReynoldsNotConverged(f"singular FBNS Schur complement: {err}", history) from err
+    d_p = np.where(P, y, (-f2 - dt * y) / np.where(P, 1.0, dp))
+    d_theta = np.where(P, (-f2 - dp * y) / np.where(P, dt, 1.0), y) / s
+    return d_p, d_theta

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.atomic import atomic_path
+from ..io.figure import save_figure
 
 #: (field, colour-bar label, scale to the plotted unit)
 PANELS = (("pressure_gauge", "hydrodynamic pressure $p - p_{amb}$ [MPa]", 1e-6),
@@ -37,8 +37,4 @@ def plot_point_fields(results, path, titles=None) -> Path:
             ax[row, col].set_ylabel("$x_2$ [mm]")
         title = titles[row] if titles else f"U = {res.speed:g} m/s"
         ax[row, 0].set_title(title, loc="left", fontsize="medium")
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=100)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=100)

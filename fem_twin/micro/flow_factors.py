@@ -17,6 +17,7 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from ..io.atomic import atomic_path
+from ..io.table import write_csv
 from .estimate import combine
 
 _ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "contact_fraction")
@@ -119,11 +120,7 @@ class FlowFactors:
                 "C11": self.C[:, 0, 0], "C12": self.C[:, 0, 1], "C21": self.C[:, 1, 0],
                 "C22": self.C[:, 1, 1], "d1": self.d[:, 0], "d2": self.d[:, 1],
                 "contact_fraction": self.contact_fraction}
-        path = Path(path)
-        with atomic_path(path) as tmp:
-            np.savetxt(tmp, np.column_stack(list(cols.values())), delimiter=",",
-                       header=",".join(cols), comments="", fmt="%.10g")
-        return path
+        return write_csv(path, cols)
 
     # -- interpolation -------------------------------------------------------------------
     def at(self, h0) -> "LocalFactors":

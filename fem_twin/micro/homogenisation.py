@@ -37,7 +37,6 @@ to its second-order spatial error; with contact, to the discretisation of the co
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import time
@@ -52,7 +51,7 @@ from ..contact import contact_rate
 from ..contact import solve as contact_solve
 from ..contact.levelling import TABLE4
 from ..io.atomic import atomic_path
-from ..io.checkpoint import load_or_none
+from ..io.checkpoint import input_key, load_or_none
 from ..threads import one_thread, worker_heap
 from ..topography import Topography
 from .cell_fv import CellSolverFV
@@ -492,11 +491,7 @@ def _check_patches(pin, disk):
 
 
 def _key(z_low, z_up, spacing, settings) -> str:
-    h = hashlib.sha256()
-    for a in (z_low, z_up):
-        h.update(np.ascontiguousarray(a).tobytes())
-    h.update(json.dumps([spacing, settings.__dict__, __version__], sort_keys=True).encode())
-    return h.hexdigest()[:16]
+    return input_key(np.asarray(z_low), np.asarray(z_up), list(spacing), settings.__dict__)
 
 
 def _point_path(folder: Path, key: str, h0: float) -> Path:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.atomic import atomic_path
+from ..io.figure import save_figure
 from ..io.mesh import grid_mesh, write_pvd, write_vtu
 from .flow_factors import FlowFactors
 from .homogenisation import (CellSettings, _cell_solver, _check_patches, sliding_cells,
@@ -47,11 +47,7 @@ def plot_flow_factors(factors, path, labels=None) -> Path:
             top = a.secondary_xaxis("top", functions=(lambda u: u * 1e-6 / sq,
                                                       lambda r: r * sq * 1e6))
             top.set_xlabel(f"$h_0 / S_q$ [-] ($S_q$ = {sq * 1e9:.0f} nm)", fontsize="small")
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def composite_sq(factors: FlowFactors) -> float | None:

@@ -8,11 +8,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.atomic import atomic_path
+from ..io.figure import save_figure
+from ..io.table import write_csv
 from ..macro.friction import BOUNDARY_FRICTION
 
 COLUMNS = ("speed", "hersey", "friction_coefficient", "viscosity", "hydrodynamic_friction",
            "boundary_friction", "contact_load_fraction", "h_d", "iterations")
+#: the CSV header of each column: its name with the SI unit (:mod:`fem_twin.io.table`)
+HEADERS = dict(zip(COLUMNS, ("speed_m_s", "hersey", "friction_coefficient", "viscosity_Pa_s",
+                             "hydrodynamic_friction_N", "boundary_friction_N",
+                             "contact_load_fraction", "h_d_m", "iterations")))
 
 
 def hersey_number(viscosity, speed, diameter: float, load: float):
@@ -44,12 +49,6 @@ class StribeckCurve:
     h_d: np.ndarray
     iterations: np.ndarray
 
-    def rows(self):
-        for i in range(len(self.speed)):
-            yield [self.speed[i], self.hersey[i], self.friction_coefficient[i], self.viscosity,
-                   self.hydrodynamic_friction[i], self.boundary_friction[i],
-                   self.contact_load_fraction[i], self.h_d[i], int(self.iterations[i])]
-
     def at_hersey(self, hersey):
         """C_f interpolated (monotone cubic, PCHIP, in log H) at Hersey numbers inside this
         curve's range; NaN outside it."""
@@ -64,27 +63,27 @@ class StribeckCurve:
 
 
 def write_stribeck_csv(path, curves, band=None) -> Path:
-    """All curves into one CSV (columns :data:`COLUMNS`, SI units), atomically; ``band``:
-    optional ``(cf_min, cf_max)`` per curve (the patch scatter band), two more columns."""
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        with open(tmp, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(COLUMNS + (("cf_min", "cf_max") if band is not None else ()))
-            for k, c in enumerate(curves):
-                for i, row in enumerate(c.rows()):
-                    if band is not None:
-                        row += [float(band[k][0][i]), float(band[k][1][i])]
-                    w.writerow([f"{v:.10g}" if isinstance(v, float) else v for v in row])
-    return path
+    """All curves into one CSV (:data:`HEADERS`, SI units), atomically; ``band``: optional
+    ``(cf_min, cf_max)`` per curve (the patch scatter band), two more columns."""
+    curves = list(curves)
+    columns = {HEADERS[k]: np.concatenate([np.broadcast_to(getattr(c, k), c.speed.shape)
+                                           for c in curves]) for k in COLUMNS}
+    columns["iterations"] = columns["iterations"].astype(int)
+    if band is not None:
+        columns["cf_min"] = np.concatenate([np.asarray(b[0], float) for b in band])
+        columns["cf_max"] = np.concatenate([np.asarray(b[1], float) for b in band])
+    return write_csv(path, columns)
 
 
 def read_stribeck_csv(path) -> list[StribeckCurve]:
-    """Curves written by :func:`write_stribeck_csv`, one per viscosity."""
+    """Curves written by :func:`write_stribeck_csv` (or with the unit-less headers of
+    fem_twin 0.1), one per viscosity."""
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
+    if rows and set(HEADERS.values()) <= set(rows[0]):
+        rows = [{k: r[HEADERS[k]] for k in COLUMNS} for r in rows]
     if not rows or set(COLUMNS) - set(rows[0]):
-        raise ValueError(f"{path}: not a Stribeck CSV with columns {COLUMNS}")
+        raise ValueError(f"{path}: not a Stribeck CSV with columns {tuple(HEADERS.values())}")
     out = []
     for mu in dict.fromkeys(float(r["viscosity"]) for r in rows):
         sel = [r for r in rows if float(r["viscosity"]) == mu]
@@ -134,11 +133,7 @@ def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None
     ax.legend(fontsize="small", loc="upper right")
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 @dataclass(frozen=True, eq=False)

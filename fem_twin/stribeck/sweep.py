@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import hashlib
-import json
 from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
-from ..io.checkpoint import load_or_none
+from ..io.checkpoint import input_key, load_or_none
 from ..io.mesh import write_pvd
 from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
 from ..micro.flow_factors import FlowFactors
@@ -85,15 +83,10 @@ def sweep_key(gap, spacing, factors, load, lubricant, settings, face,
               slide_to_roll=None) -> str:
     """Key of a sweep's checkpoints (``point_KEY_*.npz``): a hash of all its inputs, with
     ``factors`` a :class:`FlowFactors` or a key string of their inputs."""
-    h = hashlib.sha256()
     flow = ((factors.h0, factors.h_m, factors.p_con, factors.A, factors.b, factors.C,
-             factors.d) if isinstance(factors, FlowFactors) else (np.frombuffer(
-                 str(factors).encode(), np.uint8),))
-    for a in (gap, np.asarray(spacing, float), *flow,
-              np.zeros(0) if face is None else np.asarray(face, bool)):
-        h.update(np.ascontiguousarray(a).tobytes())
+             factors.d) if isinstance(factors, FlowFactors) else (str(factors),))
     inputs = [load, lubricant.__dict__, settings.__dict__]
     if slide_to_roll is not None:
         inputs.append(slide_to_roll)
-    h.update(json.dumps(inputs, sort_keys=True, default=str).encode())
-    return h.hexdigest()[:12]
+    return input_key(np.asarray(gap, float), np.asarray(spacing, float), *flow,
+                     None if face is None else np.asarray(face, bool), inputs, length=12)
