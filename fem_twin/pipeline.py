@@ -25,6 +25,7 @@ from .contact.levelling import average_pins, level_pin
 from .errors import RunLocked, SchedulerUnreachable
 from .io.atomic import atomic_path
 from .io.checkpoint import input_key, load_or_none
+from .io.table import write_csv
 from .io.files import read_topography, write_topography
 from .io.mesh import grid_mesh, write_vtu
 from .macro import MacroSettings, MixedResult
@@ -553,9 +554,9 @@ def validate(case: Case, curves, outdir: Path, labels) -> list:
                       boundary=case.tribometer.boundary_friction)
         result.append({"viscosity_Pa_s": curve.viscosity, "measured": str(path),
                        "max_abs_cf_dev": float(np.nanmax(np.abs(dev)))})
-    with atomic_path(outdir / "validation.csv") as tmp:
-        tmp.write_text("viscosity,speed,measured_cf,cf_dev\n" + "".join(
-            f"{a:.10g},{b:.10g},{c:.10g},{d:.10g}\n" for a, b, c, d in rows))
+    write_csv(outdir / "validation.csv", dict(zip(
+        ("viscosity_Pa_s", "speed_m_s", "measured_cf", "cf_dev"),
+        zip(*rows) if rows else ((),) * 4)))
     return result
 
 

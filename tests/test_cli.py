@@ -126,7 +126,7 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     ref = tmp_path / "ref"
     assert main(["run", str(case), "-o", str(ref), "--no-progress"]) == 0
     rows = list(csv.DictReader(open(ref / "stribeck.csv")))
-    assert {"speed", "hersey", "friction_coefficient", "viscosity"} <= set(rows[0])
+    assert {"speed_m_s", "hersey", "friction_coefficient", "viscosity_Pa_s"} <= set(rows[0])
     assert len(rows) == 10 and {float(r["viscosity_Pa_s"]) for r in rows} == {0.066, 0.024}
     for mu in (0.066, 0.024):
         r = [x for x in rows if float(x["viscosity_Pa_s"]) == mu]
@@ -161,7 +161,7 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     r66 = [x for x in rows if float(x["viscosity_Pa_s"]) == 0.066]
     measured = tmp_path / "measured_24C.csv"
     measured.write_text("speed,friction_coefficient,cf_min,cf_max\n" + "".join(
-        f"{x['speed']},{float(x['friction_coefficient']) + 0.01 / (3 * 3 ** 0.5)!r},0,1\n"
+        f"{x['speed_m_s']},{float(x['friction_coefficient']) + 0.01 / (3 * 3 ** 0.5)!r},0,1\n"
         for x in r66))
     with_val = tmp_path / "case_val.toml"
     with_val.write_text(case.read_text() + f'\n[validation]\nmeasured = ["{measured}"]\n')
