@@ -97,7 +97,9 @@ def bench_contact_pk(sizes=(256, 1024)):
     (100 MPa), gap control (the separation of that state), gap + hardness (a cap of 0.6 x the
     elastic peak, so points are plastic) and load + hardness.  Both at tol 1e-8 (each its own
     criterion); accuracy: L2 of the pressure against a tol 1e-12 reference (fem_twin), bar
-    1e-6.  FFT pairs per iteration counted in both.  Baseline: one rfft2+irfft2 pair."""
+    1e-6.  FFT pairs per iteration counted in both (fem_twin: double + single precision).
+    Tamaas's load-controlled PK beside them when it is installed (``pip install tamaas``).
+    Baseline: one rfft2+irfft2 pair."""
     shared = os.path.join(HERE, "..", "..", "shared", "baselines")
     if not os.path.isfile(os.path.join(shared, "pk_numpy.py")):
         return 1.0, [("pk_numpy.py absent (../shared/baselines): nothing to compare", 0.0, "")]
@@ -107,15 +109,26 @@ def bench_contact_pk(sizes=(256, 1024)):
     from fem_twin import contact
     from fem_twin.contact import elastic
     from fem_twin.topography.synthetic import self_affine
+    try:
+        import tamaas
+        tamaas.initialize(1)
+        tamaas.set_log_level(tamaas.LogLevel.error)
+    except ImportError:
+        tamaas = None
 
-    calls = {"n": 0}
-    plain = elastic.ElasticOperator.__call__
+    calls = {"n": 0, "single": 0}
+    plain, single = elastic.ElasticOperator.__call__, elastic.ElasticOperator.single
 
     def counted(self, p):
         calls["n"] += 1
         return plain(self, p)
 
+    def counted_single(self, p):
+        calls["single"] += 1
+        return single(self, p)
+
     elastic.ElasticOperator.__call__ = counted
+    elastic.ElasticOperator.single = counted_single
     e_red = contact.reduced_modulus(210e9, 0.3, 210e9, 0.3)
     rows, base = [], None
     try:
@@ -141,18 +154,35 @@ def bench_contact_pk(sizes=(256, 1024)):
                     pk_kw["offset"] = kw["separation"]
                 K.nfft = 0
                 t_pk, out = best_of(lambda: pk_numpy.solve(K, -shape, **pk_kw), 1)
-                calls["n"] = 0
+                calls["n"] = calls["single"] = 0
                 t_ft, res = best_of(lambda: contact.solve(shape, dx, e_red, periodic=True,
                                                           tol=1e-8, **kw), 1)
                 l2 = lambda p: np.linalg.norm(p - ref) / np.linalg.norm(ref)  # noqa: E731
                 rows += [(f"{n}^2 {name}: pk_numpy", t_pk, f"{out['it']} it, "
                           f"{out['nfft'] / 2 / out['it']:.2f} FFT pairs/it, L2 {l2(out['p']):.1e}"),
                          (f"{n}^2 {name}: fem_twin", t_ft, f"{res.iterations} it, "
-                          f"{calls['n'] / res.iterations:.2f} FFT pairs/it, "
+                          f"{calls['n'] / res.iterations:.2f} + "
+                          f"{calls['single'] / res.iterations:.2f} single FFT pairs/it, "
                           f"L2 {l2(res.pressure):.1e}; pk_numpy / fem_twin = {t_pk / t_ft:.2f}")]
+                if name == "load" and tamaas is not None:
+                    rows.append(_tamaas_row(tamaas, shape, dx, e_red, ref, t_ft, f"{n}^2 {name}"))
     finally:
         elastic.ElasticOperator.__call__ = plain
+        elastic.ElasticOperator.single = single
     return base, rows
+
+
+def _tamaas_row(tamaas, shape, dx, e_red, ref, t_ft, label):
+    """Tamaas's Polonsky-Keer (Rey's variant, one thread) under the same mean pressure
+    (100 MPa) at tol 1e-8; its E* = E'/2 against a rigid surface of heights -shape."""
+    n = shape.shape[0]
+    model = tamaas.ModelFactory.createModel(tamaas.model_type.basic_2d, [n * dx] * 2, [n, n])
+    model.E, model.nu = e_red / 2, 0.0
+    solver = tamaas.PolonskyKeerRey(model, np.ascontiguousarray(-shape), 1e-8)
+    t, _ = best_of(lambda: solver.solve(100e6), 1)
+    p = np.array(model.traction).reshape(n, n)
+    return (f"{label}: Tamaas", t, f"L2 {np.linalg.norm(p - ref) / np.linalg.norm(ref):.1e}; "
+            f"Tamaas / fem_twin = {t / t_ft:.2f}")
 
 
 def _warm_patch_sweep(e_red):

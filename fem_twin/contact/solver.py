@@ -147,56 +147,68 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
     p = _initial(s, area, load, separation, hardness, p_min, initial_pressure)
 
     history = []
-    t = np.zeros_like(s)
+    by_load, capped = load is not None, bool(np.isfinite(hardness))
+    t, g, gm, m, spare = (np.zeros_like(s) for _ in range(5))   # no allocation in the loop
     g_old, delta, was_wrong = 1.0, 0.0, np.zeros(s.shape, bool)
     h0 = 0.0 if separation is None else float(separation)
-    u, fresh = None, 0
+    u, fresh, precise = None, 0, False
     dot = lambda a, b: float(np.dot(a.ravel(), b.ravel()))  # noqa: E731  (BLAS, no copies)
     size = (lambda q: q.sum()) if p_min >= 0 else (lambda q: np.abs(q).sum())  # noqa: E731
+    size_old = size(p)
     for it in range(1, max_iter + 1):
         if u is None or fresh >= _REFRESH:
             u, fresh = op(p), 0
-        g = s + u
-        free = (p > p_min) & (p < hardness)
-        m = free.astype(float)                     # free-set mask as numbers: masked sums
-        n_free = dot(m, m)                         # are dot products, without index copies
-        if load is not None and n_free:
+        np.add(s, u, out=g)
+        free = p > p_min
+        if capped:
+            free &= p < hardness
+        np.copyto(m, free)                         # free-set mask as numbers: masked sums
+        n_free = float(np.count_nonzero(free))     # are dot products, without index copies
+        if by_load and n_free:
             h0 = -dot(g, m) / n_free
         g += h0
-        gm = g * m
+        np.multiply(g, m, out=gm)
         gg = dot(gm, gm)
-        t *= delta * (gg / g_old)
-        t += g
+        t *= delta * (gg / g_old)                  # t = m (g + beta t)
         t *= m
+        t += gm
         g_old = gg if gg > 0 else 1.0
-        kt = op(t)
-        r = kt - dot(kt, m) / n_free if load is not None and n_free else kt
-        rt = dot(r, t)
+        kt = op(t) if precise else op.single(t)
+        rt = dot(kt, t)                            # (K t - its free-set mean) . t under load
+        if by_load and n_free:
+            rt -= dot(kt, m) / n_free * float(t.sum())
         tau = dot(g, t) / rt if rt > 0 else 0.0
-        p_old = p
-        p = p - tau * t
-        linear = p.min() >= p_min and p.max() <= hardness   # no bound hit: K p = u - tau K t
+        p_old, p = p, spare
+        np.multiply(t, -tau, out=p)
+        p += p_old
+        linear = p.min() >= p_min and (not capped or p.max() <= hardness)  # K p = u - tau K t
         if not linear:
             np.clip(p, p_min, hardness, out=p)
-        # points off the free set whose gap asks to move: p_min with overlap, H with gap open
-        wrong = _wrong_set(p, p_old, g, free, was_wrong, tau, op, p_min, hardness)
+        wrong = _wrong_set(p, p_old, g, free, was_wrong, tau, op, p_min, hardness, capped)
         any_wrong = wrong.any()
         delta = 0.0 if any_wrong else 1.0
         was_wrong = wrong
         factor = 1.0
-        if load is not None:
-            p, factor = _enforce_load(p, load / area, p_min, hardness)
+        if by_load:
+            factor = _rescale(p, load / area, p_min, hardness, capped)
             linear &= factor is not None and (factor == 1.0 or p_min == 0.0)
         # the next deformation from this iteration's K t (one FFT pair per iteration instead
         # of two) while no bound was hit; recomputed every _REFRESH iterations against drift
-        if linear and not any_wrong:
-            u, fresh = factor * (u - tau * kt), fresh + 1
+        if linear and not any_wrong and precise:
+            kt *= -tau
+            u += kt
+            u *= factor
+            fresh += 1
         else:
             u = None
+        precise = linear and not any_wrong
         # relative change, with a floor of 1e-14 E' per point (no contact: nothing to resolve)
-        scale = max(size(p), size(p_old), 1e-14 * e_reduced * p.size)
-        change = np.abs(p - p_old).sum() / scale
+        size_new = size(p)
+        scale = max(size_new, size_old, 1e-14 * e_reduced * p.size)
+        np.subtract(p, p_old, out=gm)
+        change = float(np.abs(gm, out=gm).sum()) / scale
         history.append(change)
+        spare, size_old = p_old, size_new
         if change < tol:
             break
     else:
@@ -221,7 +233,7 @@ def _check(s, area, load, separation, hardness, p_min):
             raise ValueError(f"load {load} N exceeds what the hardness can carry on this grid")
 
 
-def _wrong_set(p, p_old, g, free, was_wrong, tau, op, p_min, hardness):
+def _wrong_set(p, p_old, g, free, was_wrong, tau, op, p_min, hardness, capped):
     """Points off the free set whose gap asks to move (p_min with overlap, H with the gap
     open), moved in place in ``p``; returns their mask.
 
@@ -229,17 +241,49 @@ def _wrong_set(p, p_old, g, free, was_wrong, tau, op, p_min, hardness):
     the same points are wrong again, no larger than the set's joint stiffness allows (one
     point's step made points released from and pressed back to the cap cycle forever; the
     extra FFT pair is paid only then)."""
-    wrong = (p_old <= p_min) & (g < 0)
-    if np.isfinite(hardness):
-        wrong |= (p_old >= hardness) & (g > 0)
-    wrong &= ~free
+    if capped:
+        wrong = ((p_old <= p_min) & (g < 0)) | ((p_old >= hardness) & (g > 0))
+    else:                                   # off the free set = at the floor
+        wrong = np.greater(g < 0, free)
     if wrong.any():
         step = tau
         if tau <= 0 or (wrong & was_wrong).any():
             joint = 1.0 / op(wrong.astype(float)).max()
             step = min(joint, tau) if tau > 0 else joint
-        p[wrong] = np.clip(p[wrong] - step * g[wrong], p_min, hardness)
+        idx = np.flatnonzero(wrong)
+        flat = p.ravel()
+        flat[idx] = np.clip(flat[idx] - step * g.ravel()[idx], p_min, hardness)
     return wrong
+
+
+def _rescale(p, total, p_min, hardness, capped):
+    """Scale ``p`` in place so that its sum is ``total`` (as :func:`_enforce_load`, without
+    temporaries); the uniform factor, or None."""
+    if not capped:
+        current = float(p.sum()) - p_min * p.size
+        if current > 0 and p_min == 0.0:
+            factor = total / current
+            p *= factor
+            return factor
+        np.copyto(p, _enforce_load(p, total, p_min, hardness)[0])
+        return None
+    for k in range(50):
+        plastic = np.flatnonzero(p >= hardness)           # the capped points stay at H
+        n_pl = plastic.size
+        target = total - p_min * p.size - (hardness - p_min) * n_pl
+        current = float(p.sum()) - p_min * (p.size - n_pl) - hardness * n_pl
+        if target <= 0 or current <= 0:
+            np.copyto(p, _enforce_load(p, total, p_min, hardness)[0])
+            return None
+        factor = target / current
+        p -= p_min
+        p *= factor
+        p += p_min
+        p.ravel()[plastic] = hardness
+        if p.max() <= hardness:
+            return factor if k == 0 and n_pl == 0 else None
+        np.minimum(p, hardness, out=p)
+    return None
 
 
 def _result(s, u, p, h0, by_load, area, p_min, hardness, gap_floor, it, history):
