@@ -221,6 +221,30 @@ def _patch_pair(n=256):
     return pin, disk
 
 
+def _amg_rows(cs, gap):
+    """The FE cell step with smoothed-aggregation AMG (pyamg) as the CG preconditioner,
+    setup included, to tol 1e-10, against the direct solution of the production step: why
+    the cell problems are solved directly (README, Notes)."""
+    import pyamg
+    import scipy.sparse.linalg as spla
+    h_q = cs.at_quadrature(gap)
+    K = cs.operator(h_q ** 3)
+    F = cs.right_hand_sides(h_q, h_q ** 3)
+    direct = cs._factor.factor(K.data).solve(F)
+
+    def amg():
+        ml = pyamg.smoothed_aggregation_solver(K, symmetry="symmetric")
+        M, its = ml.aspreconditioner(), [0]
+        out = [spla.cg(K, F[:, k], M=M, rtol=1e-10, atol=0.0,
+                       callback=lambda _: its.__setitem__(0, its[0] + 1))[0] for k in range(3)]
+        return np.column_stack(out), its[0]
+
+    t, (X, its) = best_of(amg, 1)
+    err = np.abs(X - direct).max() / np.abs(direct).max()
+    return [("FE cell step, pyamg SA + CG (3 solves)", t,
+             f"{its} CG it, max diff to direct {err:.1e}, h0 = 0.2 um")]
+
+
 def bench_micro(full=False):
     """Cell problems at 256^2 (sample patch 3) against a full scikit-fem assembly.
 
@@ -252,6 +276,7 @@ def bench_micro(full=False):
             t, _ = best_of(lambda: solver.solve(gap))
             rows.append((f"{name} cell step, {backend}", t,
                          "assemble + factor + 3 solves + means, h0 = 0.2 um"))
+    rows += _amg_rows(cs, gap)
     t, r = best_of(lambda: solve(shape, pin.spacing, TABLE4["e_reduced"], separation=0.2e-6,
                                  hardness=TABLE4["hardness"], periodic=True))
     rows.append(("periodic contact, cold", t, f"{r.iterations} it"))
