@@ -8,7 +8,6 @@ import pytest
 from fem_twin import Topography
 from fem_twin.fvm import CellSolverFV
 from fem_twin.micro import CellSolver, FlowFactors, average, homogenise
-from fem_twin.micro import homogenisation as homogenise_module
 from fem_twin.micro.cell import couette_form, flow_form, pressure_form_1, squeeze_form
 from fem_twin.topography.synthetic import self_affine
 
@@ -380,26 +379,29 @@ def test_average_over_patches(small_factors):
 
 
 # -- runs: checkpoints, processes, bad input ---------------------------------------------------
-def test_checkpoint_resume_computes_only_missing(tmp_path, monkeypatch):
+def test_checkpoint_resume_computes_only_missing(tmp_path):
+    """A rerun computes (writes) only the h0 without a checkpoint and leaves the others'
+    files untouched (same inode and mtime: atomic writes would replace them); other settings
+    make a new key, so their point is computed anew beside the old ones."""
     pin, disk = rough_pair(16)
     h0 = np.geomspace(0.15e-6, 0.8e-6, 3)
+
+    def files():
+        return {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in tmp_path.glob("*.json")}
+
     first = homogenise(pin, disk, h0[:2], n_steps=2, checkpoint=tmp_path, error_estimate=False)
-    assert len(list(tmp_path.glob("*.json"))) == 2
-    calls = []
-    real = homogenise_module._run_chunk
-
-    def counting(points, **kw):
-        calls.extend(h for _, h in points)
-        return real(points, **kw)
-
-    monkeypatch.setattr(homogenise_module, "_run_chunk", counting)
+    before = files()
+    assert len(before) == 2
     again = homogenise(pin, disk, h0, n_steps=2, checkpoint=tmp_path, error_estimate=False)
-    assert calls == [h0[2]]
+    after = files()
+    new = set(after) - set(before)
+    assert len(new) == 1 and f"{h0[2]:.9e}" in new.pop()
+    assert all(after[k] == v for k, v in before.items())
     assert np.array_equal(again.A[:2], first.A) and np.array_equal(again.p_con[:2], first.p_con)
-    calls.clear()
     other = homogenise(pin, disk, h0[:1], n_steps=4, checkpoint=tmp_path,   # other settings
                        error_estimate=False)
-    assert calls == [h0[0]] and other.meta["n_steps"] == 4
+    new = set(files()) - set(after)
+    assert len(new) == 1 and f"{h0[0]:.9e}" in new.pop() and other.meta["n_steps"] == 4
 
 
 def test_process_pool_gives_the_serial_numbers():
