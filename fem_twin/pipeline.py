@@ -412,9 +412,8 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                  "%.3g", level + 1, extra.size, case.sweep.refine_step * tr.boundary_friction)
         speeds = np.unique(np.r_[speeds, extra])[::-1]
     tasks = [(dict(common, speeds=speeds), lub) for lub in lubricants]
-    band_tasks = [(dict(kw, starts=_points_of(kw_avg, lub)), lub)
-                  for kw in band_sweeps(case, outdir, dict(common, speeds=speeds))
-                  for kw_avg, lub in tasks] if case.run.patch_band else []
+    band_tasks = [(kw, lub) for kw in band_sweeps(case, outdir, dict(common, speeds=speeds))
+                  for lub in lubricants] if case.run.patch_band else []
     patch_curves = run_sweeps(band_tasks, executor, progress, desc="patch band points")
     patch_curves = [patch_curves[i:i + len(lubricants)]
                     for i in range(0, len(patch_curves), len(lubricants))]
@@ -601,12 +600,6 @@ def _sweep_key(kwargs: dict, lubricant) -> str:
     return sweep_key(kwargs["gap"], kwargs["spacing"], kwargs["factors_key"], kwargs["load"],
                      lubricant, kwargs["settings"], kwargs["face"],
                      kwargs.get("slide_to_roll"))
-
-
-def _points_of(kwargs: dict, lubricant) -> list:
-    """Checkpoint paths of a sweep task's points, one per speed (the band's warm starts)."""
-    key = _sweep_key(kwargs, lubricant)
-    return [Path(kwargs["checkpoint"]) / f"point_{key}_{u:.9e}.npz" for u in kwargs["speeds"]]
 
 
 def _prune_points(folder: Path, tasks) -> None:

@@ -302,22 +302,3 @@ def test_start_separations_find_analytic_roots():
     exact = h_c - (load / (k * area.sum())) ** (2 / 3)
     assert abs(dry_separation(factors, gap, area, load, s) - exact) <= 1e-12 * h_c
     assert dry_separation(factors, gap, area, 1e9, s) == s.gap_floor   # cannot carry it
-
-
-def test_sweep_warm_started_from_given_points_reaches_the_same_curve(case32, factors, tmp_path):
-    """``stribeck_sweep(starts=...)`` (the patch band's start from the average curve at the
-    same speed): from the converged points of the same sweep every point is reached again
-    within the coupling tolerance (C_f to 1e-5: tol 1e-6 on p/p_ref, h_el/h_ref and the
-    load), in fewer coupling iterations than the sweep that starts from the previous speed;
-    a ``starts`` of the wrong length is refused."""
-    from fem_twin.stribeck import stribeck_sweep
-    gap, spacing, face = case32
-    speeds = np.array([1.0, 0.1, 0.01])
-    kw = dict(load=150.0, lubricant=Lubricant(0.066), face=face)
-    first = stribeck_sweep(gap, spacing, factors, speeds, checkpoint=tmp_path, **kw)
-    points = sorted(tmp_path.glob("point_*.npz"), key=lambda p: -MixedResult.load(p).speed)
-    again = stribeck_sweep(gap, spacing, factors, speeds, starts=points, **kw)
-    assert np.allclose(again.friction_coefficient, first.friction_coefficient, rtol=1e-5)
-    assert again.iterations.sum() < first.iterations.sum()
-    with pytest.raises(ValueError, match="one entry per speed"):
-        stribeck_sweep(gap, spacing, factors, speeds, starts=points[:2], **kw)

@@ -21,7 +21,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    settings: MacroSettings = MacroSettings(), checkpoint=None, fields=None,
                    origin=(0.0, 0.0), progress: bool = False,
                    factors_key: str | None = None,
-                   slide_to_roll: float | None = None, starts=None) -> StribeckCurve:
+                   slide_to_roll: float | None = None) -> StribeckCurve:
     """C_f over ``speeds`` [m/s] at one viscosity (paper 3.2: from 2 m/s down to 0.01 m/s).
 
     Each point warm-starts from the previous one (give speeds from fast to slow: the
@@ -33,18 +33,12 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     recomputing a lost micro checkpoint (same numbers to ~1e-10) keeps the points.
     ``slide_to_roll``: a rolling-sliding contact (a ball on a disk): ``speeds`` are then the
     entrainment speeds u_m and each point slides at ``u_r = slide_to_roll * u_m``.
-    ``starts``: per speed, a converged point (``MixedResult`` or its ``.npz`` path, None or
-    a missing file for none) to warm-start from instead of the previous speed: the patch
-    band's sweeps start from the average curve at the same speed (measured on the bundled
-    case: 120 instead of 183 coupling iterations over 8 speeds, C_f equal to 6 digits).
     """
     speeds = np.asarray(speeds, float)
     if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
         raise ValueError("speeds must be a non-empty list of positive values [m/s]")
     if slide_to_roll is not None and not (0 < slide_to_roll <= 2):
         raise ValueError(f"slide_to_roll must be in (0, 2], got {slide_to_roll}")
-    if starts is not None and len(starts) != speeds.size:
-        raise ValueError(f"starts: one entry per speed ({speeds.size}), got {len(starts)}")
     gap = np.asarray(gap, float)
     key = sweep_key(gap, spacing, factors if factors_key is None else factors_key, load,
                     lubricant, settings, face, slide_to_roll)
@@ -61,7 +55,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                 speed=float(slide_to_roll * speed), entrainment=float(speed))
             res = solve_mixed(gap, spacing, factors, load=load, **sliding,
                               lubricant=lubricant, face=face, settings=settings,
-                              initial=_start(starts, i) or previous)
+                              initial=previous)
             if path is not None:
                 res.save(path)
         results.append(res)
@@ -83,15 +77,6 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         boundary_friction=get("boundary_friction"),
         contact_load_fraction=get("contact_load") / load, h_d=get("h_d"),
         iterations=get("iterations"))
-
-
-def _start(starts, i):
-    """The ``i``-th warm start of ``starts`` (see :func:`stribeck_sweep`), or None."""
-    if starts is None or starts[i] is None:
-        return None
-    if isinstance(starts[i], MixedResult):
-        return starts[i]
-    return load_or_none(starts[i], MixedResult.load)
 
 
 def sweep_key(gap, spacing, factors, load, lubricant, settings, face,
