@@ -190,7 +190,7 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
         was_wrong = wrong
         factor = 1.0
         if by_load:
-            factor = _rescale(p, load / area, p_min, hardness, capped)
+            factor = _rescale(p, load / area, p_min, hardness)
             linear &= factor is not None and (factor == 1.0 or p_min == 0.0)
         # the next deformation from this iteration's K t (one FFT pair per iteration instead
         # of two) while no bound was hit; recomputed every _REFRESH iterations against drift
@@ -214,8 +214,7 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
     else:
         raise ContactNotConverged(f"contact did not converge in {max_iter} iterations "
                                   f"(tol {tol})", history)
-    return _result(s, op(p), p, h0, load is not None, area, p_min, hardness, gap_floor, it,
-                   history)
+    return _result(s, op(p), p, h0, by_load, area, p_min, hardness, gap_floor, it, history)
 
 
 def _check(s, area, load, separation, hardness, p_min):
@@ -256,34 +255,40 @@ def _wrong_set(p, p_old, g, free, was_wrong, tau, op, p_min, hardness, capped):
     return wrong
 
 
-def _rescale(p, total, p_min, hardness, capped):
-    """Scale ``p`` in place so that its sum is ``total`` (as :func:`_enforce_load`, without
-    temporaries); the uniform factor, or None."""
-    if not capped:
-        current = float(p.sum()) - p_min * p.size
-        if current > 0 and p_min == 0.0:
-            factor = total / current
-            p *= factor
-            return factor
-        np.copyto(p, _enforce_load(p, total, p_min, hardness)[0])
-        return None
+def _rescale(p, total, p_min, hardness):
+    """Scale, in place, the pressure above the floor of the points below the cap so that
+    ``sum(p) = total``; the uniform factor when one scaling did it, else None."""
+    capped = np.isfinite(hardness)
+    floor = p_min * p.size
     for k in range(50):
-        plastic = np.flatnonzero(p >= hardness)           # the capped points stay at H
-        n_pl = plastic.size
-        target = total - p_min * p.size - (hardness - p_min) * n_pl
-        current = float(p.sum()) - p_min * (p.size - n_pl) - hardness * n_pl
-        if target <= 0 or current <= 0:
-            np.copyto(p, _enforce_load(p, total, p_min, hardness)[0])
+        plastic = np.flatnonzero(p >= hardness) if capped else np.zeros(0, int)
+        held = (hardness - p_min) * plastic.size if plastic.size else 0.0   # stay at H
+        target = total - floor - held
+        current = float(p.sum()) - floor - held
+        if target <= 0 < current + held:
+            # the capped points alone carry more than the load: lower every point alike
+            # (the CG then frees the ones whose gap opens)
+            _scale_above(p, p_min, (total - floor) / (current + held))
             return None
+        if current <= 0:
+            break
         factor = target / current
-        p -= p_min
-        p *= factor
-        p += p_min
+        _scale_above(p, p_min, factor)
         p.ravel()[plastic] = hardness
-        if p.max() <= hardness:
-            return factor if k == 0 and n_pl == 0 else None
+        if not capped or p.max() <= hardness:
+            return factor if k == 0 and plastic.size == 0 else None
         np.minimum(p, hardness, out=p)
+    np.minimum(p, hardness, out=p)
     return None
+
+
+def _scale_above(p, p_min, factor):
+    """``p = p_min + factor (p - p_min)`` in place."""
+    if p_min:
+        p -= p_min
+    p *= factor
+    if p_min:
+        p += p_min
 
 
 def _result(s, u, p, h0, by_load, area, p_min, hardness, gap_floor, it, history):
@@ -307,33 +312,12 @@ def _initial(s, area, load, separation, hardness, p_min, initial_pressure):
         if p.shape != s.shape:
             raise ValueError(f"initial_pressure shape {p.shape} != shape {s.shape}")
         if load is not None:
-            p = _enforce_load(p if p.sum() > 0 else np.full(s.shape, 1.0), load / area, p_min,
-                              hardness)[0]
+            p = p if p.sum() > 0 else np.full(s.shape, 1.0)
+            _rescale(p, load / area, p_min, hardness)
         return p
     if load is not None:
-        return _enforce_load(np.full(s.shape, 1.0), load / area, p_min, hardness)[0]
+        p = np.full(s.shape, 1.0)
+        _rescale(p, load / area, p_min, hardness)
+        return p
     # separation control: start from the points that overlap the rigid surface
     return np.where(s + separation < 0, min(hardness, 1e6 + p_min), p_min)
-
-
-def _enforce_load(p, total, p_min, hardness):
-    """Scale the pressure above the floor of the non-plastic points so that sum(p) = total;
-    return it and the scale factor when one uniform scaling did it (else None)."""
-    for k in range(50):
-        plastic = p >= hardness
-        excess = p - p_min
-        excess[plastic] = 0.0
-        target = total - p_min * p.size - ((hardness - p_min) * plastic.sum() if plastic.any() else 0.0)
-        current = excess.sum()
-        if target <= 0 < current + (hardness - p_min) * plastic.sum():
-            # the capped points alone carry more than the load: lower every point alike
-            # (the CG then frees the ones whose gap opens)
-            excess = p - p_min
-            return p_min + excess * ((total - p_min * p.size) / excess.sum()), None
-        if current <= 0:
-            break
-        p = np.where(plastic, hardness, p_min + excess * (target / current))
-        if p.max() <= hardness:
-            return p, (target / current if k == 0 and not plastic.any() else None)
-        p = np.minimum(p, hardness)
-    return np.minimum(p, hardness), None

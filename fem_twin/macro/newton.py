@@ -422,14 +422,12 @@ def rigid_start(P: Problem, load: float, ratio: float):
     Returns the state and the load it carries (at most ``load``)."""
     from .reynolds import solve_complementarity, upwind_couette
     s = P.settings
-    rho0 = P.lubricant.density_ratio(0.0)
     touch = s.gap_floor - float(P.gap.min())
     t = float(P.factors.h0[-1]) - float(P.gap.min()) - touch
     for _ in range(80):
         h_d = touch + t
-        loc = P.factors.at(np.maximum(h_d + P.gap, s.gap_floor))
-        g = rho0 * loc.h_m ** 3 / (12 * P.lubricant.viscosity)
-        q = rho0 * loc.h_m * P.entrainment
+        loc, _, _, g, q = P.coefficients(np.zeros(P.shape), np.maximum(h_d + P.gap,
+                                                                         s.gap_floor))
         B = upwind_couette(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing)
         phi, _, _ = solve_complementarity(P.poiseuille(g, loc.A), B, P.boundary,
                                           s.ambient_pressure - s.cavitation_pressure, s.p_ref)
