@@ -103,6 +103,8 @@ class MicroSpec:
     time_derivative: str = "exact"
     error_tolerance: float = 0.02
     time_tol: float = 0.0            # > 0: adaptive instants per h0 (homogenise time_tol)
+    h0_tol: float = 0.005            # > 0: adaptive h0, a subset of the h0_count candidates
+                                     # (homogenise h0_tol); 0: all of them (the paper)
 
 
 @dataclass(frozen=True)
@@ -312,6 +314,9 @@ def _micro(data, where) -> MicroSpec:
     if not 0 <= micro.time_tol < 1 or (micro.time_tol and micro.time_derivative != "exact"):
         raise CaseError(f"{where} [micro] time_tol: 0 (off) or a fraction in (0, 1), with "
                         "time_derivative = 'exact'")
+    if not 0 <= micro.h0_tol < 1:
+        raise CaseError(f"{where} [micro] h0_tol: 0 (every h0) or a fraction in (0, 1), "
+                        "e.g. 0.005")
     if not 0 < micro.error_tolerance < 1:
         raise CaseError(f"{where} [micro] error_tolerance: a fraction in (0, 1), e.g. 0.02")
     if not (0 < micro.h0_min < micro.h0_max < 1e-3) or micro.h0_count < 2 or micro.steps < 1:

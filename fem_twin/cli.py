@@ -226,13 +226,17 @@ def _add_homogenise(sub):
     hr.add_argument("--time-tol", type=float,
                     help="adaptive instants: add midpoints at an h0 while A11 or b1 change by "
                          "more than this fraction (exact scheme)")
+    hr.add_argument("--h0-tol", type=float,
+                    help="adaptive h0: solve only the subset of the N values the log-h0 "
+                         "interpolant needs to miss the others by less than this fraction "
+                         "(e.g. 0.005; default: every value)")
     hr.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                     help="processes over h0 values (default: all cores)")
     hr.add_argument("--fields", type=float, nargs="*", default=(), metavar="H0",
                     help="also write the cell fields (VTU/PVD) at these h0 [m]")
     hr.add_argument("--no-progress", action="store_true", help="no progress bar")
     hr.set_defaults(func=_homogenise_run)
-    ha = hs.add_parser("average", help="average flow factors over patches (same h0 values)")
+    ha = hs.add_parser("average", help="average flow factors over patches (same h0 range)")
     ha.add_argument("inputs", type=Path, nargs="+", help="flow_factors.npz files")
     ha.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     ha.set_defaults(func=_homogenise_average)
@@ -411,8 +415,7 @@ def _homogenise_run(args):
         raise ValueError(f"the number of h0 values must be a positive integer, got {n}")
     ff = homogenise(pin, disk, np.geomspace(lo, hi, int(n)), n_steps=args.steps,
                     method=args.method, time_derivative=args.time_derivative,
-                    time_tol=args.time_tol,
-                    workers=args.workers,
+                    time_tol=args.time_tol, h0_tol=args.h0_tol, workers=args.workers,
                     checkpoint=args.output / "checkpoints", progress=not args.no_progress,
                     patch_id=f"{args.pin.stem}/{args.disk.stem}")
     _write_factors(args.output, ff)

@@ -312,7 +312,8 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
             ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=e_red,
                             hardness=m.hardness, method=mc.method,
                             time_derivative=mc.time_derivative,
-                            time_tol=mc.time_tol or None, executor=executor,
+                            time_tol=mc.time_tol or None, h0_tol=mc.h0_tol or None,
+                            executor=executor,
                             workers=getattr(executor, "n_workers", 1),
                             checkpoint=out.parent / "checkpoints", progress=progress,
                             patch_id=f"patch {i + 1}")

@@ -487,3 +487,85 @@ def test_grid_convergence_on_a_fixed_measured_surface_is_nearly_second_order():
         order = np.log2(d[:-1] / d[1:])
     assert np.all((order[:, 0] > 1.5) & (order[:, 0] < 2.5)), order[:, 0]     # A11
     assert np.all((order[:, 1, :2] > 1.4) & (order[:, 1, :2] < 2.6)), order[:, 1]  # p_con
+
+
+# -- adaptive separations ------------------------------------------------------------------
+def analytic_factors(h0, jitter=0.0, seed=0):
+    """Smooth factors of a contact onset at 0.3 um (p_con ~ (h_c - h0)^2, exact zero
+    above), with ``jitter`` added to d1 at every separation, and the same over 'every other
+    instant' with another draw of the jitter (the time-sampling error of each point)."""
+    rng = np.random.default_rng(seed)
+    n, x = len(h0), np.log(h0 / 1e-7)
+    onset = np.clip(3e-7 - h0, 0, None) / 1e-7
+
+    def make(noise):
+        a = 1 - 0.9 * np.exp(-1.5 * x)
+        A = np.zeros((n, 2, 2))
+        A[:, 0, 0], A[:, 1, 1] = a, 0.9 * a
+        b = np.stack([1 + 0.3 * np.exp(-x), 0 * x], 1)
+        d = np.stack([-0.2 * np.exp(-x) + noise, 0 * x], 1)
+        return FlowFactors(h0=h0, h_m=h0 * (1 + 0.1 * np.exp(-2 * x)), p_con=1e8 * onset ** 2,
+                           A=A, b=b, C=A.copy(), d=d, contact_fraction=0.1 * onset)
+    return make(jitter * rng.standard_normal(n)), make(jitter * rng.standard_normal(n))
+
+
+def subset(factors, idx):
+    return FlowFactors(**{k: getattr(factors, k)[idx] for k in ("h0", "h_m", "p_con", "A", "b",
+                                                                "C", "d", "contact_fraction")})
+
+
+def test_adaptive_separations_meet_their_tolerance_on_a_dense_sample():
+    """On analytic factors with a contact onset the chosen subset's interpolant misses
+    every skipped candidate by less than the tolerance (the measure of the refinement:
+    relative, floored at 1 % of the range's largest value), and well under half the
+    candidates are solved; a twice tighter tolerance takes more."""
+    from fem_twin.micro.sampling import adaptive_separations, interpolation_misses
+    h0 = np.geomspace(1e-7, 1e-6, 100)
+    full, half = analytic_factors(h0)
+    counts = []
+    for tol in (0.01, 0.005):
+        chosen, bound = adaptive_separations(h0, lambda i: (subset(full, i), None), tol)
+        misses = interpolation_misses(subset(full, chosen), full)
+        assert max(m.max() for m in misses.values()) < tol
+        assert max(bound.values()) < tol and chosen[0] == 0 and chosen[-1] == 99
+        counts.append(len(chosen))
+    assert 17 <= counts[0] < counts[1] < 50
+
+
+def test_adaptive_separations_do_not_chase_time_sampling_jitter():
+    """Jitter in d1 no larger than the points' own time-sampling error (half pass) is not a
+    reason to refine: with it, the same subset as without; judged without the half pass,
+    the jitter drives the refinement."""
+    from fem_twin.micro.sampling import adaptive_separations
+    h0 = np.geomspace(1e-7, 1e-6, 100)
+    clean, _ = analytic_factors(h0)
+    full, half = analytic_factors(h0, jitter=0.01)
+    ref, _ = adaptive_separations(h0, lambda i: (subset(clean, i), None), 0.005)
+    aware, _ = adaptive_separations(h0, lambda i: (subset(full, i), subset(half, i)), 0.005)
+    blind, _ = adaptive_separations(h0, lambda i: (subset(full, i), None), 0.005)
+    assert len(aware) <= len(ref) + 2 < len(blind)
+
+
+def test_homogenise_with_adaptive_h0_matches_the_dense_run(tmp_path):
+    """homogenise(h0_tol=...): a subset of the candidates is solved, each point as in the
+    dense run; the interpolant of the subset reads the dense factors within the larger of
+    the h0 bound and the time-error estimate it reports (the jitter of 8 instants); a rerun
+    resumes everything from the checkpoints."""
+    pin, disk = rough_pair(32)
+    h0 = np.geomspace(0.05e-6, 0.5e-6, 40)
+    dense = homogenise(pin, disk, h0, n_steps=8)
+    ad = homogenise(pin, disk, h0, n_steps=8, h0_tol=0.005, checkpoint=tmp_path)
+    idx = np.searchsorted(h0, ad.h0)
+    assert np.allclose(h0[idx], ad.h0, rtol=1e-14) and 17 <= len(ad) < 30
+    assert np.allclose(ad.A, dense.A[idx], rtol=1e-6) and np.allclose(ad.b, dense.b[idx],
+                                                                       rtol=1e-6)
+    est = ad.meta["error_estimate"]
+    loc = ad.at(h0)
+    for name, get in (("A11", lambda f: f.A[:, 0, 0]), ("b1", lambda f: f.b[:, 0]),
+                      ("p_con", lambda f: f.p_con), ("d1", lambda f: f.d[:, 0])):
+        miss = np.abs(get(loc) - get(dense)).max() / np.abs(get(dense)).max()
+        assert miss <= max(est["h0"][name], est["time"][name]), name
+    again = homogenise(pin, disk, h0, n_steps=8, h0_tol=0.005, checkpoint=tmp_path)
+    assert again.meta["seconds"]["computed_h0"] == 0 and np.array_equal(again.A, ad.A)
+    mean = average([ad, dense])
+    assert mean.h0.size == h0.size and np.allclose(mean.A[idx], (ad.A + dense.A[idx]) / 2)

@@ -63,7 +63,7 @@ def combine(estimates) -> dict:
     if not estimates:
         return {}
     out = {}
-    for kind in ("time", "grid"):
+    for kind in ("time", "grid", "h0"):
         parts = [e[kind] for e in estimates if kind in e]
         if parts:
             out[kind] = {q: max(p[q] for p in parts) for q in parts[0]}

@@ -209,16 +209,22 @@ class LocalFactors:
 
 
 def average(factors) -> FlowFactors:
-    """Arithmetic mean over patches at the same ``h0`` (the paper's test average, Fig 4-5)."""
+    """Arithmetic mean over patches at the same ``h0`` (the paper's test average, Fig 4-5).
+
+    Patches sampled at different separations over the same range (adaptive sampling picks
+    its own subset per patch) are averaged at the union of their separations, each read
+    there by its interpolant (:meth:`FlowFactors.at`, within its ``h0`` error estimate)."""
     factors = list(factors)
     if not factors:
         raise ValueError("no flow factors to average")
-    h0 = factors[0].h0
-    for f in factors[1:]:
-        if f.h0.shape != h0.shape or not np.allclose(f.h0, h0, rtol=1e-12, atol=0):
-            raise ValueError("flow factors to average must share the same h0 values")
-    mean = {k: np.mean([getattr(f, k) for f in factors], axis=0) for k in _ARRAYS if k != "h0"}
+    h0 = np.unique(np.concatenate([f.h0 for f in factors]))
+    for f in factors:
+        if not np.allclose(f.h0[[0, -1]], h0[[0, -1]], rtol=1e-12, atol=0):
+            raise ValueError("flow factors to average must share the same h0 values "
+                             "(or at least the same h0 range, when sampled adaptively)")
+    local = [f if f.h0.size == h0.size else f.at(h0) for f in factors]
+    mean = {k: np.mean([getattr(f, k) for f in local], axis=0) for k in _ARRAYS if k != "h0"}
     meta = {"average_of": [f.meta for f in factors], "method": factors[0].meta.get("method"),
             "version": factors[0].meta.get("version"),
             "error_estimate": combine(f.meta.get("error_estimate") for f in factors)}
-    return FlowFactors(h0=h0.copy(), **mean, meta=meta)
+    return FlowFactors(h0=h0, **mean, meta=meta)

@@ -57,6 +57,7 @@ from ..topography import Topography
 from .cell_fv import CellSolverFV
 from .estimate import discrepancy, grid_separations
 from .flow_factors import FlowFactors
+from .sampling import adaptive_separations
 
 #: the paper's separations: 100 values geometrically spaced in [0.1, 1] um
 DEFAULT_H0 = np.geomspace(1e-7, 1e-6, 100)
@@ -104,7 +105,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
                method: str = "fe", moving: str = "upper", time_derivative: str = "exact",
                first_step: str = "steady", gap_floor: float = 1e-9, workers: int = 1,
                executor=None, checkpoint=None, progress: bool = False, patch_id=None,
-               error_estimate: bool = True, time_tol: float | None = None) -> FlowFactors:
+               error_estimate: bool = True, time_tol: float | None = None,
+               h0_tol: float | None = None) -> FlowFactors:
     """Flow factors of a roughness patch pair versus h0 (eqs 11-16).
 
     Parameters
@@ -139,73 +141,129 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
         A11 or b1 change by more than this relative tolerance from every other instant to
         all, up to one pixel per step; ``n_steps`` is then the smallest count
         (``meta["steps_used"]`` per h0).  None: ``n_steps`` everywhere.
+    h0_tol : adaptive separations: ``h0`` is the dense candidate set and only the subset
+        :func:`fem_twin.micro.sampling.adaptive_separations` needs is solved, so that the
+        interpolant in log h0 misses the factors at the skipped candidates by less than
+        this relative tolerance (its bound: ``meta["error_estimate"]["h0"]``).  None: every
+        ``h0``.
     """
     settings = CellSettings(int(n_steps), float(e_reduced), float(hardness), float(gap_floor),
                             method, moving, first_step, time_derivative=time_derivative,
                             time_tol=time_tol)
     z_low, z_up, spacing = _check_patches(pin, disk)
-    h0 = DEFAULT_H0 if h0 is None else np.asarray(h0, dtype=float)
-    if h0.ndim != 1 or h0.size == 0 or not np.all(np.isfinite(h0)) or np.any(h0 <= 0):
-        raise ValueError("h0 must be a non-empty 1D array of positive separations [m]")
-    if np.unique(h0).size != h0.size:
-        raise ValueError("h0 values must be distinct")
-    order = np.argsort(h0)[::-1]                 # large to small: warm starts add contact
+    h0 = _check_separations(DEFAULT_H0 if h0 is None else h0)
+    if h0_tol is not None and not 0 < h0_tol < 1:
+        raise ValueError(f"h0_tol is a relative tolerance in (0, 1), got {h0_tol}")
     key = _key(z_low, z_up, spacing, settings)
-    folder = Path(checkpoint) if checkpoint is not None else None
-    done = {}
-    if folder is not None:
-        for i in order:
-            m = _load_point(folder, key, h0[i])
-            if m is not None:
-                done[i] = m
-    todo = [i for i in order if i not in done]
-    chunks = _chunks(todo, 1 if (workers <= 1 and executor is None) else 4 * max(workers, 2))
     args = dict(z_low=z_low, z_up=z_up, spacing=spacing, settings=settings,
-                folder=None if folder is None else str(folder), key=key,
+                folder=None if checkpoint is None else str(checkpoint), key=key,
                 half_pass=error_estimate)
-    bar = _progress(len(h0), len(done), progress, patch_id)
+    points = _Separations(h0, args, workers, executor,
+                          _progress(len(h0), progress, patch_id, h0_tol is not None))
     try:
-        if executor is None and workers <= 1:
-            for chunk in chunks:
-                for i, m in _run_chunk([(i, h0[i]) for i in chunk], **args):
-                    done[i] = m
-                    bar.update(1)
+        if h0_tol is None:
+            chosen, bound = list(range(len(h0))), None
         else:
-            own = executor is None
-            pool = ProcessPoolExecutor(workers) if own else executor
-            try:
-                futures = [pool.submit(_chunk_task, ([(i, h0[i]) for i in c], args))
-                           for c in chunks]
-                for fut in as_completed(futures):
-                    for i, m in fut.result():
-                        done[i] = m
-                        bar.update(1)
-            finally:
-                if own:
-                    pool.shutdown(cancel_futures=True)
+            chosen, bound = adaptive_separations(h0, points.factors, h0_tol)
+        moments = points.moments(chosen)
     finally:
-        bar.close()
-    idx = np.argsort(h0)
+        points.close()
     meta = {"patch_id": patch_id, "shape": list(z_low.shape), "spacing": list(spacing),
             "e_reduced": settings.e_reduced, "hardness": settings.hardness,
             "gap_floor": settings.gap_floor, "n_steps": settings.n_steps,
             "method": settings.method, "moving": settings.moving,
             "first_step": settings.first_step, "time_derivative": settings.time_derivative,
             "version": __version__, "checkpoint_keys": [key], "time_tol": settings.time_tol,
-            "steps_used": [int(done[i].get("n_steps", settings.n_steps)) for i in idx],
+            "h0_tol": h0_tol, "h0_candidates": len(h0),
+            "steps_used": [int(m.get("n_steps", settings.n_steps)) for m in moments],
             "sq": float(np.hypot(z_low.std(), z_up.std())),
             "pin": pin.meta.get("sample", pin.meta.get("source")),
             "disk": disk.meta.get("sample", disk.meta.get("source")),
-            "seconds": {"contact": sum(done[i].get("seconds_contact", 0.0) for i in todo),
-                        "cell": sum(done[i].get("seconds_cell", 0.0) for i in todo),
-                        "computed_h0": len(todo)}}
-    moments = [done[i] for i in idx]
-    factors = factors_from_moments(h0[idx], moments, meta)
+            "seconds": points.seconds()}
+    factors = factors_from_moments(h0[chosen], moments, meta)
     if not error_estimate:
         return factors
-    estimate = estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder)
+    estimate = estimate_errors(factors, moments, z_low, z_up, spacing, settings,
+                               None if checkpoint is None else Path(checkpoint))
+    if bound is not None:
+        estimate["h0"] = bound
     keys = meta["checkpoint_keys"] + estimate.pop("checkpoint_keys", [])
     return replace(factors, meta={**meta, "error_estimate": estimate, "checkpoint_keys": keys})
+
+
+def _check_separations(h0) -> np.ndarray:
+    h0 = np.asarray(h0, dtype=float)
+    if h0.ndim != 1 or h0.size == 0 or not np.all(np.isfinite(h0)) or np.any(h0 <= 0):
+        raise ValueError("h0 must be a non-empty 1D array of positive separations [m]")
+    if np.unique(h0).size != h0.size:
+        raise ValueError("h0 values must be distinct")
+    return np.sort(h0)
+
+
+class _Separations:
+    """The moments at the separations ``h0[i]`` of one run: resumed from the checkpoint
+    folder or computed (in this process, or as ``4 workers`` chunks on a pool or
+    ``executor``, each large to small so that contact warm-starts along h0)."""
+
+    def __init__(self, h0, args, workers, executor, bar):
+        self.h0, self.args, self.workers, self.executor, self.bar = (h0, args, workers,
+                                                                     executor, bar)
+        self.done, self.computed, self.own = {}, [], False
+
+    def factors(self, indices):
+        """Eqs 11-16 at ``h0[indices]`` (sorted), and over every other instant (None
+        without the time-error estimate)."""
+        moments = self.moments(indices)
+        half = (factors_from_moments(self.h0[indices], moments, {}, prefix="half_")
+                if all("half_h" in m for m in moments) else None)
+        return factors_from_moments(self.h0[indices], moments, {}), half
+
+    def moments(self, indices) -> list:
+        todo = [i for i in sorted(indices, reverse=True) if i not in self.done]
+        folder = self.args["folder"]
+        for i in todo:
+            m = None if folder is None else _load_point(Path(folder), self.args["key"],
+                                                        self.h0[i])
+            if m is not None:
+                self.done[i] = m
+                self.bar.update(1)
+        todo = [i for i in todo if i not in self.done]
+        serial = self.workers <= 1 and self.executor is None
+        chunks = [[(i, self.h0[i]) for i in c]
+                  for c in _chunks(todo, 1 if serial else 4 * max(self.workers, 2))]
+        for i, m in (self._serial(chunks) if serial else self._parallel(chunks)):
+            self.done[i] = m
+            self.computed.append(i)
+            self.bar.update(1)
+        return [self.done[i] for i in indices]
+
+    def _serial(self, chunks):
+        for chunk in chunks:
+            yield from _run_chunk(chunk, **self.args)
+
+    def _parallel(self, chunks):
+        if self.executor is None:            # one own pool for all the calls of a run
+            self.executor, self.own = ProcessPoolExecutor(self.workers), True
+        futures = [self.executor.submit(_chunk_task, (c, self.args)) for c in chunks]
+        try:
+            for fut in as_completed(futures):
+                yield from fut.result()
+        except BaseException:
+            for fut in futures:
+                fut.cancel()
+            raise
+
+    def close(self):
+        self.bar.close()
+        if self.own:
+            self.executor.shutdown(cancel_futures=True)
+
+    def seconds(self) -> dict:
+        """CPU seconds of contact and cells over the computed (not resumed) separations."""
+        done = [self.done[i] for i in self.computed]
+        return {"contact": sum(m.get("seconds_contact", 0.0) for m in done),
+                "cell": sum(m.get("seconds_cell", 0.0) for m in done),
+                "computed_h0": len(done)}
 
 
 def prune_checkpoints(folder, keep) -> int:
@@ -523,7 +581,9 @@ def _load_point(folder, key, h0):
     return load_or_none(_point_path(folder, key, h0), _read_point)
 
 
-def _progress(total, initial, enabled, patch_id=None):
+def _progress(total, enabled, patch_id=None, adaptive=False):
+    """Bar over the h0 values (adaptive: over the candidates, of which a part is solved)."""
     from tqdm.auto import tqdm
-    return tqdm(total=total, initial=initial, desc=f"homogenise {patch_id or 'h0'}", unit="h0",
+    desc = f"homogenise {patch_id or 'h0'}" + (" (adaptive h0)" if adaptive else "")
+    return tqdm(total=total, desc=desc, unit="h0",
                 disable=not enabled or os.environ.get("FEM_TWIN_NO_PROGRESS") == "1")

@@ -1,0 +1,120 @@
+"""Adaptive choice of the separations h0 at which the cell problems are solved.
+
+The macro scale reads the flow factors between the computed separations by monotone cubic
+interpolation in ``log h0`` (:meth:`FlowFactors.at`), and the factors are smooth in
+``log h0`` over most of the paper's range, so most of its 100 fixed values add nothing the
+interpolant does not already give.  Here the separations are a subset of a dense candidate
+set (default: the paper's 100 values): a coarse start bisected once, then, while the
+interpolant through all the other points misses a point by more than a relative tolerance
+(leave one out), the gaps on either side of that point are bisected, down to neighbouring
+candidates at most.
+
+A point left out doubles the spacing around it, so its miss overestimates the error of the
+final interpolant between the points (by about 4x where the factors are smooth, 2x at a
+kink): the largest miss over the points next to skipped candidates is the error estimate,
+the error check against a denser sample.  Misses are relative to the local value, floored at ``FLOOR`` times the largest
+magnitude over the range, so a factor that vanishes at one end of the range (``p_con`` out
+of contact) is not refined where it is negligible; ``d1``, which corrects the sliding
+shear of eq 31, is measured against that term.
+
+A miss no larger than the time-sampling error of the midpoint itself (``|f_N - f_N/2|``,
+the estimate of :mod:`fem_twin.micro.estimate`) is not a reason to refine: in contact the
+factors jitter from one separation to the next as pixels enter contact between instants
+(``d1`` by 2-3 % on a 128^2 cell at 16 steps), and a denser h0 sample only resolves that
+jitter, which is error of the time average, not information.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .estimate import QUANTITIES
+
+#: separations of the coarse start (8 intervals: 17 points after the first bisection)
+START = 9
+#: misses are relative to max(|f|, FLOOR max |f|) per quantity ...
+FLOOR = 0.01
+#: ... and for d1 to at least 1/3, its weight beside the sliding term of eq 31
+#: (-6 u_m d + u_r e1 with u_r = 2 u_m on a pin-on-disk: 3 (1/3 - d))
+SCALES = {"d1": 1.0 / 3.0}
+#: a leave-one-out miss within this multiple of the points' time-sampling error is jitter:
+#: the point is compared with its neighbours' interpolant, each with an error of its own
+#: (independent errors e give misses up to about 3 e; the half-pass difference is >= e)
+JITTER = 2.0
+
+
+def adaptive_separations(h0, factors_at, tol: float, start: int = START):
+    """Indices into the sorted candidates ``h0`` [m] where the factors are needed.
+
+    ``factors_at(indices)`` returns the :class:`FlowFactors` at ``h0[indices]`` (sorted
+    indices; it computes what it does not hold yet) and those over every other instant
+    (the time-error estimate; None when not available).  Returns ``(indices, estimate)``:
+    the chosen sorted indices and ``{quantity: bound}``, the largest relative miss of the
+    leave-one-out test over the chosen points next to skipped candidates."""
+    if not 0 < tol < 1:
+        raise ValueError(f"the h0 tolerance is relative, in (0, 1); got {tol}")
+    n = len(h0)
+    chosen = sorted({int(i) for i in np.linspace(0, n - 1, min(start, n)).round()})
+    chosen = sorted(set(chosen) | set(_midpoints(chosen, range(len(chosen)))))
+    while True:
+        misses = leave_one_out(*factors_at(chosen))
+        worst = np.max(np.array(list(misses.values())), axis=0)
+        new = set(_midpoints(chosen, np.flatnonzero(worst > tol) + 1))
+        if not new:
+            break
+        chosen = sorted(set(chosen) | new)
+    gaps = np.diff(chosen)
+    open_ = np.maximum(gaps[:-1], gaps[1:]) > 1          # interior points next to a gap
+    return chosen, {q: float(m[open_].max(initial=0.0)) for q, m in misses.items()}
+
+
+def _midpoints(chosen, positions):
+    """Midpoints of the gaps on either side of ``chosen[p]`` for ``p`` in ``positions``
+    (of every gap from ``chosen[p]`` on, for the start)."""
+    out = []
+    for p in positions:
+        for a, b in ((p - 1, p), (p, p + 1)):
+            if 0 <= a and b < len(chosen) and chosen[b] - chosen[a] > 1:
+                out.append((chosen[a] + chosen[b]) // 2)
+    return out
+
+
+def leave_one_out(full, half=None) -> dict:
+    """Relative miss per quantity at each interior point of ``full`` (a
+    :class:`FlowFactors`) of the interpolant through all the others (see
+    :func:`interpolation_misses`), zero where it is within ``JITTER`` times the
+    time-sampling error ``|f - f_half|`` of that point or a neighbour (``half``: the
+    factors over every other instant; one point's estimate may be small by chance where its
+    neighbours' are not)."""
+    inner = np.arange(1, len(full) - 1)
+    local = [_without(full, k).at(full.h0[k:k + 1]) for k in inner]
+    out = {}
+    for name, get in QUANTITIES.items():
+        f = get(full)[inner]
+        miss = np.abs(f - np.concatenate([get(loc) for loc in local]))
+        if half is not None:
+            jitter = np.abs(get(full) - get(half))
+            jitter = np.maximum(np.maximum(jitter[:-2], jitter[1:-1]), jitter[2:])
+            miss = np.where(miss > JITTER * jitter, miss, 0.0)
+        out[name] = _relative(name, miss, f, get(full))
+    return out
+
+
+def interpolation_misses(coarse, dense) -> dict:
+    """Relative miss per quantity of the interpolant through ``coarse`` at the separations
+    of ``dense`` (both :class:`FlowFactors`): ``|f - I f| / max(|f|, FLOOR max |f|)``
+    (for d1 at least 1/3)."""
+    local = coarse.at(dense.h0)
+    return {name: _relative(name, np.abs(get(dense) - get(local)), get(dense), get(dense))
+            for name, get in QUANTITIES.items()}
+
+
+def _relative(name, miss, f, over):
+    floor = max(FLOOR * np.abs(over).max(), SCALES.get(name, 0.0))
+    return miss / np.maximum(np.abs(f), floor) if floor > 0 else 0.0 * f
+
+
+def _without(factors, k):
+    keep = np.arange(len(factors)) != k
+    return type(factors)(**{name: getattr(factors, name)[keep] for name in
+                            ("h0", "h_m", "p_con", "A", "b", "C", "d", "contact_fraction")})
