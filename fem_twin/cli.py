@@ -445,7 +445,7 @@ def _write_factors(folder, ff, patches=()):
                       "estimated_relative_error": {
                           kind: {q: round(e, 5) for q, e in errors.items()}
                           for kind, errors in ff.meta.get("error_estimate", {}).items()
-                          if kind in ("time", "grid")},
+                          if kind in ("time", "grid", "h0")},
                       "files": [str(folder / n) for n in ("flow_factors.npz",
                                                           "flow_factors.csv",
                                                           "flow_factors.png")]}, indent=2))
@@ -509,7 +509,8 @@ def _confirm_cost(case, yes: bool) -> bool:
     seconds = case.estimated_seconds(cores)
     mc = case.micro
     print(f"fem-twin run: {len(case.geometry.patches)} patch pairs at {mc.resolution[0]}x"
-          f"{mc.resolution[1]}, {mc.h0_count} h0 x {mc.steps} steps; "
+          f"{mc.resolution[1]}, {mc.h0_count} h0 x {mc.steps} steps"
+          f"{f' (adaptive h0, tolerance {mc.h0_tol:g})' if mc.h0_tol else ''}; "
           f"{len(case.lubricant.viscosities)} x {case.sweep.count} speeds; estimated "
           f"{seconds / 60:.0f} min on {cores} cores", file=sys.stderr)
     if seconds > LONG_RUN_SECONDS and not yes:
@@ -552,7 +553,7 @@ def _short_summary(summary: dict, out: Path) -> str:
                      f"(Hamrock-Dowson, smooth: {film['hamrock_dowson_h_c_m'] * 1e9:.0f} nm, "
                      f"{film['hamrock_dowson_h_min_m'] * 1e9:.0f} nm)")
     est = stages["micro"].get("error_estimate", {})
-    for kind in ("time", "grid"):
+    for kind in ("time", "grid", "h0"):
         if kind in est:
             lines.append(f"  flow factors, estimated {kind} error: " + ", ".join(
                 f"{q} {e:.1%}" for q, e in est[kind].items() if q in ("A11", "b1", "p_con")))

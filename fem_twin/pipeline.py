@@ -13,6 +13,7 @@ import json
 import logging
 import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
@@ -294,34 +295,25 @@ def level_pins(case: Case, outdir: Path, progress: bool = True) -> dict:
 def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool = True,
                        h0=None):
     """Flow factors of every patch pair (checkpointed per h0) and their average (``h0``:
-    the case's range unless given)."""
+    the case's range unless given).  With an executor the patches run side by side (a
+    thread each hands its h0 tasks to the shared pool), so the pool is not left idle at
+    the end of a patch or of a round of adaptive h0, and a cluster gets every patch's
+    tasks at once."""
     folder.mkdir(parents=True, exist_ok=True)
-    geo = folder.parent / "geometry"
-    mc, m = case.micro, case.materials
+    mc = case.micro
     h0 = np.geomspace(mc.h0_min, mc.h0_max, mc.h0_count) if h0 is None else np.asarray(h0)
-    e_red = m.e_reduced
-    factors = []
-    for i in range(len(case.geometry.patches)):
-        out = folder / f"patch_{i + 1}" / "flow_factors.npz"
-        ff = load_or_none(out, FlowFactors.load)
-        if ff is None:
-            low = read_topography(geo / f"patch_{i + 1}_low.npz")
-            up = read_topography(geo / f"patch_{i + 1}_up.npz")
-            if low.shape != tuple(mc.resolution):
-                low, up = resample_cell(low, mc.resolution), resample_cell(up, mc.resolution)
-            ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=e_red,
-                            hardness=m.hardness, method=mc.method,
-                            time_derivative=mc.time_derivative,
-                            time_tol=mc.time_tol or None, h0_tol=mc.h0_tol or None,
-                            executor=executor,
-                            workers=getattr(executor, "n_workers", 1),
-                            checkpoint=out.parent / "checkpoints", progress=progress,
-                            patch_id=f"patch {i + 1}")
-            ff.save(out)
-            stale = prune_checkpoints(out.parent / "checkpoints", ff.meta["checkpoint_keys"])
-            if stale:
-                log.info("patch %d: %d stale h0 checkpoints removed", i + 1, stale)
-        factors.append(ff)
+    n = len(case.geometry.patches)
+    bar = tqdm(total=n * len(h0), desc="flow factors", unit="h0", disable=not progress
+               or os.environ.get("FEM_TWIN_NO_PROGRESS") == "1")
+    try:
+        if executor is None:
+            factors = [_patch_factors(case, folder, i, h0, None, bar) for i in range(n)]
+        else:
+            with ThreadPoolExecutor(n) as threads:
+                factors = list(threads.map(
+                    lambda i: _patch_factors(case, folder, i, h0, executor, bar), range(n)))
+    finally:
+        bar.close()
     mean = average(factors)
     mean.save(folder / "flow_factors.npz")
     mean.write_csv(folder.parent / "flow_factors.csv")
@@ -335,12 +327,40 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
                     "; ".join(f"{kind} {q} {e:.1%}" for kind, errs in above.items()
                               for q, e in errs.items()))
     return {"patches": len(factors), "h0_m": [float(h0[0]), float(h0[-1]), len(h0)],
+            "h0_solved": [len(f) for f in factors], "h0_tol": mc.h0_tol,
             "grid": list(mc.resolution), "steps": mc.steps,
             "time_derivative": mc.time_derivative,
             "error_estimate": estimate, "error_tolerance": mc.error_tolerance,
             "above_tolerance": above,
             "p_con_max_Pa": float(mean.p_con.max()), "files": ["flow_factors.csv",
                                                                "flow_factors.png"]}
+
+
+def _patch_factors(case: Case, folder: Path, i: int, h0, executor, bar) -> FlowFactors:
+    """Flow factors of patch pair ``i`` (0-based): its file if present, else computed."""
+    mc, m = case.micro, case.materials
+    out = folder / f"patch_{i + 1}" / "flow_factors.npz"
+    ff = load_or_none(out, FlowFactors.load)
+    if ff is not None:
+        bar.update(len(h0))
+        return ff
+    geo = folder.parent / "geometry"
+    low = read_topography(geo / f"patch_{i + 1}_low.npz")
+    up = read_topography(geo / f"patch_{i + 1}_up.npz")
+    if low.shape != tuple(mc.resolution):
+        low, up = resample_cell(low, mc.resolution), resample_cell(up, mc.resolution)
+    ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=m.e_reduced,
+                    hardness=m.hardness, method=mc.method,
+                    time_derivative=mc.time_derivative, time_tol=mc.time_tol or None,
+                    h0_tol=mc.h0_tol or None, executor=executor,
+                    workers=getattr(executor, "n_workers", 1),
+                    checkpoint=out.parent / "checkpoints", progress=bar,
+                    patch_id=f"patch {i + 1}")
+    ff.save(out)
+    stale = prune_checkpoints(out.parent / "checkpoints", ff.meta["checkpoint_keys"])
+    if stale:
+        log.info("patch %d: %d stale h0 checkpoints removed", i + 1, stale)
+    return ff
 
 
 def macro_geometry(case: Case, outdir: Path):

@@ -133,7 +133,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
         (each warm-starts along its own h0 values), so a 64-worker cluster gets 100 tasks
         of one h0 from the paper's 100 values.
     checkpoint : folder that keeps one file per finished h0; a rerun resumes from it.
-    progress : show a progress bar.
+    progress : show a progress bar (or a tqdm-like bar to advance, shared by several runs).
     patch_id : recorded in the metadata.
     error_estimate : estimate the time and grid errors (``meta["error_estimate"]``, see
         :mod:`fem_twin.micro.estimate`; about ``3 / (4 len(h0))`` of the run's cost).
@@ -158,16 +158,20 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     args = dict(z_low=z_low, z_up=z_up, spacing=spacing, settings=settings,
                 folder=None if checkpoint is None else str(checkpoint), key=key,
                 half_pass=error_estimate)
-    points = _Separations(h0, args, workers, executor,
-                          _progress(len(h0), progress, patch_id, h0_tol is not None))
+    own_bar = not hasattr(progress, "update")
+    bar = _progress(len(h0), progress, patch_id, h0_tol is not None) if own_bar else progress
+    points = _Separations(h0, args, workers, executor, bar)
     try:
         if h0_tol is None:
             chosen, bound = list(range(len(h0))), None
         else:
             chosen, bound = adaptive_separations(h0, points.factors, h0_tol)
         moments = points.moments(chosen)
+        bar.update(len(h0) - len(chosen))             # the candidates interpolated
     finally:
         points.close()
+        if own_bar:
+            bar.close()
     meta = {"patch_id": patch_id, "shape": list(z_low.shape), "spacing": list(spacing),
             "e_reduced": settings.e_reduced, "hardness": settings.hardness,
             "gap_floor": settings.gap_floor, "n_steps": settings.n_steps,
@@ -254,7 +258,6 @@ class _Separations:
             raise
 
     def close(self):
-        self.bar.close()
         if self.own:
             self.executor.shutdown(cancel_futures=True)
 
