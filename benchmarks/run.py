@@ -428,45 +428,61 @@ def bench_newton():
 
 def bench_paper():
     """A reduced paper case and the whole-twin extrapolation (examples/paper.toml: 6 patch
-    pairs at 256^2 x 100 h0 x 32 steps, 2 viscosities x 25 speeds (+ refinement, ~37 points)
-    at 256^2, patch band: 12 more sweeps; 2 cores).  Measured here: one patch pair at 10 of
-    the 100 h0 (every 10th, 32 steps, exact squeeze term, one process) and one warm-started
-    sweep of 6 speeds at 256^2 with the macro groups' flow factors (patch 1 at 64^2, 30 h0).  Baseline: the measured micro time of one h0."""
+    pairs at 256^2 x 32 steps over the paper's 100 h0 candidates, adaptive h0; 2
+    viscosities x 25 speeds (+ refinement, ~37 points) at 256^2; patch band: 12 more
+    sweeps; 2 cores).  Measured here: sample patch pair 3 at 256^2, adaptive h0 on 2
+    processes, and the previous method's cost of one h0 (10 of the 100, serial); 8
+    consecutive speeds of the paper's 25 (0.53 -> 0.07 m/s) at 256^2 with the macro groups'
+    flow factors (patch 1 at 64^2, 30 h0), the first point cold.  Baseline: the measured
+    micro time of one h0."""
     from fem_twin.case import load_case
     from fem_twin.macro import Lubricant
     from fem_twin.micro import DEFAULT_H0, homogenise
     from fem_twin.stribeck import stribeck_sweep
 
     case = load_case(os.path.join(HERE, "..", "examples", "paper.toml"))
+    cores, patches, n_mu = 2, len(case.geometry.patches), len(case.lubricant.viscosities)
     pin, disk = _patch_pair()
-    h0 = DEFAULT_H0[::10]
     t0 = time.perf_counter()
-    ff = homogenise(pin, disk, h0, workers=1, error_estimate=False)
-    t_micro = time.perf_counter() - t0
-    per_h0 = t_micro / h0.size
+    homogenise(pin, disk, DEFAULT_H0[::10], workers=1, error_estimate=False)
+    per_h0 = (time.perf_counter() - t0) / 10
+    t0 = time.perf_counter()
+    ad = homogenise(pin, disk, DEFAULT_H0, workers=cores, h0_tol=case.micro.h0_tol)
+    t_pair = time.perf_counter() - t0
     gap, spacing, face = _macro_gap(256)
-    speeds = np.geomspace(2.0, 0.01, 6)
+    speeds = np.geomspace(2.0, 0.01, case.sweep.count)[6:14]
     ff = _macro_factors()          # smooth factors (30 h0): 10 h0 kink p_con, the sweep stalls
     t0 = time.perf_counter()
-    curve = stribeck_sweep(gap, spacing, ff, speeds, load=150.0,
-                           lubricant=Lubricant(0.066), face=face)
-    per_point = (time.perf_counter() - t0) / speeds.size
-    cores, patches, n_mu = 2, len(case.geometry.patches), len(case.lubricant.viscosities)
-    micro = per_h0 * case.micro.h0_count * patches / cores
+    stribeck_sweep(gap, spacing, ff, speeds[:1], load=150.0, lubricant=Lubricant(0.066),
+                   face=face)
+    cold = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    curve = stribeck_sweep(gap, spacing, ff, speeds, load=150.0, lubricant=Lubricant(0.066),
+                           face=face)
+    warm = (time.perf_counter() - t0 - cold) / (speeds.size - 1)
+    dense = per_h0 * case.micro.h0_count * patches / cores
+    micro = t_pair * patches
     points = case.sweep.count * 1.5                      # refinement adds ~50 % (bundled)
-    sweeps = n_mu * (1 + patches)
-    macro_avg = per_point * points * n_mu / cores
-    macro_band = per_point * points * patches * n_mu / cores
+    sweep = cold + (points - 1) * warm
+    macro_avg = sweep * n_mu / min(cores, n_mu)
+    macro_band = sweep * patches * n_mu / cores
     return per_h0, [
-        ("micro: one h0 (32 steps, 256^2), measured", per_h0, f"{h0.size} h0 in {t_micro:.0f} s"),
-        ("macro: one 256^2 point of a warm sweep, measured", per_point,
-         f"{int(curve.iterations.sum())} coupling iterations over {speeds.size} speeds"),
-        ("paper twin, micro stage (extrapolated)", micro,
-         f"{case.micro.h0_count} h0 x {patches} pairs / {cores} cores"),
+        ("micro: one h0 (32 steps, 256^2), measured", per_h0, "serial, 10 of the 100 h0"),
+        ("micro: one patch pair, adaptive h0, measured", t_pair,
+         f"{len(ad)} of {case.micro.h0_count} h0 on {cores} processes, error estimate "
+         f"included; h0 bound {max(ad.meta['error_estimate']['h0'].values()):.1e}"),
+        ("macro: cold 256^2 point, measured", cold, f"{speeds[0]:.2f} m/s"),
+        ("macro: warm 256^2 point, measured", warm,
+         f"{int(curve.iterations[1:].sum())} coupling iterations over {speeds.size - 1} "
+         f"speeds {speeds[1]:.2f} -> {speeds[-1]:.2f} m/s"),
+        ("paper twin, micro stage, all 100 h0 (extrapolated)", dense,
+         f"{case.micro.h0_count} h0 x {patches} pairs / {cores} cores: the previous method"),
+        ("paper twin, micro stage, adaptive h0 (extrapolated)", micro,
+         f"{patches} pairs; {dense / micro:.1f}x faster than all 100 h0"),
         ("paper twin, Stribeck sweeps (extrapolated)", macro_avg,
          f"{points:.0f} points x {n_mu} viscosities / {cores} cores"),
         ("paper twin, patch band (extrapolated)", macro_band,
-         f"{sweeps - n_mu} single-patch sweeps / {cores} cores"),
+         f"{patches * n_mu} single-patch sweeps / {cores} cores"),
         ("paper twin, whole (extrapolated)", micro + macro_avg + macro_band,
          f"{(micro + macro_avg + macro_band) / 60:.0f} min; {(micro + macro_avg) / 60:.0f} min "
          "without the band"),

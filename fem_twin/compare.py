@@ -50,7 +50,7 @@ def reference_factors(case: Case, outdir: Path, h0, *, executor=None,
     settings, so ``|f - f_ref|`` measures each method's own discretisation error."""
     from .pipeline import homogenise_patches
     mc = case.micro
-    fine = replace(case, micro=replace(mc, method="fe", steps=2 * mc.steps,
+    fine = replace(case, micro=replace(mc, method="fe", steps=2 * mc.steps, h0_tol=0.0,
                                        resolution=tuple(2 * n for n in mc.resolution)))
     folder = outdir / "reference"
     folder.mkdir(exist_ok=True)
@@ -73,7 +73,8 @@ def field_differences(fe: MixedResult, fvm: MixedResult) -> dict:
 
 
 def compare(case: Case, outdir, *, progress: bool = True) -> dict:
-    """Run the case's micro and macro stages with both methods; write ``compare.json``,
+    """Run the case's micro and macro stages with both methods, each at every h0 of the case
+    (no adaptive subset, so that they meet at the same separations); write ``compare.json``,
     ``compare_flow_factors.csv``, ``compare_stribeck.csv`` and ``compare.png``."""
     from .pipeline import (executor_for, homogenise_patches, level_pins, macro_geometry,
                            macro_settings, reconstruct_geometry)
@@ -90,7 +91,7 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
                 link = sub / name
                 if not link.exists():
                     link.symlink_to((outdir / name).resolve(), target_is_directory=True)
-            c = replace(case, micro=replace(case.micro, method=method))
+            c = replace(case, micro=replace(case.micro, method=method, h0_tol=0.0))
             homogenise_patches(c, sub / "micro", executor, progress)
             factors[method] = FlowFactors.load(sub / "micro" / "flow_factors.npz")
     reference = reference_factors(case, outdir, factors["fe"].h0, executor=None,

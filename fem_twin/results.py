@@ -45,13 +45,19 @@ class RunResults:
 
 
 def flow_factor_dataset(factors, labels):
-    """Flow factors of several patches (same h0) as a Dataset over (patch, h0); A, b, C, d
-    split into named components (A11, A12, ..., d2)."""
+    """Flow factors of several patches as a Dataset over (patch, h0), h0 the union of their
+    samples: NaN where a patch's adaptive sample skipped an h0 (its interpolant,
+    ``FlowFactors.at``, reads it there); A, b, C, d split into named components (A11, A12,
+    ..., d2)."""
     import xarray as xr
-    h0 = factors[0].h0
-    if any(f.h0.shape != h0.shape or not np.allclose(f.h0, h0, rtol=1e-12) for f in factors):
-        raise ValueError("flow factors of a run must share their h0 samples")
-    stack = lambda name: np.stack([getattr(f, name) for f in factors])  # noqa: E731
+    h0 = np.unique(np.concatenate([f.h0 for f in factors]))
+    where = [np.searchsorted(h0, f.h0) for f in factors]
+
+    def stack(name):
+        out = np.full((len(factors), h0.size) + getattr(factors[0], name).shape[1:], np.nan)
+        for k, (f, idx) in enumerate(zip(factors, where)):
+            out[k, idx] = getattr(f, name)
+        return out
     data = {"h_m": (stack("h_m"), "m", "mean gap (eq 12)"),
             "p_con": (stack("p_con"), "Pa", "mean contact pressure (eq 11)"),
             "contact_fraction": (stack("contact_fraction"), "1", "pixels in contact")}

@@ -569,3 +569,19 @@ def test_homogenise_with_adaptive_h0_matches_the_dense_run(tmp_path):
     assert again.meta["seconds"]["computed_h0"] == 0 and np.array_equal(again.A, ad.A)
     mean = average([ad, dense])
     assert mean.h0.size == h0.size and np.allclose(mean.A[idx], (ad.A + dense.A[idx]) / 2)
+
+
+def test_results_dataset_holds_patches_sampled_at_different_h0():
+    """Patches with their own adaptive subsets go into one (patch, h0) Dataset over the
+    union: the solved values where solved, NaN where skipped; the average is complete."""
+    pytest.importorskip("xarray")
+    from fem_twin.results import flow_factor_dataset
+    h0 = np.geomspace(1e-7, 1e-6, 20)
+    full, _ = analytic_factors(h0)
+    one, two = subset(full, [0, 5, 10, 19]), subset(full, [0, 3, 10, 12, 19])
+    mean = average([one, two])
+    ds = flow_factor_dataset([one, two, mean], ["1", "2", "average"])
+    assert np.array_equal(ds.h0.values, h0[[0, 3, 5, 10, 12, 19]])
+    a1 = ds.A11.sel(patch="1").values
+    assert np.array_equal(a1[[0, 2, 3, 5]], one.A[:, 0, 0]) and np.isnan(a1[[1, 4]]).all()
+    assert np.isfinite(ds.A11.sel(patch="average").values).all()
