@@ -475,9 +475,9 @@ def bench_paper():
         ("macro: warm 256^2 point, measured", warm,
          f"{int(curve.iterations[1:].sum())} coupling iterations over {speeds.size - 1} "
          f"speeds {speeds[1]:.2f} -> {speeds[-1]:.2f} m/s"),
-        ("paper twin, micro stage, all 100 h0 (extrapolated)", dense,
+        ("paper twin, micro, all 100 h0 (extrapolated)", dense,
          f"{case.micro.h0_count} h0 x {patches} pairs / {cores} cores: the previous method"),
-        ("paper twin, micro stage, adaptive h0 (extrapolated)", micro,
+        ("paper twin, micro, adaptive h0 (extrapolated)", micro,
          f"{patches} pairs; {dense / micro:.1f}x faster than all 100 h0"),
         ("paper twin, Stribeck sweeps (extrapolated)", macro_avg,
          f"{points:.0f} points x {n_mu} viscosities / {cores} cores"),
