@@ -196,12 +196,16 @@ class CellSolver:
         h : <h> [m];  h3_grad : <h^3 (I + G)> [m^3], G[i, j] = d chi_{j+2} / dx_i;
         h3_g1 : <h^3 grad chi_1> [m];  h_grad : <h (I + G)> [m];  h_g1 : <h grad chi_1> [1/m]
         """
-        g1 = self.gradient(chi[0])
-        G = np.stack([self.gradient(chi[1]), self.gradient(chi[2])], axis=1)   # (i, j, e, q)
         a_q = h_q ** 3
-        eye = np.eye(2)[:, :, None, None]
-        return {"h": float(h_q.mean()),
-                "h3_grad": (a_q * (eye + G)).mean(axis=(2, 3)),
-                "h3_g1": (a_q * g1).mean(axis=(1, 2)),
-                "h_grad": (h_q * (eye + G)).mean(axis=(2, 3)),
-                "h_g1": (h_q * g1).mean(axis=(1, 2))}
+        n = a_q.size
+        weights = np.stack([a_q.ravel(), h_q.ravel()])          # (2, n): h^3 and h
+        g1 = self.gradient(chi[0]).reshape(2, n)
+        g_mean = np.stack([weights @ self.gradient(chi[j]).reshape(2, n).T / n
+                           for j in (1, 2)], axis=2)            # <w G[i, j]>: (w, i, j)
+        w_mean = weights.mean(axis=1)
+        eye = np.eye(2)
+        return {"h": float(w_mean[1]),
+                "h3_grad": w_mean[0] * eye + g_mean[0],
+                "h3_g1": g1 @ weights[0] / n,
+                "h_grad": w_mean[1] * eye + g_mean[1],
+                "h_g1": g1 @ weights[1] / n}
