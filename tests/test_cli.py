@@ -237,6 +237,30 @@ def test_homogenise_run_average_and_fields(tmp_path, capsys):
     assert np.allclose(mean.A, (outs[0].A + outs[1].A) / 2, rtol=1e-14)
 
 
+def test_homogenise_run_with_adaptive_h0(tmp_path, capsys):
+    """--h0-tol: a subset of the N candidates is solved, the same as the API's, and the h0
+    error estimate is printed beside the time and grid ones."""
+    from fem_twin.micro import FlowFactors, homogenise
+    pin, disk = tmp_path / "pin.npz", tmp_path / "disk.npz"
+    src = ROOT / "meshes" / "sample"
+    assert main(["topography", "prepare-patch", str(src / "patch_3_pin.npz"), str(pin),
+                 "--shape", "16", "16"]) == 0
+    assert main(["topography", "prepare-patch", str(src / "patch_3_disk.npz"), str(disk),
+                 "--shape", "16", "16", "--upper"]) == 0
+    capsys.readouterr()
+    assert main(["homogenise", "run", str(pin), str(disk), "-o", str(tmp_path / "ff"), "--h0",
+                 "1e-7", "1e-6", "40", "--steps", "4", "--h0-tol", "0.01", "--workers", "1",
+                 "--no-progress"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    ff = FlowFactors.load(tmp_path / "ff" / "flow_factors.npz")
+    api = homogenise(read_topography(pin), read_topography(disk), np.geomspace(1e-7, 1e-6, 40),
+                     n_steps=4, h0_tol=0.01)
+    assert printed["points"] == len(ff) == len(api) < 40 and np.array_equal(ff.h0, api.h0)
+    assert {"time", "grid", "h0"} <= set(printed["estimated_relative_error"])
+    assert main(["homogenise", "run", str(pin), str(disk), "-o", str(tmp_path / "bad"),
+                 "--h0-tol", "2", "--no-progress"]) == 2
+
+
 def test_compare_fe_against_fvm(tmp_path):
     """fem-twin compare: both methods on one case; the differences are reported and small
     (the convergence of the difference under refinement is tested in test_micro and
@@ -381,6 +405,7 @@ def test_a_lost_micro_checkpoint_does_not_recompute_the_sweep(tmp_path):
     ("pin_diameter = 8e-3", "pin_diameter = 8", "pin_diameter"),
     ("speed_max = 2.0", "speed_max = 2000", "speed_max"),
     ("fwhm_px = 9 ", "fwhm_px = 9e-6 ", "fwhm_px"), ("hardness = 6.99e9", "hardness = 7", "hardness"),
+    ("h0_tol = 0.01 ", "h0_tol = 1.5 ", "h0_tol"),
     ("viscosities = [0.066, 0.024] # mu_0 [Pa s] at the temperatures below\n"
      "temperatures = [24.0, 50.0]", "viscosities = []\ntemperatures = []", "viscosities")])
 def test_implausible_case_values_are_refused_naming_the_key(tmp_path, old, new, key):
