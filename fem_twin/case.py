@@ -88,8 +88,9 @@ class Materials:
         return reduced_modulus(self.e_pin, self.nu_pin, self.e_disk, self.nu_disk)
 
 
-#: separations an adaptive h0 sample solves, for the time estimate (measured: 20-26 of the
-#: paper's 100 at h0_tol = 0.01 on sample patches 1 and 3, 128^2 x 16 and 256^2 x 32)
+#: separations an adaptive h0 sample solves, for the time estimate (measured at h0_tol =
+#: 0.01: 20-26 of the paper's 100 on sample patches 1 and 3 at 128^2 x 16, 24-39 over the
+#: six at 256^2 x 32)
 ADAPTIVE_H0 = 28
 
 
@@ -179,8 +180,7 @@ class Case:
         for 288 s estimated) growing as N^1.2 (pixels), ~2.5 s at 73^2 for a ball (67 s
         measured for examples/ball_on_disk.toml), one sweep
         per viscosity and, with ``[run] patch_band``, one more per patch.  Adaptive h0
-        (``h0_tol``) solves about ``ADAPTIVE_H0`` of the candidates (measured: 20-26 of the
-        paper's 100 on sample patches 1 and 3)."""
+        (``h0_tol``) solves about ``ADAPTIVE_H0`` of the candidates."""
         patches = len(self.geometry.patches)
         h0 = min(self.micro.h0_count, ADAPTIVE_H0) if self.micro.h0_tol else self.micro.h0_count
         micro = (3e-6 * self.micro.resolution[0] * self.micro.resolution[1] * self.micro.steps

@@ -20,7 +20,8 @@ from ..io.atomic import atomic_path
 from ..io.table import write_csv
 from .estimate import combine
 
-_ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "contact_fraction")
+#: the arrays of a FlowFactors value, in the order of its fields
+ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "contact_fraction")
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,7 +95,7 @@ class FlowFactors:
         path = Path(path)
         with atomic_path(path) as tmp:
             with open(tmp, "wb") as f:
-                np.savez(f, **{k: getattr(self, k) for k in _ARRAYS},
+                np.savez(f, **{k: getattr(self, k) for k in ARRAYS},
                          meta=np.array(json.dumps(self.meta, sort_keys=True)))
         return path
 
@@ -104,10 +105,10 @@ class FlowFactors:
         path = Path(path)
         try:
             with np.load(path, allow_pickle=False) as z:
-                missing = [k for k in _ARRAYS if k not in z]
+                missing = [k for k in ARRAYS if k not in z]
                 if missing:
                     raise KeyError(f"missing {missing}")
-                return cls(**{k: z[k] for k in _ARRAYS}, meta=json.loads(str(z["meta"])))
+                return cls(**{k: z[k] for k in ARRAYS}, meta=json.loads(str(z["meta"])))
         except (OSError, EOFError, ValueError, KeyError) as err:
             raise ValueError(f"{path}: cannot read flow factors ({err})") from err
 
@@ -223,7 +224,7 @@ def average(factors) -> FlowFactors:
             raise ValueError("flow factors to average must share the same h0 values "
                              "(or at least the same h0 range, when sampled adaptively)")
     local = [f if f.h0.size == h0.size else f.at(h0) for f in factors]
-    mean = {k: np.mean([getattr(f, k) for f in local], axis=0) for k in _ARRAYS if k != "h0"}
+    mean = {k: np.mean([getattr(f, k) for f in local], axis=0) for k in ARRAYS if k != "h0"}
     meta = {"average_of": [f.meta for f in factors], "method": factors[0].meta.get("method"),
             "version": factors[0].meta.get("version"),
             "error_estimate": combine(f.meta.get("error_estimate") for f in factors)}

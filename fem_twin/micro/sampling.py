@@ -12,16 +12,16 @@ candidates at most.
 A point left out doubles the spacing around it, so its miss overestimates the error of the
 final interpolant between the points (by about 4x where the factors are smooth, 2x at a
 kink): the largest miss over the points next to skipped candidates is the error estimate,
-the error check against a denser sample.  Misses are relative to the local value, floored at ``FLOOR`` times the largest
-magnitude over the range, so a factor that vanishes at one end of the range (``p_con`` out
-of contact) is not refined where it is negligible; ``d1``, which corrects the sliding
-shear of eq 31, is measured against that term.
+the error check against a denser sample.  Misses are relative to the local value, floored
+at ``FLOOR`` times the largest magnitude over the range, so a factor that vanishes at one
+end of the range (``p_con`` out of contact) is not refined where it is negligible; ``d1``,
+which corrects the sliding shear of eq 31, is measured against that term.
 
-A miss no larger than the time-sampling error of the midpoint itself (``|f_N - f_N/2|``,
-the estimate of :mod:`fem_twin.micro.estimate`) is not a reason to refine: in contact the
-factors jitter from one separation to the next as pixels enter contact between instants
-(``d1`` by 2-3 % on a 128^2 cell at 16 steps), and a denser h0 sample only resolves that
-jitter, which is error of the time average, not information.
+A miss within ``JITTER`` times the time-sampling error (``|f_N - f_N/2|``, the estimate of
+:mod:`fem_twin.micro.estimate`) of the point or a neighbour is not a reason to refine: in
+contact the factors jitter from one separation to the next as pixels enter contact between
+instants (``d1`` by 2-3 % on a 128^2 cell at 16 steps), and a denser h0 sample only
+resolves that jitter, which is error of the time average, not information.
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from .estimate import QUANTITIES
+from .flow_factors import ARRAYS
 
 #: separations of the coarse start (8 intervals: 17 points after the first bisection)
 START = 9
@@ -70,7 +71,7 @@ def adaptive_separations(h0, factors_at, tol: float, start: int = START):
 
 def _midpoints(chosen, positions):
     """Midpoints of the gaps on either side of ``chosen[p]`` for ``p`` in ``positions``
-    (of every gap from ``chosen[p]`` on, for the start)."""
+    (a gap shared by two positions is listed twice)."""
     out = []
     for p in positions:
         for a, b in ((p - 1, p), (p, p + 1)):
@@ -116,5 +117,4 @@ def _relative(name, miss, f, over):
 
 def _without(factors, k):
     keep = np.arange(len(factors)) != k
-    return type(factors)(**{name: getattr(factors, name)[keep] for name in
-                            ("h0", "h_m", "p_con", "A", "b", "C", "d", "contact_fraction")})
+    return type(factors)(**{name: getattr(factors, name)[keep] for name in ARRAYS})
