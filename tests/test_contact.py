@@ -226,3 +226,28 @@ def test_rough_contact_at_tol_1e8_is_within_1e6_of_the_converged_pressure(kw):
     res = contact.solve(shape, size / n, e_red, load=load, periodic=True, tol=1e-8, **kw)
     assert np.linalg.norm(res.pressure - ref.pressure) <= 1e-6 * np.linalg.norm(ref.pressure)
     assert res.load == pytest.approx(load, rel=1e-8)
+
+
+@pytest.mark.parametrize("cap", [None, 0.6])
+def test_rough_contact_under_the_loaded_separation_returns_the_loaded_state(cap):
+    """Separation control at the separation that load control found gives back the load
+    and the pressure (1e-6 L2; each at tol 1e-10 from a cold start, with and without a cap
+    of 0.6 x the elastic peak).  Both controls carry the gap from single-precision
+    increments; the result's deformation is recomputed exactly, so KKT is checked on it."""
+    from fem_twin.topography.synthetic import self_affine
+    n, size = 128, 85e-6
+    shape = -self_affine((n, n), size / n, 0.8, 150e-9, rng=2).heights
+    e_red = contact.reduced_modulus(210e9, 0.3, 210e9, 0.3)
+    load = 100e6 * size ** 2
+    hardness = np.inf
+    if cap is not None:
+        hardness = cap * contact.solve(shape, size / n, e_red, load=load, periodic=True).pressure.max()
+    by_load = contact.solve(shape, size / n, e_red, load=load, periodic=True, hardness=hardness)
+    by_gap = contact.solve(shape, size / n, e_red, separation=by_load.separation, periodic=True,
+                           hardness=hardness)
+    p, ref = by_gap.pressure, by_load.pressure
+    assert np.linalg.norm(p - ref) <= 1e-6 * np.linalg.norm(ref)
+    assert by_gap.load == pytest.approx(load, rel=1e-6)
+    g, scale = by_gap.raw_gap, np.ptp(shape)
+    elastic = (p > 0) & (p < hardness)
+    assert np.abs(g[elastic]).max() < 1e-8 * scale and g[p == 0].min() > -1e-8 * scale

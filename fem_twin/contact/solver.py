@@ -77,7 +77,9 @@ def solve(shape, spacing, e_reduced, *, load=None, separation=None, hardness=np.
     kept by scaling the points below it); should that not converge or miss the load, the
     separation is found by a bracketed root search (Brent) on the load of warm-started
     separation-controlled solves.  While no pressure bound is hit, the deformation is
-    updated from the step's K t, so most iterations cost one FFT pair instead of two.
+    updated from the step's K t; the points the bounds move add a single-precision pair, so an
+    iteration costs one or two single-precision FFT pairs (an exact double pair every
+    ``_REFRESH`` iterations) against the two double pairs of the textbook method.
     """
     kw = dict(hardness=hardness, periodic=periodic, p_min=p_min, gap_floor=gap_floor,
               tol=tol, max_iter=max_iter)
@@ -137,84 +139,124 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
         initial_pressure, tol, max_iter) -> ContactResult:
     """Polonsky-Keer CG (load) or its separation-controlled variant, pressure in [p_min, H].
 
-    One loop of about 60 lines: the CG state (direction, free set, the deformation carried
-    from ``K t``) is shared by every line of an iteration, so it is not split further."""
+    Only the loaded points (``p > p_min``, a few per cent of a rough contact) carry the CG
+    vectors, as index sets into the grid; the dense grid is touched by the FFT pairs, the
+    gap update and one comparison for the points that ask to be loaded.  The gap without
+    the separation, ``G = shape + K p``, is carried from the step's ``K t`` and, where the
+    bounds or the load scaling moved points, the ``K c`` of their correction (both single
+    precision, about 1e-6 of the increment), and recomputed exactly every ``_REFRESH``
+    iterations."""
     s = np.asarray(shape, dtype=float)
     dx1, dx2 = np.broadcast_to(np.asarray(spacing, float), (2,))
     area = dx1 * dx2
     _check(s, area, load, separation, hardness, p_min)
     op = elastic_operator(s.shape, (dx1, dx2), e_reduced, periodic)
-    p = _initial(s, area, load, separation, hardness, p_min, initial_pressure)
-
-    history = []
-    by_load, capped = load is not None, bool(np.isfinite(hardness))
-    t, g, gm, m, spare = (np.zeros_like(s) for _ in range(5))   # no allocation in the loop
-    g_old, delta, was_wrong = 1.0, 0.0, np.zeros(s.shape, bool)
+    p = _initial(s, area, load, separation, hardness, p_min, initial_pressure).ravel().copy()
+    grid, n, by_load = s.shape, s.size, load is not None
+    deform = lambda q, exact=True: (op if exact else op.single)(q.reshape(grid)).ravel()  # noqa: E731
+    floor = lambda k: abs(p_min) * (n - k)   # noqa: E731  (|p| summed over unloaded points)
     h0 = 0.0 if separation is None else float(separation)
-    u, fresh, precise = None, 0, False
-    dot = lambda a, b: float(np.dot(a.ravel(), b.ravel()))  # noqa: E731  (BLAS, no copies)
-    size = (lambda q: q.sum()) if p_min >= 0 else (lambda q: np.abs(q).sum())  # noqa: E731
-    size_old = size(p)
+    loaded = np.flatnonzero(p > p_min)
+    is_loaded = p > p_min
+    t32, c32 = np.zeros(n, np.float32), np.zeros(n, np.float32)
+    t_at, was_wrong, delta, g_old, G, fresh = loaded[:0], loaded[:0], 0.0, 1.0, None, 0
+    history, size_old = [], floor(loaded.size) + np.abs(p[loaded]).sum()
     for it in range(1, max_iter + 1):
-        if u is None or fresh >= _REFRESH:
-            u, fresh = op(p), 0
-        np.add(s, u, out=g)
-        free = p > p_min
-        if capped:
-            free &= p < hardness
-        np.copyto(m, free)                         # free-set mask as numbers: masked sums
-        n_free = float(np.count_nonzero(free))     # are dot products, without index copies
-        if by_load and n_free:
-            h0 = -dot(g, m) / n_free
-        g += h0
-        np.multiply(g, m, out=gm)
-        gg = dot(gm, gm)
-        t *= delta * (gg / g_old)                  # t = m (g + beta t)
-        t *= m
-        t += gm
+        if G is None or fresh >= _REFRESH:
+            exact, fresh = s.ravel() + deform(p), 0
+            if G is not None:
+                jump = exact[t_at] - G[t_at]       # the carried gap's drift: past 1 % of the
+                if jump @ jump > 1e-4 * g_old:     # free-set gap, the CG restarts (the
+                    delta = 0.0                    # directions no longer conjugate)
+            G = exact
+            loaded.sort()
+        pl = p[loaded]
+        fi = loaded[pl < hardness]                 # the free set
+        gf = G[fi]
+        if by_load and fi.size:
+            h0 = -gf.mean()
+        gf += h0
+        gg = float(gf @ gf)
+        tf = gf + delta * (gg / g_old) * t32[fi] if delta else gf   # t = m (g + beta t)
         g_old = gg if gg > 0 else 1.0
-        kt = op(t) if precise else op.single(t)
-        rt = dot(kt, t)                            # (K t - its free-set mean) . t under load
-        if by_load and n_free:
-            rt -= dot(kt, m) / n_free * float(t.sum())
-        tau = dot(g, t) / rt if rt > 0 else 0.0
-        p_old, p = p, spare
-        np.multiply(t, -tau, out=p)
-        p += p_old
-        linear = p.min() >= p_min and (not capped or p.max() <= hardness)  # K p = u - tau K t
-        if not linear:
-            np.clip(p, p_min, hardness, out=p)
-        wrong = _wrong_set(p, p_old, g, free, was_wrong, tau, op, p_min, hardness, capped)
-        any_wrong = wrong.any()
-        delta = 0.0 if any_wrong else 1.0
-        was_wrong = wrong
+        t32[t_at] = 0.0
+        t32[fi] = tf
+        t_at, tf = fi, t32[fi].astype(float)       # the direction as transformed
+        kt = deform(t32, exact=False)
+        ktf = kt[fi].astype(float)
+        rt = float(ktf @ tf)                       # (K t - its free-set mean) . t under load
+        if by_load and fi.size:
+            rt -= ktf.mean() * tf.sum()
+        tau = float(gf @ tf) / rt if rt > 0 else 0.0
+        wrong, low = _wrong_points(G, h0, is_loaded, loaded[pl >= hardness])
+        cand = np.concatenate([loaded, low])       # every point whose pressure may change
+        p_was = p[cand]
+        pf = p[fi] - tau * tf
+        bounded = fi.size > 0 and (pf.min() < p_min or pf.max() > hardness)
+        p[fi] = np.clip(pf, p_min, hardness, out=pf)
+        _move_wrong(p, wrong, G, h0, tau, was_wrong, deform, c32, p_min, hardness)
+        new = cand[p[cand] > p_min]
         factor = 1.0
         if by_load:
-            factor = _rescale(p, load / area, p_min, hardness)
-            linear &= factor is not None and (factor == 1.0 or p_min == 0.0)
-        # the next deformation from this iteration's K t (one FFT pair per iteration instead
-        # of two) while no bound was hit; recomputed every _REFRESH iterations against drift
-        if linear and not any_wrong and precise:
-            kt *= -tau
-            u += kt
-            u *= factor
-            fresh += 1
-        else:
-            u = None
-        precise = linear and not any_wrong
-        # relative change, with a floor of 1e-14 E' per point (no contact: nothing to resolve)
-        size_new = size(p)
-        scale = max(size_new, size_old, 1e-14 * e_reduced * p.size)
-        np.subtract(p, p_old, out=gm)
-        change = float(np.abs(gm, out=gm).sum()) / scale
+            pl = p[new]
+            factor = _rescale(pl, load / area - p_min * (n - new.size), p_min, hardness)
+            p[new] = pl
+        diff = p[cand] - p_was
+        size_new = floor(new.size) + np.abs(p[new]).sum()
+        change = np.abs(diff).sum() / max(size_new, size_old, 1e-14 * e_reduced * n)
         history.append(change)
-        spare, size_old = p_old, size_new
+        corrected = bounded or wrong.size > 0 or factor != 1.0
+        _carry_gap(G, kt, tau, t32, c32, cand, diff if corrected else None, deform)
+        is_loaded[cand] = False
+        is_loaded[new] = True
+        loaded, was_wrong, delta, size_old = new, wrong, 0.0 if wrong.size else 1.0, size_new
+        fresh += 1
         if change < tol:
             break
     else:
         raise ContactNotConverged(f"contact did not converge in {max_iter} iterations "
                                   f"(tol {tol})", history)
+    p = p.reshape(grid)
     return _result(s, op(p), p, h0, by_load, area, p_min, hardness, gap_floor, it, history)
+
+
+def _wrong_points(G, h0, is_loaded, plastic):
+    """Points off the free set whose gap asks to move: unloaded with overlap (``low``) and
+    plastic with the gap open; returns (all of them, the unloaded ones)."""
+    low = np.flatnonzero(np.greater(G < -h0, is_loaded))
+    return np.concatenate([low, plastic[G[plastic] > -h0]]), low
+
+
+def _move_wrong(p, wrong, G, h0, tau, was_wrong, deform, scratch, p_min, hardness):
+    """Give the wrong points, in place, the pressure that closes a uniform overlap on them:
+    the CG step; when some were wrong last time too, no larger than the set's joint
+    stiffness allows (one point's step made points released from and pressed back to the
+    cap cycle forever; the extra single-precision FFT pair is paid only then)."""
+    if not wrong.size:
+        return
+    step = tau
+    if tau <= 0 or np.intersect1d(wrong, was_wrong).size:
+        scratch[wrong] = 1.0
+        joint = 1.0 / deform(scratch, exact=False).max()
+        scratch[wrong] = 0.0
+        step = min(joint, tau) if tau > 0 else joint
+    p[wrong] = np.clip(p[wrong] - step * (G[wrong] + h0), p_min, hardness)
+
+
+def _carry_gap(G, kt, tau, t32, c32, cand, diff, deform):
+    """``G += K (p - p_old)`` in place from the step's ``K t``: ``- tau K t``, plus, when
+    the bounds moved points (``diff = p - p_old`` on ``cand``, else None), ``K c`` of the
+    correction ``c = diff + tau t`` (a single-precision pair)."""
+    if diff is not None:
+        c32[cand] = diff + tau * t32[cand]
+        kc = deform(c32, exact=False)
+        c32[cand] = 0.0
+        kt *= np.float32(-tau)
+        kc += kt
+        G += kc
+    else:
+        kt *= np.float32(-tau)
+        G += kt
 
 
 def _check(s, area, load, separation, hardness, p_min):
@@ -230,29 +272,6 @@ def _check(s, area, load, separation, hardness, p_min):
             raise ValueError(f"load {load} N must exceed the floor load p_min * area")
         if load >= hardness * s.size * area:
             raise ValueError(f"load {load} N exceeds what the hardness can carry on this grid")
-
-
-def _wrong_set(p, p_old, g, free, was_wrong, tau, op, p_min, hardness, capped):
-    """Points off the free set whose gap asks to move (p_min with overlap, H with the gap
-    open), moved in place in ``p``; returns their mask.
-
-    They get the pressure that closes a uniform overlap on the wrong set: the CG step; when
-    the same points are wrong again, no larger than the set's joint stiffness allows (one
-    point's step made points released from and pressed back to the cap cycle forever; the
-    extra FFT pair is paid only then)."""
-    if capped:
-        wrong = ((p_old <= p_min) & (g < 0)) | ((p_old >= hardness) & (g > 0))
-    else:                                   # off the free set = at the floor
-        wrong = np.greater(g < 0, free)
-    if wrong.any():
-        step = tau
-        if tau <= 0 or (wrong & was_wrong).any():
-            joint = 1.0 / op(wrong.astype(float)).max()
-            step = min(joint, tau) if tau > 0 else joint
-        idx = np.flatnonzero(wrong)
-        flat = p.ravel()
-        flat[idx] = np.clip(flat[idx] - step * g.ravel()[idx], p_min, hardness)
-    return wrong
 
 
 def _rescale(p, total, p_min, hardness):
