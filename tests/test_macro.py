@@ -302,3 +302,21 @@ def test_start_separations_find_analytic_roots():
     exact = h_c - (load / (k * area.sum())) ** (2 / 3)
     assert abs(dry_separation(factors, gap, area, load, s) - exact) <= 1e-12 * h_c
     assert dry_separation(factors, gap, area, 1e9, s) == s.gap_floor   # cannot carry it
+
+
+@pytest.mark.parametrize("speed", [1.0, 0.01])
+def test_inexact_inner_solves_reach_the_exact_state(case32, factors, speed):
+    """One Newton step per Reynolds solve while the coupling is far from converged (the
+    default) ends on the state of inner solves to convergence (``inner_steps=0``, the
+    previous method) within two independent 1e-6 stops, in full film and in mixed
+    lubrication: the outer iteration corrects the truncated solves and stops only after an
+    exact one."""
+    gap, spacing, face = case32
+    kw = dict(load=150.0, speed=speed, lubricant=Lubricant(0.066), face=face)
+    exact = solve_mixed(gap, spacing, factors, **kw, settings=MacroSettings(inner_steps=0))
+    cut = solve_mixed(gap, spacing, factors, **kw)
+    assert cut.h_d == pytest.approx(exact.h_d, rel=1e-5)
+    assert cut.friction_coefficient == pytest.approx(exact.friction_coefficient, rel=1e-5)
+    assert np.abs(cut.pressure - exact.pressure).max() < 1e-5 * exact.pressure.max()
+    with pytest.raises(ValueError, match="inner_steps"):
+        MacroSettings(inner_steps=-1)

@@ -24,7 +24,7 @@ from ..errors import ReynoldsNotConverged
 
 
 def solve_complementarity_fb(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=1e-10,
-                             max_iter=200):
+                             max_iter=200, inexact=False):
     """FBNS on the interior nodes; same arguments and results as
     :func:`fem_twin.macro.reynolds.solve_complementarity`."""
     n = K.shape[0]
@@ -66,9 +66,7 @@ def solve_complementarity_fb(K, B, dirichlet, p_boundary, scale, *, phi0=None, t
         res = max(float(np.max(np.abs(f1) / (size + abs(KI) @ p))), float(np.max(np.abs(f2))) / s)
         history.append(res)
         if res < tol:
-            phi = np.full(n, float(p_boundary))
-            phi[interior] = np.where(p >= s * theta, p, -theta * scale)
-            return phi, it, history
+            return _phi(p, theta, s, scale, n, interior, p_boundary), it, history
         d_p, d_theta = _newton_direction(KI, BI, p, theta, s, f1, f2, history)
         merit, lam = norm(f1, f2, s), 1.0
         while True:
@@ -77,8 +75,17 @@ def solve_complementarity_fb(K, B, dirichlet, p_boundary, scale, *, phi0=None, t
                 break
             lam /= 2
         p, theta = p_new, theta_new
+    if inexact:                     # a truncated inner solve (see solve_complementarity)
+        return _phi(p, theta, s, scale, n, interior, p_boundary), max_iter + 1, history
     raise ReynoldsNotConverged(f"FBNS: no convergence in {max_iter} Newton steps (tol {tol})",
                                history)
+
+
+def _phi(p, theta, s, scale, n, interior, p_boundary):
+    """The switch variable of :func:`fem_twin.macro.reynolds.solve_complementarity`."""
+    phi = np.full(n, float(p_boundary))
+    phi[interior] = np.where(p >= s * theta, p, -theta * scale)
+    return phi
 
 
 def _newton_direction(KI, BI, p, theta, s, f1, f2, history):

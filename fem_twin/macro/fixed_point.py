@@ -18,7 +18,9 @@ rigid-body separation ``h_d`` (eqs 28-30):
 
 Converged when, between two iterations, the change of ``h_el`` / h_ref, the update of
 ``p_con`` / p_ref (eq 27), the change of ``p`` / p_ref and the load residual (eq 30) are all
-below ``tol``.
+below ``tol``.  While the residual is above ``INEXACT * tol`` the Reynolds solves are cut
+to ``MacroSettings.inner_steps`` Newton steps (inexact inner solves: the outer iteration
+corrects what they leave); convergence is only accepted after an exact one.
 """
 
 from __future__ import annotations
@@ -38,6 +40,10 @@ ELASTIC_RATIO = 15.0
 RETRIES = 12
 #: Anderson iterations without halving the residual before its history is restarted
 STAGNATION = 25
+#: the inner Reynolds solves stop after ``MacroSettings.inner_steps`` Newton steps while the
+#: coupling residual exceeds this multiple of ``tol`` (measured on the paper's 25-speed sweep
+#: at 256^2: 1.41x faster with one step, C_f within 1.1e-7 C_f,b of exact inner solves)
+INEXACT = 100.0
 
 
 class Concentrated(Exception):
@@ -52,10 +58,12 @@ def solve_fixed_point(P, load: float, face, initial=None, progress=None):
     inner = _Reynolds(P, initial)
     h_el, h_d, p_con = _start(P, inner, load, face, initial)
     outer = _Pid(s) if s.coupling == "pid" else _Mixing(P, load, face)
-    history, good, retries, row = [], None, 0, (np.nan,) * 4
+    history, good, retries, row, res = [], None, 0, (np.nan,) * 4, np.inf
     for it in range(1, s.max_iter + 1):
+        exact = not s.inner_steps or it == 1 or res < INEXACT * s.tol
         try:
-            ev = inner.evaluate(h_el, h_d, p_con if s.coupling == "pid" else None)
+            ev = inner.evaluate(h_el, h_d, p_con if s.coupling == "pid" else None,
+                                steps=None if exact else s.inner_steps)
         except ReynoldsNotConverged as err:     # an over-long step (gap far too thin)
             retries += 1
             if good is None or retries > RETRIES:
@@ -75,7 +83,7 @@ def solve_fixed_point(P, load: float, face, initial=None, progress=None):
         history.append((it, *row, h_d, inner.newton))
         if progress is not None:
             progress(it, res)
-        if res < s.tol and it > 1:
+        if res < s.tol and it > 1 and exact:
             return ev, h_el, h_d, it, history
         h_el, h_d, p_con = outer.update(ev, h_el, h_d, p_con, row, res)
     raise MixedNotConverged(
@@ -111,17 +119,19 @@ class _Reynolds:
         """A cold inner start (the state is far from the last one)."""
         self.phi, self.p = None, np.full(self.P.shape, self.p_amb_rel)
 
-    def evaluate(self, h_el, h_d, p_con=None) -> dict:
+    def evaluate(self, h_el, h_d, p_con=None, steps=None) -> dict:
         """Solve at ``h0 = h_d + h_g + h_el`` (eq 19); ``p_con`` [Pa] is used in the load and
-        the deformation when given (``"pid"``), else ``p_con(h0)``.  Returns every field the
-        updates and the result need."""
+        the deformation when given (``"pid"``), else ``p_con(h0)``; ``steps`` cuts the solve
+        to that many Newton steps (an inexact inner solve).  Returns every field the updates
+        and the result need."""
         P, s = self.P, self.P.settings
         h0 = np.maximum(h_d + P.gap + h_el, s.gap_floor)
         p_prev = self.p
         loc, mu, rho, g, q = P.coefficients(p_prev, h0)
         B = upwind_couette(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing)
+        cut = {} if steps is None else dict(max_iter=steps, inexact=True)
         phi, its, _ = self.solver(P.poiseuille(g, loc.A), B, P.boundary, self.p_amb_rel,
-                                  s.p_ref, phi0=self.phi)
+                                  s.p_ref, phi0=self.phi, **cut)
         self.phi, self.newton = phi, its
         p = np.maximum(phi, 0).reshape(P.shape)
         self.p = p

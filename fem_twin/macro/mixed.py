@@ -66,6 +66,8 @@ class MacroSettings:
     relaxation_elastic: float = 0.1          # under-relaxation of h_el ("pid")
     gains: tuple = T.MACRO_GAINS             # K_P, K_I, K_D of eq 29 ("pid")
     anderson_depth: int = 8
+    inner_steps: int = 1                     # Newton steps per Reynolds solve while far from
+    #                                          the fixed point (0: every one to convergence)
     p_ref: float = 100e6
     h_ref: float = 1e-6
     tol: float = 1e-6
@@ -83,6 +85,8 @@ class MacroSettings:
         if self.complementarity not in ("switch", "fb"):
             raise ValueError(f"complementarity must be 'switch' or 'fb', got "
                              f"{self.complementarity!r}")
+        if not (isinstance(self.inner_steps, int) and self.inner_steps >= 0):
+            raise ValueError(f"inner_steps must be an integer >= 0, got {self.inner_steps!r}")
         if not 0 < self.relaxation_pcon <= 1:
             raise ValueError("relaxation_pcon must be in (0, 1]")
 
