@@ -403,7 +403,8 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
     the sides of the outlet cavity makes the Newton coupling cycle between two states."""
     settings = MacroSettings(e_reduced=case.materials.e_reduced,
                              boundary_friction=case.tribometer.boundary_friction,
-                             method=method or case.macro.method, coupling=case.macro.coupling)
+                             method=method or case.macro.method, coupling=case.macro.coupling,
+                             inner_steps=case.macro.inner_steps)
     if case.tribometer.ball:
         settings = replace(settings, cavitation_pressure=settings.ambient_pressure)
     return settings

@@ -406,6 +406,7 @@ def test_a_lost_micro_checkpoint_does_not_recompute_the_sweep(tmp_path):
     ("speed_max = 2.0", "speed_max = 2000", "speed_max"),
     ("fwhm_px = 9 ", "fwhm_px = 9e-6 ", "fwhm_px"), ("hardness = 6.99e9", "hardness = 7", "hardness"),
     ("h0_tol = 0.01 ", "h0_tol = 1.5 ", "h0_tol"),
+    ("inner_steps = 1 ", "inner_steps = 0.5 ", "inner_steps"),
     ("viscosities = [0.066, 0.024] # mu_0 [Pa s] at the temperatures below\n"
      "temperatures = [24.0, 50.0]", "viscosities = []\ntemperatures = []", "viscosities")])
 def test_implausible_case_values_are_refused_naming_the_key(tmp_path, old, new, key):
