@@ -76,10 +76,10 @@ def solve(shape, spacing, e_reduced, *, load=None, separation=None, hardness=np.
     Under an imposed load, Polonsky-Keer's load-constrained CG, with the cap too (the load
     kept by scaling the points below it); should that not converge or miss the load, the
     separation is found by a bracketed root search (Brent) on the load of warm-started
-    separation-controlled solves.  While no pressure bound is hit, the deformation is
-    updated from the step's K t; the points the bounds move add a single-precision pair, so an
-    iteration costs one or two single-precision FFT pairs (an exact double pair every
-    ``_REFRESH`` iterations) against the two double pairs of the textbook method.
+    separation-controlled solves.  The gap is carried from the step's K t; the points the
+    bounds move add a single-precision pair, so an iteration costs one or two single-
+    precision FFT pairs (an exact double pair every ``_REFRESH`` iterations) against the
+    two double pairs of the textbook method, and works on the loaded points only.
     """
     kw = dict(hardness=hardness, periodic=periodic, p_min=p_min, gap_floor=gap_floor,
               tol=tol, max_iter=max_iter)
@@ -153,7 +153,8 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
     op = elastic_operator(s.shape, (dx1, dx2), e_reduced, periodic)
     p = _initial(s, area, load, separation, hardness, p_min, initial_pressure).ravel().copy()
     grid, n, by_load = s.shape, s.size, load is not None
-    deform = lambda q, exact=True: (op if exact else op.single)(q.reshape(grid)).ravel()  # noqa: E731
+    deform = lambda q, exact=True: (  # noqa: E731  (flat in, flat out; single: float32)
+        (op if exact else op.single)(q.reshape(grid)).ravel())
     floor = lambda k: abs(p_min) * (n - k)   # noqa: E731  (|p| summed over unloaded points)
     h0 = 0.0 if separation is None else float(separation)
     loaded = np.flatnonzero(p > p_min)
