@@ -157,8 +157,8 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
         (op if exact else op.single)(q.reshape(grid)).ravel())
     floor = lambda k: abs(p_min) * (n - k)   # noqa: E731  (|p| summed over unloaded points)
     h0 = 0.0 if separation is None else float(separation)
-    loaded = np.flatnonzero(p > p_min)
     is_loaded = p > p_min
+    loaded = np.flatnonzero(is_loaded)
     t32, c32 = np.zeros(n, np.float32), np.zeros(n, np.float32)
     t_at, was_wrong, delta, g_old, G, fresh = loaded[:0], loaded[:0], 0.0, 1.0, None, 0
     history, size_old = [], floor(loaded.size) + np.abs(p[loaded]).sum()
@@ -248,16 +248,12 @@ def _carry_gap(G, kt, tau, t32, c32, cand, diff, deform):
     """``G += K (p - p_old)`` in place from the step's ``K t``: ``- tau K t``, plus, when
     the bounds moved points (``diff = p - p_old`` on ``cand``, else None), ``K c`` of the
     correction ``c = diff + tau t`` (a single-precision pair)."""
+    kt *= np.float32(-tau)
     if diff is not None:
         c32[cand] = diff + tau * t32[cand]
-        kc = deform(c32, exact=False)
+        kt += deform(c32, exact=False)
         c32[cand] = 0.0
-        kt *= np.float32(-tau)
-        kc += kt
-        G += kc
-    else:
-        kt *= np.float32(-tau)
-        G += kt
+    G += kt
 
 
 def _check(s, area, load, separation, hardness, p_min):

@@ -41,8 +41,8 @@ RETRIES = 12
 #: Anderson iterations without halving the residual before its history is restarted
 STAGNATION = 25
 #: the inner Reynolds solves stop after ``MacroSettings.inner_steps`` Newton steps while the
-#: coupling residual exceeds this multiple of ``tol`` (measured on the paper's 25-speed sweep
-#: at 256^2: 1.41x faster with one step, C_f within 1.1e-7 C_f,b of exact inner solves)
+#: coupling residual exceeds this multiple of ``tol`` (``benchmarks/run.py newton``, 8 speeds
+#: at 256^2: 2.0x faster than exact inner solves with one step, C_f within 3e-8 C_f,b)
 INEXACT = 100.0
 
 
