@@ -126,6 +126,8 @@ class MacroSpec:
     grid: int = 97
     inner_steps: int = 1             # Newton steps per Reynolds solve far from the fixed
                                      # point (MacroSettings.inner_steps; 0: exact solves)
+    couette: str = "central"         # Couette flux of eq 17: second order, or "upwind"
+                                     # (the paper's first order); fem_twin.macro.couette
 
 
 @dataclass(frozen=True)
@@ -341,6 +343,9 @@ def _macro(data, where, tribometer, geometry) -> MacroSpec:
                                                                     "newton", "pid"):
         raise CaseError(f"{where} [macro]: method 'fe'|'fvm', coupling "
                         "'auto'|'anderson'|'newton'|'pid'")
+    if macro.couette not in ("central", "upwind"):
+        raise CaseError(f"{where} [macro] couette: 'central' (second order) or 'upwind' (the "
+                        f"paper's first order), got {macro.couette!r}")
     if not (isinstance(macro.inner_steps, int) and macro.inner_steps >= 0):
         raise CaseError(f"{where} [macro] inner_steps: an integer >= 0 (1: one Newton step "
                         "per Reynolds solve far from convergence, 0: exact), got "

@@ -263,6 +263,9 @@ def _add_macro(sub):
     mp.add_argument("--coupling", choices=("auto", "anderson", "newton", "pid"),
                     default="auto", help="macro coupling: Anderson, with Newton for "
                     "elastically dominated contacts (auto), or one of them; pid is the paper's")
+    mp.add_argument("--couette", choices=("central", "upwind"), default="central",
+                    help="Couette flux of eq 17: second order (central) or the paper's "
+                    "first-order upwind")
     mp.set_defaults(func=_macro_point)
 
 
@@ -464,7 +467,8 @@ def _macro_point(args):
     res = solve_mixed(upper - pin.heights, pin.spacing, FlowFactors.load(args.factors),
                       load=args.load, speed=args.speed, lubricant=Lubricant(args.viscosity),
                       face=face, settings=MacroSettings(method=args.method,
-                                                        coupling=args.coupling))
+                                                        coupling=args.coupling,
+                                                        couette=args.couette))
     args.output.mkdir(parents=True, exist_ok=True)
     res.save(args.output / "point.npz")
     res.write_vtu(args.output / "point.vtu", origin=pin.origin)

@@ -404,7 +404,7 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
     settings = MacroSettings(e_reduced=case.materials.e_reduced,
                              boundary_friction=case.tribometer.boundary_friction,
                              method=method or case.macro.method, coupling=case.macro.coupling,
-                             inner_steps=case.macro.inner_steps)
+                             inner_steps=case.macro.inner_steps, couette=case.macro.couette)
     if case.tribometer.ball:
         settings = replace(settings, cavitation_pressure=settings.ambient_pressure)
     return settings

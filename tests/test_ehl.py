@@ -66,15 +66,19 @@ def test_smooth_ball_converges_with_the_acceptance_call(mourier97):
 
 
 def test_film_against_hamrock_dowson_and_the_measured_plateau(mourier97):
-    """h_c and h_min within 10 % of Hamrock-Dowson (their fit's accuracy); the central film
-    within 10 % of the plateau measured on this contact away from the dent (median over the
-    five instants of |x| < 100 um, ~210 nm), and the exit constriction on the centre line
-    within 10 % of the measured one."""
+    """h_c within 10 % of Hamrock-Dowson (their fit's accuracy) and h_min within 15 %: the
+    converged h_min of this contact is 8.3 % below the fit (central Couette flux on 49, 97,
+    193, 385 nodes: 98.4, 114.1, 118.7, 119.6 nm, limit ~119.8 nm; h_c 205.0, 207.7, 212.0,
+    213.1 nm, limit ~213.5 nm, which the paper's upwind flux approaches from above: 230.2,
+    228.4, 222.7, 218.5 nm), and 97^2 is 4.8 % below that.  The central film within 10 %
+    of the plateau measured on this contact away from the dent (median over the five
+    instants of |x| < 100 um, ~210 nm; 207.7 nm here), and the exit constriction on the
+    centre line within 10 % of the measured one."""
     res, x1, x2 = mourier97
     h_c, h_min = film_thickness(res, x1, x2)
     hd_c, hd_min = MOURIER.hamrock_dowson()
     assert abs(h_c / hd_c - 1) < 0.10, (h_c, hd_c)
-    assert abs(h_min / hd_min - 1) < 0.10, (h_min, hd_min)
+    assert abs(h_min / hd_min - 1) < 0.15, (h_min, hd_min)
     if not EHL.is_dir():
         pytest.skip(f"measured EHL films not found at {EHL}")
     plateau, exit_min = [], []
@@ -91,12 +95,15 @@ def test_film_against_hamrock_dowson_and_the_measured_plateau(mourier97):
 
 @pytest.mark.parametrize("M, L", [(10, 5), (10, 20), (100, 5), (100, 20)])
 def test_central_film_over_the_moes_range(M, L):
-    """Central film within 10 % of Hamrock-Dowson from light (M = 10) to heavy (M = 100)
-    loads and L = 5-20, piezoviscous and compressible, at 49^2 (measured -6 % to +6 %)."""
+    """Central film within 15 % of Hamrock-Dowson from light (M = 10) to heavy (M = 100)
+    loads and L = 5-20, piezoviscous and compressible, at 49^2: the fit's 10 % and the
+    grid's share (measured at L = 5: M = 10 -11.3, -10.1, -9.8 % on 49, 97, 193 nodes, the
+    upwind flux converging to the same film from above, -5.6, -7.1, -8.2 %; M = 100 -10.0,
+    -8.2, -5.2 %)."""
     contact = PointContact.from_moes(M, L)
     res, x1, x2 = solve_point(contact, 49)
     h_c, _ = film_thickness(res, x1, x2)
-    assert abs(h_c / contact.hamrock_dowson()[0] - 1) < 0.10
+    assert abs(h_c / contact.hamrock_dowson()[0] - 1) < 0.15
 
 
 def test_elastic_film_converges_under_refinement():

@@ -29,7 +29,8 @@ import numpy as np
 
 from ..anderson import Anderson
 from ..errors import MixedNotConverged
-from .reynolds import ReynoldsNotConverged, complementarity_solver, upwind_couette
+from .couette import couette_matrix
+from .reynolds import ReynoldsNotConverged, complementarity_solver
 from .start import dry_separation, rigid_separation
 
 #: ``coupling="auto"`` takes the Newton coupling when the first iterate's elastic
@@ -128,7 +129,7 @@ class _Reynolds:
         h0 = np.maximum(h_d + P.gap + h_el, s.gap_floor)
         p_prev = self.p
         loc, mu, rho, g, q = P.coefficients(p_prev, h0)
-        B = upwind_couette(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing)
+        B = couette_matrix(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing, s.couette)
         cut = {} if steps is None else dict(max_iter=steps, inexact=True)
         phi, its, _ = self.solver(P.poiseuille(g, loc.A), B, P.boundary, self.p_amb_rel,
                                   s.p_ref, phi0=self.phi, **cut)

@@ -35,6 +35,7 @@ from ..errors import MixedNotConverged
 from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from . import newton
+from .couette import SCHEMES
 from .fixed_point import Concentrated, solve_fixed_point
 from .friction import BOUNDARY_FRICTION
 from .lubricant import Lubricant
@@ -62,6 +63,8 @@ class MacroSettings:
     method: str = "fe"                       # Poiseuille term: "fe" or "fvm"
     coupling: str = "auto"                   # "anderson", "newton" or "pid" (the paper's)
     complementarity: str = "switch"          # or "fb" (the paper's FBNS; slower)
+    couette: str = "central"                 # Couette flux: second order, or "upwind" (the
+    #                                          paper's first order), :mod:`.couette`
     relaxation_pcon: float = T.RELAXATION_PCON   # alpha_pcon of eq 26 ("pid")
     relaxation_elastic: float = 0.1          # under-relaxation of h_el ("pid")
     gains: tuple = T.MACRO_GAINS             # K_P, K_I, K_D of eq 29 ("pid")
@@ -85,6 +88,8 @@ class MacroSettings:
         if self.complementarity not in ("switch", "fb"):
             raise ValueError(f"complementarity must be 'switch' or 'fb', got "
                              f"{self.complementarity!r}")
+        if self.couette not in SCHEMES:
+            raise ValueError(f"couette must be one of {SCHEMES}, got {self.couette!r}")
         if not (isinstance(self.inner_steps, int) and self.inner_steps >= 0):
             raise ValueError(f"inner_steps must be an integer >= 0, got {self.inner_steps!r}")
         if not 0 < self.relaxation_pcon <= 1:

@@ -32,8 +32,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import MixedNotConverged
+from .couette import couette, couette_matrix
 from .problem import MAX_COEFFICIENT_PRESSURE, Problem
-from .reynolds import couette_parts
 
 #: a node joins the dense elastic block when its elastic coupling exceeds this fraction of
 #: its pressure-flow coupling
@@ -70,14 +70,14 @@ def evaluate(P: Problem, x: State, load: float) -> dict:
     loc, mu, rho, g, q = P.coefficients(p, h0)
     K = P.poiseuille(g, loc.A)
     q1, q2 = (q * loc.b[..., 0]).ravel(), (q * loc.b[..., 1]).ravel()
-    B1, B2 = couette_parts(q1.reshape(shape), q2.reshape(shape), P.spacing)
-    open_ = 1 - theta.ravel()
-    flux = K @ p.ravel() + B1 @ (q1 * open_) + B2 @ (q2 * open_)
-    size = abs(K) @ p.ravel() + abs(B1) @ np.abs(q1) + abs(B2) @ np.abs(q2)
+    C = couette(q1.reshape(shape), q2.reshape(shape), P.spacing, s.couette)
+    B = C.matrix()
+    flux = K @ p.ravel() + B @ (1 - theta.ravel())
+    size = abs(K) @ p.ravel() + C.size()
     p_tot = p + s.cavitation_pressure + loc.p_con - s.ambient_pressure
     F = float(np.sum(P.area * p_tot))
     return dict(p=p, theta=theta, h0=h0, touching=h_raw <= s.gap_floor, loc=loc, mu=mu,
-                rho=rho, g=g, q=q, K=K, B=(B1, B2), q12=(q1, q2), p_con=loc.p_con,
+                rho=rho, g=g, q=q, K=K, B=B, couette=C, p_con=loc.p_con,
                 R=flux[P.interior], size=size[P.interior] + 1e-300,
                 G=x.w - P.elastic(p_tot), F=F,
                 F_hd=float(np.sum(P.area * (p + s.cavitation_pressure - s.ambient_pressure))),
@@ -123,19 +123,16 @@ def jacobian(P: Problem, ev: dict) -> dict:
     g, q, loc, p = ev["g"], ev["q"], ev["loc"], ev["p"].ravel()
     Kg = _probe(P, lambda c: (c, loc.A), p)
     KA = _probe(P, lambda c: (g, c[..., None, None] * d["A"] * free[..., None, None]), p)
-    B1, B2 = ev["B"]
-    open_ = 1 - ev["theta"].ravel()
+    Q1, Q2 = ev["couette"].q_derivatives(1 - ev["theta"].ravel())
     b1, b2 = loc.b[..., 0].ravel(), loc.b[..., 1].ravel()
-    Bq = B1 @ sp.diags(b1 * open_) + B2 @ sp.diags(b2 * open_)
-    Bb = (B1 @ sp.diags(q.ravel() * open_ * d["b"][..., 0].ravel())
-          + B2 @ sp.diags(q.ravel() * open_ * d["b"][..., 1].ravel()))
+    Bq = Q1 @ sp.diags(b1) + Q2 @ sp.diags(b2)
+    Bb = (Q1 @ sp.diags(q.ravel() * d["b"][..., 0].ravel())
+          + Q2 @ sp.diags(q.ravel() * d["b"][..., 1].ravel()))
     dg_dp, dq_dp = (g * (dlnrho - dlnmu)).ravel(), (q * dlnrho).ravel()
     dhm = d["h_m"] * free
     dg_dh, dq_dh = (3 * g * dhm / loc.h_m).ravel(), (q * dhm / loc.h_m).ravel()
-    q1, q2 = ev["q12"]
     dtheta = np.where(pos, 0.0, 1.0 / P.settings.p_ref)
-    Bfull = B1 @ sp.diags(q1) + B2 @ sp.diags(q2)
-    J_p = (ev["K"] @ sp.diags(pos * 1.0) + Bfull @ sp.diags(dtheta)
+    J_p = (ev["K"] @ sp.diags(pos * 1.0) + ev["B"] @ sp.diags(dtheta)
            + (Kg @ sp.diags(dg_dp) + Bq @ sp.diags(dq_dp)) @ sp.diags(pos * 1.0))
     J_h = Kg @ sp.diags(dg_dh) + Bq @ sp.diags(dq_dh) + KA + Bb @ sp.diags(free.ravel() * 1.0)
     J_p, J_h = J_p.tocsr()[I], J_h.tocsr()[I]
@@ -420,7 +417,7 @@ def rigid_start(P: Problem, load: float, ratio: float):
     (halving ``h_d - h_touch`` from the first-contact separation) whose load reaches
     ``load`` or whose elastic deformation reaches ``ratio`` of its thinnest loaded film.
     Returns the state and the load it carries (at most ``load``)."""
-    from .reynolds import solve_complementarity, upwind_couette
+    from .reynolds import solve_complementarity
     s = P.settings
     touch = s.gap_floor - float(P.gap.min())
     t = float(P.factors.h0[-1]) - float(P.gap.min()) - touch
@@ -428,7 +425,7 @@ def rigid_start(P: Problem, load: float, ratio: float):
         h_d = touch + t
         loc, _, _, g, q = P.coefficients(np.zeros(P.shape), np.maximum(h_d + P.gap,
                                                                          s.gap_floor))
-        B = upwind_couette(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing)
+        B = couette_matrix(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing, s.couette)
         phi, _, _ = solve_complementarity(P.poiseuille(g, loc.A), B, P.boundary,
                                           s.ambient_pressure - s.cavitation_pressure, s.p_ref)
         x = State(phi, np.zeros(P.shape), h_d)

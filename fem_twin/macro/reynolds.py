@@ -8,12 +8,14 @@ four edges (flooded inlet).
 
 Discretisation.  The Poiseuille term is the Q1 finite-element stiffness of ``G`` (scikit-fem
 form, 2 x 2 Gauss) for ``method="fe"``, or the paper's 5-point central finite volumes for
-``method="fvm"``.  The Couette term is in both the first-order upwind flux through the faces
-of the node's dual cell, ``dx2 q_1 (1 - theta)`` taken from the upstream node.  A Galerkin
-Couette term is unstable here: in a cavitated zone the equation is pure transport of
-``(1 - theta) h`` with no pressure diffusion at all (infinite Peclet number), so only an
-upwind flux keeps theta monotone and conserves mass exactly (each face flux leaves one dual
-cell and enters the next).
+``method="fvm"``.  The Couette term is in both a flux through the faces of the node's dual
+cell with the liquid fraction ``1 - theta`` from the upstream node
+(:mod:`fem_twin.macro.couette`): the face-centred, second-order ``"central"`` scheme by
+default, the paper's first-order ``"upwind"`` one as an option.  A Galerkin Couette term is
+unstable here: in a cavitated zone the equation is pure transport of ``(1 - theta) h`` with
+no pressure diffusion at all (infinite Peclet number), so only an upwind liquid fraction
+keeps theta monotone, and the face fluxes conserve mass exactly (each leaves one dual cell
+and enters the next).
 
 Complementarity.  One unknown per node, ``phi``: ``p = max(phi, 0)``, ``theta =
 max(-phi, 0) / s`` (the p-theta switch), which makes ``p theta = 0`` exact.  The residual
@@ -37,6 +39,7 @@ from ..assembly import FixedPattern, element_entries, unit_element
 from ..io.mesh import grid_mesh
 from ..linalg import SPDSolver, default_backend
 from ..ordering import nested_dissection
+from .couette import SCHEMES, couette_matrix
 from .fbns import solve_complementarity_fb
 from .lubricant import Lubricant
 from .reynolds_fv import fvm_poiseuille
@@ -79,7 +82,8 @@ def homogenised_poiseuille_form(u, v, w):
 
 def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 0.0,
                    cavitation_pressure: float = 0.0, method: str = "fe", tol: float = 1e-10,
-                   max_iter: int = 200, complementarity: str = "switch") -> ReynoldsResult:
+                   max_iter: int = 200, complementarity: str = "switch",
+                   couette: str = "central") -> ReynoldsResult:
     """Smooth rigid-gap Reynolds with JFO cavitation, one surface sliding at ``speed``.
 
     Parameters
@@ -95,6 +99,8 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     method : ``"fe"`` (Q1 Poiseuille) or ``"fvm"`` (5-point Poiseuille)
     complementarity : ``"switch"`` (p-theta semismooth Newton) or ``"fb"`` (the paper's
         Fischer-Burmeister-Newton-Schur, :mod:`fem_twin.fvm.fbns`; slower, same solution)
+    couette : ``"central"`` (second order) or ``"upwind"`` (the paper's first order), the
+        Couette flux of :mod:`fem_twin.macro.couette`
     """
     h = np.asarray(gap, dtype=float)
     if h.ndim != 2 or min(h.shape) < 3:
@@ -109,6 +115,8 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
         raise ValueError("ambient pressure must not be below the cavitation pressure [Pa]")
     if method not in ("fe", "fvm"):
         raise ValueError(f"method must be 'fe' or 'fvm', got {method!r}")
+    if couette not in SCHEMES:
+        raise ValueError(f"couette must be one of {SCHEMES}, got {couette!r}")
     dx = tuple(float(s) for s in np.broadcast_to(np.asarray(spacing, float), (2,)))
     boundary = np.zeros(h.shape, bool)
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
@@ -119,9 +127,10 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     for _ in range(max_iter if lubricant is not None else 1):
         g = rho * h ** 3 / (12 * mu)
         q1 = rho * h * speed / 2
-        phi, its, history = solver(assemble(g, dx), upwind_couette(q1, np.zeros_like(q1), dx),
-                                   boundary, ambient_pressure - cavitation_pressure, scale,
-                                   phi0=phi, tol=tol, max_iter=max_iter)
+        B = couette_matrix(q1, np.zeros_like(q1), dx, couette)
+        phi, its, history = solver(assemble(g, dx), B, boundary,
+                                   ambient_pressure - cavitation_pressure, scale, phi0=phi,
+                                   tol=tol, max_iter=max_iter)
         p = np.maximum(phi, 0).reshape(h.shape)
         if lubricant is None:
             break
@@ -217,50 +226,6 @@ class PoiseuilleAssembly:
 @lru_cache(maxsize=8)
 def _assembly(shape, spacing) -> PoiseuilleAssembly:
     return PoiseuilleAssembly(shape, spacing)
-
-
-def upwind_couette(q1, q2, spacing) -> sp.csr_matrix:
-    """Net upwind Couette outflow of each node's dual cell: ``B @ (1 - theta)`` [m^3/s].
-
-    ``q = (q1, q2)`` nodal Couette flow per unit width [m^2/s]; the flux through the face
-    between two neighbours is ``dx_perp * q_up * (1 - theta_up)`` from the upstream node
-    (the sign of the face mean of q decides).
-    """
-    rows, cols, vals = [], [], []
-    for a, b, up, width, q in _upwind_faces(q1, q2, spacing):
-        f = width * q[up]
-        # flux f leaves node a and enters node b (negative f: the other way)
-        rows += [a, b]
-        cols += [up, up]
-        vals += [f, -f]
-    n = q1.size
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(n, n))
-
-
-def couette_parts(q1, q2, spacing):
-    """``(B1, B2)`` with ``upwind_couette(q1, q2) = B1 diag(q1) + B2 diag(q2)``: the upwind
-    Couette operator per unit flow, upwinded by the signs of ``q``.  Its derivative with
-    respect to ``q`` at fixed upwinding is ``B1 diag(1 - theta)`` (macro Newton coupling)."""
-    n = q1.size
-    parts = []
-    for a, b, up, width, _ in _upwind_faces(q1, q2, spacing):
-        w = np.full(a.size, float(width))
-        parts.append(sp.csr_matrix((np.r_[w, -w], (np.r_[a, b], np.r_[up, up])),
-                                   shape=(n, n)))
-    return tuple(parts)
-
-
-def _upwind_faces(q1, q2, spacing):
-    """Per direction: the faces' two nodes ``a -> b``, the upwind node, the face width and
-    the flow component (flattened)."""
-    ny, nx = q1.shape
-    idx = np.arange(ny * nx).reshape(ny, nx)
-    for q, a, b, width in ((q1, idx[:, :-1], idx[:, 1:], spacing[1]),
-                           (q2, idx[:-1, :], idx[1:, :], spacing[0])):
-        a, b, q = a.ravel(), b.ravel(), np.asarray(q, float).ravel()
-        up = np.where((q[a] + q[b]) / 2 >= 0, a, b)
-        yield a, b, up, width, q
 
 
 def complementarity_solver(name: str):
