@@ -97,8 +97,7 @@ ADAPTIVE_H0 = 28
 @dataclass(frozen=True)
 class MicroSpec:
     """Micro scale: patch resolution (resampled), h0 range [m] and count, time steps, the
-    squeeze term (``"exact"`` or the paper's ``"backward"``) and the relative error above
-    which the run warns (its estimate: :mod:`fem_twin.micro.estimate`)."""
+    squeeze term (``"exact"`` or the paper's ``"backward"``), adaptive instants and h0."""
 
     resolution: tuple[int, int] = (256, 256)
     h0_min: float = 1e-7
@@ -107,7 +106,6 @@ class MicroSpec:
     steps: int = 32
     method: str = "fe"
     time_derivative: str = "exact"
-    error_tolerance: float = 0.02
     time_tol: float = 0.0            # > 0: adaptive instants per h0 (homogenise time_tol)
     h0_tol: float = 0.01             # > 0: adaptive h0, a subset of the h0_count candidates
                                      # (homogenise h0_tol); 0: all of them (the paper)
@@ -134,13 +132,16 @@ class MacroSpec:
 class SweepSpec:
     """Speeds from ``speed_max`` down to ``speed_min`` [m/s], ``count`` log-spaced, then
     ``refine`` passes that add the geometric midpoints where C_f jumps by more than
-    ``refine_step`` C_f,b (the transition from full film to boundary friction)."""
+    ``refine_step`` C_f,b (the transition from full film to boundary friction); the run warns
+    where a point's estimated discretisation error of C_f exceeds ``error_tolerance`` C_f,b."""
 
     speed_max: float = 2.0
     speed_min: float = 0.01
     count: int = 25
     refine: int = 1             # passes adding midpoints where C_f jumps (0: off)
     refine_step: float = 0.1    # ... by more than this fraction of C_f,b
+    error_tolerance: float = 0.005   # warn where the estimated discretisation error of C_f
+                                     # exceeds this fraction of C_f,b (fem_twin.macro.estimate)
 
     @property
     def speeds(self):
@@ -318,6 +319,10 @@ def _lubricant(data, where) -> LubricantSpec:
 
 
 def _micro(data, where) -> MicroSpec:
+    if isinstance(data.get("micro"), dict) and "error_tolerance" in data["micro"]:
+        raise CaseError(f"{where} [micro] error_tolerance: moved to [sweep] error_tolerance, "
+                        "the estimated error of C_f as a fraction of C_f,b (e.g. 0.005); the "
+                        "flow factors' own estimates are in summary.json")
     micro = _section(data, "micro", MicroSpec, where)
     if micro.method not in ("fe", "fvm"):
         raise CaseError(f"{where} [micro] method: 'fe' or 'fvm'")
@@ -329,8 +334,6 @@ def _micro(data, where) -> MicroSpec:
     if not 0 <= micro.h0_tol < 1:
         raise CaseError(f"{where} [micro] h0_tol: 0 (every h0) or a fraction in (0, 1), "
                         "e.g. 0.005")
-    if not 0 < micro.error_tolerance < 1:
-        raise CaseError(f"{where} [micro] error_tolerance: a fraction in (0, 1), e.g. 0.02")
     if not (0 < micro.h0_min < micro.h0_max < 1e-3) or micro.h0_count < 2 or micro.steps < 1:
         raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
                         "h0_count >= 2 and steps >= 1")
@@ -364,6 +367,9 @@ def _sweep(data, where) -> SweepSpec:
     if not 0 <= sweep.refine <= 4 or not 0 < sweep.refine_step < 1:
         raise CaseError(f"{where} [sweep]: refine is 0-4 passes, refine_step a fraction of "
                         "C_f,b in (0, 1)")
+    if not 0 < sweep.error_tolerance < 1:
+        raise CaseError(f"{where} [sweep] error_tolerance: a fraction of C_f,b in (0, 1), "
+                        f"e.g. 0.005, got {sweep.error_tolerance}")
     if sweep.speed_min > sweep.speed_max or sweep.count < 1:
         raise CaseError(f"{where} [sweep]: need speed_min <= speed_max [m/s] and count >= 1")
     return sweep

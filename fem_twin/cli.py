@@ -556,11 +556,13 @@ def _short_summary(summary: dict, out: Path) -> str:
                      f"{film['h_c_m'] * 1e9:.0f} nm, h_min {film['h_min_m'] * 1e9:.0f} nm "
                      f"(Hamrock-Dowson, smooth: {film['hamrock_dowson_h_c_m'] * 1e9:.0f} nm, "
                      f"{film['hamrock_dowson_h_min_m'] * 1e9:.0f} nm)")
-    est = stages["micro"].get("error_estimate", {})
-    for kind in ("time", "grid", "h0"):
-        if kind in est:
-            lines.append(f"  flow factors, estimated {kind} error: " + ", ".join(
-                f"{q} {e:.1%}" for q, e in est[kind].items() if q in ("A11", "b1", "p_con")))
+    err = stages["stribeck"].get("cf_error")
+    if err:
+        lines.append(f"  C_f estimated discretisation error: at most "
+                     f"{err['max_relative']:.2%} of C_f,b (" + ", ".join(
+                         f"{k} {v:.2%}" for k, v in err["parts_max_relative"].items())
+                     + f"; tolerance {err['tolerance']:.2%}; flow-factor estimates in "
+                     "summary.json)")
     lines.append(f"results in {out}/ (stribeck.csv, plots, results.nc and fields.nc for "
                  f"fem_twin.results.open_run, fields/ for ParaView, summary.json, run.log); "
                  f"the figures on one page: fem-twin report {out}")

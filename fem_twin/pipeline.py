@@ -35,10 +35,10 @@ from .macro.friction import BOUNDARY_FRICTION
 from .macro.point_contact import PointContact, film_thickness
 from .micro import FlowFactors, average, homogenise
 from .micro.homogenisation import prune_checkpoints
-from .micro.estimate import exceeding
 from .micro.output import plot_flow_factors
 from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)
+from .stribeck.accuracy import error_summary
 from .stribeck.sweep import sweep_key
 from .threads import one_thread, worker_heap
 from .topography import resample_cell
@@ -320,18 +320,11 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
     plot_flow_factors([*factors, mean], folder.parent / "flow_factors.png",
                       labels=[f"patch {i + 1}" for i in range(len(factors))] + ["average"])
     estimate = mean.meta.get("error_estimate", {})
-    above = exceeding(estimate, mc.error_tolerance)
-    if above:
-        log.warning("flow factors: estimated relative errors above the tolerance %g: %s "
-                    "(raise [micro] resolution or steps)", mc.error_tolerance,
-                    "; ".join(f"{kind} {q} {e:.1%}" for kind, errs in above.items()
-                              for q, e in errs.items()))
     return {"patches": len(factors), "h0_m": [float(h0[0]), float(h0[-1]), len(h0)],
             "h0_solved": [len(f) for f in factors], "h0_tol": mc.h0_tol,
             "grid": list(mc.resolution), "steps": mc.steps,
             "time_derivative": mc.time_derivative,
-            "error_estimate": estimate, "error_tolerance": mc.error_tolerance,
-            "above_tolerance": above,
+            "error_estimate": estimate,
             "p_con_max_Pa": float(mean.p_con.max()), "files": ["flow_factors.csv",
                                                                "flow_factors.png"]}
 
@@ -425,15 +418,15 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
     lubricants = lb.lubricants()
     speeds = case.sweep.speeds
     for level in range(case.sweep.refine + 1):
-        curves = run_sweeps([(dict(common, speeds=speeds), lub) for lub in lubricants],
-                            executor, progress)
+        curves = run_sweeps([(dict(common, speeds=speeds, error_estimate=True), lub)
+                             for lub in lubricants], executor, progress)
         extra = transition_speeds(curves, case.sweep.refine_step * tr.boundary_friction)
         if level == case.sweep.refine or extra.size == 0:
             break
         log.info("sweep refinement %d: %d speeds added where C_f changes by more than "
                  "%.3g", level + 1, extra.size, case.sweep.refine_step * tr.boundary_friction)
         speeds = np.unique(np.r_[speeds, extra])[::-1]
-    tasks = [(dict(common, speeds=speeds), lub) for lub in lubricants]
+    tasks = [(dict(common, speeds=speeds, error_estimate=True), lub) for lub in lubricants]
     band_tasks = [(kw, lub) for kw in band_sweeps(case, outdir, dict(common, speeds=speeds))
                   for lub in lubricants] if case.run.patch_band else []
     patch_curves = run_sweeps(band_tasks, executor, progress, desc="patch band points")
@@ -451,6 +444,7 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                      *(f"fields_mu{c.viscosity:g}.png" for c in curves)]}
     if band is not None:
         out["patch_band_max_width"] = float(max(np.max(hi - lo) for lo, hi in band))
+    out["cf_error"] = error_summary(curves, tr.boundary_friction, case.sweep.error_tolerance)
     plot_curves(case, curves, band, outdir)
     points = sweep_points(common["checkpoint"], tasks)
     for mu in lb.viscosities:

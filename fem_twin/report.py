@@ -96,8 +96,9 @@ def plot_centre_lines(files, path) -> Path:
 
 def stribeck_section(outdir: Path) -> str:
     pngs = [outdir / "stribeck_speed.png", outdir / "stribeck_hersey.png"]
-    text = ("Friction coefficient (eq 34) of the patch-average flow factors; the shaded band "
-            "spans the single-patch curves (Figure 13), squares are measured curves.")
+    text = ("Friction coefficient (eq 34) of the patch-average flow factors with the estimated "
+            "discretisation error of each point as error bars; the shaded band spans the "
+            "single-patch curves (Figure 13), squares are measured curves.")
     body = figure_section("Stribeck curves (Figure 14)", pngs, text)
     fields = sorted(outdir.glob("fields_mu*.png"))
     val = sorted(outdir.glob("validation_mu*.png"))
@@ -123,11 +124,12 @@ def tables_section(summary: dict) -> str:
                  if isinstance(kind[q], float)})
     errors = _table(["estimate", *qs], [(k, *(f"{v.get(q, float('nan')):.2%}" for q in qs))
                                        for k, v in est.items() if isinstance(v, dict)])
-    tol = micro.get("error_tolerance")
-    body = (f"<h3>Timings</h3><p>Of the last <code>fem-twin run</code> of this folder: stages "
-            f"reused from its checkpoints take seconds.</p>{timing}<h3>Estimated flow-factor errors (relative, largest "
-            f"over h0; tolerance {tol})</h3>{errors}")
     stribeck = stages.get("stribeck", {})
+    body = (f"<h3>Timings</h3><p>Of the last <code>fem-twin run</code> of this folder: stages "
+            f"reused from its checkpoints take seconds.</p>{timing}"
+            + cf_error_paragraph(stribeck.get("cf_error"))
+            + "<h3>Estimated flow-factor errors (relative, largest over h0; the detail "
+            f"behind the C_f estimate)</h3>{errors}")
     if "patch_band_max_width" in stribeck:
         body += (f"<p>Widest patch scatter band: ΔC_f = {stribeck['patch_band_max_width']:.4f}"
                  "</p>")
@@ -176,6 +178,19 @@ def _figure(png, caption: str) -> str:
     data = base64.b64encode(Path(png).read_bytes()).decode()
     return (f'<figure><img alt="{html.escape(caption)}" src="data:image/png;base64,{data}">'
             f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+
+def cf_error_paragraph(err) -> str:
+    """The line on the C_f error estimate (``summary["stages"]["stribeck"]["cf_error"]``)."""
+    if not err:
+        return ""
+    parts = ", ".join(f"{k} {v:.2%}" for k, v in err["parts_max_relative"].items())
+    verdict = ("within" if err["points_above"] == 0 else
+               f"above at {err['points_above']} points of")
+    return (f"<h3>Accuracy of C_f</h3><p>Estimated discretisation error of every point's "
+            f"friction coefficient (error bars of the Stribeck plots, <code>cf_err</code> in "
+            f"stribeck.csv): at most {err['max_relative']:.2%} of C_f,b ({parts}), "
+            f"{verdict} the tolerance {err['tolerance']:.2%} of C_f,b.</p>")
 
 
 def _table(header, rows) -> str:

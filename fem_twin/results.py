@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .io.atomic import atomic_path
+from .macro.estimate import PARTS
 
 ENGINE = "h5netcdf"
 FIELD_UNITS = {"pressure": "Pa", "contact_pressure": "Pa", "cavity_fraction": "1", "h0": "m",
@@ -104,6 +105,17 @@ def stribeck_dataset(curves, patch_curves=None):
     if patch_curves:
         ds["patch_friction_coefficient"] = (("patch", "viscosity", "speed"), cf, {
             "units": "1", "long_name": "C_f with one patch's flow factors"})
+    if any(c.friction_error is not None for c in curves):
+        parts = {"cf_err": "total"} | {f"cf_err_{p}": p for p in PARTS}
+        for name, part in parts.items():
+            v = np.full((mu.size, speed.size), np.nan)
+            for i, c in enumerate(curves):
+                if c.friction_error is not None:
+                    v[i, np.searchsorted(speed, c.speed)] = (
+                        c.friction_error if part == "total" else c.friction_error_parts[part])
+            ds[name] = (("viscosity", "speed"), v, {
+                "units": "1", "long_name": f"estimated discretisation error of C_f, {part}"
+                + (" (fem_twin.macro.estimate)" if part == "total" else " part")})
     return ds
 
 

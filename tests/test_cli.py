@@ -201,7 +201,7 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     keys = FlowFactors.load(out / "micro" / "patch_1" / "flow_factors.npz").meta[
         "checkpoint_keys"]
     ckpts = list((out / "micro" / "patch_1" / "checkpoints").rglob("*_h0_*.json"))
-    assert len(ckpts) == 6 + 3 and {p.name.split("_h0_")[0] for p in ckpts} == set(keys)
+    assert len(ckpts) == 6 + 6 and {p.name.split("_h0_")[0] for p in ckpts} == set(keys)
     assert len(list((out / "stribeck" / "checkpoints").glob("point_*.npz"))) == 10
 
 
@@ -660,6 +660,18 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
             assert sum(np.array_equal(fields.sel(viscosity=mu, speed=u).values, r.pressure)
                        for r in points if r.speed == u) == 1
     assert run.summary["stages"]["stribeck"]["patch_band_max_width"] > 0
+    # issue 27: every point of the average curves carries its C_f error estimate (CSV, the
+    # parts in results.nc, the summary's largest over C_f,b); the band's sweeps do not
+    err = run.summary["stages"]["stribeck"]["cf_error"]
+    for r in rows:
+        point = st.sel(viscosity=float(r["viscosity_Pa_s"]), speed=float(r["speed_m_s"]),
+                       method="nearest")
+        parts = [float(point[f"cf_err_{p}"]) for p in ("macro", "time", "grid", "h0")]
+        assert float(r["cf_err"]) == pytest.approx(sum(parts), rel=1e-9)
+        assert float(r["cf_err"]) > 0
+        assert float(point.cf_err) == pytest.approx(float(r["cf_err"]), rel=1e-9)
+        assert float(r["cf_err"]) <= err["max_relative"] * 0.1924500897 * (1 + 1e-9)
+    assert sum("error_estimate" in p.meta for p in points) == 10
     assert (out / "stribeck_speed.png").is_file()
     run.fields.close()
     # issue 16 item 3: the report page, every image embedded and a valid PNG

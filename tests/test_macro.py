@@ -320,3 +320,35 @@ def test_inexact_inner_solves_reach_the_exact_state(case32, factors, speed):
     assert np.abs(cut.pressure - exact.pressure).max() < 1e-5 * exact.pressure.max()
     with pytest.raises(ValueError, match="inner_steps"):
         MacroSettings(inner_steps=-1)
+
+
+def test_friction_error_parts(case32, factors):
+    """The C_f error estimate of a point (fem_twin.macro.estimate): the macro part is the
+    change to the grid coarsened by two over 2^1.5 - 1; each micro part the change of the
+    coarse point with that variant of the factors; smooth factors have no micro parts and
+    factors without variants report theirs as missing (NaN, left out of the total)."""
+    from dataclasses import replace
+
+    from fem_twin.macro.estimate import MACRO_ORDER, PARTS, coarsened, friction_error
+    gap, dx, face = case32
+    kw = dict(load=150.0, lubricant=Lubricant(0.066), settings=MacroSettings())
+    res = solve_mixed(gap, dx, factors, speed=0.05, face=face, **kw)
+    est = friction_error(res, gap, dx, factors, face=face, **kw)
+    gap2, dx2, face2 = coarsened(gap, dx, face)
+    base = solve_mixed(gap2, dx2, factors, speed=0.05, face=face2, initial=res, **kw)
+    assert est["macro"] == pytest.approx(abs(res.friction_coefficient
+                                             - base.friction_coefficient)
+                                         / (2 ** MACRO_ORDER - 1), rel=1e-4)
+    time = solve_mixed(gap2, dx2, factors.variants()["time"], speed=0.05, face=face2,
+                       initial=base, **kw)
+    assert est["time"] == pytest.approx(abs(time.friction_coefficient
+                                            - base.friction_coefficient), rel=1e-3)
+    assert est["total"] == pytest.approx(sum(est[p] for p in PARTS))
+    assert all(est[p] > 0 for p in PARTS) and "missing" not in est
+    bare = replace(factors, meta={})
+    est = friction_error(res, gap, dx, bare, face=face, **kw)
+    assert est["missing"] == ["time", "grid", "h0"] and np.isnan(est["grid"])
+    assert est["total"] == pytest.approx(est["macro"])
+    smooth = solve_mixed(gap, dx, FlowFactors.smooth(), speed=1.0, face=face, **kw)
+    est = friction_error(smooth, gap, dx, FlowFactors.smooth(), face=face, **kw)
+    assert est["time"] == est["grid"] == est["h0"] == 0 and est["total"] == est["macro"] > 0

@@ -9,6 +9,7 @@ from fem_twin import Topography
 from fem_twin.fvm import CellSolverFV
 from fem_twin.micro import CellSolver, FlowFactors, average, homogenise
 from fem_twin.micro.cell import couette_form, flow_form, pressure_form_1, squeeze_form
+from fem_twin.micro.flow_factors import ARRAYS
 from fem_twin.topography.synthetic import self_affine
 
 L = 80e-6                                        # cell length [m]
@@ -271,7 +272,7 @@ def test_error_estimate_resumes_from_its_checkpoints(tmp_path):
     pin, disk = rough_pair(32)
     h0 = np.geomspace(0.15e-6, 0.8e-6, 4)
     first = homogenise(pin, disk, h0, n_steps=4, checkpoint=tmp_path)
-    assert len(list((tmp_path / "coarse").glob("*.json"))) == 3      # smallest, middle, largest
+    assert len(list((tmp_path / "coarse").glob("*.json"))) == 4      # every separation
     stamps = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.json")}
     again = homogenise(pin, disk, h0, n_steps=4, checkpoint=tmp_path)
     assert {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.json")} == stamps
@@ -327,6 +328,36 @@ def test_fvm_face_integral_tracks_the_bilinear_gap_in_heavy_contact():
     assert fv2 / continuum - 1 > 0.05
     with pytest.raises(ValueError, match="face"):
         CellSolverFV(h.shape, pin.spacing, face="harmonic")
+
+
+def test_variants_carry_each_estimated_error():
+    """The factors with each estimated error added (what the macro scale re-solves for the
+    C_f estimate): "time" is the pass of every other instant, "grid" adds the coarsened
+    cell's difference to the pass of as many instants (normwise the grid estimate), "h0"
+    keeps every other
+    separation and both ends; they survive save/load and average over patches."""
+    pin, disk = rough_pair(32)
+    h0 = np.geomspace(0.12e-6, 0.8e-6, 5)
+    ff = homogenise(pin, disk, h0, n_steps=4)
+    v = ff.variants()
+    assert sorted(v) == ["grid", "h0", "time"]
+    est = ff.meta["error_estimate"]
+    for kind in ("time", "grid"):
+        assert np.array_equal(v[kind].h0, ff.h0)
+    scale = np.abs(ff.b[:, 0]).max()
+    assert np.abs(v["time"].b[:, 0] - ff.b[:, 0]).max() / scale == pytest.approx(
+        est["time"]["b1"], rel=1e-9)
+    half = v["time"].A[:, 0, 0]                   # the coarse cell ran as many instants
+    assert np.abs(v["grid"].A[:, 0, 0] - ff.A[:, 0, 0]).max() / np.abs(half).max() \
+        == pytest.approx(est["grid"]["A11"], rel=1e-9)
+    assert est["grid_shape"] == [16, 16] and est["grid_steps"] == 2
+    assert np.array_equal(v["h0"].h0, h0[[0, 2, 4]])
+    other = FlowFactors(**{k: getattr(ff, k) * (1 if k == "h0" else 3) for k in ARRAYS},
+                        meta={"variants": {}})
+    mean = average([ff, other])
+    assert np.allclose(mean.variants()["time"].A, (v["time"].A + 3 * ff.A) / 2)
+    assert np.array_equal(mean.variants()["h0"].h0, mean.h0)       # the union of samples
+    assert not any("variants" in m for m in mean.meta["average_of"])
 
 
 # -- FlowFactors value ------------------------------------------------------------------------

@@ -10,8 +10,9 @@ sampling alone would not see it.  ``|f_N - f_{N/2}|`` estimates the error of ``f
 it falls at first order in ``1 / N_t`` and bounds it when faster.
 
 Grid: the same problem on the cell coarsened by two (every other pixel, exact for a
-periodic cell) at a few separations.  Coarsening a measured patch also drops its shortest
-wavelengths, and the flow factors then change at first order in the pixel size (measured on
+periodic cell) at every separation, with half the instants (the same pixels per step),
+against the pass of as many instants of the run itself (about an eighth of the run's
+cost).  Coarsening a measured patch also drops its shortest wavelengths, and the flow factors then change at first order in the pixel size (measured on
 the bundled patches), so ``|f_h - f_{2h}|`` estimates the error of ``f_h``; where they
 converge at second order (a smooth or fully resolved surface) it is 3x the error.
 
@@ -19,9 +20,17 @@ Each estimate is normwise per quantity: the largest difference over the separati
 relative to the largest magnitude over the range (``max |f - g| / max |f|``), so a factor
 that vanishes at one end of the range (``A`` at percolation, ``p_con`` out of contact,
 ``d`` without roughness) is not judged by its relative error where it is negligible.
+
+What the macro scale needs is the effect of these errors on the friction coefficient: the
+estimate also keeps, per kind, the factors with that error added (:func:`variants`), which
+the macro scale solves again (:mod:`fem_twin.macro.estimate`): ``"time"`` the factors over
+every other instant, ``"grid"`` the factors plus the difference to the coarsened cell,
+``"h0"`` the factors at every other computed separation (read by the interpolant between).
 """
 
 from __future__ import annotations
+
+from dataclasses import fields
 
 import numpy as np
 
@@ -50,11 +59,18 @@ def grid_separations(h0: np.ndarray, count: int = 3) -> np.ndarray:
     return np.unique(np.asarray(h0)[np.linspace(0, len(h0) - 1, count).round().astype(int)])
 
 
-def exceeding(estimate: dict, tolerance: float) -> dict:
-    """The ``{"time"|"grid": {quantity: error}}`` entries above ``tolerance``."""
-    return {kind: {q: e for q, e in errors.items() if e > tolerance}
-            for kind, errors in estimate.items() if isinstance(errors, dict)
-            and any(e > tolerance for e in errors.values())}
+def variants(factors, half=None, grid=None) -> dict:
+    """``{kind: {array: list}}``: ``factors`` (a :class:`FlowFactors`) with each estimated
+    error added, as JSON-able arrays: ``half`` (the factors over every other instant),
+    ``grid`` (the factors plus the coarsened cell's difference) and, from five separations
+    on, the factors at every other separation (the ends kept)."""
+    arrays = [f.name for f in fields(factors) if f.name != "meta"]     # h0 first
+    out = {"time": half, "grid": grid}
+    if len(factors) >= 5:
+        keep = sorted(set(range(0, len(factors), 2)) | {len(factors) - 1})
+        out["h0"] = type(factors)(**{n: getattr(factors, n)[keep] for n in arrays})
+    return {kind: {n: getattr(f, n).tolist() for n in arrays}
+            for kind, f in out.items() if f is not None}
 
 
 def combine(estimates) -> dict:

@@ -184,6 +184,13 @@ class FlowFactors:
             cache[name] = PchipInterpolator(np.log(self.h0), v, axis=0)
         return cache[name]
 
+    def variants(self) -> dict:
+        """``{kind: FlowFactors}``: these factors with each estimated discretisation error
+        added (``"time"``, ``"grid"``, ``"h0"``; :func:`fem_twin.micro.estimate.variants`),
+        for the macro scale's error estimate; empty when the micro stage kept none."""
+        return {kind: FlowFactors(**{k: np.asarray(v, float) for k, v in arrays.items()})
+                for kind, arrays in self.meta.get("variants", {}).items()}
+
     def smooth_limit_error(self) -> float:
         """Largest deviation from the smooth-surface factors ``A = C = I, b = e1, d = 0``."""
         eye = np.eye(2)
@@ -225,7 +232,21 @@ def average(factors) -> FlowFactors:
                              "(or at least the same h0 range, when sampled adaptively)")
     local = [f if f.h0.size == h0.size else f.at(h0) for f in factors]
     mean = {k: np.mean([getattr(f, k) for f in local], axis=0) for k in ARRAYS if k != "h0"}
-    meta = {"average_of": [f.meta for f in factors], "method": factors[0].meta.get("method"),
-            "version": factors[0].meta.get("version"),
-            "error_estimate": combine(f.meta.get("error_estimate") for f in factors)}
+    meta = {"average_of": [{k: v for k, v in f.meta.items() if k != "variants"}
+                           for f in factors],
+            "method": factors[0].meta.get("method"), "version": factors[0].meta.get("version"),
+            "error_estimate": combine(f.meta.get("error_estimate") for f in factors),
+            "variants": _average_variants(factors)}
     return FlowFactors(h0=h0, **mean, meta=meta)
+
+
+def _average_variants(factors) -> dict:
+    """The variants of a patch average: per kind, the average of the patches' variants (a
+    patch without that kind enters as itself), when at least one patch has it."""
+    each = [f.variants() for f in factors]
+    kinds = sorted({kind for v in each for kind in v})
+    out = {}
+    for kind in kinds:
+        mean = average([v.get(kind, f) for v, f in zip(each, factors)])
+        out[kind] = {k: getattr(mean, k).tolist() for k in ARRAYS}
+    return out

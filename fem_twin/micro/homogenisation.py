@@ -55,8 +55,8 @@ from ..io.checkpoint import input_key, load_or_none
 from ..threads import one_thread, worker_heap
 from ..topography import Topography
 from .cell_fv import CellSolverFV
-from .estimate import discrepancy, grid_separations
-from .flow_factors import FlowFactors
+from .estimate import discrepancy, variants
+from .flow_factors import ARRAYS, FlowFactors
 from .sampling import adaptive_separations
 
 #: the paper's separations: 100 values geometrically spaced in [0.1, 1] um
@@ -169,6 +169,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
             chosen, bound = adaptive_separations(h0, points.factors, h0_tol)
         moments = points.moments(chosen)
         bar.update(len(h0) - len(chosen))             # the candidates interpolated
+        coarse = (_coarse_moments(points, chosen, z_low, z_up, spacing, settings, checkpoint)
+                  if error_estimate else None)
     finally:
         points.close()
         if own_bar:
@@ -188,12 +190,13 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     factors = factors_from_moments(h0[chosen], moments, meta)
     if not error_estimate:
         return factors
-    estimate = estimate_errors(factors, moments, z_low, z_up, spacing, settings,
-                               None if checkpoint is None else Path(checkpoint))
+    estimate = estimate_errors(factors, moments, coarse, settings)
     if bound is not None:
         estimate["h0"] = bound
     keys = meta["checkpoint_keys"] + estimate.pop("checkpoint_keys", [])
-    return replace(factors, meta={**meta, "error_estimate": estimate, "checkpoint_keys": keys})
+    moved = estimate.pop("variants")
+    return replace(factors, meta={**meta, "error_estimate": estimate, "checkpoint_keys": keys,
+                                  "variants": moved})
 
 
 def _check_separations(h0) -> np.ndarray:
@@ -282,28 +285,48 @@ def prune_checkpoints(folder, keep) -> int:
     return removed
 
 
-def estimate_errors(factors, moments, z_low, z_up, spacing, settings, folder=None) -> dict:
+def _coarse_moments(points, indices, z_low, z_up, spacing, settings, checkpoint):
+    """``(moments, settings, key, shape)`` of the cell coarsened by two (every other pixel) at the
+    separations ``h0[indices]``, with half the instants when the run has its half pass
+    (the same pixels per step), on the run's workers; None for a small or odd cell."""
+    if min(z_low.shape) < 16 or z_low.shape[0] % 2 or z_low.shape[1] % 2:
+        return None
+    low, up = z_low[::2, ::2].copy(), z_up[::2, ::2].copy()
+    wide = (2 * spacing[0], 2 * spacing[1])
+    if settings.n_steps % 2 == 0:
+        settings = replace(settings, n_steps=settings.n_steps // 2)
+    key = _key(low, up, wide, settings)
+    args = dict(z_low=low, z_up=up, spacing=wide, settings=settings, key=key,
+                folder=None if checkpoint is None else str(Path(checkpoint) / "coarse"),
+                half_pass=False)
+    runner = _Separations(points.h0, args, points.workers, points.executor,
+                          _progress(len(indices), False))
+    try:
+        return runner.moments(indices), settings, key, list(low.shape)
+    finally:
+        runner.close()                       # only a pool of its own (the run's stays)
+
+
+def estimate_errors(factors, moments, coarse, settings) -> dict:
     """Time and grid error estimates (see :mod:`fem_twin.micro.estimate`): every other
-    instant of this run, and the cell coarsened by two at three separations (large to
-    small, warm-starting contact as the main run does)."""
-    out = {}
+    instant of this run, and the coarsened cell (``coarse``, from :func:`_coarse_moments`,
+    compared with the pass of as many instants); ``"variants"``: the factors with each
+    error added (:func:`fem_twin.micro.estimate.variants`)."""
+    out, half, grid = {}, None, None
     if all("half_h" in m for m in moments):
         half = factors_from_moments(factors.h0, moments, {}, prefix="half_")
         out["time"] = discrepancy(factors, half)
         out["time_steps"] = [settings.n_steps, settings.n_steps // 2]
-    if min(z_low.shape) >= 16 and z_low.shape[0] % 2 == 0 == z_low.shape[1] % 2:
-        low, up = z_low[::2, ::2].copy(), z_up[::2, ::2].copy()
-        wide = (2 * spacing[0], 2 * spacing[1])
-        h0 = grid_separations(factors.h0)
-        sub = None if folder is None else folder / "coarse"
-        done = _run_chunk(list(enumerate(h0))[::-1], z_low=low, z_up=up, spacing=wide,
-                          settings=settings, folder=sub, key=_key(low, up, wide, settings),
-                          resume=True, half_pass=False)
-        done = [m for _, m in sorted(done, key=lambda item: item[0])]
-        out["grid"] = discrepancy(factors, factors_from_moments(h0, done, {}))
-        out["grid_h0"] = h0.tolist()
-        out["grid_shape"] = list(low.shape)
-        out["checkpoint_keys"] = [_key(low, up, wide, settings)]
+    if coarse is not None:
+        coarse_moments, coarse_settings, key, shape = coarse
+        other = factors_from_moments(factors.h0, coarse_moments, {})
+        same = half if coarse_settings.n_steps != settings.n_steps else factors
+        out["grid"] = discrepancy(same, other)
+        out["grid_shape"], out["grid_steps"] = shape, coarse_settings.n_steps
+        grid = replace(factors, meta={}, **{k: getattr(factors, k) + getattr(other, k)
+                                            - getattr(same, k) for k in ARRAYS[1:]})
+        out["checkpoint_keys"] = [key]
+    out["variants"] = variants(factors, half, grid)
     return out
 
 

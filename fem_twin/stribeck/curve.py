@@ -36,7 +36,10 @@ class StribeckCurve:
 
     speed [m/s], hersey [-], friction_coefficient [-], viscosity mu_0 [Pa s] (scalar),
     hydrodynamic_friction and boundary_friction: F_T parts [N], contact_load_fraction:
-    share of F_N carried by p_con, h_d [m], iterations of the macro solver.
+    share of F_N carried by p_con, h_d [m], iterations of the macro solver;
+    friction_error: the estimated discretisation error of C_f [-] (absolute, both scales,
+    :mod:`fem_twin.macro.estimate`) and friction_error_parts its parts by name, when the
+    sweep estimated them (None otherwise).
     """
 
     speed: np.ndarray
@@ -48,6 +51,8 @@ class StribeckCurve:
     contact_load_fraction: np.ndarray
     h_d: np.ndarray
     iterations: np.ndarray
+    friction_error: np.ndarray | None = None
+    friction_error_parts: dict | None = None
 
     def at_hersey(self, hersey):
         """C_f interpolated (monotone cubic, PCHIP, in log H) at Hersey numbers inside this
@@ -63,12 +68,17 @@ class StribeckCurve:
 
 
 def write_stribeck_csv(path, curves, band=None) -> Path:
-    """All curves into one CSV (:data:`HEADERS`, SI units), atomically; ``band``: optional
+    """All curves into one CSV (:data:`HEADERS`, SI units), atomically; ``cf_err``, the
+    estimated discretisation error of C_f, when a curve has it; ``band``: optional
     ``(cf_min, cf_max)`` per curve (the patch scatter band), two more columns."""
     curves = list(curves)
     columns = {HEADERS[k]: np.concatenate([np.broadcast_to(getattr(c, k), c.speed.shape)
                                            for c in curves]) for k in COLUMNS}
     columns["iterations"] = columns["iterations"].astype(int)
+    if any(c.friction_error is not None for c in curves):
+        columns["cf_err"] = np.concatenate([np.full(c.speed.shape, np.nan)
+                                            if c.friction_error is None else c.friction_error
+                                            for c in curves])
     if band is not None:
         columns["cf_min"] = np.concatenate([np.asarray(b[0], float) for b in band])
         columns["cf_max"] = np.concatenate([np.asarray(b[1], float) for b in band])
@@ -81,7 +91,8 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
     if rows and set(HEADERS.values()) <= set(rows[0]):
-        rows = [{k: r[HEADERS[k]] for k in COLUMNS} for r in rows]
+        rows = [{**{k: r[HEADERS[k]] for k in COLUMNS},
+                 **({"cf_err": r["cf_err"]} if "cf_err" in r else {})} for r in rows]
     if not rows or set(COLUMNS) - set(rows[0]):
         raise ValueError(f"{path}: not a Stribeck CSV with columns {tuple(HEADERS.values())}")
     out = []
@@ -89,6 +100,8 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
         sel = [r for r in rows if float(r["viscosity"]) == mu]
         col = {k: np.array([float(r[k]) for r in sel]) for k in COLUMNS if k != "viscosity"}
         col["iterations"] = col["iterations"].astype(int)
+        if "cf_err" in sel[0]:
+            col["friction_error"] = np.array([float(r["cf_err"]) for r in sel])
         out.append(StribeckCurve(viscosity=mu, **col))
     return out
 
@@ -103,7 +116,8 @@ def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None
     ``boundary``: C_f,b of eq 32, drawn as the boundary-friction limit; ``bands``: optional
     ``(cf_min, cf_max)`` per curve, drawn as a shaded band (the patch scatter, Figure 13);
     ``measured``: optional :class:`MeasuredCurve` (or None) per curve, drawn on top in the
-    curve's colour (on the Hersey axis with ``diameter`` [m] and ``load`` [N] of eq 46).
+    curve's colour; a curve's ``friction_error`` is drawn as error bars (capped, distinct
+    from the shaded scatter band) (on the Hersey axis with ``diameter`` [m] and ``load`` [N] of eq 46).
     ``speed_label``: the speed axis (a ball-on-disk sweep is over entrainment speeds).
     """
     import matplotlib.pyplot as plt
@@ -111,6 +125,10 @@ def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None
     for i, c in enumerate(curves):
         label = labels[i] if labels else f"$\\mu_0$ = {c.viscosity:g} Pa s"
         line, = ax.plot(getattr(c, x), c.friction_coefficient, "o-", ms=3, label=label)
+        if c.friction_error is not None:
+            ax.errorbar(getattr(c, x), c.friction_coefficient, yerr=c.friction_error,
+                        fmt="none", ecolor=line.get_color(), elinewidth=1.2, capsize=2.5,
+                        label="estimated discretisation error" if i == 0 else None)
         if bands is not None and bands[i] is not None:
             ax.fill_between(getattr(c, x), *bands[i], color=line.get_color(), alpha=0.2, lw=0,
                             label="patch scatter" if i == 0 else None)

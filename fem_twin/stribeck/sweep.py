@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +11,7 @@ from tqdm import tqdm
 from ..io.checkpoint import input_key, load_or_none
 from ..io.mesh import write_pvd
 from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
+from ..macro.estimate import PARTS, friction_error
 from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from .curve import StribeckCurve, hersey_number
@@ -21,7 +23,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    settings: MacroSettings = MacroSettings(), checkpoint=None, fields=None,
                    origin=(0.0, 0.0), progress: bool = False,
                    factors_key: str | None = None,
-                   slide_to_roll: float | None = None) -> StribeckCurve:
+                   slide_to_roll: float | None = None,
+                   error_estimate: bool = False) -> StribeckCurve:
     """C_f over ``speeds`` [m/s] at one viscosity (paper 3.2: from 2 m/s down to 0.01 m/s).
 
     Each point warm-starts from the previous one (give speeds from fast to slow: the
@@ -33,6 +36,9 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     recomputing a lost micro checkpoint (same numbers to ~1e-10) keeps the points.
     ``slide_to_roll``: a rolling-sliding contact (a ball on a disk): ``speeds`` are then the
     entrainment speeds u_m and each point slides at ``u_r = slide_to_roll * u_m``.
+    ``error_estimate``: estimate each point's discretisation error of C_f
+    (:func:`fem_twin.macro.estimate.friction_error`, kept in the point's ``meta`` and
+    checkpoint): the curve's ``friction_error`` and ``friction_error_parts``.
     """
     speeds = np.asarray(speeds, float)
     if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
@@ -58,6 +64,12 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                               initial=previous)
             if path is not None:
                 res.save(path)
+        if error_estimate and "error_estimate" not in res.meta:
+            res = replace(res, meta={**res.meta, "error_estimate": friction_error(
+                res, gap, spacing, factors, load=load, lubricant=lubricant, face=face,
+                settings=settings, entrainment=res.meta.get("entrainment"))})
+            if path is not None:
+                res.save(path)
         results.append(res)
         previous = res
     if fields is not None:
@@ -69,6 +81,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
             entries.append((float(res.speed), vtu))            # ParaView time = U [m/s]
         write_pvd(fields / f"stribeck_mu{lubricant.viscosity:g}.pvd", entries)
     get = lambda name: np.array([getattr(r, name) for r in results])  # noqa: E731
+    errors = ({part: np.array([r.meta["error_estimate"][part] for r in results])
+               for part in (*PARTS, "total")} if error_estimate else None)
     return StribeckCurve(
         speed=speeds.copy(),
         hersey=hersey_number(lubricant.viscosity, speeds, diameter, load),
@@ -76,7 +90,9 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         hydrodynamic_friction=get("hydrodynamic_friction"),
         boundary_friction=get("boundary_friction"),
         contact_load_fraction=get("contact_load") / load, h_d=get("h_d"),
-        iterations=get("iterations"))
+        iterations=get("iterations"),
+        friction_error=None if errors is None else errors.pop("total"),
+        friction_error_parts=errors)
 
 
 def sweep_key(gap, spacing, factors, load, lubricant, settings, face,

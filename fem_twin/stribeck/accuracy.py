@@ -1,0 +1,41 @@
+"""How accurate a computed Stribeck curve is: its points' estimated C_f errors, summarised.
+
+Each point of a sweep run with ``error_estimate=True`` carries the estimated discretisation
+error of its friction coefficient, in total and per part (macro grid; the flow factors'
+time, grid and h0 sampling: :mod:`fem_twin.macro.estimate`).  Here they are put relative to
+the boundary friction coefficient C_f,b, the scale of eq 35's deviations, and the points
+above a tolerance are named.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from ..macro.estimate import PARTS
+
+log = logging.getLogger("fem_twin")
+
+
+def error_summary(curves, boundary: float, tolerance: float) -> dict:
+    """The largest estimated C_f error of ``curves`` over C_f,b, in total and per part, and
+    the number of points above ``tolerance`` (a fraction of C_f,b), with a logged warning
+    naming the worst one."""
+    def largest(values):
+        values = np.concatenate(values) / boundary
+        return float(np.nanmax(values)) if np.isfinite(values).any() else float("nan")
+
+    above = [(e / boundary, c.viscosity, u) for c in curves
+             for u, e in zip(c.speed, c.friction_error) if e > tolerance * boundary]
+    if above:
+        worst = max(above)
+        log.warning("C_f: estimated discretisation error above %.2g %% of C_f,b at %d of %d "
+                    "points (largest %.2f %% at mu_0 = %g Pa s, U = %.3g m/s; its parts in "
+                    "summary.json): refine [preprocessing] resolution (the macro grid) or "
+                    "[micro] resolution, steps or h0_count", 100 * tolerance, len(above),
+                    sum(c.speed.size for c in curves), 100 * worst[0], worst[1], worst[2])
+    return {"max_relative": largest([c.friction_error for c in curves]),
+            "parts_max_relative": {part: largest([c.friction_error_parts[part]
+                                                  for c in curves]) for part in PARTS},
+            "tolerance": tolerance, "points_above": len(above)}
