@@ -1,7 +1,8 @@
 """Run the benchmarks and print wall times with ratios to a same-run baseline.
 
-    python benchmarks/run.py [GROUP ...]      # topography contact micro macro stribeck
-                                              # (micro-full: ~15 min)
+    python benchmarks/run.py [GROUP ...]      # topography contact micro macro stribeck ...
+                                              # (micro-full: ~15 min, estimate: ~10 min;
+                                              #  both only when named)
 """
 
 from __future__ import annotations
@@ -494,13 +495,56 @@ def bench_paper():
     ]
 
 
+def bench_estimate(viscosity=0.066):
+    """Honesty of the C_f error estimate at full size: the bundled case with its first patch
+    pair and first viscosity (128^2 macro and cell, 16 h0 candidates, 16 steps, no speed
+    refinement) against a reference at twice the resolution on both scales (256^2), 31 h0
+    candidates and four times the steps (64).  Rows: per speed, the estimate over the change
+    to the reference (goal: 1 to 3, or both below 0.05 % C_f,b).  Baseline: the base run."""
+    import tempfile
+    from dataclasses import replace
+
+    from fem_twin import pipeline
+    from fem_twin.case import load_case
+    from fem_twin.stribeck.curve import read_stribeck_csv
+
+    case = load_case(os.path.join(HERE, "..", "examples", "pin_on_disk.toml"))
+    case = replace(case, geometry=replace(case.geometry, patches=case.geometry.patches[:1]),
+                   lubricant=replace(case.lubricant, viscosities=(viscosity,),
+                                     temperatures=case.lubricant.temperatures[:1]),
+                   sweep=replace(case.sweep, refine=0), measured=(),
+                   run=replace(case.run, patch_band=False))
+    fine = replace(case, macro_geometry=replace(case.macro_geometry, resolution=(256, 256)),
+                   micro=replace(case.micro, resolution=(256, 256), steps=64, h0_count=31))
+    curves, times = [], []
+    for c in (case, fine):
+        with tempfile.TemporaryDirectory() as tmp:
+            t0 = time.perf_counter()
+            pipeline.run(c, tmp, progress=False)
+            times.append(time.perf_counter() - t0)
+            curves.append(read_stribeck_csv(os.path.join(tmp, "stribeck.csv"))[0])
+    base, ref = curves
+    cb = case.tribometer.boundary_friction
+    rows = [("baseline: bundled case, 1 patch, 1 viscosity", times[0], ""),
+            ("reference: 256^2 both scales, 31 h0, 64 steps", times[1], "")]
+    for u, cf, err, cf_ref in zip(base.speed, base.friction_coefficient, base.friction_error,
+                                  ref.friction_coefficient):
+        actual = abs(cf - cf_ref)
+        ok = (err < 5e-4 * cb and actual < 5e-4 * cb) or 1 <= err / actual <= 3
+        rows.append((f"  {u:.4g} m/s: C_f {cf:.5f}, reference {cf_ref:.5f}", 0.0,
+                     f"estimate {err / cb:.3%}, actual {actual / cb:.3%} C_f,b, "
+                     f"effectivity {err / actual:.2f} {'ok' if ok else 'OUTSIDE'}"))
+    return times[0], rows
+
+
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
           "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "paper": bench_paper, "stribeck": bench_stribeck,
+          "estimate": bench_estimate,
           "micro-full": lambda: bench_micro(full=True)}
 
 
 def main(argv):
-    groups = argv or [g for g in GROUPS if g != "micro-full"]
+    groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate")]
     for name in groups:
         base, rows = GROUPS[name]()
         print(f"\n## {name}")

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .case import Case
+from .errors import InputError
 from .io.atomic import atomic_path
 from .io.figure import save_figure
 from .micro import FlowFactors
@@ -47,7 +48,7 @@ def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
         return out, f"{int(max(values))} px"
     if study == "disk":
         if not case.geometry.disks:
-            raise ValueError("the disk study needs measured disks in [geometry] disks")
+            raise InputError("the disk study needs measured disks in [geometry] disks")
         flat = replace(case, geometry=replace(case.geometry, disks=()))
         return {"measured disk": (case, None), "flat disk": (flat, None)}, "measured disk"
     if study == "pins":
@@ -60,7 +61,7 @@ def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
         for k in range(1, len(case.geometry.patches) + 1):
             out[f"patch {k}"] = (case, k)
         return out, "patch average"
-    raise ValueError(f"unknown study {study!r}; choose one of {STUDIES}")
+    raise InputError(f"unknown study {study!r}; choose one of {STUDIES}")
 
 
 def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = True) -> dict:

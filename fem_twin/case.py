@@ -8,6 +8,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from . import tables as T
+from .checks import QUANTITIES
 from .errors import InputError
 from .topography.prepare import MacroOptions
 
@@ -208,7 +209,7 @@ def load_case(path) -> Case:
     if not path.is_file():
         raise CaseError(f"case file not found: {path}")
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))   # a BOM is harmless
     except tomllib.TOMLDecodeError as err:
         raise CaseError(f"{path}: not valid TOML: {err}") from err
     return parse_case(data, base=path.parent, source=path)
@@ -230,6 +231,14 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     macro = _macro(data, where, tribometer, geometry)
     sweep = _sweep(data, where)
     run = _section(data, "run", RunSpec, where)
+    if run.workers < 0:
+        raise CaseError(f"{where} [run] workers: a number of processes >= 0 (0: all cores), "
+                        f"got {run.workers}")
+    radius = macro_geometry.level_radius
+    if not tribometer.ball and radius is not None and not 0 < radius <= tribometer.pin_diameter:
+        raise CaseError(f"{where} [preprocessing] level_radius = {radius}: the mean-plane radius "
+                        f"in metres, at most the pin diameter {tribometer.pin_diameter:g} m "
+                        "(3 mm is 3e-3)")
     if not geometry.patches:
         raise CaseError(f"{where} [geometry]: at least one roughness patch pair is required")
     measured = _measured(data.get("validation", {}), base, where, lubricant)
@@ -334,6 +343,10 @@ def _micro(data, where) -> MicroSpec:
     if not 0 <= micro.h0_tol < 1:
         raise CaseError(f"{where} [micro] h0_tol: 0 (every h0) or a fraction in (0, 1), "
                         "e.g. 0.005")
+    if len(micro.resolution) != 2 or min(micro.resolution) < 8:
+        raise CaseError(f"{where} [micro] resolution: [rows, columns] of at least 8 pixels each "
+                        f"(the error estimate solves the cell coarsened by two), got "
+                        f"{list(micro.resolution)}")
     if not (0 < micro.h0_min < micro.h0_max < 1e-3) or micro.h0_count < 2 or micro.steps < 1:
         raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
                         "h0_count >= 2 and steps >= 1")
@@ -404,6 +417,9 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
         if isinstance(default, tuple):
             if not isinstance(v, list) or not all(isinstance(x, (int, float)) for x in v):
                 raise CaseError(f"{where} [{name}] {f.name}: expected a list of numbers")
+            if default and isinstance(default[0], int) and not all(isinstance(x, int)
+                                                                    for x in v):
+                raise CaseError(f"{where} [{name}] {f.name}: expected whole numbers, got {v}")
             v = tuple(type(default[0])(x) if default else x for x in v)
             if not all(math.isfinite(x) for x in v):
                 raise CaseError(f"{where} [{name}] {f.name}: values must be finite numbers")
@@ -418,6 +434,8 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
         elif isinstance(default, (int, float)):
             if not isinstance(v, (int, float)) or isinstance(v, bool):
                 raise CaseError(f"{where} [{name}] {f.name}: expected a number (SI units)")
+            if isinstance(default, int) and not isinstance(v, int):
+                raise CaseError(f"{where} [{name}] {f.name}: expected a whole number, got {v}")
             if not math.isfinite(v):
                 raise CaseError(f"{where} [{name}] {f.name}: must be a finite number, got {v}")
             if positive and (v < 0 if f.name in zero_ok else v <= 0):
@@ -427,29 +445,29 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
     return cls(**values)
 
 
-#: (section, key) -> (lowest, highest) plausible value in SI units, and the hint shown
+#: (section, key) -> the quantity of :data:`fem_twin.checks.QUANTITIES` (range, unit hint)
 PLAUSIBLE = {
-    ("tribometer", "load"): (1e-3, 1e4, "N"),
-    ("tribometer", "pin_diameter"): (1e-4, 0.1, "m (8 mm is 8e-3)"),
-    ("tribometer", "sliding_radius"): (1e-3, 1.0, "m (30 mm is 30e-3)"),
-    ("tribometer", "boundary_friction"): (1e-3, 1.0, "(a friction coefficient)"),
-    ("tribometer", "ball_radius"): (1e-4, 1.0, "m (12.7 mm is 12.7e-3)"),
-    ("tribometer", "slide_to_roll"): (1e-3, 2.0, "u_r / u_m, in (0, 2] (50 % is 0.5)"),
-    ("tribometer", "track_radius"): (1e-3, 1.0, "m (20 mm is 20e-3)"),
-    ("lubricant", "viscosities"): (1e-5, 10.0, "Pa s (66 mPa s is 0.066)"),
-    ("lubricant", "density"): (100.0, 2e4, "kg/m^3"),
-    ("lubricant", "roelands_alpha"): (0.0, 1e-7, "1/Pa (22 GPa^-1 is 22e-9)"),
-    ("lubricant", "eyring_stress"): (0.0, 1e9, "Pa (5 MPa is 5e6; 0: Newtonian)"),
-    ("materials", "e_pin"): (1e8, 2e12, "Pa (210 GPa is 210e9)"),
-    ("materials", "e_disk"): (1e8, 2e12, "Pa (210 GPa is 210e9)"),
-    ("materials", "nu_pin"): (0.0, 0.4999, "Poisson ratio in [0, 0.5)"),
-    ("materials", "nu_disk"): (0.0, 0.4999, "Poisson ratio in [0, 0.5)"),
-    ("materials", "hardness"): (1e7, 1e11, "Pa (6.99 GPa is 6.99e9)"),
-    ("micro", "h0_min"): (1e-10, 1e-4, "m (0.1 um is 1e-7)"),
-    ("micro", "h0_max"): (1e-10, 1e-4, "m (1 um is 1e-6)"),
-    ("sweep", "speed_max"): (1e-6, 100.0, "m/s"),
-    ("sweep", "speed_min"): (1e-6, 100.0, "m/s"),
-    ("preprocessing", "fwhm_px"): (0.0, 200.0, "pixels (0 or at least 1)"),
+    ("tribometer", "load"): "load",
+    ("tribometer", "pin_diameter"): "pin_diameter",
+    ("tribometer", "sliding_radius"): "length",
+    ("tribometer", "boundary_friction"): "friction",
+    ("tribometer", "ball_radius"): "length",
+    ("tribometer", "slide_to_roll"): "slide_to_roll",
+    ("tribometer", "track_radius"): "length",
+    ("lubricant", "viscosities"): "viscosity",
+    ("lubricant", "density"): "density",
+    ("lubricant", "roelands_alpha"): "pressure_viscosity",
+    ("lubricant", "eyring_stress"): "eyring_stress",
+    ("materials", "e_pin"): "modulus",
+    ("materials", "e_disk"): "modulus",
+    ("materials", "nu_pin"): "poisson",
+    ("materials", "nu_disk"): "poisson",
+    ("materials", "hardness"): "hardness",
+    ("micro", "h0_min"): "separation",
+    ("micro", "h0_max"): "separation",
+    ("sweep", "speed_max"): "speed",
+    ("sweep", "speed_min"): "speed",
+    ("preprocessing", "fwhm_px"): "fwhm_px",
 }
 
 
@@ -457,7 +475,7 @@ def _plausible(section, key, value, where):
     """Refuse a value outside the plausible SI range of ``PLAUSIBLE``, naming the key."""
     if (section, key) not in PLAUSIBLE or isinstance(value, bool):
         return
-    lo, hi, unit = PLAUSIBLE[(section, key)]
+    lo, hi, unit = QUANTITIES[PLAUSIBLE[(section, key)]]
     values = value if isinstance(value, list) else [value]
     for v in values:
         if isinstance(v, (int, float)) and math.isfinite(v) and not lo <= v <= hi:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NotConverged, RunLocked, SchedulerUnreachable
+from .errors import InputError, MissingFile, NotConverged, RunLocked, SchedulerUnreachable
 
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
@@ -54,6 +54,8 @@ def main(argv=None) -> int:
     logging.basicConfig(format="%(levelname)s %(name)s: %(message)s")
     for handler in logging.getLogger().handlers:   # the terminal; run.log keeps everything
         handler.setLevel(level)
+        if not args.debug:                          # tracebacks: run.log; the error: below
+            handler.addFilter(lambda record: not record.exc_info)
     try:
         return args.func(args) or 0
     except KeyboardInterrupt:
@@ -415,7 +417,7 @@ def _homogenise_run(args):
     pin, disk = read_topography(args.pin), read_topography(args.disk)
     lo, hi, n = args.h0
     if int(n) != n or n < 1:
-        raise ValueError(f"the number of h0 values must be a positive integer, got {n}")
+        raise InputError(f"the number of h0 values must be a positive integer, got {n}")
     ff = homogenise(pin, disk, np.geomspace(lo, hi, int(n)), n_steps=args.steps,
                     method=args.method, time_derivative=args.time_derivative,
                     time_tol=args.time_tol, h0_tol=args.h0_tol, workers=args.workers,
@@ -462,7 +464,7 @@ def _macro_point(args):
     pin = read_topography(args.pin)
     upper = read_topography(args.disk).heights if args.disk else 0.0 * pin.heights
     if np.shape(upper) != pin.shape:
-        raise ValueError(f"disk grid {np.shape(upper)} does not match the pin grid {pin.shape}")
+        raise InputError(f"disk grid {np.shape(upper)} does not match the pin grid {pin.shape}")
     face = pin.heights > -0.5e-3                 # the holder sits 1 mm below the face
     res = solve_mixed(upper - pin.heights, pin.spacing, FlowFactors.load(args.factors),
                       load=args.load, speed=args.speed, lubricant=Lubricant(args.viscosity),
@@ -529,7 +531,7 @@ def _run(args):
     from .case import load_case
     from .pipeline import run
     if not args.case.is_file():
-        raise FileNotFoundError(f"case file not found: {args.case} (give the case file as "
+        raise MissingFile(f"case file not found: {args.case} (give the case file as "
                                 "the first argument)")
     case = load_case(args.case)
     if not _confirm_cost(case, args.yes):
@@ -595,14 +597,14 @@ def _validate(args):
     from .stribeck.curve import read_stribeck_csv
     csv_path = args.run / "stribeck.csv"
     if not csv_path.is_file():
-        raise FileNotFoundError(f"{csv_path} not found: give the output folder of fem-twin run")
+        raise MissingFile(f"{csv_path} not found: give the output folder of fem-twin run")
     curves = read_stribeck_csv(csv_path)
     if args.viscosity is None:
         curve = curves[0]
     else:
         match = [c for c in curves if np.isclose(c.viscosity, args.viscosity, rtol=1e-6)]
         if not match:
-            raise ValueError(f"no curve at mu_0 = {args.viscosity} Pa s in {csv_path} (it has "
+            raise InputError(f"no curve at mu_0 = {args.viscosity} Pa s in {csv_path} (it has "
                              f"{[c.viscosity for c in curves]})")
         curve = match[0]
     case_file = _run_case_file(args.run)
@@ -612,11 +614,11 @@ def _validate(args):
     if args.rpm:
         radius = args.radius or (case.tribometer.sliding_radius if case else None)
         if radius is None:
-            raise ValueError("--rpm needs the sliding radius: give --radius [m]")
+            raise InputError("--rpm needs the sliding radius: give --radius [m]")
         measured = replace(measured, speed=measured.speed * 2 * np.pi * radius / 60)
     dev = deviation_from_measured(curve, measured, boundary)
     if not np.any(np.isfinite(dev)):
-        raise ValueError(f"the measured speeds ({measured.speed.min():.3g} to "
+        raise InputError(f"the measured speeds ({measured.speed.min():.3g} to "
                          f"{measured.speed.max():.3g} m/s) lie outside the simulated range")
     stem = f"validation_{args.measured.stem}"
     band = None if measured.low is None else (measured.low, measured.high)

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .case import Case
+from .errors import InputError
 from .io.atomic import atomic_path
 from .io.figure import save_figure
 from .io.table import write_csv
@@ -30,7 +31,7 @@ def flow_factor_differences(fe: FlowFactors, fvm: FlowFactors) -> dict:
     """Per-h0 differences [-]: max |Delta A| / max |A| (likewise b, C), |Delta h_m| / h0,
     |Delta d|, and |Delta p_con| / max p_con."""
     if not np.allclose(fe.h0, fvm.h0):
-        raise ValueError("flow factors to compare must share their h0 values")
+        raise InputError("flow factors to compare must share their h0 values")
 
     def rel(a, b, axes):
         return np.abs(a - b).max(axis=axes) / np.maximum(np.abs(b).max(axis=axes), 1e-300)

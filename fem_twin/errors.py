@@ -1,6 +1,11 @@
-"""fem_twin's exceptions: one root, :class:`FemTwinError`, that every error of the package
-derives from (bad input also derives from ``ValueError``, solver failures from
-``RuntimeError``), so ``except FemTwinError`` catches exactly what fem_twin raises."""
+"""fem_twin's exceptions: one root, :class:`FemTwinError`, that every error the package
+raises on purpose derives from, so ``except FemTwinError`` catches exactly what fem_twin
+raises.  Each also derives from the builtin a caller would expect: bad input
+(:class:`InputError`) from ``ValueError``, solver failures (:class:`NotConverged`,
+:class:`SolverError`) from ``RuntimeError``, files (:class:`FileSystemError`,
+:class:`MissingFile`) from ``OSError`` / ``FileNotFoundError``, an absent optional package
+(:class:`MissingDependency`) from ``ImportError``.  A test walks every ``raise`` of the
+package and fails on a bare builtin."""
 
 from __future__ import annotations
 
@@ -13,6 +18,26 @@ class FemTwinError(Exception):
 
 class InputError(FemTwinError, ValueError):
     """Bad input (a case file, a topography file, an argument), found before work starts."""
+
+
+class FileSystemError(FemTwinError, OSError):
+    """A file or folder of a run cannot be read or written as it should."""
+
+
+class MissingFile(FileSystemError, FileNotFoundError):
+    """A file the user named (or a run should have written) does not exist."""
+
+
+class MissingDependency(FemTwinError, ImportError):
+    """An optional package that the chosen option needs is not installed."""
+
+
+class SolverError(FemTwinError, RuntimeError):
+    """A linear solver or an internal consistency check failed (please report it)."""
+
+
+class NotPositiveDefinite(FemTwinError, np.linalg.LinAlgError):
+    """A matrix that should be symmetric positive definite has a zero or negative pivot."""
 
 
 class NotConverged(FemTwinError, RuntimeError):

@@ -33,6 +33,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .errors import InputError, MissingDependency, NotPositiveDefinite, SolverError
+
 BACKENDS = ("superlu", "pardiso")
 
 
@@ -58,7 +60,7 @@ def default_backend() -> str:
     if choice == "auto":
         return "pardiso" if _mkl_rt() is not None else "superlu"
     if choice not in BACKENDS:
-        raise ValueError(f"FEM_TWIN_SPARSE must be 'auto' or one of {BACKENDS}, got {choice!r}")
+        raise InputError(f"FEM_TWIN_SPARSE must be 'auto' or one of {BACKENDS}, got {choice!r}")
     return choice
 
 
@@ -75,7 +77,7 @@ class SPDSolver:
     def __init__(self, indptr, indices, backend: str | None = None, symmetric: bool = True):
         self.backend = default_backend() if backend is None else backend
         if self.backend not in BACKENDS:
-            raise ValueError(f"backend must be one of {BACKENDS}, got {self.backend!r}")
+            raise InputError(f"backend must be one of {BACKENDS}, got {self.backend!r}")
         self._indptr = np.asarray(indptr)
         self._indices = np.asarray(indices)
         self.n = self._indptr.size - 1
@@ -87,7 +89,7 @@ class SPDSolver:
             self._ja = self._indices.astype(np.int32)
         elif self.backend == "pardiso":
             if _mkl_rt() is None:
-                raise ImportError("the 'pardiso' backend needs MKL: pip install "
+                raise MissingDependency("the 'pardiso' backend needs MKL: pip install "
                                   "'fem-twin[pardiso]' (or use backend='superlu')")
             rows = np.repeat(np.arange(self.n), np.diff(self._indptr))
             self._upper = self._indices >= rows
@@ -131,10 +133,10 @@ class SPDSolver:
         rhs = np.asarray(rhs, dtype=float)
         if self.backend == "superlu":
             if self._lu is None:
-                raise RuntimeError("factor() a matrix before solve()")
+                raise SolverError("factor() a matrix before solve()")
             return self._lu.solve(rhs)
         if self._a is None:
-            raise RuntimeError("factor() a matrix before solve()")
+            raise SolverError("factor() a matrix before solve()")
         b = np.asfortranarray(rhs.reshape(self.n, -1))
         return self._pardiso(33, b).reshape(rhs.shape)
 
@@ -163,10 +165,10 @@ class SPDSolver:
                     iparm.ctypes.data_as(i32), ref(0), b.ctypes.data_as(ctypes.c_void_p),
                     x.ctypes.data_as(ctypes.c_void_p), ctypes.byref(error))
         if error.value == -4:
-            raise np.linalg.LinAlgError("PARDISO: the matrix is not positive definite "
-                                        "(zero or negative pivot)")
+            raise NotPositiveDefinite("PARDISO: the matrix is not positive definite "
+                                      "(zero or negative pivot)")
         if error.value != 0:
-            raise RuntimeError(f"PARDISO phase {phase} failed with error {error.value}")
+            raise SolverError(f"PARDISO phase {phase} failed with error {error.value}")
         if phase == 22:
             self.perturbed = int(iparm[13])
         return x

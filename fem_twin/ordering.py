@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import SolverError
+
 
 def _dissect(rows, cols, nx, out, leaf):
     if len(rows) * len(cols) <= leaf * leaf or min(len(rows), len(cols)) < 3:
@@ -28,7 +30,7 @@ def _dissect(rows, cols, nx, out, leaf):
 def _checked(out, n):
     order = np.concatenate(out)
     if order.size != n or np.unique(order).size != n:   # guard against a wrong partition
-        raise AssertionError("nested dissection lost or repeated pixels")
+        raise SolverError("nested dissection lost or repeated pixels")
     return order
 
 

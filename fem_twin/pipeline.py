@@ -23,7 +23,7 @@ from tqdm import tqdm
 
 from .case import Case
 from .contact.levelling import average_pins, level_pin
-from .errors import RunLocked, SchedulerUnreachable
+from .errors import InputError, RunLocked, SchedulerUnreachable
 from .io.atomic import atomic_path
 from .io.checkpoint import input_key, load_or_none
 from .io.table import write_csv
@@ -40,7 +40,7 @@ from .stribeck import (deviation_from_measured, friction_deviation, plot_stribec
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)
 from .stribeck.accuracy import error_summary
 from .stribeck.sweep import sweep_key
-from .threads import one_thread, worker_heap
+from .threads import one_thread, process_pool, stop_pool, worker_heap
 from .topography import resample_cell
 from .topography.plausibility import check_patch, check_pin
 from .topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
@@ -52,6 +52,11 @@ log = logging.getLogger("fem_twin")
 def run(case: Case, outdir, *, progress: bool = True) -> dict:
     """Run the whole pipeline of ``case`` into ``outdir``; return the summary."""
     outdir = Path(outdir)
+    if outdir.exists() and not outdir.is_dir():
+        raise InputError(f"{outdir} is a file: give a folder for the results (-o)")
+    for path in case.measured:                 # [validation] curves: checked before any work
+        if path is not None:
+            read_measured_csv(path)
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     summary = {"case": case.name, "provenance": provenance(case), "stages": {},
@@ -70,7 +75,7 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
             try:
                 summary["stages"][name] = stage()
             except BaseException:
-                log.exception("stage %s failed", name)
+                log.exception("stage %s failed", name)    # run.log only (see cli)
                 raise
             summary["seconds"][name] = round(time.perf_counter() - t, 2)
             log.info("stage %s done in %.1f s", name, summary["seconds"][name])
@@ -118,7 +123,14 @@ def invalidate_changed_stages(case: Case, outdir: Path) -> None:
     Stribeck points and micro checkpoints are keyed by their inputs already)."""
     import shutil
     path = outdir / "stage_keys.json"
-    old = json.loads(path.read_text()) if path.exists() else {}
+    old = {}
+    if path.exists():
+        try:
+            old = json.loads(path.read_text())
+            assert isinstance(old, dict)
+        except (ValueError, AssertionError, UnicodeDecodeError):
+            log.warning("%s is damaged: every cached stage is recomputed", path)
+            old = {stage: "damaged" for stage in ("geometry", "levelling", "micro")}
     new = stage_keys(case)
     for stage, key in new.items():
         if old.get(stage) not in (None, key):
@@ -191,10 +203,14 @@ def executor_for(case: Case):
     if workers <= 1:
         yield None
         return
-    from concurrent.futures import ProcessPoolExecutor
-    with ProcessPoolExecutor(workers) as pool:
-        pool.n_workers = workers
+    pool = process_pool(workers)
+    pool.n_workers = workers
+    try:
         yield pool
+    except BaseException:
+        stop_pool(pool, failed=True)
+        raise
+    stop_pool(pool)
 
 
 def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dict:
@@ -213,7 +229,7 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
                 disk = (prepare_disk(read_topography(case.geometry.disks[i]), opts)
                         if case.geometry.disks else flat_disk(pin))
                 if disk.shape != pin.shape:
-                    raise ValueError(f"pin {i + 1} and its disk differ in resolution "
+                    raise InputError(f"pin {i + 1} and its disk differ in resolution "
                                      f"{pin.shape} vs {disk.shape}")
                 write_vtu(outdir / f"macro_{i + 1}.vtu",
                           grid_mesh(pin.shape, pin.spacing, pin.origin),

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import MissingFile
 from .io.atomic import atomic_path
 from .io.figure import save_figure
 from .io.files import read_topography
@@ -28,7 +29,7 @@ def write_report(outdir, path=None, *, render: bool = True) -> Path:
     outdir = Path(outdir)
     summary_path = outdir / "summary.json"
     if not summary_path.is_file():
-        raise FileNotFoundError(f"{summary_path} not found: give the output folder of a "
+        raise MissingFile(f"{summary_path} not found: give the output folder of a "
                                 "finished fem-twin run")
     summary = json.loads(summary_path.read_text())
     work = outdir / "report"

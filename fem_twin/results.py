@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import MissingFile
 from .io.atomic import atomic_path
 from .macro.estimate import PARTS
 
@@ -164,7 +165,7 @@ def open_run(outdir) -> RunResults:
     outdir = Path(outdir)
     path = outdir / "results.nc"
     if not path.is_file():
-        raise FileNotFoundError(f"{path}: no results; run `fem-twin run CASE -o {outdir}` "
+        raise MissingFile(f"{path}: no results; run `fem-twin run CASE -o {outdir}` "
                                 "first")
     load = lambda group: xr.load_dataset(path, group=group, engine=ENGINE)  # noqa: E731
     fields = (xr.open_dataset(outdir / "fields.nc", engine=ENGINE)

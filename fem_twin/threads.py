@@ -1,5 +1,6 @@
 """Thread pools of BLAS and OpenMP: one thread while fem_twin computes (threadpoolctl); the
-heap of worker processes (:func:`worker_heap`).
+heap of worker processes (:func:`worker_heap`); local process pools that stop cleanly
+(:func:`process_pool`, :func:`stop_pool`).
 
 Measured on this project's 2-core machines: two BLAS/FFT threads made pyamg, CG and FFTs
 5-50x slower under load; parallel speed comes from processes over independent work (h0
@@ -14,7 +15,11 @@ from __future__ import annotations
 import ctypes
 import functools
 import os
+import signal
 import sys
+from concurrent.futures import ProcessPoolExecutor
+
+from .errors import InputError
 
 
 def thread_limit() -> int:
@@ -23,7 +28,7 @@ def thread_limit() -> int:
     try:
         n = int(value)
     except ValueError:
-        raise ValueError(f"FEM_TWIN_THREADS must be a whole number of threads, got {value!r}") \
+        raise InputError(f"FEM_TWIN_THREADS must be a whole number of threads, got {value!r}") \
             from None
     return max(1, n)
 
@@ -59,3 +64,26 @@ def worker_heap() -> None:
 
 
 _HEAP_SET = False
+
+
+def quiet_worker() -> None:
+    """Initializer of local worker processes: Ctrl-C reaches the parent alone, which stops
+    the pool (:func:`stop_pool`), instead of every idle worker printing a traceback."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def process_pool(workers: int) -> ProcessPoolExecutor:
+    """A local pool of ``workers`` processes started by :func:`quiet_worker`."""
+    return ProcessPoolExecutor(workers, initializer=quiet_worker)
+
+
+def stop_pool(pool: ProcessPoolExecutor, failed: bool = False) -> None:
+    """Shut ``pool`` down: wait for it after success; after a failure or Ctrl-C terminate
+    its workers at once (finished work is already in the checkpoints, written atomically,
+    and the rest is cancelled)."""
+    if not failed:
+        pool.shutdown()
+        return
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        process.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)

@@ -50,3 +50,24 @@ def test_no_import_cycle_between_modules():
     for m in sorted(graph):
         if m not in state:
             visit(m, [])
+
+
+def test_every_raise_is_a_fem_twin_error():
+    """Issue 30 item 2: every exception fem_twin raises on purpose derives from
+    FemTwinError (and from the builtin a caller expects), so ``except FemTwinError`` catches
+    all of them.  Walks every ``raise Name(...)`` of the package and resolves the name in
+    its module; re-raises (``raise``, ``raise err``) are not new errors."""
+    import importlib
+
+    from fem_twin.errors import FemTwinError
+    bare = []
+    for path in PACKAGE.rglob("*.py"):
+        module = importlib.import_module(_module(path))
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Raise) and isinstance(node.exc, ast.Call):
+                func = node.exc.func
+                name = func.id if isinstance(func, ast.Name) else ast.unparse(func)
+                cls = getattr(module, name, None) if isinstance(func, ast.Name) else None
+                if not (isinstance(cls, type) and issubclass(cls, FemTwinError)):
+                    bare.append(f"{path.relative_to(PACKAGE)}:{node.lineno} raise {name}")
+    assert not bare, "\n".join(bare)

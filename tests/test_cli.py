@@ -407,12 +407,18 @@ def test_a_lost_micro_checkpoint_does_not_recompute_the_sweep(tmp_path):
     ("fwhm_px = 9 ", "fwhm_px = 9e-6 ", "fwhm_px"), ("hardness = 6.99e9", "hardness = 7", "hardness"),
     ("h0_tol = 0.01 ", "h0_tol = 1.5 ", "h0_tol"),
     ("inner_steps = 1 ", "inner_steps = 0.5 ", "inner_steps"),
+    ("count = 5", "count = 4.5", "count"), ("h0_count = 6", "h0_count = 6.5", "h0_count"),
+    ("resolution = [16, 16]", "resolution = [2, 2]", "resolution"),
+    ("resolution = [16, 16]", "resolution = [16.5, 16]", "resolution"),
+    ("level_radius = 3e-3", "level_radius = 3", "level_radius"),
+    ("workers = 0", "workers = -1", "workers"),
     ("viscosities = [0.066, 0.024] # mu_0 [Pa s] at the temperatures below\n"
      "temperatures = [24.0, 50.0]", "viscosities = []\ntemperatures = []", "viscosities")])
 def test_implausible_case_values_are_refused_naming_the_key(tmp_path, old, new, key):
-    """Issues 15 (item 5) and 18 (item 3): non-finite numbers and unit slips (mm, GPa, mPa s
-    typed as SI) are refused when the case is read, with the key in the message."""
-    text = small_case(tmp_path).read_text()
+    """Issues 15 (item 5), 18 (item 3) and 30 (item 3): non-finite numbers, unit slips (mm,
+    GPa, mPa s typed as SI) and values that would fail later (fractional counts, cells too
+    small, negative workers) are refused when the case is read, with the key named."""
+    text = small_case(tmp_path).read_text().replace("workers = 1", "workers = 0")
     assert old in text
     (tmp_path / "bad.toml").write_text(text.replace(old, new))
     with pytest.raises(CaseError, match=key):
@@ -690,3 +696,64 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
     for title in ("Figure 3", "Figures 4-5", "Figure 14", "Timings", "Case file"):
         assert title in page, title
     assert ("Figure 2: virtual pin 1" in page) or ("no 3D view" in page)   # GL or a note
+
+
+def test_the_terminal_never_shows_a_traceback(tmp_path):
+    """Issue 30 item 1, in a real terminal process (the logging handler writes to the real
+    stderr, which capsys does not see): a stage that fails, and Ctrl-C while two worker
+    processes compute, each print one error line; the traceback is in run.log only."""
+    import os
+    import signal
+    import time
+
+    case = small_case(tmp_path, workers=2)
+    text = case.read_text()
+    (tmp_path / "broken.npz").write_bytes(b"PK\x03\x04 not a topography")
+    broken = tmp_path / "broken.toml"
+    broken.write_text(text.replace(str(ROOT / "meshes" / "sample" / "pin_1.npz"),
+                                   str(tmp_path / "broken.npz")))
+    command = [sys.executable, "-m", "fem_twin.cli", "run", "-o"]
+    done = subprocess.run(command + [str(tmp_path / "a"), str(broken), "--no-progress"],
+                          capture_output=True, text=True)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert "broken.npz" in lines[-1] and "estimated" in lines[0] and len(lines) == 2
+    assert "Traceback" in (tmp_path / "a" / "run.log").read_text()
+    slow = tmp_path / "slow.toml"                     # a micro stage of several seconds
+    slow.write_text(text.replace("resolution = [16, 16]", "resolution = [64, 64]")
+                    .replace("steps = 4", "steps = 32"))
+    out = tmp_path / "b"
+    run = subprocess.Popen(command + [str(out), str(slow), "--no-progress"],
+                           stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.time() + 120
+    while not list(out.glob("micro/*/checkpoints/*.json")) and time.time() < deadline:
+        time.sleep(0.1)
+    os.killpg(run.pid, signal.SIGINT)                 # Ctrl-C: the whole process group
+    err = run.communicate(timeout=60)[1]
+    assert run.returncode == 130 and "Traceback" not in err, err
+    assert "run the same command again" in err.strip().splitlines()[-1]
+
+
+def test_inputs_that_failed_late_or_unhelpfully(tmp_path, capsys):
+    """Issue 30 items 3-4: a case file saved with a UTF-8 BOM reads; -o naming a file and a
+    measured CSV with wrong columns are refused before any stage runs (nothing written); a
+    damaged stage_keys.json is recomputed, not a failure of every rerun."""
+    case = small_case(tmp_path)
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + case.read_bytes())
+    assert load_case(bom).name == load_case(case).name
+    (tmp_path / "file").write_text("")
+    assert main(["run", str(case), "-o", str(tmp_path / "file"), "--no-progress"]) == 2
+    assert "is a file" in capsys.readouterr().err
+    (tmp_path / "m.csv").write_text("velocity,mu\n0.1,0.05\n")
+    bad = tmp_path / "measured.toml"
+    bad.write_text(case.read_text() + '\n[validation]\nmeasured = ["m.csv", ""]\n')
+    out = tmp_path / "o"
+    assert main(["run", str(bad), "-o", str(out), "--no-progress"]) == 2
+    assert "m.csv" in capsys.readouterr().err and not (out / "geometry").exists()
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    (out / "stage_keys.json").write_text('{"geometry": "1')
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    assert "stage_keys.json is damaged" in (out / "run.log").read_text()
+    assert json.loads((out / "stage_keys.json").read_text()).keys() == {
+        "geometry", "levelling", "micro"}

@@ -16,9 +16,16 @@ from functools import lru_cache
 import numpy as np
 import scipy.fft as fft
 
+from ..checks import plausible
+from ..errors import InputError
+
 
 def reduced_modulus(e1: float, nu1: float, e2: float, nu2: float) -> float:
-    """E' of eq 22: ``2 / ((1 - nu1^2)/E1 + (1 - nu2^2)/E2)`` [Pa]."""
+    """E' of eq 22: ``2 / ((1 - nu1^2)/E1 + (1 - nu2^2)/E2)`` [Pa] from the Young's moduli
+    [Pa] and Poisson ratios [-] (refused outside :data:`fem_twin.checks.QUANTITIES`)."""
+    for name, e, nu in (("1", e1, nu1), ("2", e2, nu2)):
+        plausible(f"Young's modulus e{name} [Pa]", e, "modulus")
+        plausible(f"Poisson ratio nu{name}", nu, "poisson")
     return 2.0 / ((1 - nu1 ** 2) / e1 + (1 - nu2 ** 2) / e2)
 
 
@@ -85,7 +92,7 @@ def elastic_operator(shape, spacing, e_reduced: float, periodic: bool = False) -
     """The (cached) operator for a grid; kernel FFTs are computed once per grid."""
     sp = tuple(float(v) for v in np.broadcast_to(np.asarray(spacing, float), (2,)))
     if not (e_reduced > 0 and np.isfinite(e_reduced)):
-        raise ValueError(f"e_reduced must be a positive modulus [Pa], got {e_reduced}")
+        raise InputError(f"e_reduced must be a positive modulus [Pa], got {e_reduced}")
     return _operator(tuple(int(v) for v in shape), sp, float(e_reduced), bool(periodic))
 
 

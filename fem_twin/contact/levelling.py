@@ -14,6 +14,7 @@ import numpy as np
 import scipy.ndimage as ndi
 
 from .. import tables as T
+from ..errors import InputError
 from ..topography.core import Topography
 from ..topography.geometry import pin_face
 from ..topography.levelling import level, radial_mask
@@ -47,7 +48,7 @@ def torque_residuals(pressure: np.ndarray, x1: np.ndarray, x2: np.ndarray) -> np
     t1, t2 = -x2 * pressure, x1 * pressure
     n1, n2 = np.abs(t1).sum(), np.abs(t2).sum()
     if n1 == 0 or n2 == 0:
-        raise ValueError("no contact pressure: torques undefined")
+        raise InputError("no contact pressure: torques undefined")
     return np.array([t1.sum() / n1, t2.sum() / n2])
 
 
@@ -75,9 +76,9 @@ def level_pin(pin: Topography, disk: Topography | None = None, *, load: float = 
     """
     upper = np.zeros(pin.shape) if disk is None else np.asarray(disk.heights)
     if upper.shape != pin.shape:
-        raise ValueError(f"disk grid {upper.shape} does not match pin grid {pin.shape}")
+        raise InputError(f"disk grid {upper.shape} does not match pin grid {pin.shape}")
     if method not in ("broyden", "pid"):
-        raise ValueError(f"method must be 'broyden' or 'pid', got {method!r}")
+        raise InputError(f"method must be 'broyden' or 'pid', got {method!r}")
     x1, x2 = pin.coordinates()
     state = {"p": None}
     history = []
@@ -158,7 +159,7 @@ def average_pins(pins, *, radius: float = 3e-3, truncation: float = -20e-6,
     """
     pins = list(pins)
     if not pins:
-        raise ValueError("no pins to average")
+        raise InputError("no pins to average")
     ref = pins[0]
     X1, X2 = ref.coordinates()
     total = np.zeros(ref.shape)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from .elastic import elastic_operator
 from .solver import ContactNotConverged, ContactResult
 
@@ -42,7 +43,7 @@ def contact_rate(result: ContactResult, shape_rate, spacing, e_reduced: float, *
     p = np.asarray(result.pressure, float)
     rate = np.asarray(shape_rate, float)
     if rate.shape != p.shape or not np.all(np.isfinite(rate)):
-        raise ValueError(f"shape_rate must be a finite {p.shape} array, got {rate.shape}")
+        raise InputError(f"shape_rate must be a finite {p.shape} array, got {rate.shape}")
     op = elastic_operator(p.shape, spacing, e_reduced, periodic)
     on = (p > p_min) & (p < hardness)
     x = np.zeros_like(p)

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from ..errors import NotConverged
+from ..checks import plausible
+from ..errors import InputError, NotConverged
 from .elastic import elastic_operator
 
 
@@ -81,6 +82,10 @@ def solve(shape, spacing, e_reduced, *, load=None, separation=None, hardness=np.
     precision FFT pairs (an exact double pair every ``_REFRESH`` iterations) against the
     two double pairs of the textbook method, and works on the loaded points only.
     """
+    plausible("spacing [m]", spacing, "pitch")
+    plausible("reduced modulus e_reduced [Pa]", e_reduced, "reduced_modulus")
+    if np.isfinite(hardness):                          # inf: purely elastic
+        plausible("hardness [Pa]", hardness, "hardness")
     kw = dict(hardness=hardness, periodic=periodic, p_min=p_min, gap_floor=gap_floor,
               tol=tol, max_iter=max_iter)
     if load is not None and np.isfinite(hardness) and separation is None:
@@ -259,16 +264,16 @@ def _carry_gap(G, kt, tau, t32, c32, cand, diff, deform):
 def _check(s, area, load, separation, hardness, p_min):
     """Clear errors before the work: shape, one control, bounds, a load the grid carries."""
     if s.ndim != 2 or not np.all(np.isfinite(s)):
-        raise ValueError("shape must be a finite 2D array [m]")
+        raise InputError("shape must be a finite 2D array [m]")
     if (load is None) == (separation is None):
-        raise ValueError("give exactly one of load [N] or separation [m]")
+        raise InputError("give exactly one of load [N] or separation [m]")
     if not hardness > p_min:
-        raise ValueError(f"hardness {hardness} must exceed p_min {p_min}")
+        raise InputError(f"hardness {hardness} must exceed p_min {p_min}")
     if load is not None:
         if not load > p_min * s.size * area:
-            raise ValueError(f"load {load} N must exceed the floor load p_min * area")
+            raise InputError(f"load {load} N must exceed the floor load p_min * area")
         if load >= hardness * s.size * area:
-            raise ValueError(f"load {load} N exceeds what the hardness can carry on this grid")
+            raise InputError(f"load {load} N exceeds what the hardness can carry on this grid")
 
 
 def _rescale(p, total, p_min, hardness):
@@ -326,7 +331,7 @@ def _initial(s, area, load, separation, hardness, p_min, initial_pressure):
     if initial_pressure is not None:
         p = np.clip(np.asarray(initial_pressure, float), p_min, hardness)
         if p.shape != s.shape:
-            raise ValueError(f"initial_pressure shape {p.shape} != shape {s.shape}")
+            raise InputError(f"initial_pressure shape {p.shape} != shape {s.shape}")
         if load is not None:
             p = p if p.sum() > 0 else np.full(s.shape, 1.0)
             _rescale(p, load / area, p_min, hardness)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, MissingFile
 from ..topography.core import Topography
 from .atomic import atomic_path
 
@@ -54,9 +54,9 @@ def read_topography(path, *, spacing=None, unit: str = "m") -> Topography:
     """
     path = Path(path)
     if not path.is_file():
-        raise FileNotFoundError(f"no such topography file: {path}")
+        raise MissingFile(f"no such topography file: {path}")
     if unit not in UNITS:
-        raise ValueError(f"unknown unit {unit!r}; use one of {sorted(UNITS)}")
+        raise InputError(f"unknown unit {unit!r}; use one of {sorted(UNITS)}")
     suffix = path.suffix.lower()
     try:
         if suffix == ".npz":
@@ -93,7 +93,7 @@ def write_topography(path, topo: Topography, *, height_scale: float | None = Non
             np.savetxt(tmp, np.column_stack([x1.ravel(), x2.ravel(), topo.heights.ravel()]),
                        header=_ascii_header(topo))
         else:
-            raise ValueError(f"cannot write {suffix!r}; use .npz, .npy, .txt, .csv or .xyz")
+            raise InputError(f"cannot write {suffix!r}; use .npz, .npy, .txt, .csv or .xyz")
     return path
 
 
@@ -106,7 +106,7 @@ def _write_npz(path: Path, topo: Topography, height_scale):
     else:
         q = np.round(np.nan_to_num(topo.heights) / height_scale)
         if np.abs(q).max() >= 2 ** 31:
-            raise ValueError("height_scale too small for int32 storage")
+            raise InputError("height_scale too small for int32 storage")
         arrays["heights"] = q.astype(np.int32)
         arrays["height_scale"] = np.array(float(height_scale))
     if topo.mask is not None:

@@ -23,6 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 import skfem
 
+from ..errors import InputError
 from .atomic import atomic_path
 
 
@@ -70,14 +71,14 @@ class GridMesh:
         """Grid field ``(ny, nx)`` -> nodal vector (images copied on a periodic mesh)."""
         field = np.asarray(field)
         if field.shape[:2] != tuple(self.shape):
-            raise ValueError(f"field shape {field.shape} does not match grid {self.shape}")
+            raise InputError(f"field shape {field.shape} does not match grid {self.shape}")
         return field.reshape(self.shape[0] * self.shape[1], *field.shape[2:])[self.node_pixel]
 
     def to_grid(self, nodal: np.ndarray) -> np.ndarray:
         """Nodal vector -> grid field ``(ny, nx)`` (values at the pixels' own nodes)."""
         nodal = np.asarray(nodal)
         if nodal.shape[0] != self.mesh.nvertices:
-            raise ValueError(f"nodal vector has {nodal.shape[0]} entries, mesh has "
+            raise InputError(f"nodal vector has {nodal.shape[0]} entries, mesh has "
                              f"{self.mesh.nvertices} nodes")
         ny, nx = self.shape
         return nodal.reshape(*self.node_shape, *nodal.shape[1:])[:ny, :nx]
@@ -92,12 +93,12 @@ def grid_mesh(shape, spacing, origin=(0.0, 0.0), *, periodic: bool = False,
     """
     ny, nx = (int(v) for v in shape)
     if ny < 2 or nx < 2:
-        raise ValueError(f"a grid mesh needs at least 2 x 2 pixels, got {shape}")
+        raise InputError(f"a grid mesh needs at least 2 x 2 pixels, got {shape}")
     dx1, dx2 = (float(v) for v in np.broadcast_to(np.asarray(spacing, float), (2,)))
     if not (dx1 > 0 and dx2 > 0):
-        raise ValueError(f"spacing must be positive [m], got {spacing}")
+        raise InputError(f"spacing must be positive [m], got {spacing}")
     if kind not in ("quad", "tri"):
-        raise ValueError(f"kind must be 'quad' or 'tri', got {kind!r}")
+        raise InputError(f"kind must be 'quad' or 'tri', got {kind!r}")
     my, mx = (ny + 1, nx + 1) if periodic else (ny, nx)
     x1 = origin[0] + dx1 * np.arange(mx)
     x2 = origin[1] + dx2 * np.arange(my)
@@ -154,7 +155,7 @@ def from_meshio(mesh: meshio.Mesh, *, periodic: bool | None = None) -> tuple[Gri
         ux, uy = _unique_coords(x), _unique_coords(y)
         mx, my = ux.size, uy.size
         if mx * my != len(x):
-            raise ValueError(f"points do not form a structured grid ({mx} x {my} coordinates "
+            raise InputError(f"points do not form a structured grid ({mx} x {my} coordinates "
                              f"for {len(x)} points)")
         i, j = _nearest(ux, x), _nearest(uy, y)
         spacing = ((ux[-1] - ux[0]) / (mx - 1), (uy[-1] - uy[0]) / (my - 1))
@@ -162,7 +163,7 @@ def from_meshio(mesh: meshio.Mesh, *, periodic: bool | None = None) -> tuple[Gri
         shape = (my - 1, mx - 1) if per else (my, mx)
         gm = grid_mesh(shape, spacing, (ux[0], uy[0]), periodic=per)
     if np.unique(j * mx + i).size != len(x):
-        raise ValueError("points do not map one-to-one onto the grid")
+        raise InputError("points do not map one-to-one onto the grid")
     fields = {}
     for name, values in mesh.point_data.items():
         v = np.asarray(values)
@@ -170,7 +171,7 @@ def from_meshio(mesh: meshio.Mesh, *, periodic: bool | None = None) -> tuple[Gri
         nodes[j, i] = v
         if gm.periodic and not (np.array_equal(nodes[-1], nodes[0])
                                 and np.array_equal(nodes[:, -1], nodes[:, 0])):
-            raise ValueError(f"field {name!r} is not periodic on the periodic mesh")
+            raise InputError(f"field {name!r} is not periodic on the periodic mesh")
         fields[name] = nodes[:gm.shape[0], :gm.shape[1]].copy()
     return gm, fields
 
@@ -200,7 +201,7 @@ def write_vtu(path, gm: GridMesh, point_data: dict | None = None, *,
     """Write grid fields on ``gm`` to a binary VTU file for ParaView, atomically."""
     path = Path(path)
     if path.suffix != ".vtu":
-        raise ValueError(f"VTU files end in .vtu, got {path.name}")
+        raise InputError(f"VTU files end in .vtu, got {path.name}")
     m = to_meshio(gm, point_data, elevation=elevation)
     with atomic_path(path) as tmp:
         meshio.write(tmp, m, file_format="vtu", binary=True)

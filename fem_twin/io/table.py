@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError
 from .atomic import atomic_path
 
 
@@ -20,7 +21,7 @@ def write_csv(path, columns: dict) -> Path:
     path = Path(path)
     values = [list(v) for v in columns.values()]
     if len({len(v) for v in values}) > 1:
-        raise ValueError(f"columns of {path.name} differ in length: "
+        raise InputError(f"columns of {path.name} differ in length: "
                          f"{ {k: len(v) for k, v in zip(columns, values)} }")
     with atomic_path(path) as tmp:
         with open(tmp, "w", newline="") as f:

@@ -44,6 +44,8 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import InputError
+
 #: the Couette schemes (``MacroSettings.couette``, ``solve_reynolds(couette=...)``)
 SCHEMES = ("central", "upwind")
 
@@ -77,7 +79,7 @@ def couette(q1, q2, spacing, scheme: str = "central") -> Couette:
     """The :class:`Couette` term of the nodal coefficient ``(q1, q2)`` (ny, nx) [m^2/s] on a
     non-periodic grid of spacing ``(dx1, dx2)`` [m]."""
     if scheme not in SCHEMES:
-        raise ValueError(f"couette scheme must be one of {SCHEMES}, got {scheme!r}")
+        raise InputError(f"couette scheme must be one of {SCHEMES}, got {scheme!r}")
     q1, q2 = np.asarray(q1, float), np.asarray(q2, float)
     parts = []
     for k, q in enumerate((q1, q2)):

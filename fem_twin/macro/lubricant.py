@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import tables as T
+from ..errors import InputError
 
 
 @dataclass(frozen=True)
@@ -41,20 +42,20 @@ class Lubricant:
     def __post_init__(self):
         if self.eyring_stress is not None and not (np.isfinite(self.eyring_stress)
                                                    and self.eyring_stress > 0):
-            raise ValueError(f"Lubricant.eyring_stress must be positive [Pa] or None, got "
+            raise InputError(f"Lubricant.eyring_stress must be positive [Pa] or None, got "
                              f"{self.eyring_stress}")
         if self.piezoviscosity not in ("roelands", "barus"):
-            raise ValueError("Lubricant.piezoviscosity must be 'roelands' or 'barus', got "
+            raise InputError("Lubricant.piezoviscosity must be 'roelands' or 'barus', got "
                              f"{self.piezoviscosity!r}")
         for name in ("viscosity", "density", "roelands_p0", "dh_c1", "dh_c2"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
-                raise ValueError(f"Lubricant.{name} must be positive and finite, got {v}")
+                raise InputError(f"Lubricant.{name} must be positive and finite, got {v}")
         if self.viscosity > 10:
-            raise ValueError(f"Lubricant.viscosity {self.viscosity} Pa s is implausible: "
+            raise InputError(f"Lubricant.viscosity {self.viscosity} Pa s is implausible: "
                              "give mu_0 in Pa s (0.066, not 66 mPa s)")
         if not (np.isfinite(self.roelands_alpha) and self.roelands_alpha >= 0):
-            raise ValueError("Lubricant.roelands_alpha must be >= 0 [1/Pa]")
+            raise InputError("Lubricant.roelands_alpha must be >= 0 [1/Pa]")
 
     @property
     def roelands_z(self) -> float:

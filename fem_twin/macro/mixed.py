@@ -31,7 +31,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .. import tables as T
-from ..errors import MixedNotConverged
+from ..checks import plausible
+from ..errors import InputError, MixedNotConverged
 from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from . import newton
@@ -79,21 +80,21 @@ class MacroSettings:
 
     def __post_init__(self):
         if self.method not in ("fe", "fvm"):
-            raise ValueError(f"method must be 'fe' or 'fvm', got {self.method!r}")
+            raise InputError(f"method must be 'fe' or 'fvm', got {self.method!r}")
         if self.coupling not in ("auto", "anderson", "pid", "newton"):
-            raise ValueError("coupling must be 'auto', 'anderson', 'pid' or 'newton', got "
+            raise InputError("coupling must be 'auto', 'anderson', 'pid' or 'newton', got "
                              f"{self.coupling!r}")
         if self.ambient_pressure < self.cavitation_pressure:
-            raise ValueError("ambient pressure must not be below the cavitation pressure [Pa]")
+            raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
         if self.complementarity not in ("switch", "fb"):
-            raise ValueError(f"complementarity must be 'switch' or 'fb', got "
+            raise InputError(f"complementarity must be 'switch' or 'fb', got "
                              f"{self.complementarity!r}")
         if self.couette not in SCHEMES:
-            raise ValueError(f"couette must be one of {SCHEMES}, got {self.couette!r}")
+            raise InputError(f"couette must be one of {SCHEMES}, got {self.couette!r}")
         if not (isinstance(self.inner_steps, int) and self.inner_steps >= 0):
-            raise ValueError(f"inner_steps must be an integer >= 0, got {self.inner_steps!r}")
+            raise InputError(f"inner_steps must be an integer >= 0, got {self.inner_steps!r}")
         if not 0 < self.relaxation_pcon <= 1:
-            raise ValueError("relaxation_pcon must be in (0, 1]")
+            raise InputError("relaxation_pcon must be in (0, 1]")
 
 
 @one_thread
@@ -121,20 +122,19 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
     """
     h_g = np.asarray(gap, float)
     if h_g.ndim != 2 or min(h_g.shape) < 3:
-        raise ValueError(f"gap must be a 2D field of at least 3 x 3 nodes, got {h_g.shape}")
+        raise InputError(f"gap must be a 2D field of at least 3 x 3 nodes, got {h_g.shape}")
     if not np.all(np.isfinite(h_g)):
-        raise ValueError("gap contains NaN or inf: repair the topography first")
-    if not (load > 0 and np.isfinite(load)):
-        raise ValueError(f"load must be a positive force [N], got {load}")
-    if not (speed > 0 and np.isfinite(speed)):
-        raise ValueError(f"speed must be positive [m/s], got {speed}")
+        raise InputError("gap contains NaN or inf: repair the topography first")
+    plausible("load [N]", load, "load")
+    plausible("speed [m/s]", speed, "speed")
+    plausible("spacing [m]", spacing, "pitch")
     u_m = speed / 2 if entrainment is None else float(entrainment)
     if not (u_m > 0 and np.isfinite(u_m)):
-        raise ValueError(f"entrainment speed must be positive [m/s], got {entrainment}")
+        raise InputError(f"entrainment speed must be positive [m/s], got {entrainment}")
     dx = tuple(float(v) for v in np.broadcast_to(np.asarray(spacing, float), (2,)))
     face = np.ones(h_g.shape, bool) if face is None else np.asarray(face, bool)
     if face.shape != h_g.shape:
-        raise ValueError(f"face mask {face.shape} does not match the gap {h_g.shape}")
+        raise InputError(f"face mask {face.shape} does not match the gap {h_g.shape}")
     t0 = time.perf_counter()
     if initial is None and min(h_g.shape) >= 2 * COARSE_START:
         initial = _coarse_start(h_g, dx, factors, load, speed, entrainment, lubricant, face,

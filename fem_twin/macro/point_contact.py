@@ -27,6 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
+
 
 @dataclass(frozen=True)
 class PointContact:
@@ -44,12 +46,12 @@ class PointContact:
         for name in ("radius", "load", "e_reduced", "viscosity", "entrainment"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
-                raise ValueError(f"PointContact.{name} must be positive and finite, got {v}")
+                raise InputError(f"PointContact.{name} must be positive and finite, got {v}")
         if not (np.isfinite(self.alpha) and self.alpha >= 0):
-            raise ValueError(f"PointContact.alpha must be >= 0 [1/Pa], got {self.alpha}")
+            raise InputError(f"PointContact.alpha must be >= 0 [1/Pa], got {self.alpha}")
         if self.radius_y is not None and not (np.isfinite(self.radius_y)
                                               and self.radius_y >= self.radius):
-            raise ValueError("PointContact.radius_y must be at least the radius R_x [m], got "
+            raise InputError("PointContact.radius_y must be at least the radius R_x [m], got "
                              f"{self.radius_y}")
 
     @property
@@ -66,7 +68,7 @@ class PointContact:
         (``u_m`` from ``L``, then ``F`` from ``M``)."""
         G = alpha * e_reduced
         if not (M > 0 and L > 0 and G > 0):
-            raise ValueError("M, L and alpha E' must be positive")
+            raise InputError("M, L and alpha E' must be positive")
         U = (L / G) ** 4 / 2
         W = M * (2 * U) ** 0.75
         return cls(radius, W * e_reduced * radius ** 2, e_reduced, viscosity, alpha,

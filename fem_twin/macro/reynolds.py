@@ -34,7 +34,7 @@ import scipy.sparse.linalg as spla
 import skfem
 from skfem.helpers import dot, grad
 
-from ..errors import ReynoldsNotConverged
+from ..errors import InputError, ReynoldsNotConverged
 from ..assembly import FixedPattern, element_entries, unit_element
 from ..io.mesh import grid_mesh
 from ..linalg import SPDSolver, default_backend
@@ -104,19 +104,19 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     """
     h = np.asarray(gap, dtype=float)
     if h.ndim != 2 or min(h.shape) < 3:
-        raise ValueError(f"gap must be a 2D field of at least 3 x 3 nodes, got shape {h.shape}")
+        raise InputError(f"gap must be a 2D field of at least 3 x 3 nodes, got shape {h.shape}")
     if not np.all(np.isfinite(h)) or h.min() <= 0:
-        raise ValueError("gap must be finite and positive everywhere [m]")
+        raise InputError("gap must be finite and positive everywhere [m]")
     lubricant = viscosity if isinstance(viscosity, Lubricant) else None
     mu0 = lubricant.viscosity if lubricant is not None else viscosity
     if not mu0 > 0:
-        raise ValueError(f"viscosity must be positive [Pa s], got {viscosity}")
+        raise InputError(f"viscosity must be positive [Pa s], got {viscosity}")
     if ambient_pressure < cavitation_pressure:
-        raise ValueError("ambient pressure must not be below the cavitation pressure [Pa]")
+        raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
     if method not in ("fe", "fvm"):
-        raise ValueError(f"method must be 'fe' or 'fvm', got {method!r}")
+        raise InputError(f"method must be 'fe' or 'fvm', got {method!r}")
     if couette not in SCHEMES:
-        raise ValueError(f"couette must be one of {SCHEMES}, got {couette!r}")
+        raise InputError(f"couette must be one of {SCHEMES}, got {couette!r}")
     dx = tuple(float(s) for s in np.broadcast_to(np.asarray(spacing, float), (2,)))
     boundary = np.zeros(h.shape, bool)
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
@@ -210,10 +210,10 @@ class PoiseuilleAssembly:
 
     def matrix(self, g, A=None) -> sp.csr_matrix:
         if np.shape(g) != self.shape:
-            raise ValueError(f"coefficient shape {np.shape(g)} does not match the grid "
+            raise InputError(f"coefficient shape {np.shape(g)} does not match the grid "
                              f"{self.shape}")
         if A is not None and np.shape(A) != (*self.shape, 2, 2):
-            raise ValueError(f"flow factor field shape {np.shape(A)} is not {(*self.shape, 2, 2)}")
+            raise InputError(f"flow factor field shape {np.shape(A)} is not {(*self.shape, 2, 2)}")
         gq = self.at_quadrature(g)                               # (nelems, nq, 1)
         if A is None:
             data = gq[..., 0] @ (self._T[:, 0, 0] + self._T[:, 1, 1])
@@ -234,7 +234,7 @@ def complementarity_solver(name: str):
         return solve_complementarity
     if name == "fb":
         return solve_complementarity_fb
-    raise ValueError(f"complementarity must be 'switch' or 'fb', got {name!r}")
+    raise InputError(f"complementarity must be 'switch' or 'fb', got {name!r}")
 
 
 def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=1e-10,

@@ -24,6 +24,7 @@ import scipy.sparse as sp
 import skfem
 from skfem.helpers import dot, grad
 
+from ..errors import InputError
 from ..io.mesh import GridMesh, grid_mesh
 from ..assembly import FixedPattern, element_entries, periodic_unknowns, unit_element
 from ..linalg import SPDSolver
@@ -87,7 +88,7 @@ class CellSolver:
         self.grid: GridMesh = grid_mesh(self.shape, self.spacing, periodic=True)
         n = self.shape[0] * self.shape[1]
         if not 0 <= pinned < n:
-            raise ValueError(f"pinned pixel {pinned} outside the {self.shape} grid")
+            raise InputError(f"pinned pixel {pinned} outside the {self.shape} grid")
         self.pinned = int(pinned)
         self.basis = skfem.Basis(self.grid.mesh, skfem.ElementQuad1(), intorder=2)
         ref = self._reference_element()
@@ -169,9 +170,9 @@ class CellSolver:
         """
         h = np.asarray(gap, float)
         if h.shape != self.shape:
-            raise ValueError(f"gap shape {h.shape} does not match the cell {self.shape}")
+            raise InputError(f"gap shape {h.shape} does not match the cell {self.shape}")
         if not np.all(np.isfinite(h)) or h.min() <= 0:
-            raise ValueError("the gap must be finite and positive (truncate it first) [m]")
+            raise InputError("the gap must be finite and positive (truncate it first) [m]")
         h_q = self.at_quadrature(h)
         a_q = h_q ** 3
         tau_q = None

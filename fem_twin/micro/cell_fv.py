@@ -30,6 +30,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..assembly import FixedPattern, periodic_unknowns
+from ..errors import InputError
 from ..linalg import SPDSolver
 from .cell import CellSolution
 
@@ -60,16 +61,16 @@ class CellSolverFV:
     def __init__(self, shape, spacing, *, pinned: int = 0, face: str = "bilinear",
                  backend: str | None = None):
         if face not in FACE_RULES:
-            raise ValueError(f"face must be one of {sorted(FACE_RULES)}, got {face!r}")
+            raise InputError(f"face must be one of {sorted(FACE_RULES)}, got {face!r}")
         self.face = face
         self.shape = (int(shape[0]), int(shape[1]))
         self.spacing = tuple(float(s) for s in np.broadcast_to(np.asarray(spacing, float), (2,)))
         ny, nx = self.shape
         n = ny * nx
         if min(self.shape) < 3:
-            raise ValueError(f"the FVM cell needs at least 3 x 3 pixels, got {self.shape}")
+            raise InputError(f"the FVM cell needs at least 3 x 3 pixels, got {self.shape}")
         if not 0 <= pinned < n:
-            raise ValueError(f"pinned pixel {pinned} outside the {self.shape} grid")
+            raise InputError(f"pinned pixel {pinned} outside the {self.shape} grid")
         self.pinned = int(pinned)
         idx = np.arange(n).reshape(ny, nx)
         east, north = np.roll(idx, -1, axis=1).ravel(), np.roll(idx, -1, axis=0).ravel()
@@ -118,9 +119,9 @@ class CellSolverFV:
         """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady)."""
         h = np.asarray(gap, float)
         if h.shape != self.shape:
-            raise ValueError(f"gap shape {h.shape} does not match the cell {self.shape}")
+            raise InputError(f"gap shape {h.shape} does not match the cell {self.shape}")
         if not np.all(np.isfinite(h)) or h.min() <= 0:
-            raise ValueError("the gap must be finite and positive (truncate it first) [m]")
+            raise InputError("the gap must be finite and positive (truncate it first) [m]")
         dx1, dx2 = self.spacing
         hf = self.face_values(h)
         cf = self.face_conductance(h)

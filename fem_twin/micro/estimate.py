@@ -34,6 +34,8 @@ from dataclasses import fields
 
 import numpy as np
 
+from ..errors import InputError
+
 #: the quantities estimated, with how each is read from a FlowFactors
 QUANTITIES = {"A11": lambda f: f.A[:, 0, 0], "A22": lambda f: f.A[:, 1, 1],
               "b1": lambda f: f.b[:, 0], "C11": lambda f: f.C[:, 0, 0],
@@ -45,7 +47,7 @@ def discrepancy(fine, coarse) -> dict:
     :class:`~fem_twin.micro.FlowFactors`; those of ``coarse`` among those of ``fine``)."""
     idx = np.searchsorted(fine.h0, coarse.h0)
     if np.any(idx >= fine.h0.size) or not np.allclose(fine.h0[idx], coarse.h0, rtol=1e-12):
-        raise ValueError("the coarse separations must be among the fine ones")
+        raise InputError("the coarse separations must be among the fine ones")
     out = {}
     for name, get in QUANTITIES.items():
         ref, other = get(fine), get(coarse)

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
+from ..errors import InputError
 from ..io.atomic import atomic_path
 from ..io.table import write_csv
 from .estimate import combine
@@ -56,12 +57,12 @@ class FlowFactors:
         for name, shape in expect.items():
             v = np.asarray(getattr(self, name), dtype=float)
             if v.shape != shape:
-                raise ValueError(f"FlowFactors.{name} has shape {v.shape}, expected {shape}")
+                raise InputError(f"FlowFactors.{name} has shape {v.shape}, expected {shape}")
             if not np.all(np.isfinite(v)):
-                raise ValueError(f"FlowFactors.{name} contains NaN or inf")
+                raise InputError(f"FlowFactors.{name} contains NaN or inf")
             object.__setattr__(self, name, v)
         if len(n) != 1 or n[0] < 1 or np.any(np.diff(self.h0) <= 0) or self.h0[0] <= 0:
-            raise ValueError("h0 must be a positive, strictly increasing 1D array [m]")
+            raise InputError("h0 must be a positive, strictly increasing 1D array [m]")
 
     def __len__(self) -> int:
         return self.h0.size
@@ -107,10 +108,10 @@ class FlowFactors:
             with np.load(path, allow_pickle=False) as z:
                 missing = [k for k in ARRAYS if k not in z]
                 if missing:
-                    raise KeyError(f"missing {missing}")
+                    raise InputError(f"missing {missing}")
                 return cls(**{k: z[k] for k in ARRAYS}, meta=json.loads(str(z["meta"])))
         except (OSError, EOFError, ValueError, KeyError) as err:
-            raise ValueError(f"{path}: cannot read flow factors ({err})") from err
+            raise InputError(f"{path}: cannot read flow factors ({err})") from err
 
     def write_csv(self, path) -> Path:
         """Table with one row per h0, SI units named in the header (h0_m, h_m_m, p_con_Pa;
@@ -135,7 +136,7 @@ class FlowFactors:
         """
         x = np.asarray(h0, dtype=float)
         if np.any(~np.isfinite(x)) or np.any(x <= 0):
-            raise ValueError("h0 must be finite and positive [m]")
+            raise InputError("h0 must be finite and positive [m]")
         flat = x.ravel()
         lo, hi = self.h0[0], self.h0[-1]
         xc = np.log(np.clip(flat, lo, hi))
@@ -158,7 +159,7 @@ class FlowFactors:
         """``p_con(h0)`` alone [Pa], with the rules of :meth:`at` (cheaper than ``at``)."""
         x = np.asarray(h0, dtype=float)
         if np.any(~np.isfinite(x)) or np.any(x <= 0):
-            raise ValueError("h0 must be finite and positive [m]")
+            raise InputError("h0 must be finite and positive [m]")
         flat = x.ravel()
         lo, hi = self.h0[0], self.h0[-1]
         if len(self) == 1:
@@ -224,11 +225,11 @@ def average(factors) -> FlowFactors:
     there by its interpolant (:meth:`FlowFactors.at`, within its ``h0`` error estimate)."""
     factors = list(factors)
     if not factors:
-        raise ValueError("no flow factors to average")
+        raise InputError("no flow factors to average")
     h0 = np.unique(np.concatenate([f.h0 for f in factors]))
     for f in factors:
         if not np.allclose(f.h0[[0, -1]], h0[[0, -1]], rtol=1e-12, atol=0):
-            raise ValueError("flow factors to average must share the same h0 values "
+            raise InputError("flow factors to average must share the same h0 values "
                              "(or at least the same h0 range, when sampled adaptively)")
     local = [f if f.h0.size == h0.size else f.at(h0) for f in factors]
     mean = {k: np.mean([getattr(f, k) for f in local], axis=0) for k in ARRAYS if k != "h0"}

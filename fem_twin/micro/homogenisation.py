@@ -40,7 +40,7 @@ from __future__ import annotations
 import json
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -50,10 +50,13 @@ from .. import __version__
 from ..contact import contact_rate
 from ..contact import solve as contact_solve
 from ..contact.levelling import TABLE4
+from ..checks import plausible
+from ..errors import InputError
 from ..io.atomic import atomic_path
 from ..io.checkpoint import input_key, load_or_none
-from ..threads import one_thread, worker_heap
+from ..threads import one_thread, process_pool, stop_pool, worker_heap
 from ..topography import Topography
+from ..topography.plausibility import check_patch
 from .cell_fv import CellSolverFV
 from .estimate import discrepancy, variants
 from .flow_factors import ARRAYS, FlowFactors
@@ -81,22 +84,22 @@ class CellSettings:
 
     def __post_init__(self):
         if int(self.n_steps) != self.n_steps or self.n_steps < 1:
-            raise ValueError(f"n_steps must be a positive integer, got {self.n_steps}")
+            raise InputError(f"n_steps must be a positive integer, got {self.n_steps}")
         if self.method not in ("fe", "fvm"):
-            raise ValueError(f"method must be 'fe' or 'fvm', got {self.method!r}")
+            raise InputError(f"method must be 'fe' or 'fvm', got {self.method!r}")
         if self.moving not in ("upper", "lower"):
-            raise ValueError(f"moving must be 'upper' (disk) or 'lower' (pin), got {self.moving!r}")
+            raise InputError(f"moving must be 'upper' (disk) or 'lower' (pin), got {self.moving!r}")
         if self.time_derivative not in ("exact", "backward"):
-            raise ValueError("time_derivative must be 'exact' or 'backward' (paper), got "
+            raise InputError("time_derivative must be 'exact' or 'backward' (paper), got "
                              f"{self.time_derivative!r}")
         if self.time_tol is not None and not (0 < self.time_tol < 1
                                               and self.time_derivative == "exact"):
-            raise ValueError("time_tol is a relative tolerance in (0, 1), with "
+            raise InputError("time_tol is a relative tolerance in (0, 1), with "
                              "time_derivative='exact' only")
         if self.first_step not in ("steady", "periodic"):
-            raise ValueError(f"first_step must be 'steady' or 'periodic', got {self.first_step!r}")
+            raise InputError(f"first_step must be 'steady' or 'periodic', got {self.first_step!r}")
         if not (self.e_reduced > 0 and self.hardness > 0 and self.gap_floor > 0):
-            raise ValueError("e_reduced, hardness and gap_floor must be positive (Pa, Pa, m)")
+            raise InputError("e_reduced, hardness and gap_floor must be positive (Pa, Pa, m)")
 
 
 @one_thread
@@ -152,9 +155,11 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
                             method, moving, first_step, time_derivative=time_derivative,
                             time_tol=time_tol)
     z_low, z_up, spacing = _check_patches(pin, disk)
+    plausible("reduced modulus e_reduced [Pa]", e_reduced, "reduced_modulus")
+    plausible("hardness [Pa]", hardness, "hardness")
     h0 = _check_separations(DEFAULT_H0 if h0 is None else h0)
     if h0_tol is not None and not 0 < h0_tol < 1:
-        raise ValueError(f"h0_tol is a relative tolerance in (0, 1), got {h0_tol}")
+        raise InputError(f"h0_tol is a relative tolerance in (0, 1), got {h0_tol}")
     key = _key(z_low, z_up, spacing, settings)
     args = dict(z_low=z_low, z_up=z_up, spacing=spacing, settings=settings,
                 folder=None if checkpoint is None else str(checkpoint), key=key,
@@ -171,8 +176,12 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
         bar.update(len(h0) - len(chosen))             # the candidates interpolated
         coarse = (_coarse_moments(points, chosen, z_low, z_up, spacing, settings, checkpoint)
                   if error_estimate else None)
-    finally:
+    except BaseException:
+        points.close(failed=True)
+        raise
+    else:
         points.close()
+    finally:
         if own_bar:
             bar.close()
     meta = {"patch_id": patch_id, "shape": list(z_low.shape), "spacing": list(spacing),
@@ -202,9 +211,9 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
 def _check_separations(h0) -> np.ndarray:
     h0 = np.asarray(h0, dtype=float)
     if h0.ndim != 1 or h0.size == 0 or not np.all(np.isfinite(h0)) or np.any(h0 <= 0):
-        raise ValueError("h0 must be a non-empty 1D array of positive separations [m]")
+        raise InputError("h0 must be a non-empty 1D array of positive separations [m]")
     if np.unique(h0).size != h0.size:
-        raise ValueError("h0 values must be distinct")
+        raise InputError("h0 values must be distinct")
     return np.sort(h0)
 
 
@@ -251,7 +260,7 @@ class _Separations:
 
     def _parallel(self, chunks):
         if self.executor is None:            # one own pool for all the calls of a run
-            self.executor, self.own = ProcessPoolExecutor(self.workers), True
+            self.executor, self.own = process_pool(self.workers), True
         futures = [self.executor.submit(_chunk_task, (c, self.args)) for c in chunks]
         try:
             for fut in as_completed(futures):
@@ -261,9 +270,9 @@ class _Separations:
                 fut.cancel()
             raise
 
-    def close(self):
+    def close(self, failed: bool = False):
         if self.own:
-            self.executor.shutdown(cancel_futures=True)
+            stop_pool(self.executor, failed)
 
     def seconds(self) -> dict:
         """CPU seconds of contact and cells over the computed (not resumed) separations."""
@@ -302,9 +311,12 @@ def _coarse_moments(points, indices, z_low, z_up, spacing, settings, checkpoint)
     runner = _Separations(points.h0, args, points.workers, points.executor,
                           _progress(len(indices), False))
     try:
-        return runner.moments(indices), settings, key, list(low.shape)
-    finally:
-        runner.close()                       # only a pool of its own (the run's stays)
+        out = runner.moments(indices), settings, key, list(low.shape)
+    except BaseException:
+        runner.close(failed=True)            # only a pool of its own (the run's stays)
+        raise
+    runner.close()
+    return out
 
 
 def estimate_errors(factors, moments, coarse, settings) -> dict:
@@ -562,15 +574,18 @@ def _chunks(indices, n):
 def _check_patches(pin, disk):
     for name, t in (("pin", pin), ("disk", disk)):
         if not isinstance(t, Topography):
-            raise TypeError(f"{name} must be a Topography, got {type(t).__name__}")
+            raise InputError(f"{name} must be a Topography, got {type(t).__name__}")
         if not np.all(np.isfinite(t.heights)):
-            raise ValueError(f"{name} patch has invalid (NaN) pixels: fill them first")
+            raise InputError(f"{name} patch has invalid (NaN) pixels: fill them first")
     if pin.shape != disk.shape:
-        raise ValueError(f"pin {pin.shape} and disk {disk.shape} patches differ in shape")
+        raise InputError(f"pin {pin.shape} and disk {disk.shape} patches differ in shape")
     if not np.allclose(pin.spacing, disk.spacing, rtol=1e-6):
-        raise ValueError(f"pin {pin.spacing} and disk {disk.spacing} pixel pitches differ [m]")
+        raise InputError(f"pin {pin.spacing} and disk {disk.spacing} pixel pitches differ [m]")
     if min(pin.shape) < 4:
-        raise ValueError(f"a roughness cell needs at least 4 x 4 pixels, got {pin.shape}")
+        raise InputError(f"a roughness cell needs at least 4 x 4 pixels, got {pin.shape}")
+    for name, t in (("pin", pin), ("disk", disk)):   # unit slips of 1e3 (warnings: CLI);
+        if t.rms_height() > 0:                          # a smooth surface is a valid limit
+            check_patch(t, f"{name} patch")
     return (np.ascontiguousarray(pin.heights, float), np.ascontiguousarray(disk.heights, float),
             tuple(float(s) for s in pin.spacing))
 
@@ -600,7 +615,7 @@ def _read_point(path):
                for k, v in data["moments"].items()}
     missing = [k for k in _MOMENTS if k not in moments]
     if missing or not np.all([np.all(np.isfinite(moments[k])) for k in _MOMENTS]):
-        raise ValueError(f"checkpoint lacks or has non-finite moments {missing or ''}")
+        raise InputError(f"checkpoint lacks or has non-finite moments {missing or ''}")
     return moments
 
 

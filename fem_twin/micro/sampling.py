@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from .estimate import QUANTITIES
 from .flow_factors import ARRAYS
 
@@ -53,7 +54,7 @@ def adaptive_separations(h0, factors_at, tol: float, start: int = START):
     the chosen sorted indices and ``{quantity: bound}``, the largest relative miss of the
     leave-one-out test over the chosen points next to skipped candidates."""
     if not 0 < tol < 1:
-        raise ValueError(f"the h0 tolerance is relative, in (0, 1); got {tol}")
+        raise InputError(f"the h0 tolerance is relative, in (0, 1); got {tol}")
     n = len(h0)
     chosen = sorted({int(i) for i in np.linspace(0, n - 1, min(start, n)).round()})
     chosen = sorted(set(chosen) | set(_midpoints(chosen, range(len(chosen)))))

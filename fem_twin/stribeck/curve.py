@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError
 from ..io.figure import save_figure
 from ..io.table import write_csv
 from ..macro.friction import BOUNDARY_FRICTION
@@ -94,7 +95,7 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
         rows = [{**{k: r[HEADERS[k]] for k in COLUMNS},
                  **({"cf_err": r["cf_err"]} if "cf_err" in r else {})} for r in rows]
     if not rows or set(COLUMNS) - set(rows[0]):
-        raise ValueError(f"{path}: not a Stribeck CSV with columns {tuple(HEADERS.values())}")
+        raise InputError(f"{path}: not a Stribeck CSV with columns {tuple(HEADERS.values())}")
     out = []
     for mu in dict.fromkeys(float(r["viscosity"]) for r in rows):
         sel = [r for r in rows if float(r["viscosity"]) == mu]
@@ -168,25 +169,32 @@ def read_measured_csv(path, unit: str = "m/s") -> MeasuredCurve:
     """CSV with a header: ``speed`` [m/s, or rpm with ``unit="rpm"``, converted by the
     caller] and ``friction_coefficient`` (or ``cf``), and optionally ``cf_min``/``cf_max``
     (the scatter band of a test set)."""
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as f:
+            rows = list(csv.DictReader(f))
+    except (UnicodeDecodeError, csv.Error) as err:
+        raise InputError(f"{path}: not a CSV text file ({err})") from err
     if not rows:
-        raise ValueError(f"{path}: empty measured curve")
-    cols = set(rows[0])
+        raise InputError(f"{path}: empty measured curve")
+    cols = {k for k in rows[0] if k is not None}
     cf_key = "friction_coefficient" if "friction_coefficient" in cols else "cf"
     if "speed" not in cols or cf_key not in cols:
-        raise ValueError(f"{path}: needs columns 'speed' [m/s] and 'friction_coefficient' "
+        raise InputError(f"{path}: needs columns 'speed' [m/s] and 'friction_coefficient' "
                          f"(found {sorted(cols)})")
 
     def col(k):
         try:
-            return np.array([float(r[k]) for r in rows])
-        except ValueError as err:
-            raise ValueError(f"{path}: column {k!r} is not numeric: {err}") from err
+            values = np.array([float(r[k]) for r in rows])
+        except (ValueError, TypeError) as err:     # TypeError: a row shorter than the header
+            raise InputError(f"{path}: column {k!r} is not numeric in every row: {err}") \
+                from err
+        if not np.all(np.isfinite(values)):
+            raise InputError(f"{path}: column {k!r} holds a non-finite value")
+        return values
 
     speed = col("speed")
     if np.any(~(speed > 0)) or (unit == "m/s" and speed.max() > 100):
-        raise ValueError(f"{path}: speeds must be positive and in m/s (max {speed.max()}; "
+        raise InputError(f"{path}: speeds must be positive and in m/s (max {speed.max()}; "
                          "for rpm use --rpm)")
     band = ("cf_min" in cols and "cf_max" in cols)
     return MeasuredCurve(speed, col(cf_key), col("cf_min") if band else None,

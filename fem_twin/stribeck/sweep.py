@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from ..errors import InputError
 from ..io.checkpoint import input_key, load_or_none
 from ..io.mesh import write_pvd
 from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
@@ -42,9 +43,9 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     """
     speeds = np.asarray(speeds, float)
     if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
-        raise ValueError("speeds must be a non-empty list of positive values [m/s]")
+        raise InputError("speeds must be a non-empty list of positive values [m/s]")
     if slide_to_roll is not None and not (0 < slide_to_roll <= 2):
-        raise ValueError(f"slide_to_roll must be in (0, 2], got {slide_to_roll}")
+        raise InputError(f"slide_to_roll must be in (0, 2], got {slide_to_roll}")
     gap = np.asarray(gap, float)
     key = sweep_key(gap, spacing, factors if factors_key is None else factors_key, load,
                     lubricant, settings, face, slide_to_roll)

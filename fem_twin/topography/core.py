@@ -18,11 +18,15 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..errors import InputError
+
 #: Largest peak-to-valley [m] accepted for a topography.  A pin-on-disk map spans a few
 #: millimetres at most (pin height 1 mm); anything larger almost surely is in um or nm.
 MAX_PEAK_TO_VALLEY = 0.05
 #: Largest pixel pitch [m] accepted (a grid finer than 1 m per pixel); larger means mm or um.
 MAX_SPACING = 1.0
+#: the smallest pixel pitch [m]: below an atomic distance, a unit slip
+MIN_SPACING = 1e-10
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,27 +56,27 @@ class Topography:
     def __post_init__(self):
         h = np.array(self.heights, dtype=float)
         if h.ndim != 2:
-            raise ValueError(f"heights must be a 2D array (ny, nx), got shape {h.shape}")
+            raise InputError(f"heights must be a 2D array (ny, nx), got shape {h.shape}")
         if min(h.shape) < 2:
-            raise ValueError(f"heights need at least 2 x 2 pixels, got shape {h.shape}")
+            raise InputError(f"heights need at least 2 x 2 pixels, got shape {h.shape}")
         spacing = np.broadcast_to(np.asarray(self.spacing, dtype=float), (2,))
         if not np.all(np.isfinite(spacing)) or np.any(spacing <= 0):
-            raise ValueError(f"spacing must be positive and finite [m], got {tuple(spacing)}")
-        if np.any(spacing > MAX_SPACING):
-            raise ValueError(
+            raise InputError(f"spacing must be positive and finite [m], got {tuple(spacing)}")
+        if np.any(spacing > MAX_SPACING) or np.any(spacing < MIN_SPACING):
+            raise InputError(
                 f"spacing {tuple(spacing)} m per pixel is implausible: give it in metres "
                 "(e.g. 16e-6 for a 16 um pitch)")
         valid = np.isfinite(h)
         if self.mask is not None:
             m = np.asarray(self.mask)
             if m.shape != h.shape:
-                raise ValueError(f"mask shape {m.shape} does not match heights shape {h.shape}")
+                raise InputError(f"mask shape {m.shape} does not match heights shape {h.shape}")
             valid &= m.astype(bool)
         if not valid.any():
-            raise ValueError("topography has no valid pixel (all NaN or masked)")
+            raise InputError("topography has no valid pixel (all NaN or masked)")
         ptv = np.ptp(h[valid])
         if ptv > MAX_PEAK_TO_VALLEY:
-            raise ValueError(
+            raise InputError(
                 f"peak-to-valley {ptv:.3g} m is implausible for a tribometer surface: "
                 "heights must be given in metres (convert um or nm at I/O)")
         h[~valid] = np.nan

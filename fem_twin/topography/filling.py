@@ -6,7 +6,12 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..errors import InputError
 from .core import Topography
+
+
+#: the fraction of measured pixels below which a map is refused, not filled
+MIN_VALID = 0.01
 
 
 def fill_defects(topo: Topography) -> Topography:
@@ -17,10 +22,15 @@ def fill_defects(topo: Topography) -> Topography:
     where a hole touches the edge of the map, as Gwyddion's "Laplace" defect removal does.
     The stencil is exact for harmonic polynomials up to degree 3.
 
-    Returns a new, fully valid :class:`Topography`.
+    Returns a new, fully valid :class:`Topography`; raises :class:`~fem_twin.errors.InputError`
+    for a map with fewer than ``MIN_VALID`` (1 %) or 3 measured pixels.
     """
     if topo.mask is None:
         return topo
+    valid = int(topo.mask.sum())
+    if valid < max(3, MIN_VALID * topo.mask.size):
+        raise InputError(f"only {valid} of {topo.mask.size} pixels hold a height: too few to "
+                         f"fill the defects from (at least {MIN_VALID:.0%} and 3 are needed)")
     ny, nx = topo.shape
     holes = ~topo.mask
     z = np.where(topo.mask, topo.heights, 0.0)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.ndimage as ndi
 
+from ..errors import InputError
 from .core import Topography
 
 #: FWHM of a Gaussian in units of its standard deviation, 2 sqrt(2 ln 2).
@@ -14,7 +15,7 @@ FWHM_PER_SIGMA = 2.0 * np.sqrt(2.0 * np.log(2.0))
 def clip_heights(topo: Topography, lower: float = -20e-6, upper: float = 20e-6) -> Topography:
     """Limit heights to ``[lower, upper]`` [m] (paper: height range limited to 20 um)."""
     if not lower < upper:
-        raise ValueError(f"clip range must satisfy lower < upper, got [{lower}, {upper}]")
+        raise InputError(f"clip range must satisfy lower < upper, got [{lower}, {upper}]")
     return topo.with_heights(np.clip(topo.heights, lower, upper),
                              meta=topo.with_history(f"clip[{lower:.3g}, {upper:.3g}] m"))
 
@@ -27,7 +28,7 @@ def gaussian_filter(topo: Topography, fwhm_px: float) -> Topography:
     invalid.  ``fwhm_px = 0`` returns the topography unchanged (the paper's "unfiltered").
     """
     if not np.isfinite(fwhm_px) or fwhm_px < 0:
-        raise ValueError(f"fwhm_px must be >= 0 pixels, got {fwhm_px}")
+        raise InputError(f"fwhm_px must be >= 0 pixels, got {fwhm_px}")
     if fwhm_px == 0:
         return topo
     sigma = fwhm_px / FWHM_PER_SIGMA

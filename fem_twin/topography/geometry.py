@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from .core import Topography
 
 #: Rotations (number of 90-degree turns counter-clockwise) that bring a measured axis onto
@@ -18,7 +19,7 @@ def extract_patch(topo: Topography, shape=(256, 256), start=(0, 0)) -> Topograph
     """
     (ny, nx), (r0, c0) = shape, start
     if r0 < 0 or c0 < 0 or r0 + ny > topo.shape[0] or c0 + nx > topo.shape[1]:
-        raise ValueError(f"patch {shape} at {start} does not fit a {topo.shape} topography")
+        raise InputError(f"patch {shape} at {start} does not fit a {topo.shape} topography")
     sl = (slice(r0, r0 + ny), slice(c0, c0 + nx))
     mask = None if topo.mask is None else topo.mask[sl]
     origin = (topo.origin[0] + c0 * topo.spacing[0], topo.origin[1] + r0 * topo.spacing[1])
@@ -33,7 +34,7 @@ def align_sliding(topo: Topography, direction: str = "+x1") -> Topography:
     surface (heights) as it is, only the in-plane axes turn.
     """
     if direction not in _TURNS:
-        raise ValueError(f"direction must be one of {sorted(_TURNS)}, got {direction!r}")
+        raise InputError(f"direction must be one of {sorted(_TURNS)}, got {direction!r}")
     k = _TURNS[direction]
     if k == 0:
         return topo
@@ -73,7 +74,7 @@ def pin_centre(topo: Topography, face: np.ndarray) -> tuple[float, float]:
     """Centroid (x1, x2) [m] of the pin face pixels ``face`` (boolean array)."""
     x1, x2 = topo.coordinates()
     if not face.any():
-        raise ValueError("pin face is empty: no pixel above the truncation height")
+        raise InputError("pin face is empty: no pixel above the truncation height")
     return float(x1[face].mean()), float(x2[face].mean())
 
 
@@ -98,7 +99,7 @@ def mount_pin(topo: Topography, truncation: float = -20e-6, holder_height: float
         x1, x2 = topo.coordinates()
         face &= x1 ** 2 + x2 ** 2 <= radius ** 2
     if not face.any():
-        raise ValueError(f"no pin face: no valid pixel above the truncation {truncation} m")
+        raise InputError(f"no pin face: no valid pixel above the truncation {truncation} m")
     return topo.with_heights(np.where(face, topo.heights, holder_height), mask=None,
                              meta=topo.with_history(
                                  f"mount_pin(truncation={truncation:.3g} m, holder={holder_height:.3g} m)"))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from .core import Topography
 
 
@@ -19,7 +20,7 @@ def mean_plane(topo: Topography, mask: np.ndarray | None = None) -> np.ndarray:
     c1, c2 = x1[sel].mean(), x2[sel].mean()
     design = np.column_stack([np.ones(sel.sum()), x1[sel] - c1, x2[sel] - c2])
     if np.linalg.matrix_rank(design) < 3:
-        raise ValueError("mean plane is undefined: the fitted pixels lie on a line")
+        raise InputError("mean plane is undefined: the fitted pixels lie on a line")
     a, b1, b2 = np.linalg.lstsq(design, topo.heights[sel], rcond=None)[0]
     return np.array([a - b1 * c1 - b2 * c2, b1, b2])
 
@@ -55,8 +56,8 @@ def _selection(topo: Topography, mask) -> np.ndarray:
     if mask is not None:
         mask = np.asarray(mask, bool)
         if mask.shape != topo.shape:
-            raise ValueError(f"mask shape {mask.shape} does not match topography {topo.shape}")
+            raise InputError(f"mask shape {mask.shape} does not match topography {topo.shape}")
         sel = sel & mask
     if sel.sum() < 3:
-        raise ValueError("fewer than 3 valid pixels selected by the mask")
+        raise InputError("fewer than 3 valid pixels selected by the mask")
     return sel

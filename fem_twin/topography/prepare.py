@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from .core import Topography
 from .filling import fill_defects
 from .filtering import clip_heights, gaussian_filter
@@ -46,7 +47,11 @@ def pin_face_guess(topo: Topography) -> np.ndarray:
     """
     z = topo.heights[topo.valid]
     lo, hi = np.percentile(z, [5, 90])
-    return topo.valid & (np.nan_to_num(topo.heights, nan=-np.inf) > 0.5 * (lo + hi))
+    face = topo.valid & (np.nan_to_num(topo.heights, nan=-np.inf) > 0.5 * (lo + hi))
+    if face.sum() < 3:
+        raise InputError(f"no pin face in the map: its heights span {np.ptp(z):.3g} m without "
+                         "a face standing above the chamfer and holder (is it a pin map?)")
+    return face
 
 
 def prepare_pin(raw: Topography, opts: MacroOptions = MacroOptions()) -> Topography:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.ndimage as ndi
 
+from ..errors import InputError
 from .core import Topography
 
 _ORDER = {"nearest": 0, "linear": 1, "cubic": 3}
@@ -19,7 +20,7 @@ def resample(topo: Topography, shape: tuple[int, int], method: str = "linear") -
     like MATLAB's interp2), ``"cubic"`` (interpolating spline) or ``"nearest"``.
     """
     if method not in _ORDER:
-        raise ValueError(f"method must be one of {sorted(_ORDER)}, got {method!r}")
+        raise InputError(f"method must be one of {sorted(_ORDER)}, got {method!r}")
     ny, nx = _target(topo, shape, "resample")
     oy, ox = topo.shape
     # exact rational positions: i (n-1) / (m-1) is an integer whenever the refinement is exact
@@ -37,7 +38,7 @@ def resample(topo: Topography, shape: tuple[int, int], method: str = "linear") -
 def refine(topo: Topography, factor: int, method: str = "linear") -> Topography:
     """Insert ``factor - 1`` points between neighbours: ``n -> factor (n - 1) + 1`` pixels."""
     if int(factor) != factor or factor < 1:
-        raise ValueError(f"refinement factor must be a positive integer, got {factor}")
+        raise InputError(f"refinement factor must be a positive integer, got {factor}")
     ny, nx = topo.shape
     return resample(topo, (factor * (ny - 1) + 1, factor * (nx - 1) + 1), method)
 
@@ -63,8 +64,8 @@ def resample_cell(topo: Topography, shape: tuple[int, int]) -> Topography:
 def _target(topo: Topography, shape, name: str) -> tuple[int, int]:
     """The checked target ``(ny, nx)`` of a resampling of a fully valid ``topo``."""
     if topo.mask is not None:
-        raise ValueError(f"{name} needs a fully valid topography: call fill_defects first")
+        raise InputError(f"{name} needs a fully valid topography: call fill_defects first")
     ny, nx = (int(v) for v in shape)
     if ny < 2 or nx < 2:
-        raise ValueError(f"target shape must be at least 2 x 2, got {shape}")
+        raise InputError(f"target shape must be at least 2 x 2, got {shape}")
     return ny, nx

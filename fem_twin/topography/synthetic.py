@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from .core import Topography
 
 
@@ -18,9 +19,9 @@ def self_affine(shape, spacing, hurst: float, rms: float, *, rolloff_wavelength=
     the requested ``rms`` (Sq).
     """
     if not 0 < hurst <= 1:
-        raise ValueError(f"hurst must be in (0, 1], got {hurst}")
+        raise InputError(f"hurst must be in (0, 1], got {hurst}")
     if not rms > 0:
-        raise ValueError(f"rms must be positive [m], got {rms}")
+        raise InputError(f"rms must be positive [m], got {rms}")
     rng = np.random.default_rng(rng)
     ny, nx = shape
     dx1, dx2 = np.broadcast_to(np.asarray(spacing, float), (2,))

@@ -1,0 +1,61 @@
+"""Plausible physical inputs, declared once for the case file and the Python API.
+
+A value in the wrong unit (mm given as m, GPa as Pa, mPa s as Pa s) is off by 1e3 or more
+and lands outside these ranges, which bracket every pin-on-disk, ball-on-disk and MTM setup
+with steel, ceramics, polymers and lubricating oils.  :func:`plausible` raises
+:class:`~fem_twin.errors.InputError` naming the argument (or case-file key), the range and
+an example in SI units; the case parser (:mod:`fem_twin.case`) and the public entry points
+(``reduced_modulus``, ``contact.solve``, ``homogenise``, ``solve_mixed``) call it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import InputError
+
+#: quantity -> (lowest, highest) plausible value in SI units, and the hint shown
+QUANTITIES = {
+    "load": (1e-3, 1e4, "N"),
+    "length": (1e-4, 1.0, "m (8 mm is 8e-3)"),
+    "pin_diameter": (1e-4, 0.1, "m (8 mm is 8e-3)"),
+    "friction": (1e-3, 1.0, "(a friction coefficient)"),
+    "slide_to_roll": (1e-3, 2.0, "u_r / u_m, in (0, 2] (50 % is 0.5)"),
+    "viscosity": (1e-5, 10.0, "Pa s (66 mPa s is 0.066)"),
+    "density": (100.0, 2e4, "kg/m^3"),
+    "pressure_viscosity": (0.0, 1e-7, "1/Pa (22 GPa^-1 is 22e-9)"),
+    "eyring_stress": (0.0, 1e9, "Pa (5 MPa is 5e6; 0: Newtonian)"),
+    "modulus": (1e8, 2e12, "Pa (210 GPa is 210e9)"),
+    "reduced_modulus": (1e8, 4e12, "Pa (231 GPa is 231e9)"),
+    "poisson": (0.0, 0.4999, "Poisson ratio in [0, 0.5)"),
+    "hardness": (1e7, 1e11, "Pa (6.99 GPa is 6.99e9)"),
+    "separation": (1e-10, 1e-4, "m (0.1 um is 1e-7)"),
+    "speed": (1e-6, 100.0, "m/s"),
+    "pitch": (1e-9, 1e-2, "m (0.3 um is 3e-7, 31 um is 3.1e-5)"),
+    "fwhm_px": (0.0, 200.0, "pixels (0 or at least 1)"),
+}
+
+
+def plausible(name: str, value, quantity: str):
+    """``value`` (a number or an array of them) if finite and inside the plausible range of
+    ``quantity`` (:data:`QUANTITIES`); else :class:`InputError` naming ``name``."""
+    lo, hi, unit = QUANTITIES[quantity]
+    values = np.atleast_1d(np.asarray(value, dtype=float)) if _numeric(value) else None
+    if values is None or values.size == 0:
+        raise InputError(f"{name}: expected a number in {unit}, got {value!r}")
+    for v in values.ravel():
+        if not math.isfinite(v):
+            raise InputError(f"{name} = {v}: must be a finite number ({unit})")
+        if not lo <= v <= hi:
+            raise InputError(f"{name} = {v:g}: implausible; expected {lo:g} to {hi:g} {unit}")
+    return value
+
+
+def _numeric(value) -> bool:
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError):
+        return False
+    return array.dtype.kind in "iuf" and array.dtype != bool

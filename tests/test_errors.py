@@ -1,0 +1,69 @@
+"""Failures surface cleanly in the API (issue 30): every error fem_twin raises on purpose is
+a FemTwinError of the builtin kind a caller expects, bad input is refused before work
+starts with the argument named, and errors survive pickling to and from workers."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+from fem_twin import Topography, contact, errors
+from fem_twin.errors import FemTwinError, InputError
+from fem_twin.micro import homogenise
+from fem_twin.topography import fill_defects
+from fem_twin.topography.prepare import prepare_pin
+from fem_twin.topography.synthetic import self_affine
+
+
+@pytest.mark.parametrize("args,words", [
+    ((0.0, 0.3, 210e9, 0.3), "e1"), ((210e9, 0.7, 210e9, 0.3), "nu1"),
+    ((210e9, 0.3, 210e3, 0.3), "e2"), ((210e9, 0.3, np.nan, 0.3), "finite")])
+def test_reduced_modulus_refuses_impossible_materials(args, words):
+    with pytest.raises(InputError, match=words):
+        contact.reduced_modulus(*args)
+
+
+def test_contact_refuses_a_zero_pitch_and_wrong_units():
+    shape = np.zeros((8, 8))
+    e = contact.reduced_modulus(210e9, 0.3, 210e9, 0.3)
+    with pytest.raises(InputError, match="spacing"):
+        contact.solve(shape, (0.0, 0.0), e, load=1.0)
+    with pytest.raises(InputError, match="e_reduced"):
+        contact.solve(shape, 1e-6, e / 1e9, load=1.0)           # GPa typed as Pa
+    with pytest.raises(InputError, match="hardness"):
+        contact.solve(shape, 1e-6, e, load=1.0, hardness=6.99)
+
+
+def test_fill_defects_refuses_a_map_with_almost_no_data():
+    z = np.full((32, 32), np.nan)
+    z[3, 4] = 1e-6
+    with pytest.raises(InputError, match="1 of 1024 pixels"):
+        fill_defects(Topography(z, 1e-6))
+
+
+def test_a_constant_map_is_not_a_pin():
+    with pytest.raises(InputError, match="no pin face"):
+        prepare_pin(Topography(np.full((64, 64), 1e-6), 1e-4))
+
+
+def test_homogenise_refuses_a_patch_in_micrometres():
+    """A patch with heights in um typed as m (1e3 too high) ran to p_con = 1.75 GPa."""
+    pin = self_affine((16, 16), 1e-6, 0.8, 100e-9, rng=1)
+    disk = self_affine((16, 16), 1e-6, 0.8, 100e-9, rng=2)
+    slip = Topography(pin.heights * 1e3, pin.spacing)
+    with pytest.raises(InputError, match="Sq"):
+        homogenise(slip, disk, [1e-7, 2e-7], n_steps=2)
+
+
+def test_every_error_class_is_a_fem_twin_error_and_pickles():
+    classes = [c for c in vars(errors).values()
+               if isinstance(c, type) and issubclass(c, Exception)]
+    assert len(classes) >= 12
+    for cls in classes:
+        assert issubclass(cls, FemTwinError)
+        err = (cls("message", [1.0, 0.5]) if issubclass(cls, errors.NotConverged)
+               else cls("message"))
+        back = pickle.loads(pickle.dumps(err))
+        assert type(back) is cls and "message" in str(back)
+    assert issubclass(errors.MissingFile, FileNotFoundError)
+    assert issubclass(errors.InputError, ValueError)
