@@ -67,3 +67,19 @@ def test_every_error_class_is_a_fem_twin_error_and_pickles():
         assert type(back) is cls and "message" in str(back)
     assert issubclass(errors.MissingFile, FileNotFoundError)
     assert issubclass(errors.InputError, ValueError)
+
+
+def test_a_cropped_pin_says_why_it_cannot_be_levelled():
+    """A pin map cut through the face made the torque balance fail with 'Singular matrix'."""
+    from pathlib import Path
+
+    from fem_twin.contact import level_pin
+    from fem_twin.errors import NotConverged
+    from fem_twin.io.files import read_topography
+    from fem_twin.topography.prepare import MacroOptions
+    raw = read_topography(Path(__file__).parents[1] / "meshes" / "sample" / "pin_1.npz")
+    crop = Topography(raw.heights[:, :300], raw.spacing,
+                      mask=None if raw.mask is None else raw.mask[:, :300])
+    pin = prepare_pin(crop, MacroOptions(resolution=(48, 48)))
+    with pytest.raises(NotConverged, match="cropped"):
+        level_pin(pin, load=150.0)

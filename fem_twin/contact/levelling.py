@@ -109,7 +109,14 @@ def level_pin(pin: Topography, disk: Topography | None = None, *, load: float = 
         for _ in range(max_iter):
             if np.max(np.abs(r)) < tol:
                 break
-            step = -np.linalg.solve(jac, r)
+            try:
+                step = -np.linalg.solve(jac, r)
+            except np.linalg.LinAlgError:
+                raise ContactNotConverged(
+                    "pin levelling: a tilt does not change the contact torques (singular "
+                    "Jacobian); is the pin face cropped by the edge of the map, or the map "
+                    "not square about the pin?", [np.max(np.abs(h[2:])) for h in history]) \
+                    from None
             tilted, res, r_new = evaluate(tilt + step)
             jac += np.outer(r_new - r - jac @ step, step) / (step @ step)   # Broyden update
             tilt, r = tilt + step, r_new
