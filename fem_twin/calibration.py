@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
@@ -26,6 +25,7 @@ from .case import Case
 from .errors import InputError
 from .io.atomic import atomic_path
 from .io.figure import save_figure
+from .io.layout import RunLayout
 from .micro import FlowFactors
 from .stribeck import friction_deviation, plot_stribeck, stribeck_sweep, write_stribeck_csv
 
@@ -69,40 +69,39 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     variants) and plots of C_f and C_f,dev versus speed.  Returns the summary."""
     from .pipeline import (executor_for, homogenise_patches, level_pins, macro_geometry,
                            macro_settings, reconstruct_geometry)
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
+    out = RunLayout(outdir)
+    out.root.mkdir(parents=True, exist_ok=True)
     cases, ref_label = variants(case, study, values)
-    shared = outdir / "micro"
-    reconstruct_geometry(case, outdir / "geometry", progress)
+    reconstruct_geometry(case, out, progress)
     with executor_for(case) as executor:
-        homogenise_patches(case, shared, executor, progress)
+        homogenise_patches(case, out, executor, progress)
     lub = case.lubricant.lubricants()[0]
     curves = {}
     for i, (label, (variant, patch)) in enumerate(cases.items()):
-        folder = outdir / f"variant_{i + 1}"
-        reconstruct_geometry(variant, folder / "geometry", progress)
+        folder = out.sub(f"variant_{i + 1}")
+        reconstruct_geometry(variant, folder, progress)
         level_pins(variant, folder, progress)
-        factors = FlowFactors.load(shared / (f"patch_{patch}/flow_factors.npz" if patch
-                                             else "flow_factors.npz"))
+        factors = FlowFactors.load(out.patch_factors(patch))
         gap, spacing, face, _ = macro_geometry(variant, folder)
         curves[label] = stribeck_sweep(
             gap, spacing, factors, variant.sweep.speeds, load=variant.tribometer.load,
             lubricant=lub, diameter=variant.tribometer.pin_diameter, face=face,
             settings=macro_settings(variant),
-            checkpoint=folder / "stribeck", progress=progress)
+            checkpoint=folder.points, progress=progress)
     ref = curves[ref_label]
     dev = {k: friction_deviation(c.friction_coefficient, ref.friction_coefficient)
            for k, c in curves.items()}
     labels = list(curves)
-    write_stribeck_csv(outdir / "stribeck.csv", curves.values())
-    plot_stribeck(list(curves.values()), outdir / "stribeck_speed.png", labels=labels)
-    _plot_deviation(outdir / "cf_dev.png", ref.speed, dev, ref_label, study)
+    write_stribeck_csv(out.stribeck_csv, curves.values())
+    plot_stribeck(list(curves.values()), out.stribeck_png("speed"), labels=labels)
+    _plot_deviation(out.deviation_png, ref.speed, dev, ref_label, study)
     summary = {"study": study, "reference": ref_label, "viscosity_Pa_s": lub.viscosity,
-               "variants": {k: {"folder": f"variant_{i + 1}",
+               "variants": {k: {"folder": out.sub(f"variant_{i + 1}").root.name,
                                 "max_abs_cf_dev": float(np.abs(dev[k]).max())}
                             for i, k in enumerate(labels)},
-               "files": ["stribeck.csv", "stribeck_speed.png", "cf_dev.png"]}
-    with atomic_path(outdir / "calibration.json") as tmp:
+               "files": [p.name for p in (out.stribeck_csv, out.stribeck_png("speed"),
+                                          out.deviation_png)]}
+    with atomic_path(out.calibration) as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     return summary
 

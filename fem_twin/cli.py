@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError, MissingFile, NotConverged, RunLocked, SchedulerUnreachable
+from .io.layout import RunLayout
 
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
@@ -439,10 +440,11 @@ def _homogenise_average(args):
 
 def _write_factors(folder, ff, patches=()):
     from .micro.output import plot_flow_factors
-    ff.save(folder / "flow_factors.npz")
-    ff.write_csv(folder / "flow_factors.csv")
+    out = RunLayout(folder)                  # the files of a run's flow factors, in folder
+    ff.save(folder / out.flow_factors.name)
+    ff.write_csv(out.flow_factors_csv)
     labels = [f.meta.get("patch_id") or f"patch {i + 1}" for i, f in enumerate(patches)]
-    plot_flow_factors([*patches, ff], folder / "flow_factors.png",
+    plot_flow_factors([*patches, ff], out.flow_factors_png,
                       labels=[*labels, "average" if patches else ff.meta.get("patch_id") or "patch"])
     print(json.dumps({"h0_um": [ff.h0[0] * 1e6, ff.h0[-1] * 1e6], "points": len(ff),
                       "p_con_max_MPa": float(ff.p_con.max() * 1e-6),
@@ -451,9 +453,8 @@ def _write_factors(folder, ff, patches=()):
                           kind: {q: round(e, 5) for q, e in errors.items()}
                           for kind, errors in ff.meta.get("error_estimate", {}).items()
                           if kind in ("time", "grid", "h0")},
-                      "files": [str(folder / n) for n in ("flow_factors.npz",
-                                                          "flow_factors.csv",
-                                                          "flow_factors.png")]}, indent=2))
+                      "files": [str(folder / out.flow_factors.name), str(out.flow_factors_csv),
+                                str(out.flow_factors_png)]}, indent=2))
 
 
 def _macro_point(args):
@@ -595,7 +596,8 @@ def _validate(args):
     from .stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
     from .io.table import write_csv
     from .stribeck.curve import read_stribeck_csv
-    csv_path = args.run / "stribeck.csv"
+    run = RunLayout(args.run)
+    csv_path = run.stribeck_csv
     if not csv_path.is_file():
         raise MissingFile(f"{csv_path} not found: give the output folder of fem-twin run")
     curves = read_stribeck_csv(csv_path)
@@ -620,26 +622,25 @@ def _validate(args):
     if not np.any(np.isfinite(dev)):
         raise InputError(f"the measured speeds ({measured.speed.min():.3g} to "
                          f"{measured.speed.max():.3g} m/s) lie outside the simulated range")
-    stem = f"validation_{args.measured.stem}"
+    png, table = run.validation_of(args.measured, ".png"), run.validation_of(args.measured, ".csv")
     band = None if measured.low is None else (measured.low, measured.high)
-    plot_stribeck([curve], args.run / f"{stem}.png",
+    plot_stribeck([curve], png,
                   labels=[f"simulated, $\\mu_0$ = {curve.viscosity:g} Pa s"],
                   reference=(measured.speed, measured.friction_coefficient, band),
                   boundary=boundary)
-    write_csv(args.run / f"{stem}.csv", {"speed_m_s": measured.speed,
-                                         "measured_cf": measured.friction_coefficient,
-                                         "cf_dev": dev})
+    write_csv(table, {"speed_m_s": measured.speed, "measured_cf": measured.friction_coefficient,
+                      "cf_dev": dev})
     inside = np.isfinite(dev)
     print(f"fem-twin validate: mu_0 = {curve.viscosity:g} Pa s against {args.measured.name}: "
           f"max |C_f,dev| = {np.nanmax(np.abs(dev)):.2%} (eq 35, C_f,b = {boundary:.5g}) at "
-          f"{inside.sum()} of {dev.size} measured speeds; {args.run / stem}.csv, .png")
+          f"{inside.sum()} of {dev.size} measured speeds; {table}, {png.name}")
     return 0
 
 
 def _run_case_file(run: Path):
     """The case file recorded in a run's summary.json, if it still exists."""
     try:
-        path = Path(json.loads((run / "summary.json").read_text())["provenance"]["case_file"])
+        path = Path(json.loads(RunLayout(run).summary.read_text())["provenance"]["case_file"])
     except (OSError, ValueError, KeyError, TypeError):
         return None
     return path if path.is_file() else None

@@ -20,11 +20,13 @@ from .case import Case
 from .errors import InputError
 from .io.atomic import atomic_path
 from .io.figure import save_figure
+from .io.layout import RunLayout
 from .io.table import write_csv
 from .macro import MixedResult
 from .micro import FlowFactors
 from .micro.estimate import discrepancy, grid_separations
 from .stribeck import friction_deviation, stribeck_sweep
+from .stribeck.sweep import point_files
 
 
 def flow_factor_differences(fe: FlowFactors, fvm: FlowFactors) -> dict:
@@ -53,12 +55,13 @@ def reference_factors(case: Case, outdir: Path, h0, *, executor=None,
     mc = case.micro
     fine = replace(case, micro=replace(mc, method="fe", steps=2 * mc.steps, h0_tol=0.0,
                                        resolution=tuple(2 * n for n in mc.resolution)))
-    folder = outdir / "reference"
-    folder.mkdir(exist_ok=True)
-    if not (folder / "geometry").exists():
-        (folder / "geometry").symlink_to((outdir / "geometry").resolve(), target_is_directory=True)
-    homogenise_patches(fine, folder / "micro", executor, progress, h0=grid_separations(h0))
-    ref = FlowFactors.load(folder / "micro" / "flow_factors.npz")
+    out = RunLayout(outdir)
+    ref_run = out.sub("reference")
+    ref_run.root.mkdir(exist_ok=True)
+    if not ref_run.geometry.exists():
+        ref_run.geometry.symlink_to(out.geometry.resolve(), target_is_directory=True)
+    homogenise_patches(fine, ref_run, executor, progress, h0=grid_separations(h0))
+    ref = FlowFactors.load(ref_run.flow_factors)
     return FlowFactors(**{k: getattr(ref, k) for k in ("h0", "h_m", "p_con", "A", "b", "C",
                                                      "d", "contact_fraction")},
                        meta={**ref.meta, "grid": list(fine.micro.resolution),
@@ -79,49 +82,48 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     ``compare_flow_factors.csv``, ``compare_stribeck.csv`` and ``compare.png``."""
     from .pipeline import (executor_for, homogenise_patches, level_pins, macro_geometry,
                            macro_settings, reconstruct_geometry)
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    reconstruct_geometry(case, outdir / "geometry", progress)
-    level_pins(case, outdir, progress)
+    out = RunLayout(outdir)
+    out.root.mkdir(parents=True, exist_ok=True)
+    reconstruct_geometry(case, out, progress)
+    level_pins(case, out, progress)
     factors = {}
     with executor_for(case) as executor:
         for method in ("fe", "fvm"):
-            sub = outdir / method
-            sub.mkdir(exist_ok=True)
-            for name in ("geometry", "levelling"):
-                link = sub / name
+            sub = out.sub(method)
+            sub.root.mkdir(exist_ok=True)
+            for link, target in ((sub.geometry, out.geometry), (sub.levelling, out.levelling)):
                 if not link.exists():
-                    link.symlink_to((outdir / name).resolve(), target_is_directory=True)
+                    link.symlink_to(target.resolve(), target_is_directory=True)
             c = replace(case, micro=replace(case.micro, method=method, h0_tol=0.0))
-            homogenise_patches(c, sub / "micro", executor, progress)
-            factors[method] = FlowFactors.load(sub / "micro" / "flow_factors.npz")
-    reference = reference_factors(case, outdir, factors["fe"].h0, executor=None,
+            homogenise_patches(c, sub, executor, progress)
+            factors[method] = FlowFactors.load(sub.flow_factors)
+    reference = reference_factors(case, out.root, factors["fe"].h0, executor=None,
                                   progress=progress)
     against = {m: discrepancy(factors[m], reference) for m in ("fe", "fvm")}
     ffd = flow_factor_differences(factors["fe"], factors["fvm"])
-    gap, spacing, face, origin = macro_geometry(case, outdir)
+    gap, spacing, face, origin = macro_geometry(case, out)
     lub = case.lubricant.lubricants()[0]
     curves, points = {}, {}
     for method in ("fe", "fvm"):
-        ckpt = outdir / method / "stribeck"
+        ckpt = out.sub(method).points
         curves[method] = stribeck_sweep(
             gap, spacing, factors[method], case.sweep.speeds, load=case.tribometer.load,
             lubricant=lub, diameter=case.tribometer.pin_diameter, face=face,
             settings=macro_settings(case, method),
             checkpoint=ckpt, progress=progress)
-        points[method] = sorted((MixedResult.load(p) for p in ckpt.glob("point_*.npz")),
+        points[method] = sorted((MixedResult.load(p) for p in point_files(ckpt)),
                                 key=lambda r: -r.speed)            # as the curve: fast first
     dev = friction_deviation(curves["fe"].friction_coefficient,
                              curves["fvm"].friction_coefficient)
     fields = [field_differences(a, b) for a, b in zip(points["fe"], points["fvm"])]
-    write_csv(outdir / "compare_flow_factors.csv", {"h0_m" if k == "h0" else k: v
+    write_csv(out.compare_factors_csv, {"h0_m" if k == "h0" else k: v
                                                      for k, v in ffd.items()})
-    write_csv(outdir / "compare_stribeck.csv", {
+    write_csv(out.compare_stribeck_csv, {
         "speed_m_s": curves["fe"].speed, "cf_fe": curves["fe"].friction_coefficient,
         "cf_fvm": curves["fvm"].friction_coefficient, "cf_dev": dev,
         "pressure_diff": np.array([f["pressure"] for f in fields]),
         "cavity_fraction_diff": np.array([f["cavity_fraction"] for f in fields])})
-    _plot(outdir / "compare.png", ffd, curves, dev)
+    _plot(out.compare_png, ffd, curves, dev)
     summary = {"max_flow_factor_diff": {k: float(np.max(v)) for k, v in ffd.items()
                                         if k != "h0"},
                "against_reference": against,
@@ -132,8 +134,9 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
                "max_pressure_diff": max(f["pressure"] for f in fields),
                "max_cavity_fraction_diff": max(f["cavity_fraction"] for f in fields),
                "viscosity_Pa_s": lub.viscosity,
-               "files": ["compare_flow_factors.csv", "compare_stribeck.csv", "compare.png"]}
-    with atomic_path(outdir / "compare.json") as tmp:
+               "files": [p.name for p in (out.compare_factors_csv, out.compare_stribeck_csv,
+                                          out.compare_png)]}
+    with atomic_path(out.compare) as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     return summary
 

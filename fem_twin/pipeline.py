@@ -28,6 +28,7 @@ from .io.atomic import atomic_path
 from .io.checkpoint import input_key, load_or_none
 from .io.table import write_csv
 from .io.files import read_topography, write_topography
+from .io.layout import RunLayout
 from .io.mesh import grid_mesh, write_vtu
 from .macro import MacroSettings, MixedResult
 from .macro.figures import plot_point_fields
@@ -39,7 +40,7 @@ from .micro.output import plot_flow_factors
 from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)
 from .stribeck.accuracy import error_summary
-from .stribeck.sweep import sweep_key
+from .stribeck.sweep import point_files, point_key, sweep_key
 from .threads import one_thread, process_pool, stop_pool, worker_heap
 from .topography import resample_cell
 from .topography.plausibility import check_patch, check_pin
@@ -51,7 +52,8 @@ log = logging.getLogger("fem_twin")
 @one_thread
 def run(case: Case, outdir, *, progress: bool = True) -> dict:
     """Run the whole pipeline of ``case`` into ``outdir``; return the summary."""
-    outdir = Path(outdir)
+    out = RunLayout(outdir)
+    outdir = out.root
     if outdir.exists() and not outdir.is_dir():
         raise InputError(f"{outdir} is a file: give a folder for the results (-o)")
     for path in case.measured:                 # [validation] curves: checked before any work
@@ -61,14 +63,13 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
     t0 = time.perf_counter()
     summary = {"case": case.name, "provenance": provenance(case), "stages": {},
                "seconds": {}}
-    with _lock(outdir), _logfile(outdir / "run.log"), executor_for(case) as executor:
+    with _lock(out), _logfile(out.log), executor_for(case) as executor:
         log.info("case %s -> %s", case.source, outdir)
-        invalidate_changed_stages(case, outdir)
-        stages = (("geometry", lambda: reconstruct_geometry(case, outdir / "geometry", progress)),
-                  ("levelling", lambda: level_pins(case, outdir, progress)),
-                  ("micro", lambda: homogenise_patches(case, outdir / "micro", executor,
-                                                       progress)),
-                  ("stribeck", lambda: stribeck_curves(case, outdir, executor, progress)))
+        invalidate_changed_stages(case, out)
+        stages = (("geometry", lambda: reconstruct_geometry(case, out, progress)),
+                  ("levelling", lambda: level_pins(case, out, progress)),
+                  ("micro", lambda: homogenise_patches(case, out, executor, progress)),
+                  ("stribeck", lambda: stribeck_curves(case, out, executor, progress)))
         for name, stage in stages:
             t = time.perf_counter()
             log.info("stage %s", name)
@@ -80,7 +81,7 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
             summary["seconds"][name] = round(time.perf_counter() - t, 2)
             log.info("stage %s done in %.1f s", name, summary["seconds"][name])
     summary["wall_time_s"] = time.perf_counter() - t0
-    with atomic_path(outdir / "summary.json") as tmp:
+    with atomic_path(out.summary) as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     return summary
 
@@ -118,11 +119,11 @@ def stage_keys(case: Case) -> dict:
             "micro": key(geometry, case.micro, case.materials)}
 
 
-def invalidate_changed_stages(case: Case, outdir: Path) -> None:
+def invalidate_changed_stages(case: Case, out: RunLayout) -> None:
     """Remove cached stage results whose inputs changed since they were written (the
     Stribeck points and micro checkpoints are keyed by their inputs already)."""
     import shutil
-    path = outdir / "stage_keys.json"
+    path = out.stage_keys
     old = {}
     if path.exists():
         try:
@@ -136,10 +137,10 @@ def invalidate_changed_stages(case: Case, outdir: Path) -> None:
         if old.get(stage) not in (None, key):
             log.info("inputs of stage %s changed: recomputing it", stage)
             if stage == "micro":
-                for f in (outdir / "micro").glob("patch_*/flow_factors.npz"):
+                for f in out.micro.glob(f"patch_*/{out.flow_factors.name}"):
                     f.unlink()
             else:
-                shutil.rmtree(outdir / stage, ignore_errors=True)
+                shutil.rmtree(out.stage(stage), ignore_errors=True)
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(new, indent=2))
 
@@ -160,18 +161,18 @@ def _logfile(path):
 
 
 @contextmanager
-def _lock(outdir: Path):
+def _lock(out: RunLayout):
     """One run per output folder: an exclusive lock on ``OUT/.lock``, released when the run
     ends, however it ends (the system drops it with the process, also on kill -9)."""
     import fcntl
-    f = open(outdir / ".lock", "a+")
+    f = open(out.lock, "a+")
     try:
         try:
             fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             f.seek(0)
             holder = f.read().strip() or "another process"
-            raise RunLocked(f"{outdir} is in use by fem-twin run (pid {holder}); wait for it "
+            raise RunLocked(f"{out.root} is in use by fem-twin run (pid {holder}); wait for it "
                             "to finish or choose another output folder (-o)") from None
         f.seek(0)
         f.truncate()
@@ -213,15 +214,16 @@ def executor_for(case: Case):
     stop_pool(pool)
 
 
-def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dict:
+def reconstruct_geometry(case: Case, out: RunLayout, progress: bool = True) -> dict:
     """Prepare every pin (with its disk, or a flat one) and patch pair; write npz + VTU."""
+    out.geometry.mkdir(parents=True, exist_ok=True)
     opts = case.macro_geometry
     jobs = [] if case.tribometer.ball else [("pin", i) for i in range(len(case.geometry.pins))]
     jobs += [("patch", i) for i in range(len(case.geometry.patches))]
     result = {"pins": [], "patches": []}
     for kind, i in tqdm(jobs, desc="geometry", disable=not progress, unit="surface"):
         if kind == "pin":
-            pin_out, disk_out = outdir / f"pin_{i + 1}.npz", outdir / f"disk_{i + 1}.npz"
+            pin_out, disk_out = out.pin(i + 1), out.disk(i + 1)
             if not all(load_or_none(f, read_topography) for f in (pin_out, disk_out)):
                 raw = read_topography(case.geometry.pins[i])
                 check_pin(raw, case.geometry.pins[i].name, case.tribometer.pin_diameter)
@@ -231,7 +233,7 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
                 if disk.shape != pin.shape:
                     raise InputError(f"pin {i + 1} and its disk differ in resolution "
                                      f"{pin.shape} vs {disk.shape}")
-                write_vtu(outdir / f"macro_{i + 1}.vtu",
+                write_vtu(out.macro_vtu(i + 1),
                           grid_mesh(pin.shape, pin.spacing, pin.origin),
                           {"x3_low": pin.heights, "x3_up": disk.heights,
                            "pin_face": (pin.heights > opts.holder_height).astype(float)})
@@ -245,7 +247,7 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
                                    "face_range_m": [float(pin.heights[face].min()),
                                                     float(pin.heights[face].max())]})
         else:
-            low_out, up_out = outdir / f"patch_{i + 1}_low.npz", outdir / f"patch_{i + 1}_up.npz"
+            low_out, up_out = out.patch(i + 1, "low"), out.patch(i + 1, "up")
             if not all(load_or_none(f, read_topography) for f in (low_out, up_out)):
                 src_pin, src_disk = case.geometry.patches[i]
                 axis = case.macro_geometry.sliding_direction
@@ -257,7 +259,7 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
                 for t, src in ((low, src_pin), (up, src_disk)):
                     for warning in check_patch(t, src.name, case.tribometer.pin_diameter):
                         log.warning("%s", warning)
-                write_vtu(outdir / f"patch_{i + 1}.vtu",
+                write_vtu(out.patch_vtu(i + 1),
                           grid_mesh(low.shape, low.spacing, periodic=True),
                           {"x3_low": low.heights, "x3_up": up.heights})
                 write_topography(up_out, up)
@@ -269,14 +271,12 @@ def reconstruct_geometry(case: Case, outdir: Path, progress: bool = True) -> dic
     return result
 
 
-def level_pins(case: Case, outdir: Path, progress: bool = True) -> dict:
+def level_pins(case: Case, out: RunLayout, progress: bool = True) -> dict:
     """Level every pin against its disk (torque balance, Table 4 at 50 N); average the
     levelled set and level the average (paper 2.2.1).  Writes ``levelling/``."""
     if case.tribometer.ball:
         return {"skipped": "ball-on-disk: the macro gap is the ball's sphere"}
-    folder = outdir / "levelling"
-    folder.mkdir(parents=True, exist_ok=True)
-    geo = outdir / "geometry"
+    out.levelling.mkdir(parents=True, exist_ok=True)
     m = case.materials
     e_red = m.e_reduced
     holder = case.macro_geometry.holder_height
@@ -284,38 +284,36 @@ def level_pins(case: Case, outdir: Path, progress: bool = True) -> dict:
     levelled = []
     n = len(case.geometry.pins)
     for i in tqdm(range(n), desc="levelling", disable=not progress, unit="pin"):
-        out = folder / f"pin_{i + 1}.npz"
-        if load_or_none(out, read_topography) is None:
-            lev = level_pin(read_topography(geo / f"pin_{i + 1}.npz"),
-                            read_topography(geo / f"disk_{i + 1}.npz"), e_reduced=e_red,
-                            hardness=m.hardness, holder_height=holder)
-            write_topography(out, lev.pin.with_heights(lev.pin.heights, meta={
+        path = out.levelled_pin(i + 1)
+        if load_or_none(path, read_topography) is None:
+            lev = level_pin(read_topography(out.pin(i + 1)), read_topography(out.disk(i + 1)),
+                            e_reduced=e_red, hardness=m.hardness, holder_height=holder)
+            write_topography(path, lev.pin.with_heights(lev.pin.heights, meta={
                 **lev.pin.meta, "tilt_rad": list(lev.tilt),
                 "torque_residuals": list(lev.residuals)}))
-        pin = read_topography(out)
+        pin = read_topography(path)
         levelled.append(pin)
-        result["pins"].append({"file": out.name, "tilt_rad": pin.meta.get("tilt_rad")})
-    avg_out = folder / "pin_average.npz"
+        result["pins"].append({"file": path.name, "tilt_rad": pin.meta.get("tilt_rad")})
+    avg_out = out.levelled_pin("average")
     if n > 1 and load_or_none(avg_out, read_topography) is None:
         lev = level_pin(average_pins(levelled, radius=case.macro_geometry.level_radius,
                                      truncation=case.macro_geometry.truncation,
                                      holder_height=holder),
-                        read_topography(geo / "disk_1.npz"), e_reduced=e_red,
+                        read_topography(out.disk(1)), e_reduced=e_red,
                         hardness=m.hardness, holder_height=holder)
         write_topography(avg_out, lev.pin)
-    result["macro_pin"] = (avg_out.name if case.macro.pin == "average" and n > 1
-                           else f"pin_{case.macro.pin if case.macro.pin != 'average' else 1}.npz")
+    result["macro_pin"] = macro_pin_file(case, out).name
     return result
 
 
-def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool = True,
+def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool = True,
                        h0=None):
     """Flow factors of every patch pair (checkpointed per h0) and their average (``h0``:
     the case's range unless given).  With an executor the patches run side by side (a
     thread each hands its h0 tasks to the shared pool), so the pool is not left idle at
     the end of a patch or of a round of adaptive h0, and a cluster gets every patch's
     tasks at once."""
-    folder.mkdir(parents=True, exist_ok=True)
+    out.micro.mkdir(parents=True, exist_ok=True)
     mc = case.micro
     h0 = np.geomspace(mc.h0_min, mc.h0_max, mc.h0_count) if h0 is None else np.asarray(h0)
     n = len(case.geometry.patches)
@@ -323,17 +321,17 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
                or os.environ.get("FEM_TWIN_NO_PROGRESS") == "1")
     try:
         if executor is None:
-            factors = [_patch_factors(case, folder, i, h0, None, bar) for i in range(n)]
+            factors = [_patch_factors(case, out, i, h0, None, bar) for i in range(n)]
         else:
             with ThreadPoolExecutor(n) as threads:
                 factors = list(threads.map(
-                    lambda i: _patch_factors(case, folder, i, h0, executor, bar), range(n)))
+                    lambda i: _patch_factors(case, out, i, h0, executor, bar), range(n)))
     finally:
         bar.close()
     mean = average(factors)
-    mean.save(folder / "flow_factors.npz")
-    mean.write_csv(folder.parent / "flow_factors.csv")
-    plot_flow_factors([*factors, mean], folder.parent / "flow_factors.png",
+    mean.save(out.flow_factors)
+    mean.write_csv(out.flow_factors_csv)
+    plot_flow_factors([*factors, mean], out.flow_factors_png,
                       labels=[f"patch {i + 1}" for i in range(len(factors))] + ["average"])
     estimate = mean.meta.get("error_estimate", {})
     return {"patches": len(factors), "h0_m": [float(h0[0]), float(h0[-1]), len(h0)],
@@ -341,21 +339,20 @@ def homogenise_patches(case: Case, folder: Path, executor=None, progress: bool =
             "grid": list(mc.resolution), "steps": mc.steps,
             "time_derivative": mc.time_derivative,
             "error_estimate": estimate,
-            "p_con_max_Pa": float(mean.p_con.max()), "files": ["flow_factors.csv",
-                                                               "flow_factors.png"]}
+            "p_con_max_Pa": float(mean.p_con.max()),
+            "files": [out.flow_factors_csv.name, out.flow_factors_png.name]}
 
 
-def _patch_factors(case: Case, folder: Path, i: int, h0, executor, bar) -> FlowFactors:
+def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> FlowFactors:
     """Flow factors of patch pair ``i`` (0-based): its file if present, else computed."""
     mc, m = case.micro, case.materials
-    out = folder / f"patch_{i + 1}" / "flow_factors.npz"
-    ff = load_or_none(out, FlowFactors.load)
+    path, checkpoints = out.patch_factors(i + 1), out.patch_checkpoints(i + 1)
+    ff = load_or_none(path, FlowFactors.load)
     if ff is not None:
         bar.update(len(h0))
         return ff
-    geo = folder.parent / "geometry"
-    low = read_topography(geo / f"patch_{i + 1}_low.npz")
-    up = read_topography(geo / f"patch_{i + 1}_up.npz")
+    low = read_topography(out.patch(i + 1, "low"))
+    up = read_topography(out.patch(i + 1, "up"))
     if low.shape != tuple(mc.resolution):
         low, up = resample_cell(low, mc.resolution), resample_cell(up, mc.resolution)
     ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=m.e_reduced,
@@ -363,28 +360,37 @@ def _patch_factors(case: Case, folder: Path, i: int, h0, executor, bar) -> FlowF
                     time_derivative=mc.time_derivative, time_tol=mc.time_tol or None,
                     h0_tol=mc.h0_tol or None, executor=executor,
                     workers=getattr(executor, "n_workers", 1),
-                    checkpoint=out.parent / "checkpoints", progress=bar,
+                    checkpoint=checkpoints, progress=bar,
                     patch_id=f"patch {i + 1}")
-    ff.save(out)
-    stale = prune_checkpoints(out.parent / "checkpoints", ff.meta["checkpoint_keys"])
+    ff.save(path)
+    stale = prune_checkpoints(checkpoints, ff.meta["checkpoint_keys"])
     if stale:
         log.info("patch %d: %d stale h0 checkpoints removed", i + 1, stale)
     return ff
 
 
-def macro_geometry(case: Case, outdir: Path):
+def macro_pin_number(case: Case) -> int | str:
+    """The pin of the macro scale: ``"average"`` (the levelled set's average, when the set
+    has more than one pin) or its number, counted from 1 (its disk serves the average)."""
+    if case.macro.pin == "average":
+        return "average" if len(case.geometry.pins) > 1 else 1
+    return case.macro.pin
+
+
+def macro_pin_file(case: Case, out: RunLayout) -> Path:
+    """The levelled pin of the macro scale (:func:`macro_pin_number`)."""
+    return out.levelled_pin(macro_pin_number(case))
+
+
+def macro_geometry(case: Case, out: RunLayout):
     """Gap ``h_g = x3_up - x3_low``, spacing, pin-face mask and origin of the macro pin, or
     of the ball's sphere over [-4a, 2a] x [-3a, 3a] (a the Hertz radius; face: all)."""
     if case.tribometer.ball:
         gap, spacing, x1, x2 = ball_contact(case).grid(case.macro.grid)
         return gap, spacing, np.ones(gap.shape, bool), (float(x1[0]), float(x2[0]))
-    lev = outdir / "levelling"
-    pin_file = (lev / "pin_average.npz" if case.macro.pin == "average"
-                and (lev / "pin_average.npz").exists()
-                else lev / f"pin_{1 if case.macro.pin == 'average' else case.macro.pin}.npz")
-    pin = read_topography(pin_file)
-    k = 1 if case.macro.pin == "average" else case.macro.pin
-    disk = read_topography(outdir / "geometry" / f"disk_{k}.npz")
+    pin = read_topography(macro_pin_file(case, out))
+    k = macro_pin_number(case)
+    disk = read_topography(out.disk(1 if k == "average" else k))
     face = pin.heights > case.macro_geometry.holder_height / 2
     return disk.heights - pin.heights, pin.spacing, face, pin.origin
 
@@ -419,17 +425,17 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
     return settings
 
 
-def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = True) -> dict:
+def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = True) -> dict:
     """One Stribeck sweep per viscosity (in parallel on ``executor``), the patch scatter band
     (``[run] patch_band``); CSV, plots, fields, ``results.nc`` and ``fields.nc``."""
-    gap, spacing, face, origin = macro_geometry(case, outdir)
-    factors = FlowFactors.load(outdir / "micro" / "flow_factors.npz")
+    gap, spacing, face, origin = macro_geometry(case, out)
+    factors = FlowFactors.load(out.flow_factors)
     lb, tr = case.lubricant, case.tribometer
     ball = dict(slide_to_roll=tr.slide_to_roll) if tr.ball else {}
     common = dict(gap=gap, spacing=spacing, factors=factors, speeds=case.sweep.speeds,
                   load=tr.load, diameter=hersey_length(case), face=face, **ball,
                   settings=macro_settings(case),
-                  checkpoint=outdir / "stribeck" / "checkpoints", fields=outdir / "fields",
+                  checkpoint=out.points, fields=out.fields,
                   origin=origin, factors_key=stage_keys(case)["micro"])
     lubricants = lb.lubricants()
     speeds = case.sweep.speeds
@@ -443,30 +449,31 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
                  "%.3g", level + 1, extra.size, case.sweep.refine_step * tr.boundary_friction)
         speeds = np.unique(np.r_[speeds, extra])[::-1]
     tasks = [(dict(common, speeds=speeds, error_estimate=True), lub) for lub in lubricants]
-    band_tasks = [(kw, lub) for kw in band_sweeps(case, outdir, dict(common, speeds=speeds))
+    band_tasks = [(kw, lub) for kw in band_sweeps(case, out, dict(common, speeds=speeds))
                   for lub in lubricants] if case.run.patch_band else []
     patch_curves = run_sweeps(band_tasks, executor, progress, desc="patch band points")
     patch_curves = [patch_curves[i:i + len(lubricants)]
                     for i in range(0, len(patch_curves), len(lubricants))]
     band = patch_band(patch_curves) if patch_curves else None
     _prune_points(common["checkpoint"], tasks + band_tasks)
-    write_stribeck_csv(outdir / "stribeck.csv", curves, band)
-    out = {"curves": [{"viscosity_Pa_s": c.viscosity,
+    write_stribeck_csv(out.stribeck_csv, curves, band)
+    summary = {"curves": [{"viscosity_Pa_s": c.viscosity,
                        "friction_coefficient_range": [float(c.friction_coefficient.min()),
                                                       float(c.friction_coefficient.max())]}
                       for c in curves],
-           "files": ["stribeck.csv", "stribeck_speed.png", "stribeck_hersey.png",
-                     "results.nc", "fields.nc", "fields/",
-                     *(f"fields_mu{c.viscosity:g}.png" for c in curves)]}
+           "files": [p.name for p in (out.stribeck_csv, out.stribeck_png("speed"),
+                                      out.stribeck_png("hersey"), out.results, out.fields_nc,
+                                      out.fields, *(out.fields_png(c.viscosity)
+                                                    for c in curves))]}
     if band is not None:
-        out["patch_band_max_width"] = float(max(np.max(hi - lo) for lo, hi in band))
-    out["cf_error"] = error_summary(curves, tr.boundary_friction, case.sweep.error_tolerance)
-    plot_curves(case, curves, band, outdir)
+        summary["patch_band_max_width"] = float(max(np.max(hi - lo) for lo, hi in band))
+    summary["cf_error"] = error_summary(curves, tr.boundary_friction, case.sweep.error_tolerance)
+    plot_curves(case, curves, band, out)
     points = sweep_points(common["checkpoint"], tasks)
     for mu in lb.viscosities:
         u = sorted((v for m, v in points if m == mu), reverse=True)      # fast to slow
         res = [points[mu, u[i]] for i in sorted({0, len(u) // 2, len(u) - 1})]
-        plot_point_fields(res, outdir / f"fields_mu{mu:g}.png", titles=[
+        plot_point_fields(res, out.fields_png(mu), titles=[
             f"$\\mu_0$ = {mu:g} Pa s, U = {r.speed:.3g} m/s, "
             f"$C_f$ = {r.friction_coefficient:.4f}" for r in res])
     for c in curves:
@@ -475,22 +482,21 @@ def stribeck_curves(case: Case, outdir: Path, executor=None, progress: bool = Tr
             log.info("point mu_0 = %g Pa s, U = %.4g m/s: C_f = %.5f, contact share %.3f, "
                      "%d iterations", c.viscosity, u, cf, share, it)
     if len(curves) > 1:
-        out["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, tr.boundary_friction)
+        summary["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, tr.boundary_friction)
     if tr.ball:
-        out["ehl_film"] = ehl_film(case, points)
+        summary["ehl_film"] = ehl_film(case, points)
     if any(case.measured):
-        out["validation"] = validate(case, curves, outdir, curve_labels(case, curves))
-    write_run_results(case, outdir, curves, patch_curves, points, origin)
-    return out
+        summary["validation"] = validate(case, curves, out, curve_labels(case, curves))
+    write_run_results(case, out, curves, patch_curves, points, origin)
+    return summary
 
 
-def band_sweeps(case: Case, outdir: Path, common: dict) -> list[dict]:
+def band_sweeps(case: Case, out: RunLayout, common: dict) -> list[dict]:
     """Sweep arguments of every single patch's flow factors (the scatter band, Figure 13)."""
     n = len(case.geometry.patches)
     if n < 2:
         return []
-    return [dict(common, factors=FlowFactors.load(outdir / "micro" / f"patch_{i + 1}"
-                                                  / "flow_factors.npz"),
+    return [dict(common, factors=FlowFactors.load(out.patch_factors(i + 1)),
                  factors_key=f"{common['factors_key']}-patch{i + 1}", fields=None)
             for i in range(n)]
 
@@ -526,13 +532,13 @@ def hersey_length(case: Case) -> float:
             else case.tribometer.pin_diameter)
 
 
-def plot_curves(case: Case, curves, band, outdir: Path) -> None:
+def plot_curves(case: Case, curves, band, out: RunLayout) -> None:
     """C_f versus speed and versus Hersey number, with the band and measured curves."""
     measured = [read_measured_csv(m) if m is not None else None for m in case.measured]
     measured += [None] * (len(curves) - len(measured))
     tr = case.tribometer
     for x in ("speed", "hersey"):
-        plot_stribeck(curves, outdir / f"stribeck_{x}.png", x=x,
+        plot_stribeck(curves, out.stribeck_png(x), x=x,
                       labels=curve_labels(case, curves), boundary=tr.boundary_friction,
                       bands=band, measured=measured, diameter=hersey_length(case),
                       load=tr.load, speed_label=("entrainment speed $u_m$ [m/s], SRR "
@@ -544,33 +550,31 @@ def sweep_points(folder: Path, tasks) -> dict:
     """{(viscosity, speed): MixedResult} of the checkpoints of the sweeps ``tasks``."""
     points = {}
     for kw, lub in tasks:
-        for path in folder.glob(f"point_{_sweep_key(kw, lub)}_*.npz"):
+        for path in point_files(folder, _sweep_key(kw, lub)):
             res = MixedResult.load(path)
             speed = res.speed if kw.get("slide_to_roll") is None else res.meta["entrainment"]
             points[lub.viscosity, speed] = res
     return points
 
 
-def write_run_results(case: Case, outdir: Path, curves, patch_curves, points, origin) -> None:
+def write_run_results(case: Case, out: RunLayout, curves, patch_curves, points, origin) -> None:
     """``results.nc`` (flow factors per patch and average, Stribeck curves with the band,
     settings and error estimates) and ``fields.nc`` (the macro fields of ``points``)."""
     from dataclasses import asdict
 
     from .results import fields_dataset, flow_factor_dataset, stribeck_dataset, write_netcdf
-    micro = outdir / "micro"
     n = len(case.geometry.patches)
-    factors = [FlowFactors.load(micro / f"patch_{i + 1}" / "flow_factors.npz")
-               for i in range(n)] + [FlowFactors.load(micro / "flow_factors.npz")]
+    factors = [FlowFactors.load(out.patch_factors(k)) for k in [*range(1, n + 1), None]]
     attrs = {"case": json.dumps(asdict(case), default=str), "case_name": case.name,
              "provenance": json.dumps(provenance(case))}
-    write_netcdf(outdir / "results.nc",
+    write_netcdf(out.results,
                  {"flow_factors": flow_factor_dataset(factors, [str(i + 1) for i in range(n)]
                                                       + ["average"]),
                   "stribeck": stribeck_dataset(curves, patch_curves)}, attrs)
-    write_netcdf(outdir / "fields.nc", {None: fields_dataset(points, origin)}, attrs)
+    write_netcdf(out.fields_nc, {None: fields_dataset(points, origin)}, attrs)
 
 
-def validate(case: Case, curves, outdir: Path, labels) -> list:
+def validate(case: Case, curves, out: RunLayout, labels) -> list:
     """C_f,dev (eq 35) of each simulated curve against its measured CSV (paper 3.3)."""
     rows, result = [], []
     for curve, path, label in zip(curves, case.measured, labels):
@@ -581,12 +585,12 @@ def validate(case: Case, curves, outdir: Path, labels) -> list:
         rows += [(curve.viscosity, u, cf, d) for u, cf, d in
                  zip(measured.speed, measured.friction_coefficient, dev)]
         band = None if measured.low is None else (measured.low, measured.high)
-        plot_stribeck([curve], outdir / f"validation_mu{curve.viscosity:g}.png", labels=[label],
+        plot_stribeck([curve], out.validation_png(curve.viscosity), labels=[label],
                       reference=(measured.speed, measured.friction_coefficient, band),
                       boundary=case.tribometer.boundary_friction)
         result.append({"viscosity_Pa_s": curve.viscosity, "measured": str(path),
                        "max_abs_cf_dev": float(np.nanmax(np.abs(dev)))})
-    write_csv(outdir / "validation.csv", dict(zip(
+    write_csv(out.validation_csv, dict(zip(
         ("viscosity_Pa_s", "speed_m_s", "measured_cf", "cf_dev"),
         zip(*rows) if rows else ((),) * 4)))
     return result
@@ -608,8 +612,7 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     with tqdm(total=total, desc=desc, unit="point", disable=not progress) as bar:
         while not all(f.done() for f in futures):
             if folder is not None and keys:                   # points finished so far
-                bar.update(sum(_point_key(p) in keys for p in Path(folder).glob("point_*.npz"))
-                           - bar.n)
+                bar.update(sum(point_key(p) in keys for p in point_files(folder)) - bar.n)
             time.sleep(0.5)
         bar.update(total - bar.n)
     return [f.result() for f in futures]
@@ -628,7 +631,7 @@ def transition_speeds(curves, step: float) -> np.ndarray:
 
 
 def _sweep_key(kwargs: dict, lubricant) -> str:
-    """Checkpoint key of one sweep task (``point_KEY_SPEED.npz``)."""
+    """Checkpoint key of one sweep task (:func:`~fem_twin.stribeck.sweep.point_file`)."""
     return sweep_key(kwargs["gap"], kwargs["spacing"], kwargs["factors_key"], kwargs["load"],
                      lubricant, kwargs["settings"], kwargs["face"],
                      kwargs.get("slide_to_roll"))
@@ -637,15 +640,11 @@ def _sweep_key(kwargs: dict, lubricant) -> str:
 def _prune_points(folder: Path, tasks) -> None:
     """Remove the Stribeck checkpoints of no current sweep (changed inputs)."""
     keys = {_sweep_key(kw, lub) for kw, lub in tasks}
-    stale = [p for p in folder.glob("point_*.npz") if _point_key(p) not in keys]
+    stale = [p for p in point_files(folder) if point_key(p) not in keys]
     for p in stale:
         p.unlink()
     if stale:
         log.info("%d stale Stribeck checkpoints removed", len(stale))
-
-
-def _point_key(path: Path) -> str:
-    return path.name.split("_")[1]
 
 
 def hersey_collapse(curves, boundary: float = BOUNDARY_FRICTION) -> float:

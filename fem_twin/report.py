@@ -21,37 +21,37 @@ from .errors import MissingFile
 from .io.atomic import atomic_path
 from .io.figure import save_figure
 from .io.files import read_topography
+from .io.layout import RunLayout
 from .io.render import render_views
 
 
 def write_report(outdir, path=None, *, render: bool = True) -> Path:
     """Write ``OUT/report.html`` (or ``path``) for the run in ``outdir``; return its path."""
-    outdir = Path(outdir)
-    summary_path = outdir / "summary.json"
+    out = RunLayout(outdir)
+    summary_path = out.summary
     if not summary_path.is_file():
         raise MissingFile(f"{summary_path} not found: give the output folder of a "
                                 "finished fem-twin run")
     summary = json.loads(summary_path.read_text())
-    work = outdir / "report"
+    work = out.report_figures
     work.mkdir(exist_ok=True)
-    sections = [geometry_section(outdir, work, render), levelling_section(outdir, work),
-                figure_section("Flow factors (Figures 4-5)", [outdir / "flow_factors.png"],
+    sections = [geometry_section(out, work, render), levelling_section(out, work),
+                figure_section("Flow factors (Figures 4-5)", [out.flow_factors_png],
                                "Patch pairs and their average versus the separation h0."),
-                stribeck_section(outdir), calibration_section(outdir),
+                stribeck_section(out), calibration_section(out),
                 tables_section(summary)]
     page = _PAGE.format(title=html.escape(f"fem_twin report: {summary.get('case', '')}"),
                         body="\n".join(s for s in sections if s))
-    path = Path(path) if path is not None else outdir / "report.html"
+    path = Path(path) if path is not None else out.report
     with atomic_path(path) as tmp:
         tmp.write_text(page)
     return path
 
 
-def geometry_section(outdir: Path, work: Path, render: bool) -> str:
-    geo = outdir / "geometry"
-    jobs = [(geo / "macro_1.vtu", work / "geometry_pin.png",
+def geometry_section(out: RunLayout, work: Path, render: bool) -> str:
+    jobs = [(out.macro_vtu(1), work / "geometry_pin.png",
              "Figure 2: virtual pin 1 and disk 1"),
-            (geo / "patch_1.vtu", work / "geometry_patch.png",
+            (out.patch_vtu(1), work / "geometry_patch.png",
              "Figure 6: roughness patch pair 1")]
     jobs = [j for j in jobs if j[0].is_file()]
     if not render:
@@ -65,9 +65,8 @@ def geometry_section(outdir: Path, work: Path, render: bool) -> str:
     return section("Virtual geometry (Figures 2 and 6)", body)
 
 
-def levelling_section(outdir: Path, work: Path) -> str:
-    lev = outdir / "levelling"
-    files = sorted(lev.glob("pin_*.npz"))
+def levelling_section(out: RunLayout, work: Path) -> str:
+    files = out.levelled_pins()
     if not files:
         return ""
     png = plot_centre_lines(files, work / "pin_centre_lines.png")
@@ -95,21 +94,20 @@ def plot_centre_lines(files, path) -> Path:
     return save_figure(fig, path, dpi=110)
 
 
-def stribeck_section(outdir: Path) -> str:
-    pngs = [outdir / "stribeck_speed.png", outdir / "stribeck_hersey.png"]
+def stribeck_section(out: RunLayout) -> str:
+    pngs = [out.stribeck_png("speed"), out.stribeck_png("hersey")]
     text = ("Friction coefficient (eq 34) of the patch-average flow factors with the estimated "
             "discretisation error of each point as error bars; the shaded band spans the "
             "single-patch curves (Figure 13), squares are measured curves.")
     body = figure_section("Stribeck curves (Figure 14)", pngs, text)
-    fields = sorted(outdir.glob("fields_mu*.png"))
-    val = sorted(outdir.glob("validation_mu*.png"))
+    fields, val = out.fields_pngs(), out.validation_pngs()
     return (body + figure_section("Macro fields", fields, "Fastest, middle and slowest "
                                   "point of each sweep.")
             + figure_section("Validation against measured curves (eq 35)", val, ""))
 
 
-def calibration_section(outdir: Path) -> str:
-    pngs = sorted(outdir.glob("**/cf_dev.png"))
+def calibration_section(out: RunLayout) -> str:
+    pngs = out.deviation_pngs()
     return figure_section("Calibration studies (Figures 9-13)", pngs,
                           "C_f,dev (eq 35) of each variant against its reference.")
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from .errors import MissingFile
 from .io.atomic import atomic_path
+from .io.layout import RunLayout
 from .macro.estimate import PARTS
 
 ENGINE = "h5netcdf"
@@ -162,14 +163,13 @@ def open_run(outdir) -> RunResults:
     """The results of ``fem-twin run ... -o OUTDIR`` as xarray Datasets (loaded in memory;
     the fields lazily)."""
     import xarray as xr
-    outdir = Path(outdir)
-    path = outdir / "results.nc"
+    out = RunLayout(outdir)
+    path = out.results
     if not path.is_file():
         raise MissingFile(f"{path}: no results; run `fem-twin run CASE -o {outdir}` "
                                 "first")
     load = lambda group: xr.load_dataset(path, group=group, engine=ENGINE)  # noqa: E731
-    fields = (xr.open_dataset(outdir / "fields.nc", engine=ENGINE)
-              if (outdir / "fields.nc").is_file() else None)
-    summary = (json.loads((outdir / "summary.json").read_text())
-               if (outdir / "summary.json").is_file() else {})
+    fields = (xr.open_dataset(out.fields_nc, engine=ENGINE) if out.fields_nc.is_file()
+              else None)
+    summary = json.loads(out.summary.read_text()) if out.summary.is_file() else {}
     return RunResults(load("flow_factors"), load("stribeck"), fields, summary)

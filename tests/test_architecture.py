@@ -71,3 +71,17 @@ def test_every_raise_is_a_fem_twin_error():
                 if not (isinstance(cls, type) and issubclass(cls, FemTwinError)):
                     bare.append(f"{path.relative_to(PACKAGE)}:{node.lineno} raise {name}")
     assert not bare, "\n".join(bare)
+
+
+def test_run_files_are_named_only_by_the_run_layout():
+    """Issue 31 item 2: the names of the files a run writes and reads appear once, in
+    fem_twin/io/layout.py (RunLayout); every other module asks it for the path.
+    (samples.py names the bundled sample's input maps, which happen to share a pattern.)"""
+    import re
+    names = set(re.findall(r'"([\w{}*]+\.(?:npz|json|csv|nc|png|log|vtu|html))"',
+                           (PACKAGE / "io" / "layout.py").read_text()))
+    assert {"summary.json", "stribeck.csv", "flow_factors.npz", "results.nc"} <= names
+    elsewhere = [f"{path.relative_to(PACKAGE)}: {name}" for path in PACKAGE.rglob("*.py")
+                 if path.name not in ("layout.py", "samples.py") for name in names
+                 if f'"{name}"' in path.read_text()]
+    assert not elsewhere, elsewhere

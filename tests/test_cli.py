@@ -11,6 +11,7 @@ import pytest
 from fem_twin import Topography, read_topography, write_topography
 from fem_twin.case import CaseError, load_case
 from fem_twin.cli import main
+from fem_twin.io.layout import RunLayout
 from fem_twin.micro import FlowFactors
 
 from conftest import ROOT
@@ -344,10 +345,11 @@ def test_sliding_direction_turns_the_roughness_patches_too(tmp_path):
     (tmp_path / "turned.toml").write_text(text)
     other = load_case(tmp_path / "turned.toml")
     assert other.macro_geometry.sliding_direction == "+x2"
-    for c, out in ((case, tmp_path / "a"), (other, tmp_path / "b")):
+    runs = RunLayout(tmp_path / "a"), RunLayout(tmp_path / "b")
+    for c, out in zip((case, other), runs):
         reconstruct_geometry(c, out, progress=False)
-    for name in ("patch_1_low.npz", "patch_1_up.npz", "patch_2_up.npz"):
-        a, b = read_topography(tmp_path / "a" / name), read_topography(tmp_path / "b" / name)
+    for k, side in ((1, "low"), (1, "up"), (2, "up")):
+        a, b = (read_topography(r.patch(k, side)) for r in runs)
         assert np.array_equal(a.heights, b.heights) and np.allclose(a.spacing, b.spacing)
     bad = text.replace('sliding_direction = "+x2"', 'sliding_direction = "y"')
     (tmp_path / "bad.toml").write_text(bad)

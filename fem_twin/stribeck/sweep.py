@@ -19,6 +19,21 @@ from .curve import StribeckCurve, hersey_number
 
 
 @one_thread
+def point_file(folder, key: str, speed: float) -> Path:
+    """The checkpoint of one Stribeck point: ``point_KEY_SPEED.npz`` in ``folder``."""
+    return Path(folder) / f"point_{key}_{speed:.9e}.npz"
+
+
+def point_files(folder, key: str = "*") -> list[Path]:
+    """The Stribeck point checkpoints in ``folder`` (of the sweep ``key``, or all)."""
+    return sorted(Path(folder).glob(f"point_{key}_*.npz"))
+
+
+def point_key(path) -> str:
+    """The sweep key of a point checkpoint (:func:`point_file`)."""
+    return Path(path).name.split("_")[1]
+
+
 def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    lubricant: Lubricant, diameter: float = 8e-3, face=None,
                    settings: MacroSettings = MacroSettings(), checkpoint=None, fields=None,
@@ -55,7 +70,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     results, previous = [], None
     for i, speed in enumerate(tqdm(speeds, desc=f"Stribeck mu0={lubricant.viscosity:g}",
                                    disable=not progress, unit="speed")):
-        path = None if folder is None else folder / f"point_{key}_{speed:.9e}.npz"
+        path = None if folder is None else point_file(folder, key, speed)
         res = None if path is None else load_or_none(path, MixedResult.load)
         if res is None:
             sliding = dict(speed=float(speed)) if slide_to_roll is None else dict(
