@@ -142,6 +142,18 @@ def _add_case_commands(sub):
     cb = _case_command(sub, "calibrate", "calibration study of a case (paper 3.2): C_f,dev "
                                          "of variants against a reference curve",
                        "calibration", _calibrate)
+    ft = sub.add_parser("fit", help="fit C_f,b and the oil temperature of a case to measured "
+                                    "Stribeck curves (runs or resumes the case first)")
+    ft.add_argument("case", type=Path, help="case file")
+    ft.add_argument("measured", type=Path, nargs="+",
+                    help="measured CSV per viscosity of the case (speed [m/s], "
+                         "friction_coefficient, optional cf_min/cf_max)")
+    ft.add_argument("-o", "--output", type=Path, default=Path("out"), help="output folder")
+    ft.add_argument("--params", default="boundary_friction,temperature",
+                    help="comma-separated case keys to fit: boundary_friction, temperature")
+    ft.add_argument("--no-progress", action="store_true", help="no progress bars")
+    ft.add_argument("--yes", action="store_true", help="start even if the run is long")
+    ft.set_defaults(func=_fit)
     cb.add_argument("--study", required=True,
                     choices=("filter", "resolution", "disk", "pins", "patches"))
     cb.add_argument("--values", type=float, nargs="+",
@@ -570,6 +582,26 @@ def _short_summary(summary: dict, out: Path) -> str:
                  f"fem_twin.results.open_run, fields/ for ParaView, summary.json, run.log); "
                  f"the figures on one page: fem-twin report {out}")
     return "\n".join(lines)
+
+
+def _fit(args):
+    from .case import load_case
+    from .fitting import fit_case
+    if not args.case.is_file():
+        raise MissingFile(f"case file not found: {args.case}")
+    case = load_case(args.case)
+    if not _confirm_cost(case, args.yes):
+        return 2
+    result = fit_case(case, args.measured, args.output,
+                      [p.strip() for p in args.params.split(",") if p.strip()],
+                      progress=not args.no_progress)
+    for name in result["fit"]["parameters"] + [k for k in result if k.startswith("viscosity_")]:
+        v = result[name]
+        print(f"fem-twin fit: {name} = {v['value']:.5g} (95 %: {v['low']:.5g} to "
+              f"{v['high']:.5g})")
+    print(f"  rms C_f,dev {result['fit']['rms_cf_dev']:.2%} over {result['fit']['points']} "
+          f"points; {RunLayout(args.output).fit} and fit.png")
+    return 0
 
 
 def _calibrate(args):

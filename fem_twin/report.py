@@ -38,7 +38,7 @@ def write_report(outdir, path=None, *, render: bool = True) -> Path:
     sections = [geometry_section(out, work, render), levelling_section(out, work),
                 figure_section("Flow factors (Figures 4-5)", [out.flow_factors_png],
                                "Patch pairs and their average versus the separation h0."),
-                stribeck_section(out), calibration_section(out),
+                stribeck_section(out), fit_section(out), calibration_section(out),
                 tables_section(summary)]
     page = _PAGE.format(title=html.escape(f"fem_twin report: {summary.get('case', '')}"),
                         body="\n".join(s for s in sections if s))
@@ -104,6 +104,19 @@ def stribeck_section(out: RunLayout) -> str:
     return (body + figure_section("Macro fields", fields, "Fastest, middle and slowest "
                                   "point of each sweep.")
             + figure_section("Validation against measured curves (eq 35)", val, ""))
+
+
+def fit_section(out: RunLayout) -> str:
+    """``fem-twin fit``: the fitted parameters with their 95 % intervals, and the curves."""
+    if not out.fit.is_file():
+        return ""
+    fit = json.loads(out.fit.read_text())
+    names = fit["fit"]["parameters"] + [k for k in fit if k.startswith("viscosity_")]
+    text = "; ".join(f"{k} = {fit[k]['value']:.4g} (95 %: {fit[k]['low']:.4g} to "
+                     f"{fit[k]['high']:.4g})" for k in names)
+    return figure_section("Fitted to measured curves", [out.fit_png],
+                          f"{text}; rms C_f,dev {fit['fit']['rms_cf_dev']:.2%} (eq 35) over "
+                          f"{fit['fit']['points']} points, weights: {fit['fit']['weights']}.")
 
 
 def calibration_section(out: RunLayout) -> str:

@@ -165,6 +165,15 @@ class RunLayout:
         return self.root / "fields.nc"
 
     @property
+    def fit(self) -> Path:
+        """``fem-twin fit``: the fitted parameters with their 95 % intervals."""
+        return self.root / "fit.json"
+
+    @property
+    def fit_png(self) -> Path:
+        return self.root / "fit.png"
+
+    @property
     def report(self) -> Path:
         return self.root / "report.html"
 

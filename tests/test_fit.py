@@ -1,0 +1,62 @@
+"""Fitting C_f,b and the oil temperature to measured curves (fem_twin.stribeck.fit).
+
+The 'measured' curve is the twin itself, run at the true viscosity mu(T_true) of the Walther
+law through Table 3 (not rescaled by the Hersey collapse the fit uses) with the true C_f,b,
+plus 1 % noise (seeded): the fit must recover both inside their 95 % intervals."""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fem_twin.errors import InputError
+from fem_twin.macro import Lubricant, MacroSettings
+from fem_twin.macro.viscosity import WaltherLaw
+from fem_twin.stribeck import stribeck_sweep
+from fem_twin.stribeck.curve import MeasuredCurve
+from fem_twin.stribeck.fit import FitModel, fit_curves
+
+sys.path.insert(0, str(Path(__file__).parent))
+from test_macro import factors, macro_case  # noqa: E402,F401
+
+LAW = WaltherLaw.through([24.0, 50.0], [0.066, 0.024], 850.0)
+
+
+def test_walther_law_through_table_3():
+    assert LAW.viscosity([24.0, 50.0]) == pytest.approx([0.066, 0.024], rel=1e-12)
+    assert LAW.temperature(LAW.viscosity(37.0)) == pytest.approx(37.0, rel=1e-12)
+    assert 0.024 < LAW.viscosity(37.0) < 0.066
+    with pytest.raises(InputError):
+        WaltherLaw.through([24.0, 50.0], [0.024, 0.066], 850.0)      # rises with T
+
+
+def test_fit_recovers_boundary_friction_and_temperature(factors):  # noqa: F811
+    gap, dx, face = macro_case(32)
+    cfb_true, t_true = 0.15, 35.0
+    common = dict(load=150.0, face=face, settings=MacroSettings())
+    sim = stribeck_sweep(gap, dx, factors, np.geomspace(2.0, 0.004, 14),
+                         lubricant=Lubricant(0.066), **common)
+    speeds = np.geomspace(1.0, 0.01, 9)
+    true = stribeck_sweep(gap, dx, factors, speeds, lubricant=Lubricant(
+        float(LAW.viscosity(t_true))), **common)
+    cf = (true.hydrodynamic_friction + cfb_true / sim_cfb(sim) * true.boundary_friction) / 150
+    noisy = cf * (1 + 0.01 * np.random.default_rng(3).standard_normal(cf.size))
+    model = FitModel((sim,), sim_cfb(sim), 150.0, LAW)
+    out = fit_curves(model, [MeasuredCurve(speeds, noisy)], ["boundary_friction",
+                                                              "temperature"],
+                     start_temperatures=[24.0])
+    for name, value in (("boundary_friction", cfb_true), ("temperature_1", t_true)):
+        assert out[name]["low"] < value < out[name]["high"], (name, out[name])
+    assert out["temperature_1"]["high"] - out["temperature_1"]["low"] < 10.0
+    assert out["fit"]["points_outside_simulated_range"] == 0
+    fixed = fit_curves(model, [MeasuredCurve(speeds, cf)], ["boundary_friction"],
+                       start_temperatures=[t_true])           # noiseless, T known
+    assert fixed["boundary_friction"]["value"] == pytest.approx(cfb_true, rel=5e-3)
+    with pytest.raises(InputError, match="unknown"):
+        fit_curves(model, [MeasuredCurve(speeds, cf)], ["load"], start_temperatures=[24.0])
+
+
+def sim_cfb(curve):
+    """The C_f,b the simulated curve was run with (MacroSettings' default, eq 32)."""
+    return MacroSettings().boundary_friction
