@@ -151,6 +151,9 @@ def _add_case_commands(sub):
     ft.add_argument("-o", "--output", type=Path, default=Path("out"), help="output folder")
     ft.add_argument("--params", default="boundary_friction,temperature",
                     help="comma-separated case keys to fit: boundary_friction, temperature")
+    ft.add_argument("--predict", type=float, nargs="+", default=[], metavar="T",
+                    help="oil temperatures [C] of predicted curves with their 95 %% band "
+                         "(OUT/prediction_TC.csv)")
     ft.add_argument("--no-progress", action="store_true", help="no progress bars")
     ft.add_argument("--yes", action="store_true", help="start even if the run is long")
     ft.set_defaults(func=_fit)
@@ -594,7 +597,7 @@ def _fit(args):
         return 2
     result = fit_case(case, args.measured, args.output,
                       [p.strip() for p in args.params.split(",") if p.strip()],
-                      progress=not args.no_progress)
+                      predict_at=args.predict, progress=not args.no_progress)
     for name in result["fit"]["parameters"] + [k for k in result if k.startswith("viscosity_")]:
         v = result[name]
         print(f"fem-twin fit: {name} = {v['value']:.5g} (95 %: {v['low']:.5g} to "

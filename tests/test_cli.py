@@ -763,10 +763,11 @@ def test_inputs_that_failed_late_or_unhelpfully(tmp_path, capsys):
 
 
 def test_fit_a_case_to_measured_curves(tmp_path, capsys):
-    """Issue 29: fem-twin fit CASE measured.csv -o OUT --params ...: the 'measured' curves
-    are the run's own at C_f,b = 0.15 (its two viscosities, 24 and 50 C in the case), so the
-    fit returns C_f,b = 0.15 and the case's temperatures inside their 95 % intervals, writes
-    fit.json and fit.png, and refuses an unknown parameter before any work."""
+    """Issue 29: fem-twin fit CASE measured.csv -o OUT --params ... --predict T: the
+    'measured' curves are the run's own at C_f,b = 0.15 (its two viscosities, 24 and 50 C in
+    the case), so the fit returns C_f,b = 0.15 and the case's temperatures, writes fit.json,
+    fit.png and a predicted curve with its band, and refuses an unknown parameter before
+    any work."""
     case = small_case(tmp_path)
     out = tmp_path / "o"
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
@@ -778,12 +779,16 @@ def test_fit_a_case_to_measured_curves(tmp_path, capsys):
         path.write_text("speed,friction_coefficient\n" + "".join(
             f"{float(u)!r},{float(f)!r}\n" for u, f in zip(c.speed[1:-1], cf[1:-1])))
         files.append(str(path))
-    assert main(["fit", str(case), *files, "-o", str(out), "--no-progress"]) == 0
+    assert main(["fit", str(case), *files, "-o", str(out), "--no-progress",
+                 "--predict", "37"]) == 0
     fit = json.loads((out / "fit.json").read_text())
     assert fit["boundary_friction"]["value"] == pytest.approx(0.15, rel=2e-3)
     for k, t in ((1, 24.0), (2, 50.0)):
         assert abs(fit[f"temperature_{k}"]["value"] - t) < 0.5
     assert (out / "fit.png").is_file() and "boundary_friction = 0.15" in capsys.readouterr().out
+    pred = list(csv.DictReader(open(out / "prediction_37C.csv")))
+    assert all(float(r["cf_low"]) < float(r["friction_coefficient"]) < float(r["cf_high"])
+               for r in pred)
     assert main(["fit", str(case), files[0], "-o", str(tmp_path / "x"), "--params",
                  "load"]) == 2
     assert not (tmp_path / "x").exists()

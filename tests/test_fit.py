@@ -60,3 +60,35 @@ def test_fit_recovers_boundary_friction_and_temperature(factors):  # noqa: F811
 def sim_cfb(curve):
     """The C_f,b the simulated curve was run with (MacroSettings' default, eq 32)."""
     return MacroSettings().boundary_friction
+
+
+def test_prediction_at_another_temperature_holds_the_twin(factors):  # noqa: F811
+    """Fitted at 35 C (C_f,b = 0.15, noise 1 %), predicted at 45 C from simulated curves at
+    24 and 50 C: the twin run at mu(45 C) directly lies within 0.5 % C_f,b of the predicted
+    95 % band (the parameters' interval plus the spread of the two rescaled curves).
+    Measured: outside the band by at most 0.33 % C_f,b, at the onset of contact (0.03 m/s),
+    where the direct run's C_f is 0.0019 and the rescaled curves agree on 0.0023-0.0028:
+    the Hersey collapse is not exact there (elasticity and Roelands do not scale with mu U),
+    and two curves that agree with each other do not bound it."""
+    from fem_twin.stribeck.fit import predict
+    gap, dx, face = macro_case(32)
+    common = dict(load=150.0, face=face, settings=MacroSettings())
+    sim = stribeck_sweep(gap, dx, factors, np.geomspace(2.0, 0.004, 14),
+                         lubricant=Lubricant(0.066), **common)
+    cfb0 = sim_cfb(sim)
+    speeds = np.geomspace(1.0, 0.01, 9)
+    runs = {t: stribeck_sweep(gap, dx, factors, speeds, lubricant=Lubricant(
+        float(LAW.viscosity(t))), **common) for t in (35.0, 45.0)}
+    cf = {t: (r.hydrodynamic_friction + 0.15 / cfb0 * r.boundary_friction) / 150
+          for t, r in runs.items()}
+    noisy = cf[35.0] * (1 + 0.01 * np.random.default_rng(3).standard_normal(speeds.size))
+    model = FitModel((sim,), cfb0, 150.0, LAW)
+    out = fit_curves(model, [MeasuredCurve(speeds, noisy)], ["boundary_friction",
+                                                              "temperature"],
+                     start_temperatures=[35.0])
+    warm = stribeck_sweep(gap, dx, factors, np.geomspace(2.0, 0.004, 14),
+                          lubricant=Lubricant(0.024), **common)
+    p = predict(FitModel((sim, warm), cfb0, 150.0, LAW), out, speeds, 45.0, nominal=[35.0])
+    assert np.all(p["cf_low"] < p["cf"]) and np.all(p["inside_simulated_range"])
+    outside = np.maximum(p["cf_low"] - cf[45.0], cf[45.0] - p["cf_high"])
+    assert outside.max() < 5e-3 * cfb0

@@ -102,7 +102,9 @@ class RunLayout:
 
     def patch_factors(self, k: int | None) -> Path:
         """Flow factors of patch ``k`` (None: the patch average)."""
-        return self.flow_factors if k is None else self.micro / f"patch_{k}" / self.flow_factors.name
+        if k is None:
+            return self.flow_factors
+        return self.micro / f"patch_{k}" / self.flow_factors.name
 
     def patch_checkpoints(self, k: int) -> Path:
         return self.micro / f"patch_{k}" / "checkpoints"
@@ -172,6 +174,10 @@ class RunLayout:
     @property
     def fit_png(self) -> Path:
         return self.root / "fit.png"
+
+    def prediction(self, temperature: float) -> Path:
+        """``fem-twin fit --predict T``: the curve predicted for the oil at ``T`` [C]."""
+        return self.root / f"prediction_{temperature:g}C.csv"
 
     @property
     def report(self) -> Path:

@@ -149,9 +149,69 @@ def _summary(model, measured, names, sol, weighted, unpack) -> dict:
                   "rms_cf_dev": float(np.sqrt(np.mean(dev ** 2))),
                   "max_abs_cf_dev": float(np.abs(dev).max()),
                   "points_outside_simulated_range": outside,
-                  "correlation": _correlation(cov).tolist()}
+                  "correlation": _correlation(cov).tolist(), "covariance": cov.tolist(),
+                  "t_factor": float(stats.t.ppf(0.975, dof))}
     out["residuals"] = rows
     return out
+
+
+def predict(model: FitModel, result: dict, speeds, temperature: float,
+            nominal=None) -> dict:
+    """C_f at ``speeds`` [m/s] for the oil at ``temperature`` [C] with the fitted parameters
+    of ``result`` (:func:`fit_curves`), and its 95 % band from their covariance.
+
+    With fitted temperatures and the ``nominal`` oil temperatures of the measured curves
+    [C], the contact runs at ``temperature`` plus their mean offset (fitted minus nominal,
+    e.g. frictional heating), whose uncertainty joins the band; without, at
+    ``temperature``.  The simulated curve of the nearest viscosity is rescaled (Hersey);
+    the band adds the spread of all the simulated curves so rescaled (the Hersey collapse's
+    own error, when there are two or more) and their C_f error estimates (``cf_err``)."""
+    names = result["fit"]["parameters"]
+    x = np.array([result[n]["value"] for n in names])
+    cov = np.asarray(result["fit"]["covariance"])
+    temps = [i for i, n in enumerate(names) if n.startswith("temperature_")]
+
+    def cf(x, k=None):
+        cfb = x[names.index("boundary_friction")] if "boundary_friction" in names \
+            else model.boundary_friction
+        offset = (np.mean([x[i] - t for i, t in zip(temps, nominal)])
+                  if temps and nominal is not None else 0.0)
+        mu = float(model.law.viscosity(temperature + offset))
+        if k is None:
+            k = int(np.argmin([abs(np.log(c.viscosity / mu)) for c in model.curves]))
+        return model.friction(k, speeds, cfb, mu)
+
+    value, inside = cf(x)
+    discretisation = _error_at(model, speeds) + _collapse_error(model, cf, x)
+    grad = np.stack([(cf(x + step)[0] - value) / step[i]
+                     for i, step in enumerate(np.diag(np.maximum(1e-6 * np.abs(x), 1e-6)))],
+                    axis=1)
+    half = result["fit"]["t_factor"] * np.sqrt(np.einsum("ij,jk,ik->i", grad, cov, grad))
+    half = half + discretisation                  # the twin's own error (cf_err), when known
+    return {"speed_m_s": np.asarray(speeds, float), "cf": value, "cf_low": value - half,
+            "cf_high": value + half, "cf_err": discretisation,
+            "inside_simulated_range": inside}
+
+
+def _collapse_error(model: FitModel, cf, x) -> np.ndarray:
+    """Largest spread of the simulated curves rescaled to the same viscosity (eq 46)."""
+    if len(model.curves) < 2:
+        return 0.0
+    values = np.array([cf(x, k)[0] for k in range(len(model.curves))])
+    return values.max(axis=0) - values.min(axis=0)
+
+
+def _error_at(model: FitModel, speeds) -> np.ndarray:
+    """The simulated curves' C_f error estimate at ``speeds`` (the largest over the curves;
+    0 without estimates)."""
+    curves = [c for c in model.curves if c.friction_error is not None]
+    if not curves:
+        return np.zeros(np.shape(speeds))
+    out = []
+    for c in curves:
+        order = np.argsort(c.speed)
+        out.append(np.interp(np.log(speeds), np.log(c.speed[order]), c.friction_error[order]))
+    return np.max(out, axis=0)
 
 
 def _correlation(cov):
