@@ -32,14 +32,14 @@ from .io.layout import RunLayout
 from .io.mesh import grid_mesh, write_vtu
 from .macro import MacroSettings, MixedResult
 from .macro.figures import plot_point_fields
-from .macro.friction import BOUNDARY_FRICTION
 from .macro.point_contact import PointContact, film_thickness
 from .micro import FlowFactors, average, homogenise
 from .micro.homogenisation import prune_checkpoints
 from .micro.output import plot_flow_factors
-from .stribeck import (deviation_from_measured, friction_deviation, plot_stribeck,
+from .stribeck import (deviation_from_measured, plot_stribeck,
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)
 from .stribeck.accuracy import error_summary
+from .stribeck.analysis import hersey_collapse, patch_band, transition_speeds
 from .stribeck.sweep import point_files, point_key, sweep_key
 from .threads import one_thread, process_pool, stop_pool, worker_heap
 from .topography import resample_cell
@@ -501,12 +501,6 @@ def band_sweeps(case: Case, out: RunLayout, common: dict) -> list[dict]:
             for i in range(n)]
 
 
-def patch_band(patch_curves) -> list:
-    """(cf_min, cf_max) per lubricant over single-patch curves [patch][lubricant]."""
-    cf = np.array([[c.friction_coefficient for c in per_mu] for per_mu in patch_curves])
-    return [(cf[:, k].min(axis=0), cf[:, k].max(axis=0)) for k in range(cf.shape[1])]
-
-
 def curve_labels(case: Case, curves) -> list[str]:
     return [f"{t:g} °C, $\\mu_0$ = {c.viscosity:g} Pa s"
             for t, c in zip(case.lubricant.temperatures, curves)]
@@ -618,18 +612,6 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     return [f.result() for f in futures]
 
 
-def transition_speeds(curves, step: float) -> np.ndarray:
-    """Geometric midpoints of neighbouring speeds between which C_f of any curve changes by
-    more than ``step`` (where the Stribeck curve turns, from full film to boundary)."""
-    extra = []
-    for c in curves:
-        order = np.argsort(c.speed)
-        u, cf = c.speed[order], c.friction_coefficient[order]
-        jump = np.abs(np.diff(cf)) > step
-        extra.extend(np.sqrt(u[:-1] * u[1:])[jump])
-    return np.unique(np.round(extra, 12))
-
-
 def _sweep_key(kwargs: dict, lubricant) -> str:
     """Checkpoint key of one sweep task (:func:`~fem_twin.stribeck.sweep.point_file`)."""
     return sweep_key(kwargs["gap"], kwargs["spacing"], kwargs["factors_key"], kwargs["load"],
@@ -645,17 +627,3 @@ def _prune_points(folder: Path, tasks) -> None:
         p.unlink()
     if stale:
         log.info("%d stale Stribeck checkpoints removed", len(stale))
-
-
-def hersey_collapse(curves, boundary: float = BOUNDARY_FRICTION) -> float:
-    """max |C_f,dev| (eq 35, relative to ``boundary`` = C_f,b) between the first curve and
-    the others over the Hersey numbers where they overlap (the others' points, interpolated
-    on the first curve)."""
-    ref = curves[0]
-    devs = []
-    for c in curves[1:]:
-        cf_ref = ref.at_hersey(c.hersey)
-        ok = np.isfinite(cf_ref)
-        devs.extend(np.abs(friction_deviation(c.friction_coefficient[ok], cf_ref[ok],
-                                              boundary)))
-    return float(max(devs)) if devs else float("nan")

@@ -611,7 +611,7 @@ def test_example_case_ships_with_the_package(tmp_path, capsys):
 def test_sweep_refinement_adds_speeds_where_the_curve_turns(tmp_path):
     """Issue 18 item 5: [sweep] refine adds the geometric midpoints of neighbouring speeds
     between which C_f jumps by more than refine_step C_f,b; a rerun recomputes nothing."""
-    from fem_twin.pipeline import transition_speeds
+    from fem_twin.stribeck.analysis import transition_speeds
     from fem_twin.stribeck.curve import read_stribeck_csv
     text = small_case(tmp_path).read_text().replace("refine = 0 ", "refine = 1 ")
     (tmp_path / "r.toml").write_text(text)

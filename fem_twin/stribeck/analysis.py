@@ -1,0 +1,41 @@
+"""Analysis of Stribeck curves: the patch scatter band (Figure 13), the speeds where a curve
+turns (for refinement) and the Hersey collapse of curves at several viscosities (eq 46)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..macro.friction import BOUNDARY_FRICTION
+from .curve import friction_deviation
+
+
+def patch_band(patch_curves) -> list:
+    """(cf_min, cf_max) per lubricant over single-patch curves [patch][lubricant]."""
+    cf = np.array([[c.friction_coefficient for c in per_mu] for per_mu in patch_curves])
+    return [(cf[:, k].min(axis=0), cf[:, k].max(axis=0)) for k in range(cf.shape[1])]
+
+
+def transition_speeds(curves, step: float) -> np.ndarray:
+    """Geometric midpoints of neighbouring speeds between which C_f of any curve changes by
+    more than ``step`` (where the Stribeck curve turns, from full film to boundary)."""
+    extra = []
+    for c in curves:
+        order = np.argsort(c.speed)
+        u, cf = c.speed[order], c.friction_coefficient[order]
+        jump = np.abs(np.diff(cf)) > step
+        extra.extend(np.sqrt(u[:-1] * u[1:])[jump])
+    return np.unique(np.round(extra, 12))
+
+
+def hersey_collapse(curves, boundary: float = BOUNDARY_FRICTION) -> float:
+    """max |C_f,dev| (eq 35, relative to ``boundary`` = C_f,b) between the first curve and
+    the others over the Hersey numbers where they overlap (the others' points, interpolated
+    on the first curve)."""
+    ref = curves[0]
+    devs = []
+    for c in curves[1:]:
+        cf_ref = ref.at_hersey(c.hersey)
+        ok = np.isfinite(cf_ref)
+        devs.extend(np.abs(friction_deviation(c.friction_coefficient[ok], cf_ref[ok],
+                                              boundary)))
+    return float(max(devs)) if devs else float("nan")
