@@ -15,12 +15,30 @@ from fem_twin.macro import Lubricant, MacroSettings
 from fem_twin.macro.viscosity import WaltherLaw
 from fem_twin.stribeck import stribeck_sweep
 from fem_twin.stribeck.curve import MeasuredCurve
-from fem_twin.stribeck.fit import FitModel, fit_curves
+from fem_twin.stribeck.fit import FitModel, fit_curves, predict
 
 sys.path.insert(0, str(Path(__file__).parent))
 from test_macro import factors, macro_case  # noqa: E402,F401
 
 LAW = WaltherLaw.through([24.0, 50.0], [0.066, 0.024], 850.0)
+CFB = MacroSettings().boundary_friction          # the C_f,b the curves are run with (eq 32)
+CFB_TRUE = 0.15
+SPEEDS = np.geomspace(1.0, 0.01, 9)
+
+
+@pytest.fixture(scope="module")
+def twin(factors):  # noqa: F811
+    """Simulated curves at 24 and 50 C, and the 'measured' ones run directly at 35 and 45 C
+    with C_f,b = 0.15 (C_f only)."""
+    gap, dx, face = macro_case(32)
+    common = dict(load=150.0, face=face, settings=MacroSettings())
+    sim = {mu: stribeck_sweep(gap, dx, factors, np.geomspace(2.0, 0.004, 14),
+                              lubricant=Lubricant(mu), **common) for mu in (0.066, 0.024)}
+    direct = {t: stribeck_sweep(gap, dx, factors, SPEEDS, lubricant=Lubricant(
+        float(LAW.viscosity(t))), **common) for t in (35.0, 45.0)}
+    cf = {t: (r.hydrodynamic_friction + CFB_TRUE / CFB * r.boundary_friction) / 150
+          for t, r in direct.items()}
+    return sim, cf
 
 
 def test_walther_law_through_table_3():
@@ -31,38 +49,26 @@ def test_walther_law_through_table_3():
         WaltherLaw.through([24.0, 50.0], [0.024, 0.066], 850.0)      # rises with T
 
 
-def test_fit_recovers_boundary_friction_and_temperature(factors):  # noqa: F811
-    gap, dx, face = macro_case(32)
-    cfb_true, t_true = 0.15, 35.0
-    common = dict(load=150.0, face=face, settings=MacroSettings())
-    sim = stribeck_sweep(gap, dx, factors, np.geomspace(2.0, 0.004, 14),
-                         lubricant=Lubricant(0.066), **common)
-    speeds = np.geomspace(1.0, 0.01, 9)
-    true = stribeck_sweep(gap, dx, factors, speeds, lubricant=Lubricant(
-        float(LAW.viscosity(t_true))), **common)
-    cf = (true.hydrodynamic_friction + cfb_true / sim_cfb(sim) * true.boundary_friction) / 150
-    noisy = cf * (1 + 0.01 * np.random.default_rng(3).standard_normal(cf.size))
-    model = FitModel((sim,), sim_cfb(sim), 150.0, LAW)
-    out = fit_curves(model, [MeasuredCurve(speeds, noisy)], ["boundary_friction",
+def test_fit_recovers_boundary_friction_and_temperature(twin):
+    sim, cf = twin
+    noisy = cf[35.0] * (1 + 0.01 * np.random.default_rng(3).standard_normal(SPEEDS.size))
+    model = FitModel((sim[0.066],), CFB, 150.0, LAW)
+    out = fit_curves(model, [MeasuredCurve(SPEEDS, noisy)], ["boundary_friction",
                                                               "temperature"],
                      start_temperatures=[24.0])
-    for name, value in (("boundary_friction", cfb_true), ("temperature_1", t_true)):
+    for name, value in (("boundary_friction", CFB_TRUE), ("temperature_1", 35.0)):
         assert out[name]["low"] < value < out[name]["high"], (name, out[name])
     assert out["temperature_1"]["high"] - out["temperature_1"]["low"] < 10.0
     assert out["fit"]["points_outside_simulated_range"] == 0
-    fixed = fit_curves(model, [MeasuredCurve(speeds, cf)], ["boundary_friction"],
-                       start_temperatures=[t_true])           # noiseless, T known
-    assert fixed["boundary_friction"]["value"] == pytest.approx(cfb_true, rel=5e-3)
+    fixed = fit_curves(model, [MeasuredCurve(SPEEDS, cf[35.0])], ["boundary_friction"],
+                       start_temperatures=[35.0])           # noiseless, T known
+    assert fixed["boundary_friction"]["value"] == pytest.approx(CFB_TRUE, rel=5e-3)
     with pytest.raises(InputError, match="unknown"):
-        fit_curves(model, [MeasuredCurve(speeds, cf)], ["load"], start_temperatures=[24.0])
+        fit_curves(model, [MeasuredCurve(SPEEDS, cf[35.0])], ["load"],
+                   start_temperatures=[24.0])
 
 
-def sim_cfb(curve):
-    """The C_f,b the simulated curve was run with (MacroSettings' default, eq 32)."""
-    return MacroSettings().boundary_friction
-
-
-def test_prediction_at_another_temperature_holds_the_twin(factors):  # noqa: F811
+def test_prediction_at_another_temperature_holds_the_twin(twin):
     """Fitted at 35 C (C_f,b = 0.15, noise 1 %), predicted at 45 C from simulated curves at
     24 and 50 C: the twin run at mu(45 C) directly lies within 0.5 % C_f,b of the predicted
     95 % band (the parameters' interval plus the spread of the two rescaled curves).
@@ -70,25 +76,12 @@ def test_prediction_at_another_temperature_holds_the_twin(factors):  # noqa: F81
     where the direct run's C_f is 0.0019 and the rescaled curves agree on 0.0023-0.0028:
     the Hersey collapse is not exact there (elasticity and Roelands do not scale with mu U),
     and two curves that agree with each other do not bound it."""
-    from fem_twin.stribeck.fit import predict
-    gap, dx, face = macro_case(32)
-    common = dict(load=150.0, face=face, settings=MacroSettings())
-    sim = stribeck_sweep(gap, dx, factors, np.geomspace(2.0, 0.004, 14),
-                         lubricant=Lubricant(0.066), **common)
-    cfb0 = sim_cfb(sim)
-    speeds = np.geomspace(1.0, 0.01, 9)
-    runs = {t: stribeck_sweep(gap, dx, factors, speeds, lubricant=Lubricant(
-        float(LAW.viscosity(t))), **common) for t in (35.0, 45.0)}
-    cf = {t: (r.hydrodynamic_friction + 0.15 / cfb0 * r.boundary_friction) / 150
-          for t, r in runs.items()}
-    noisy = cf[35.0] * (1 + 0.01 * np.random.default_rng(3).standard_normal(speeds.size))
-    model = FitModel((sim,), cfb0, 150.0, LAW)
-    out = fit_curves(model, [MeasuredCurve(speeds, noisy)], ["boundary_friction",
-                                                              "temperature"],
-                     start_temperatures=[35.0])
-    warm = stribeck_sweep(gap, dx, factors, np.geomspace(2.0, 0.004, 14),
-                          lubricant=Lubricant(0.024), **common)
-    p = predict(FitModel((sim, warm), cfb0, 150.0, LAW), out, speeds, 45.0, nominal=[35.0])
+    sim, cf = twin
+    noisy = cf[35.0] * (1 + 0.01 * np.random.default_rng(3).standard_normal(SPEEDS.size))
+    out = fit_curves(FitModel((sim[0.066],), CFB, 150.0, LAW), [MeasuredCurve(SPEEDS, noisy)],
+                     ["boundary_friction", "temperature"], start_temperatures=[35.0])
+    p = predict(FitModel((sim[0.066], sim[0.024]), CFB, 150.0, LAW), out, SPEEDS, 45.0,
+                nominal=[35.0])
     assert np.all(p["cf_low"] < p["cf"]) and np.all(p["inside_simulated_range"])
     outside = np.maximum(p["cf_low"] - cf[45.0], cf[45.0] - p["cf_high"])
-    assert outside.max() < 5e-3 * cfb0
+    assert outside.max() < 5e-3 * CFB
