@@ -357,8 +357,8 @@ def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> Flo
         low, up = resample_cell(low, mc.resolution), resample_cell(up, mc.resolution)
     ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=m.e_reduced,
                     hardness=m.hardness, method=mc.method,
-                    time_derivative=mc.time_derivative, time_tol=mc.time_tol or None,
-                    h0_tol=mc.h0_tol or None, executor=executor,
+                    time_derivative=mc.time_derivative, time_tol=mc.time_tol,
+                    h0_tol=mc.h0_tol, executor=executor,
                     workers=getattr(executor, "n_workers", 1),
                     checkpoint=checkpoints, progress=bar,
                     patch_id=f"patch {i + 1}")

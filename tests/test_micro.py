@@ -616,3 +616,14 @@ def test_results_dataset_holds_patches_sampled_at_different_h0():
     a1 = ds.A11.sel(patch="1").values
     assert np.array_equal(a1[[0, 2, 3, 5]], one.A[:, 0, 0]) and np.isnan(a1[[1, 4]]).all()
     assert np.isfinite(ds.A11.sel(patch="average").values).all()
+
+
+def test_zero_tolerances_mean_off_as_in_the_case_file():
+    """Issue 31: h0_tol = 0 and time_tol = 0 are 'off' in the API as in the case file (every
+    h0, n_steps everywhere), with the same factors and checkpoint key as None."""
+    pin, disk = rough_pair(16)
+    h0 = [1e-7, 2e-7, 4e-7]
+    off = homogenise(pin, disk, h0, n_steps=2, h0_tol=None, time_tol=None)
+    zero = homogenise(pin, disk, h0, n_steps=2, h0_tol=0, time_tol=0.0)
+    assert len(zero) == 3 and np.array_equal(zero.A, off.A)
+    assert zero.meta["checkpoint_keys"] == off.meta["checkpoint_keys"]

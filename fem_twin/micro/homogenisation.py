@@ -144,13 +144,15 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     time_tol : adaptive instants (exact scheme): at each h0 the midpoints are added while
         A11 or b1 change by more than this relative tolerance from every other instant to
         all, up to one pixel per step; ``n_steps`` is then the smallest count
-        (``meta["steps_used"]`` per h0).  None: ``n_steps`` everywhere.
+        (``meta["steps_used"]`` per h0).  0 or None (off, as in the case file): ``n_steps``
+        everywhere.
     h0_tol : adaptive separations: ``h0`` is the dense candidate set and only the subset
         :func:`fem_twin.micro.sampling.adaptive_separations` needs is solved, so that the
         interpolant in log h0 misses the factors at the skipped candidates by less than
-        this relative tolerance (its bound: ``meta["error_estimate"]["h0"]``).  None: every
-        ``h0``.
+        this relative tolerance (its bound: ``meta["error_estimate"]["h0"]``).  0 or None
+        (off, as in the case file): every ``h0``.
     """
+    time_tol, h0_tol = time_tol or None, h0_tol or None       # 0 means off, as in the case
     settings = CellSettings(int(n_steps), float(e_reduced), float(hardness), float(gap_floor),
                             method, moving, first_step, time_derivative=time_derivative,
                             time_tol=time_tol)
