@@ -14,7 +14,7 @@ from .io.table import write_csv
 from .macro.viscosity import WaltherLaw
 from .stribeck import read_measured_csv
 from .stribeck.curve import read_stribeck_csv
-from .stribeck.fit import PARAMETERS, FitModel, fit_curves, plot_fit, predict
+from .stribeck.fit import FitModel, check_parameters, fit_curves, plot_fit, predict
 
 
 def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: bool = True,
@@ -25,9 +25,7 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     C_f with its 95 % band, :func:`~fem_twin.stribeck.fit.predict`).
     ``run``: the pipeline's ``run`` (runs or resumes the case into ``outdir``)."""
     params = list(params)
-    unknown = set(params) - set(PARAMETERS)
-    if unknown or not params:
-        raise InputError(f"--params: unknown {sorted(unknown)}; choose from {list(PARAMETERS)}")
+    check_parameters(params)                                      # before the run
     paths = [Path(p) for p in measured]
     curves_measured = [read_measured_csv(p) for p in paths]      # checked before any work
     lb = case.lubricant

@@ -128,8 +128,9 @@ def invalidate_changed_stages(case: Case, out: RunLayout) -> None:
     if path.exists():
         try:
             old = json.loads(path.read_text())
-            assert isinstance(old, dict)
-        except (ValueError, AssertionError, UnicodeDecodeError):
+        except (ValueError, UnicodeDecodeError):
+            old = None
+        if not isinstance(old, dict):
             log.warning("%s is damaged: every cached stage is recomputed", path)
             old = {stage: "damaged" for stage in ("geometry", "levelling", "micro")}
     new = stage_keys(case)

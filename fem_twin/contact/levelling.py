@@ -115,16 +115,20 @@ def level_pin(pin: Topography, disk: Topography | None = None, *, load: float = 
                 raise ContactNotConverged(
                     "pin levelling: a tilt does not change the contact torques (singular "
                     "Jacobian); is the pin face cropped by the edge of the map, or the map "
-                    "not square about the pin?", [np.max(np.abs(h[2:])) for h in history]) \
-                    from None
+                    "not square about the pin?", _residuals(history)) from None
             tilted, res, r_new = evaluate(tilt + step)
             jac += np.outer(r_new - r - jac @ step, step) / (step @ step)   # Broyden update
             tilt, r = tilt + step, r_new
     if np.max(np.abs(r)) >= tol:
         raise ContactNotConverged(f"pin levelling ({method}) did not reach torque residuals "
-                                  f"below {tol}", [np.max(np.abs(h[2:])) for h in history])
+                                  f"below {tol}", _residuals(history))
     return LevellingResult(tilted, (float(tilt[0]), float(tilt[1])), (float(r[0]), float(r[1])),
                            res, np.array(history))
+
+
+def _residuals(history) -> list:
+    """The largest torque residual of each step of a levelling ``history``."""
+    return [float(np.max(np.abs(h[2:]))) for h in history]
 
 
 def mean_plane_tilt(pin: Topography, upper: np.ndarray, holder_height: float = -1e-3):

@@ -62,6 +62,14 @@ class FitModel:
         return (hd + boundary_friction * con) / self.load, inside
 
 
+def check_parameters(params) -> None:
+    """Refuse an empty list or a name outside :data:`PARAMETERS`."""
+    unknown = set(params) - set(PARAMETERS)
+    if unknown or not params:
+        raise InputError(f"unknown fit parameter(s) {sorted(unknown)}; choose from "
+                         f"{list(PARAMETERS)}")
+
+
 def fit_curves(model: FitModel, measured, params, *, start_temperatures) -> dict:
     """Fit ``params`` (a subset of :data:`PARAMETERS`) to the ``measured`` curves
     (:class:`MeasuredCurve`, one per ``model.curves``); ``start_temperatures`` [C] start the
@@ -69,10 +77,7 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures) -> dict
     when None, each simulated curve keeps its own viscosity (``model.law`` may be None).
     Returns ``{name: {"value", "low", "high"}}`` (``temperature_K`` and its
     ``viscosity_K`` per curve K from 1) with the residuals and the fit's statistics."""
-    unknown = set(params) - set(PARAMETERS)
-    if unknown or not params:
-        raise InputError(f"unknown fit parameter(s) {sorted(unknown)}; choose from "
-                         f"{list(PARAMETERS)}")
+    check_parameters(params)
     if len(measured) != len(model.curves):
         raise InputError(f"{len(measured)} measured curves for {len(model.curves)} simulated")
     names = (["boundary_friction"] if "boundary_friction" in params else []) + (
