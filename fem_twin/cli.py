@@ -3,16 +3,14 @@
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import os
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from .errors import InputError, MissingFile, NotConverged, RunLocked, SchedulerUnreachable
-from .io.layout import RunLayout
+from . import cli_runs as runs
+from . import cli_stages as stages
+from .errors import NotConverged, RunLocked, SchedulerUnreachable
 
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
@@ -134,14 +132,14 @@ def build_parser() -> argparse.ArgumentParser:
 def _add_case_commands(sub):
     """run, compare and calibrate: the commands on a case file."""
     rn = _case_command(sub, "run", "run the pipeline of a case file (TOML) into an output "
-                                   "folder", "out", _run)
+                                   "folder", "out", runs.run)
     rn.add_argument("--yes", action="store_true",
-                    help=f"start even if estimated longer than {LONG_RUN_SECONDS // 60} min")
+                    help=f"start even if estimated longer than {runs.LONG_RUN_SECONDS // 60} min")
     _case_command(sub, "compare", "cross-check FE against the FVM reference on a case: "
-                                  "flow factors, fields, C_f,dev (eq 35)", "compare", _compare)
+                                  "flow factors, fields, C_f,dev (eq 35)", "compare", runs.compare)
     cb = _case_command(sub, "calibrate", "calibration study of a case (paper 3.2): C_f,dev "
                                          "of variants against a reference curve",
-                       "calibration", _calibrate)
+                       "calibration", runs.calibrate)
     ft = sub.add_parser("fit", help="fit C_f,b and the oil temperature of a case to measured "
                                     "Stribeck curves (runs or resumes the case first)")
     ft.add_argument("case", type=Path, help="case file")
@@ -156,7 +154,7 @@ def _add_case_commands(sub):
                          "(OUT/prediction_TC.csv)")
     ft.add_argument("--no-progress", action="store_true", help="no progress bars")
     ft.add_argument("--yes", action="store_true", help="start even if the run is long")
-    ft.set_defaults(func=_fit)
+    ft.set_defaults(func=runs.fit)
     cb.add_argument("--study", required=True,
                     choices=("filter", "resolution", "disk", "pins", "patches"))
     cb.add_argument("--values", type=float, nargs="+",
@@ -177,7 +175,7 @@ def _add_run_commands(sub):
                     help="the measured 'speed' column is in rpm: U = 2 pi r n / 60 with the "
                          "case's sliding radius (or --radius)")
     va.add_argument("--radius", type=float, help="sliding radius r [m] for --rpm")
-    va.set_defaults(func=_validate)
+    va.set_defaults(func=runs.validate)
 
     rp = sub.add_parser("report", help="one self-contained HTML page with the paper's figures "
                                        "of a finished run (3D geometry, levelled pins, flow "
@@ -187,7 +185,7 @@ def _add_run_commands(sub):
     rp.add_argument("-o", "--output", type=Path, help="HTML file (default: RUN/report.html)")
     rp.add_argument("--no-3d", action="store_true",
                     help="skip the pyvista 3D views (Figures 2 and 6)")
-    rp.set_defaults(func=_html_report)
+    rp.set_defaults(func=runs.html_report)
 
 
 def _add_topography(sub):
@@ -203,7 +201,7 @@ def _add_topography(sub):
                        help="pixel pitch [m] for files that do not store it")
         s.add_argument("--unit", default="m", help="unit of plain ASCII/.npy files")
         _step_options(name, s)
-        s.set_defaults(func=_topography)
+        s.set_defaults(func=stages.topography)
 
 
 def _add_contact(sub):
@@ -216,11 +214,11 @@ def _add_contact(sub):
     lv.add_argument("--disk", type=Path, help="flipped disk on the same grid (default: flat)")
     lv.add_argument("--load", type=float, default=50.0, help="imposed load [N]")
     lv.add_argument("--method", choices=("broyden", "pid"), default="broyden")
-    lv.set_defaults(func=_contact_level)
+    lv.set_defaults(func=stages.contact_level)
     av = cs.add_parser("average", help="set average of levelled pins, then level it again")
     av.add_argument("pins", type=Path, nargs="+")
     av.add_argument("-o", "--output", type=Path, required=True)
-    av.set_defaults(func=_contact_average)
+    av.set_defaults(func=stages.contact_average)
 
 
 def _add_homogenise(sub):
@@ -253,11 +251,11 @@ def _add_homogenise(sub):
     hr.add_argument("--fields", type=float, nargs="*", default=(), metavar="H0",
                     help="also write the cell fields (VTU/PVD) at these h0 [m]")
     hr.add_argument("--no-progress", action="store_true", help="no progress bar")
-    hr.set_defaults(func=_homogenise_run)
+    hr.set_defaults(func=stages.homogenise_run)
     ha = hs.add_parser("average", help="average flow factors over patches (same h0 range)")
     ha.add_argument("inputs", type=Path, nargs="+", help="flow_factors.npz files")
     ha.add_argument("-o", "--output", type=Path, required=True, help="output folder")
-    ha.set_defaults(func=_homogenise_average)
+    ha.set_defaults(func=stages.homogenise_average)
 
 
 def _add_macro(sub):
@@ -284,7 +282,7 @@ def _add_macro(sub):
     mp.add_argument("--couette", choices=("central", "upwind"), default="central",
                     help="Couette flux of eq 17: second order (central) or the paper's "
                     "first-order upwind")
-    mp.set_defaults(func=_macro_point)
+    mp.set_defaults(func=stages.macro_point)
 
 
 def _add_utilities(sub):
@@ -295,15 +293,15 @@ def _add_utilities(sub):
     m.add_argument("--periodic", action="store_true", help="periodic mesh (roughness patch)")
     m.add_argument("--kind", choices=("quad", "tri"), default="quad")
     m.add_argument("--spacing", type=float, nargs="+", metavar="M")
-    m.set_defaults(func=_mesh)
+    m.set_defaults(func=stages.mesh)
 
     ex = sub.add_parser("example", help="write the bundled example case and its sample twin "
                                          "into a folder (works without the repository)")
     ex.add_argument("folder", type=Path, help="where to write pin_on_disk.toml and meshes/")
-    ex.set_defaults(func=_example)
+    ex.set_defaults(func=runs.example)
     g = sub.add_parser("sample", help="regenerate the bundled sample twin (seeded)")
     g.add_argument("-o", "--output", type=Path, default=Path("meshes/sample"))
-    g.set_defaults(func=_sample)
+    g.set_defaults(func=stages.sample)
 
 
 def _case_command(sub, name, text, output, func):
@@ -346,360 +344,6 @@ def _step_options(name, s):
         s.add_argument("--fwhm", type=float, default=9.0)
         s.add_argument("--resolution", type=int, nargs=2, default=(256, 256))
         s.add_argument("--clip", type=float, default=20e-6)
-
-
-def _read(args):
-    from .io.files import read_topography
-    return read_topography(args.input, spacing=args.spacing, unit=args.unit)
-
-
-def _topography(args):
-    from . import topography as tp
-    from .io.files import write_topography
-    from .topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
-    topo = _read(args)
-    step = args.step
-    if step == "info":
-        ny, nx = topo.shape
-        inval = 0 if topo.mask is None else int((~topo.mask).sum())
-        print(json.dumps({"file": str(args.input), "pixels_x1_x2": [nx, ny],
-                          "spacing_x1_x2_m": topo.spacing, "size_x1_x2_m": topo.size,
-                          "sq_as_measured_m": topo.rms_height(),
-                          "sq_levelled_m": tp.level(tp.fill_defects(topo)).rms_height(),
-                          "invalid_pixels": inval, "meta": topo.meta}, indent=2, default=str))
-        return 0
-    if step == "convert":
-        out = topo
-    elif step == "fill":
-        out = tp.fill_defects(topo)
-    elif step == "level":
-        mask = None if args.radius is None else tp.radial_mask(topo, args.radius, args.centre)
-        out = tp.level(topo, mask)
-    elif step == "clip":
-        out = tp.clip_heights(topo, args.lower, args.upper)
-    elif step == "filter":
-        out = tp.gaussian_filter(topo, args.fwhm)
-    elif step == "resample":
-        out = tp.resample(topo, args.shape, args.method)
-    elif step == "refine":
-        out = tp.refine(topo, args.factor, args.method)
-    elif step == "patch":
-        out = tp.extract_patch(topo, args.shape, args.start)
-    elif step == "align":
-        out = tp.align_sliding(topo, args.direction)
-    elif step == "flip":
-        out = tp.flip_disk(topo)
-    elif step == "mount":
-        out = tp.mount_pin(topo, args.truncation, args.holder)
-    elif step in ("prepare-pin", "prepare-disk"):
-        opts = MacroOptions(fwhm_px=args.fwhm, resolution=tuple(args.resolution), clip=args.clip)
-        out = (prepare_pin if step == "prepare-pin" else prepare_disk)(topo, opts)
-    else:  # prepare-patch
-        out = prepare_patch(topo, args.shape, args.start, upper=args.upper)
-    write_topography(args.output, out)
-    print(f"{args.output}: {out!r}")
-    return 0
-
-
-def _contact_level(args):
-    from .contact.levelling import level_pin
-    from .io.files import read_topography, write_topography
-    pin = read_topography(args.pin)
-    disk = read_topography(args.disk) if args.disk else None
-    res = level_pin(pin, disk, load=args.load, method=args.method)
-    write_topography(args.output, res.pin)
-    print(json.dumps({"tilt_rad": res.tilt, "residuals": res.residuals,
-                      "contact_solves": len(res.history),
-                      "contact_fraction": res.contact.contact_fraction}, indent=2))
-    return 0
-
-
-def _contact_average(args):
-    from .contact.levelling import average_pins, level_pin
-    from .io.files import read_topography, write_topography
-    res = level_pin(average_pins([read_topography(p) for p in args.pins]))
-    write_topography(args.output, res.pin)
-    print(json.dumps({"pins": len(args.pins), "tilt_rad": res.tilt,
-                      "residuals": res.residuals}, indent=2))
-    return 0
-
-
-def _homogenise_run(args):
-    import numpy as np
-
-    from .io.files import read_topography
-    from .micro import homogenise
-    from .micro.output import write_cell_fields
-    pin, disk = read_topography(args.pin), read_topography(args.disk)
-    lo, hi, n = args.h0
-    if int(n) != n or n < 1:
-        raise InputError(f"the number of h0 values must be a positive integer, got {n}")
-    ff = homogenise(pin, disk, np.geomspace(lo, hi, int(n)), n_steps=args.steps,
-                    method=args.method, time_derivative=args.time_derivative,
-                    time_tol=args.time_tol, h0_tol=args.h0_tol, workers=args.workers,
-                    checkpoint=args.output / "checkpoints", progress=not args.no_progress,
-                    patch_id=f"{args.pin.stem}/{args.disk.stem}")
-    _write_factors(args.output, ff)
-    for h0 in args.fields:
-        print(write_cell_fields(args.output / "fields", pin, disk, h0, n_steps=args.steps,
-                                method=args.method, time_derivative=args.time_derivative))
-    return 0
-
-
-def _homogenise_average(args):
-    from .micro import FlowFactors, average
-    factors = [FlowFactors.load(p) for p in args.inputs]
-    _write_factors(args.output, average(factors), factors)
-    return 0
-
-
-def _write_factors(folder, ff, patches=()):
-    from .micro.output import plot_flow_factors
-    out = RunLayout(folder)                  # the files of a run's flow factors, in folder
-    ff.save(folder / out.flow_factors.name)
-    ff.write_csv(out.flow_factors_csv)
-    labels = [f.meta.get("patch_id") or f"patch {i + 1}" for i, f in enumerate(patches)]
-    plot_flow_factors([*patches, ff], out.flow_factors_png,
-                      labels=[*labels, "average" if patches else ff.meta.get("patch_id") or "patch"])
-    print(json.dumps({"h0_um": [ff.h0[0] * 1e6, ff.h0[-1] * 1e6], "points": len(ff),
-                      "p_con_max_MPa": float(ff.p_con.max() * 1e-6),
-                      "A11_range": [float(ff.A[:, 0, 0].min()), float(ff.A[:, 0, 0].max())],
-                      "estimated_relative_error": {
-                          kind: {q: round(e, 5) for q, e in errors.items()}
-                          for kind, errors in ff.meta.get("error_estimate", {}).items()
-                          if kind in ("time", "grid", "h0")},
-                      "files": [str(folder / out.flow_factors.name), str(out.flow_factors_csv),
-                                str(out.flow_factors_png)]}, indent=2))
-
-
-def _macro_point(args):
-    from .io.atomic import atomic_path
-    from .io.files import read_topography
-    from .macro import Lubricant, MacroSettings, solve_mixed
-    from .micro import FlowFactors
-    pin = read_topography(args.pin)
-    upper = read_topography(args.disk).heights if args.disk else 0.0 * pin.heights
-    if np.shape(upper) != pin.shape:
-        raise InputError(f"disk grid {np.shape(upper)} does not match the pin grid {pin.shape}")
-    face = pin.heights > -0.5e-3                 # the holder sits 1 mm below the face
-    res = solve_mixed(upper - pin.heights, pin.spacing, FlowFactors.load(args.factors),
-                      load=args.load, speed=args.speed, lubricant=Lubricant(args.viscosity),
-                      face=face, settings=MacroSettings(method=args.method,
-                                                        coupling=args.coupling,
-                                                        couette=args.couette))
-    args.output.mkdir(parents=True, exist_ok=True)
-    res.save(args.output / "point.npz")
-    res.write_vtu(args.output / "point.vtu", origin=pin.origin)
-    summary = {k: v for k, v in res.scalars().items()}
-    summary["hersey"] = args.viscosity * args.speed * args.diameter / args.load   # eq 46
-    summary["seconds"] = res.meta["seconds"]
-    with atomic_path(args.output / "point.json") as tmp:
-        tmp.write_text(json.dumps(summary, indent=2))
-    print(json.dumps(summary, indent=2))
-    return 0
-
-
-def _mesh(args):
-    from .io.files import read_topography
-    from .io.mesh import grid_mesh, write_vtu
-    topo = read_topography(args.input, spacing=args.spacing)
-    gm = grid_mesh(topo.shape, topo.spacing, topo.origin, periodic=args.periodic, kind=args.kind)
-    fields = {"height": topo.heights, "valid": topo.valid.astype(float)}
-    write_vtu(args.output, gm, fields)
-    print(f"{args.output}: {gm.mesh.nvertices} nodes, {gm.mesh.nelements} {args.kind} elements")
-    return 0
-
-
-def _sample(args):
-    from . import samples
-    for path in samples.generate(args.output):
-        print(path)
-    return 0
-
-
-#: runs estimated longer than this ask for --yes (the bundled case: about 1 minute)
-LONG_RUN_SECONDS = 10 * 60
-
-
-def _confirm_cost(case, yes: bool) -> bool:
-    """Say which sections take defaults and what the run will cost; refuse a long run
-    without ``--yes``."""
-    if case.defaulted:
-        print(f"fem-twin run: sections not in {case.source.name}, defaults used: " + ", ".join(
-            f"[{s}]" for s in case.defaulted), file=sys.stderr)
-    cores = case.run.workers or os.cpu_count() or 1
-    seconds = case.estimated_seconds(cores)
-    mc = case.micro
-    print(f"fem-twin run: {len(case.geometry.patches)} patch pairs at {mc.resolution[0]}x"
-          f"{mc.resolution[1]}, {mc.h0_count} h0 x {mc.steps} steps"
-          f"{f' (adaptive h0, tolerance {mc.h0_tol:g})' if mc.h0_tol else ''}; "
-          f"{len(case.lubricant.viscosities)} x {case.sweep.count} speeds; estimated "
-          f"{seconds / 60:.0f} min on {cores} cores", file=sys.stderr)
-    if seconds > LONG_RUN_SECONDS and not yes:
-        print(f"fem-twin run: error: this run is estimated at {seconds / 60:.0f} min (the "
-              "bundled case: about 1 min); check the case and run again with --yes",
-              file=sys.stderr)
-        return False
-    return True
-
-
-def _run(args):
-    from .case import load_case
-    from .pipeline import run
-    if not args.case.is_file():
-        raise MissingFile(f"case file not found: {args.case} (give the case file as "
-                                "the first argument)")
-    case = load_case(args.case)
-    if not _confirm_cost(case, args.yes):
-        return 2
-    summary = run(case, args.output, progress=not args.no_progress)
-    print(_short_summary(summary, args.output))
-    return 0
-
-
-def _short_summary(summary: dict, out: Path) -> str:
-    """A few lines for the terminal; everything is in ``OUT/summary.json``."""
-    stages = summary["stages"]
-    lines = [f"fem-twin run: {summary['case']} done in {summary['wall_time_s']:.0f} s ("
-             + ", ".join(f"{k} {v:.0f} s" for k, v in summary["seconds"].items()) + ")"]
-    for c in stages["stribeck"]["curves"]:
-        lo, hi = c["friction_coefficient_range"]
-        lines.append(f"  mu_0 = {c['viscosity_Pa_s']:g} Pa s: C_f from {lo:.4f} to {hi:.4f}")
-    if "hersey_collapse_max_abs_cf_dev" in stages["stribeck"]:
-        lines.append("  Hersey collapse: max |C_f,dev| = "
-                     f"{stages['stribeck']['hersey_collapse_max_abs_cf_dev']:.2%} (eq 35)")
-    film = stages["stribeck"].get("ehl_film")
-    if film:
-        lines.append(f"  EHL film at u_m = {film['entrainment_m_s']:g} m/s: h_c "
-                     f"{film['h_c_m'] * 1e9:.0f} nm, h_min {film['h_min_m'] * 1e9:.0f} nm "
-                     f"(Hamrock-Dowson, smooth: {film['hamrock_dowson_h_c_m'] * 1e9:.0f} nm, "
-                     f"{film['hamrock_dowson_h_min_m'] * 1e9:.0f} nm)")
-    err = stages["stribeck"].get("cf_error")
-    if err:
-        lines.append(f"  C_f estimated discretisation error: at most "
-                     f"{err['max_relative']:.2%} of C_f,b (" + ", ".join(
-                         f"{k} {v:.2%}" for k, v in err["parts_max_relative"].items())
-                     + f"; tolerance {err['tolerance']:.2%}; flow-factor estimates in "
-                     "summary.json)")
-    lines.append(f"results in {out}/ (stribeck.csv, plots, results.nc and fields.nc for "
-                 f"fem_twin.results.open_run, fields/ for ParaView, summary.json, run.log); "
-                 f"the figures on one page: fem-twin report {out}")
-    return "\n".join(lines)
-
-
-def _fit(args):
-    from .case import load_case
-    from .fitting import fit_case
-    if not args.case.is_file():
-        raise MissingFile(f"case file not found: {args.case}")
-    case = load_case(args.case)
-    if not _confirm_cost(case, args.yes):
-        return 2
-    result = fit_case(case, args.measured, args.output,
-                      [p.strip() for p in args.params.split(",") if p.strip()],
-                      predict_at=args.predict, progress=not args.no_progress)
-    for name in result["fit"]["parameters"] + [k for k in result if k.startswith("viscosity_")]:
-        v = result[name]
-        print(f"fem-twin fit: {name} = {v['value']:.5g} (95 %: {v['low']:.5g} to "
-              f"{v['high']:.5g})")
-    print(f"  rms C_f,dev {result['fit']['rms_cf_dev']:.2%} over {result['fit']['points']} "
-          f"points; {RunLayout(args.output).fit} and fit.png")
-    return 0
-
-
-def _calibrate(args):
-    from .calibration import calibrate
-    from .case import load_case
-    summary = calibrate(load_case(args.case), args.study, args.output, values=args.values,
-                        progress=not args.no_progress)
-    print(json.dumps(summary, indent=2))
-    return 0
-
-
-def _html_report(args):
-    from .report import write_report
-    path = write_report(args.run, args.output, render=not args.no_3d)
-    print(f"report: {path}")
-    return 0
-
-
-def _validate(args):
-    from dataclasses import replace
-
-    from .case import load_case
-    from .macro.friction import BOUNDARY_FRICTION
-    from .stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
-    from .io.table import write_csv
-    from .stribeck.curve import read_stribeck_csv
-    run = RunLayout(args.run)
-    csv_path = run.stribeck_csv
-    if not csv_path.is_file():
-        raise MissingFile(f"{csv_path} not found: give the output folder of fem-twin run")
-    curves = read_stribeck_csv(csv_path)
-    if args.viscosity is None:
-        curve = curves[0]
-    else:
-        match = [c for c in curves if np.isclose(c.viscosity, args.viscosity, rtol=1e-6)]
-        if not match:
-            raise InputError(f"no curve at mu_0 = {args.viscosity} Pa s in {csv_path} (it has "
-                             f"{[c.viscosity for c in curves]})")
-        curve = match[0]
-    case_file = _run_case_file(args.run)
-    case = load_case(case_file) if case_file else None
-    boundary = case.tribometer.boundary_friction if case else BOUNDARY_FRICTION
-    measured = read_measured_csv(args.measured, unit="rpm" if args.rpm else "m/s")
-    if args.rpm:
-        radius = args.radius or (case.tribometer.sliding_radius if case else None)
-        if radius is None:
-            raise InputError("--rpm needs the sliding radius: give --radius [m]")
-        measured = replace(measured, speed=measured.speed * 2 * np.pi * radius / 60)
-    dev = deviation_from_measured(curve, measured, boundary)
-    if not np.any(np.isfinite(dev)):
-        raise InputError(f"the measured speeds ({measured.speed.min():.3g} to "
-                         f"{measured.speed.max():.3g} m/s) lie outside the simulated range")
-    png, table = run.validation_of(args.measured, ".png"), run.validation_of(args.measured, ".csv")
-    band = None if measured.low is None else (measured.low, measured.high)
-    plot_stribeck([curve], png,
-                  labels=[f"simulated, $\\mu_0$ = {curve.viscosity:g} Pa s"],
-                  reference=(measured.speed, measured.friction_coefficient, band),
-                  boundary=boundary)
-    write_csv(table, {"speed_m_s": measured.speed, "measured_cf": measured.friction_coefficient,
-                      "cf_dev": dev})
-    inside = np.isfinite(dev)
-    print(f"fem-twin validate: mu_0 = {curve.viscosity:g} Pa s against {args.measured.name}: "
-          f"max |C_f,dev| = {np.nanmax(np.abs(dev)):.2%} (eq 35, C_f,b = {boundary:.5g}) at "
-          f"{inside.sum()} of {dev.size} measured speeds; {table}, {png.name}")
-    return 0
-
-
-def _run_case_file(run: Path):
-    """The case file recorded in a run's summary.json, if it still exists."""
-    try:
-        path = Path(json.loads(RunLayout(run).summary.read_text())["provenance"]["case_file"])
-    except (OSError, ValueError, KeyError, TypeError):
-        return None
-    return path if path.is_file() else None
-
-
-def _example(args):
-    from importlib.resources import files
-
-    from .samples import generate
-    args.folder.mkdir(parents=True, exist_ok=True)
-    case = args.folder / "pin_on_disk.toml"
-    case.write_text(files("fem_twin.cases").joinpath("pin_on_disk.toml").read_text())
-    generate(args.folder / "meshes" / "sample")
-    print(f"wrote {case} and {args.folder / 'meshes' / 'sample'}/; run it with\n"
-          f"  fem-twin run {case} -o {args.folder / 'out'}")
-    return 0
-
-
-def _compare(args):
-    from .case import load_case
-    from .compare import compare
-    summary = compare(load_case(args.case), args.output, progress=not args.no_progress)
-    print(json.dumps(summary, indent=2))
-    return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,0 +1,198 @@
+"""The ``fem-twin`` commands on a case or a finished run (run, compare, calibrate, fit,
+validate, report, example); the parser is in :mod:`fem_twin.cli`."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError, MissingFile
+from .io.layout import RunLayout
+
+
+LONG_RUN_SECONDS = 10 * 60
+
+
+def _confirm_cost(case, yes: bool) -> bool:
+    """Say which sections take defaults and what the run will cost; refuse a long run
+    without ``--yes``."""
+    if case.defaulted:
+        print(f"fem-twin run: sections not in {case.source.name}, defaults used: " + ", ".join(
+            f"[{s}]" for s in case.defaulted), file=sys.stderr)
+    cores = case.run.workers or os.cpu_count() or 1
+    seconds = case.estimated_seconds(cores)
+    mc = case.micro
+    print(f"fem-twin run: {len(case.geometry.patches)} patch pairs at {mc.resolution[0]}x"
+          f"{mc.resolution[1]}, {mc.h0_count} h0 x {mc.steps} steps"
+          f"{f' (adaptive h0, tolerance {mc.h0_tol:g})' if mc.h0_tol else ''}; "
+          f"{len(case.lubricant.viscosities)} x {case.sweep.count} speeds; estimated "
+          f"{seconds / 60:.0f} min on {cores} cores", file=sys.stderr)
+    if seconds > LONG_RUN_SECONDS and not yes:
+        print(f"fem-twin run: error: this run is estimated at {seconds / 60:.0f} min (the "
+              "bundled case: about 1 min); check the case and run again with --yes",
+              file=sys.stderr)
+        return False
+    return True
+
+
+def run(args):
+    from .case import load_case
+    from .pipeline import run
+    if not args.case.is_file():
+        raise MissingFile(f"case file not found: {args.case} (give the case file as "
+                                "the first argument)")
+    case = load_case(args.case)
+    if not _confirm_cost(case, args.yes):
+        return 2
+    summary = run(case, args.output, progress=not args.no_progress)
+    print(_short_summary(summary, args.output))
+    return 0
+
+
+def _short_summary(summary: dict, out: Path) -> str:
+    """A few lines for the terminal; everything is in ``OUT/summary.json``."""
+    stages = summary["stages"]
+    lines = [f"fem-twin run: {summary['case']} done in {summary['wall_time_s']:.0f} s ("
+             + ", ".join(f"{k} {v:.0f} s" for k, v in summary["seconds"].items()) + ")"]
+    for c in stages["stribeck"]["curves"]:
+        lo, hi = c["friction_coefficient_range"]
+        lines.append(f"  mu_0 = {c['viscosity_Pa_s']:g} Pa s: C_f from {lo:.4f} to {hi:.4f}")
+    if "hersey_collapse_max_abs_cf_dev" in stages["stribeck"]:
+        lines.append("  Hersey collapse: max |C_f,dev| = "
+                     f"{stages['stribeck']['hersey_collapse_max_abs_cf_dev']:.2%} (eq 35)")
+    film = stages["stribeck"].get("ehl_film")
+    if film:
+        lines.append(f"  EHL film at u_m = {film['entrainment_m_s']:g} m/s: h_c "
+                     f"{film['h_c_m'] * 1e9:.0f} nm, h_min {film['h_min_m'] * 1e9:.0f} nm "
+                     f"(Hamrock-Dowson, smooth: {film['hamrock_dowson_h_c_m'] * 1e9:.0f} nm, "
+                     f"{film['hamrock_dowson_h_min_m'] * 1e9:.0f} nm)")
+    err = stages["stribeck"].get("cf_error")
+    if err:
+        lines.append(f"  C_f estimated discretisation error: at most "
+                     f"{err['max_relative']:.2%} of C_f,b (" + ", ".join(
+                         f"{k} {v:.2%}" for k, v in err["parts_max_relative"].items())
+                     + f"; tolerance {err['tolerance']:.2%}; flow-factor estimates in "
+                     "summary.json)")
+    lines.append(f"results in {out}/ (stribeck.csv, plots, results.nc and fields.nc for "
+                 f"fem_twin.results.open_run, fields/ for ParaView, summary.json, run.log); "
+                 f"the figures on one page: fem-twin report {out}")
+    return "\n".join(lines)
+
+
+def fit(args):
+    from .case import load_case
+    from .fitting import fit_case
+    if not args.case.is_file():
+        raise MissingFile(f"case file not found: {args.case}")
+    case = load_case(args.case)
+    if not _confirm_cost(case, args.yes):
+        return 2
+    result = fit_case(case, args.measured, args.output,
+                      [p.strip() for p in args.params.split(",") if p.strip()],
+                      predict_at=args.predict, progress=not args.no_progress)
+    for name in result["fit"]["parameters"] + [k for k in result if k.startswith("viscosity_")]:
+        v = result[name]
+        print(f"fem-twin fit: {name} = {v['value']:.5g} (95 %: {v['low']:.5g} to "
+              f"{v['high']:.5g})")
+    print(f"  rms C_f,dev {result['fit']['rms_cf_dev']:.2%} over {result['fit']['points']} "
+          f"points; {RunLayout(args.output).fit} and fit.png")
+    return 0
+
+
+def calibrate(args):
+    from .calibration import calibrate
+    from .case import load_case
+    summary = calibrate(load_case(args.case), args.study, args.output, values=args.values,
+                        progress=not args.no_progress)
+    print(json.dumps(summary, indent=2))
+    return 0
+
+
+def html_report(args):
+    from .report import write_report
+    path = write_report(args.run, args.output, render=not args.no_3d)
+    print(f"report: {path}")
+    return 0
+
+
+def validate(args):
+    from dataclasses import replace
+
+    from .case import load_case
+    from .macro.friction import BOUNDARY_FRICTION
+    from .stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
+    from .io.table import write_csv
+    from .stribeck.curve import read_stribeck_csv
+    run = RunLayout(args.run)
+    csv_path = run.stribeck_csv
+    if not csv_path.is_file():
+        raise MissingFile(f"{csv_path} not found: give the output folder of fem-twin run")
+    curves = read_stribeck_csv(csv_path)
+    if args.viscosity is None:
+        curve = curves[0]
+    else:
+        match = [c for c in curves if np.isclose(c.viscosity, args.viscosity, rtol=1e-6)]
+        if not match:
+            raise InputError(f"no curve at mu_0 = {args.viscosity} Pa s in {csv_path} (it has "
+                             f"{[c.viscosity for c in curves]})")
+        curve = match[0]
+    case_file = _run_case_file(args.run)
+    case = load_case(case_file) if case_file else None
+    boundary = case.tribometer.boundary_friction if case else BOUNDARY_FRICTION
+    measured = read_measured_csv(args.measured, unit="rpm" if args.rpm else "m/s")
+    if args.rpm:
+        radius = args.radius or (case.tribometer.sliding_radius if case else None)
+        if radius is None:
+            raise InputError("--rpm needs the sliding radius: give --radius [m]")
+        measured = replace(measured, speed=measured.speed * 2 * np.pi * radius / 60)
+    dev = deviation_from_measured(curve, measured, boundary)
+    if not np.any(np.isfinite(dev)):
+        raise InputError(f"the measured speeds ({measured.speed.min():.3g} to "
+                         f"{measured.speed.max():.3g} m/s) lie outside the simulated range")
+    png, table = run.validation_of(args.measured, ".png"), run.validation_of(args.measured, ".csv")
+    band = None if measured.low is None else (measured.low, measured.high)
+    plot_stribeck([curve], png,
+                  labels=[f"simulated, $\\mu_0$ = {curve.viscosity:g} Pa s"],
+                  reference=(measured.speed, measured.friction_coefficient, band),
+                  boundary=boundary)
+    write_csv(table, {"speed_m_s": measured.speed, "measured_cf": measured.friction_coefficient,
+                      "cf_dev": dev})
+    inside = np.isfinite(dev)
+    print(f"fem-twin validate: mu_0 = {curve.viscosity:g} Pa s against {args.measured.name}: "
+          f"max |C_f,dev| = {np.nanmax(np.abs(dev)):.2%} (eq 35, C_f,b = {boundary:.5g}) at "
+          f"{inside.sum()} of {dev.size} measured speeds; {table}, {png.name}")
+    return 0
+
+
+def _run_case_file(run: Path):
+    """The case file recorded in a run's summary.json, if it still exists."""
+    try:
+        path = Path(json.loads(RunLayout(run).summary.read_text())["provenance"]["case_file"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return path if path.is_file() else None
+
+
+def example(args):
+    from importlib.resources import files
+
+    from .samples import generate
+    args.folder.mkdir(parents=True, exist_ok=True)
+    case = args.folder / "pin_on_disk.toml"
+    case.write_text(files("fem_twin.cases").joinpath("pin_on_disk.toml").read_text())
+    generate(args.folder / "meshes" / "sample")
+    print(f"wrote {case} and {args.folder / 'meshes' / 'sample'}/; run it with\n"
+          f"  fem-twin run {case} -o {args.folder / 'out'}")
+    return 0
+
+
+def compare(args):
+    from .case import load_case
+    from .compare import compare
+    summary = compare(load_case(args.case), args.output, progress=not args.no_progress)
+    print(json.dumps(summary, indent=2))
+    return 0
