@@ -67,8 +67,8 @@ def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
 def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = True) -> dict:
     """Run a study into ``outdir``; write ``calibration.json``, ``stribeck.csv`` (all
     variants) and plots of C_f and C_f,dev versus speed.  Returns the summary."""
-    from .pipeline import (executor_for, homogenise_patches, level_pins, macro_geometry,
-                           macro_settings, reconstruct_geometry)
+    from .pipeline import (executor_for, face_load, homogenise_patches, level_pins,
+                           macro_geometry, macro_settings, reconstruct_geometry)
     out = RunLayout(outdir)
     out.root.mkdir(parents=True, exist_ok=True)
     cases, ref_label = variants(case, study, values)
@@ -84,10 +84,11 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
         factors = FlowFactors.load(out.patch_factors(patch))
         gap, spacing, face, _ = macro_geometry(variant, folder)
         curves[label] = stribeck_sweep(
-            gap, spacing, factors, variant.sweep.speeds, load=variant.tribometer.load,
+            gap, spacing, factors, variant.sweep.speeds, load=face_load(variant),
             lubricant=lub, diameter=variant.tribometer.pin_diameter, face=face,
             settings=macro_settings(variant),
-            checkpoint=folder.points, progress=progress)
+            checkpoint=folder.points, progress=progress).with_load_share(
+                variant.tribometer.load_share)
     ref = curves[ref_label]
     dev = {k: friction_deviation(c.friction_coefficient, ref.friction_coefficient)
            for k, c in curves.items()}

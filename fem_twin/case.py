@@ -32,7 +32,8 @@ class Geometry:
 class Tribometer:
     """Operating conditions (Tables 1 and 6): imposed load [N], pin diameter [m], sliding
     radius [m] (recorded; speeds are given in m/s), boundary friction coefficient C_f,b of
-    eq 32 [-].  ``kind = "ball-on-disk"``: a ball of ``ball_radius`` [m] on the disk at
+    eq 32 [-], ``load_share``: the share of the imposed load the pin face carries (film and
+    contact, eq 28; 1 in the paper; C_f stays the friction force over the imposed load).  ``kind = "ball-on-disk"``: a ball of ``ball_radius`` [m] on the disk at
     ``slide_to_roll`` = u_r / u_m (MTM convention, in (0, 2]; the sweep's speeds are then
     entrainment speeds u_m), on a track of ``track_radius`` [m] (recorded)."""
 
@@ -40,6 +41,7 @@ class Tribometer:
     pin_diameter: float = 8e-3
     sliding_radius: float = 30e-3
     boundary_friction: float = T.BOUNDARY_FRICTION        # the paper's C_f,b, eq 32
+    load_share: float = 1.0                               # of `load` on the pin face
     kind: str = "pin-on-disk"                             # or "ball-on-disk"
     ball_radius: float = 12.5e-3
     slide_to_roll: float = 0.5
@@ -256,6 +258,9 @@ def _tribometer(data, where) -> Tribometer:
     if tribometer.kind not in ("pin-on-disk", "ball-on-disk"):
         raise CaseError(f"{where} [tribometer] kind: 'pin-on-disk' or 'ball-on-disk', got "
                         f"{tribometer.kind!r}")
+    if tribometer.ball and tribometer.load_share != 1.0:
+        raise CaseError(f"{where} [tribometer] load_share: a ball carries the whole load "
+                        "(load_share = 1); it is a pin face's share")
     return tribometer
 
 
@@ -451,6 +456,7 @@ PLAUSIBLE = {
     ("tribometer", "pin_diameter"): "pin_diameter",
     ("tribometer", "sliding_radius"): "length",
     ("tribometer", "boundary_friction"): "friction",
+    ("tribometer", "load_share"): "load_share",
     ("tribometer", "ball_radius"): "length",
     ("tribometer", "slide_to_roll"): "slide_to_roll",
     ("tribometer", "track_radius"): "length",

@@ -135,20 +135,25 @@ def _add_case_commands(sub):
                                    "folder", "out", runs.run)
     rn.add_argument("--yes", action="store_true",
                     help=f"start even if estimated longer than {runs.LONG_RUN_SECONDS // 60} min")
+    rn.add_argument("--from-fit", type=Path, metavar="FIT",
+                    help="run with the parameters of a fit.json (fem-twin fit) and write "
+                         "OUT/prediction.csv, each curve with its 95 %% band")
     _case_command(sub, "compare", "cross-check FE against the FVM reference on a case: "
                                   "flow factors, fields, C_f,dev (eq 35)", "compare", runs.compare)
     cb = _case_command(sub, "calibrate", "calibration study of a case (paper 3.2): C_f,dev "
                                          "of variants against a reference curve",
                        "calibration", runs.calibrate)
-    ft = sub.add_parser("fit", help="fit C_f,b and the oil temperature of a case to measured "
-                                    "Stribeck curves (runs or resumes the case first)")
+    ft = sub.add_parser("fit", help="fit C_f,b, the oil temperature and the load share of a "
+                                    "case to measured Stribeck curves (runs or resumes the "
+                                    "case first)")
     ft.add_argument("case", type=Path, help="case file")
     ft.add_argument("measured", type=Path, nargs="+",
                     help="measured CSV per viscosity of the case (speed [m/s], "
                          "friction_coefficient, optional cf_min/cf_max)")
     ft.add_argument("-o", "--output", type=Path, default=Path("out"), help="output folder")
     ft.add_argument("--params", default="boundary_friction,temperature",
-                    help="comma-separated case keys to fit: boundary_friction, temperature")
+                    help="comma-separated case keys to fit: boundary_friction, temperature, "
+                         "load_share")
     ft.add_argument("--predict", type=float, nargs="+", default=[], metavar="T",
                     help="oil temperatures [C] of predicted curves with their 95 %% band "
                          "(OUT/prediction_TC.csv)")

@@ -80,8 +80,8 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     """Run the case's micro and macro stages with both methods, each at every h0 of the case
     (no adaptive subset, so that they meet at the same separations); write ``compare.json``,
     ``compare_flow_factors.csv``, ``compare_stribeck.csv`` and ``compare.png``."""
-    from .pipeline import (executor_for, homogenise_patches, level_pins, macro_geometry,
-                           macro_settings, reconstruct_geometry)
+    from .pipeline import (executor_for, face_load, homogenise_patches, level_pins,
+                           macro_geometry, macro_settings, reconstruct_geometry)
     out = RunLayout(outdir)
     out.root.mkdir(parents=True, exist_ok=True)
     reconstruct_geometry(case, out, progress)
@@ -107,10 +107,10 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     for method in ("fe", "fvm"):
         ckpt = out.sub(method).points
         curves[method] = stribeck_sweep(
-            gap, spacing, factors[method], case.sweep.speeds, load=case.tribometer.load,
+            gap, spacing, factors[method], case.sweep.speeds, load=face_load(case),
             lubricant=lub, diameter=case.tribometer.pin_diameter, face=face,
             settings=macro_settings(case, method),
-            checkpoint=ckpt, progress=progress)
+            checkpoint=ckpt, progress=progress).with_load_share(case.tribometer.load_share)
         points[method] = sorted((MixedResult.load(p) for p in point_files(ckpt)),
                                 key=lambda r: -r.speed)            # as the curve: fast first
     dev = friction_deviation(curves["fe"].friction_coefficient,

@@ -1,12 +1,17 @@
 """``fem-twin fit``: the case's run (resumed when present), then its unknowns fitted to
-measured curves (:mod:`fem_twin.stribeck.fit`); ``OUT/fit.json`` and ``OUT/fit.png``."""
+measured curves (:mod:`fem_twin.stribeck.fit`), ``OUT/fit.json`` and ``OUT/fit.png``; and
+``fem-twin run --from-fit``: a case run with the fitted parameters, ``OUT/prediction.csv``."""
 
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
+
 from .case import Case
+from .checks import QUANTITIES
 from .errors import InputError
 from .io.atomic import atomic_path
 from .io.layout import RunLayout
@@ -14,7 +19,8 @@ from .io.table import write_csv
 from .macro.viscosity import WaltherLaw
 from .stribeck import read_measured_csv
 from .stribeck.curve import read_stribeck_csv
-from .stribeck.fit import FitModel, check_parameters, fit_curves, plot_fit, predict
+from .stribeck.fit import (LOAD_SHARES, FitModel, check_parameters, fit_curves, plot_fit,
+                           predict)
 
 
 def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: bool = True,
@@ -23,7 +29,9 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     ``case`` to the ``measured`` CSV files, the K-th against the case's K-th viscosity;
     ``predict_at``: oil temperatures [C] of predicted curves (``OUT/prediction_T.csv``,
     C_f with its 95 % band, :func:`~fem_twin.stribeck.fit.predict`).
-    ``run``: the pipeline's ``run`` (runs or resumes the case into ``outdir``)."""
+    ``run``: the pipeline's ``run`` (runs or resumes the case into ``outdir``); a
+    ``load_share`` fit then sweeps the first viscosity at :data:`LOAD_SHARES`
+    (checkpointed in ``OUT/fit/``, so a rerun resumes)."""
     params = list(params)
     check_parameters(params)                                      # before the run
     paths = [Path(p) for p in measured]
@@ -36,6 +44,8 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     if (predict_at or "temperature" in params) and len(set(lb.temperatures)) < 2:
         raise InputError("fitting or predicting a temperature needs viscosities at two "
                          "temperatures in [lubricant] (the Walther law of ASTM D341)")
+    if "load_share" in params and case.tribometer.ball:
+        raise InputError("load_share is a pin face's share of the load; a ball carries it all")
     law = (WaltherLaw.through(lb.temperatures, lb.viscosities, lb.density)
            if len(set(lb.temperatures)) > 1 else None)
     if run is None:
@@ -43,19 +53,124 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     run(case, outdir, progress=progress)
     out = RunLayout(outdir)
     simulated = read_stribeck_csv(out.stribeck_csv)[:len(paths)]
+    shares = (share_curves(case, out, simulated[0], progress) if "load_share" in params
+              else ())
     model = FitModel(tuple(simulated), case.tribometer.boundary_friction, case.tribometer.load,
-                     law)
-    result = fit_curves(model, curves_measured, params,
-                        start_temperatures=(list(lb.temperatures[:len(paths)])
-                                            if "temperature" in params else None))
+                     law, case.tribometer.load_share, shares)
+    nominal = list(lb.temperatures[:len(paths)])
+    result = fit_curves(model, curves_measured, params, verbose=progress,
+                        start_temperatures=nominal if "temperature" in params else None)
     result["measured"] = [str(p) for p in paths]
+    result["case"] = {"temperatures": nominal, "load_N": case.tribometer.load,
+                      "law": None if law is None else vars(law)}
     with atomic_path(out.fit) as tmp:
         tmp.write_text(json.dumps(result, indent=2))
     plot_fit(result, out.fit_png, labels=[f"{t:g} C in the case" for t in lb.temperatures])
-    speeds = simulated[0].speed
     for t in predict_at:
-        p = predict(model, result, speeds, float(t), nominal=lb.temperatures[:len(paths)])
-        write_csv(out.prediction(t), {"speed_m_s": p["speed_m_s"], "friction_coefficient":
-                                      p["cf"], "cf_low": p["cf_low"], "cf_high": p["cf_high"],
-                                      "cf_err": p["cf_err"]})
+        _write_prediction(out.prediction(t), [predict(model, result, simulated[0].speed,
+                                                      float(t), nominal=nominal)])
     return result
+
+
+def share_curves(case: Case, out: RunLayout, curve, progress: bool = True,
+                 shares=LOAD_SHARES) -> tuple:
+    """``((share, StribeckCurve), ...)``: the case's first viscosity swept at ``shares`` of
+    its load over the speeds of ``curve`` (the case's own share is ``curve``), checkpointed
+    in ``OUT/fit/checkpoints``; the micro stage's flow factors are reused."""
+    from .micro import FlowFactors
+    from .pipeline import (executor_for, hersey_length, macro_geometry, macro_settings,
+                           run_sweeps, stage_keys)
+    tr = case.tribometer
+    gap, spacing, face, _ = macro_geometry(case, out)
+    common = dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
+                  speeds=np.sort(curve.speed)[::-1], diameter=hersey_length(case), face=face,
+                  settings=macro_settings(case), checkpoint=out.fit_points,
+                  factors_key=stage_keys(case)["micro"])
+    lub = case.lubricant.lubricants()[0]
+    todo = sorted(s for s in shares if not np.isclose(s, tr.load_share, rtol=1e-9))
+    with executor_for(case) as executor:
+        swept = run_sweeps([(dict(common, load=tr.load * s), lub) for s in todo], executor,
+                           progress, desc="load-share points")
+    return tuple(sorted([*zip(todo, swept), (tr.load_share, curve)], key=lambda p: p[0]))
+
+
+def apply_fit(case: Case, result: dict) -> Case:
+    """``case`` with the fitted parameters of ``result`` (a ``fit.json``): C_f,b, the load
+    share, and viscosities from the fit's Walther law at the case's temperatures plus the
+    mean fitted offset of the contact temperature."""
+    tr, lb = case.tribometer, case.lubricant
+    get = lambda name, default: result.get(name, {}).get("value", default)  # noqa: E731
+    tr = replace(tr, boundary_friction=get("boundary_friction", tr.boundary_friction),
+                 load_share=get("load_share", tr.load_share))
+    offset = temperature_offset(result)
+    if offset is not None:
+        law = WaltherLaw(**result["case"]["law"])
+        lb = replace(lb, viscosities=tuple(float(law.viscosity(t + offset))
+                                           for t in lb.temperatures))
+    return replace(case, tribometer=tr, lubricant=lb)
+
+
+def temperature_offset(result: dict) -> float | None:
+    """Mean fitted contact temperature minus the nominal oil temperature [K] (None when no
+    temperature was fitted)."""
+    fitted = [k for k in result["fit"]["parameters"] if k.startswith("temperature_")]
+    if not fitted:
+        return None
+    nominal = result["case"]["temperatures"]
+    return float(np.mean([result[k]["value"] - t for k, t in zip(fitted, nominal)]))
+
+
+def read_fit(path) -> dict:
+    """A ``fit.json`` of ``fem-twin fit``, checked for what :func:`apply_fit` reads."""
+    try:
+        result = json.loads(Path(path).read_text())
+        result["fit"]["parameters"], result["case"]["temperatures"]
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        raise InputError(f"{path}: not a fit.json of fem-twin fit ({err})") from err
+    return result
+
+
+def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=None) -> dict:
+    """Run ``case`` with the parameters fitted in ``fit_path`` (:func:`apply_fit`): at
+    another load or oil temperature than the fit's; ``OUT/prediction.csv`` gives each
+    curve with the 95 % band of the fitted parameters' covariance (a fitted load share
+    by two more sweeps at its interval's ends) and the curve's C_f error estimate.
+    Returns the run's summary with ``"prediction"``."""
+    result = read_fit(fit_path)
+    fitted = apply_fit(case, result)
+    if run is None:
+        from .pipeline import run
+    summary = run(fitted, outdir, progress=progress)
+    out = RunLayout(outdir)
+    curves = read_stribeck_csv(out.stribeck_csv)
+    lb, tr = fitted.lubricant, fitted.tribometer
+    law = None if result["case"]["law"] is None else WaltherLaw(**result["case"]["law"])
+    shares = ()
+    if "load_share" in result:
+        lo, hi, _ = QUANTITIES["load_share"]
+        ends = {min(max(result["load_share"][e], lo), hi) for e in ("low", "high")}
+        shares = share_curves(fitted, out, curves[0], progress, shares=ends)
+        shares = shares if len(shares) > 1 else ()      # a zero-width interval
+    model = FitModel(tuple(curves), tr.boundary_friction, tr.load, law, tr.load_share, shares)
+    offset = temperature_offset(result)
+    rows = [predict(model, result, c.speed, None if offset is None else t,
+                    result["case"]["temperatures"], curve=k)
+            for k, (c, t) in enumerate(zip(curves, lb.temperatures))]
+    _write_prediction(out.prediction(), rows, [c.viscosity for c in curves])
+    summary["prediction"] = {"file": out.prediction().name, "fit": str(fit_path),
+                             "max_band_half_width": float(max(
+                                 np.max(r["cf_high"] - r["cf"]) for r in rows))}
+    return summary
+
+
+def _write_prediction(path, rows, viscosities=None) -> None:
+    """Predicted curves with their 95 % band (one block per curve)."""
+    cat = lambda key: np.concatenate([r[key] for r in rows])  # noqa: E731
+    columns = {"speed_m_s": cat("speed_m_s"), "friction_coefficient": cat("cf"),
+               "cf_low": cat("cf_low"), "cf_high": cat("cf_high"),
+               "cf_err": np.concatenate([np.broadcast_to(r["cf_err"], r["cf"].shape)
+                                         for r in rows])}
+    if viscosities is not None:
+        columns = {"viscosity_Pa_s": np.concatenate(
+            [np.full(r["cf"].shape, mu) for r, mu in zip(rows, viscosities)]), **columns}
+    write_csv(path, columns)

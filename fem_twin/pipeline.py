@@ -396,6 +396,12 @@ def macro_geometry(case: Case, out: RunLayout):
     return disk.heights - pin.heights, pin.spacing, face, pin.origin
 
 
+def face_load(case: Case) -> float:
+    """The load the macro scale balances (eq 28) [N]: ``[tribometer] load_share`` of the
+    imposed load (C_f is referred to the imposed load, ``StribeckCurve.with_load_share``)."""
+    return case.tribometer.load * case.tribometer.load_share
+
+
 def ball_contact(case: Case) -> PointContact:
     """The smooth ball of a ball-on-disk case (Hertz radius, Hamrock-Dowson films) at the
     first viscosity and the sweep's fastest entrainment speed."""
@@ -434,15 +440,16 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     lb, tr = case.lubricant, case.tribometer
     ball = dict(slide_to_roll=tr.slide_to_roll) if tr.ball else {}
     common = dict(gap=gap, spacing=spacing, factors=factors, speeds=case.sweep.speeds,
-                  load=tr.load, diameter=hersey_length(case), face=face, **ball,
+                  load=face_load(case), diameter=hersey_length(case), face=face, **ball,
                   settings=macro_settings(case),
                   checkpoint=out.points, fields=out.fields,
                   origin=origin, factors_key=stage_keys(case)["micro"])
     lubricants = lb.lubricants()
     speeds = case.sweep.speeds
     for level in range(case.sweep.refine + 1):
-        curves = run_sweeps([(dict(common, speeds=speeds, error_estimate=True), lub)
-                             for lub in lubricants], executor, progress)
+        curves = [c.with_load_share(tr.load_share) for c in run_sweeps(
+            [(dict(common, speeds=speeds, error_estimate=True), lub) for lub in lubricants],
+            executor, progress)]
         extra = transition_speeds(curves, case.sweep.refine_step * tr.boundary_friction)
         if level == case.sweep.refine or extra.size == 0:
             break
@@ -452,7 +459,8 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     tasks = [(dict(common, speeds=speeds, error_estimate=True), lub) for lub in lubricants]
     band_tasks = [(kw, lub) for kw in band_sweeps(case, out, dict(common, speeds=speeds))
                   for lub in lubricants] if case.run.patch_band else []
-    patch_curves = run_sweeps(band_tasks, executor, progress, desc="patch band points")
+    patch_curves = [c.with_load_share(tr.load_share) for c in run_sweeps(
+        band_tasks, executor, progress, desc="patch band points")]
     patch_curves = [patch_curves[i:i + len(lubricants)]
                     for i in range(0, len(patch_curves), len(lubricants))]
     band = patch_band(patch_curves) if patch_curves else None

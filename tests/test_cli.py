@@ -792,3 +792,23 @@ def test_fit_a_case_to_measured_curves(tmp_path, capsys):
     assert main(["fit", str(case), files[0], "-o", str(tmp_path / "x"), "--params",
                  "load"]) == 2
     assert not (tmp_path / "x").exists()
+    # the face's load share too (curves made at share 1, the upper bound; the case resumes,
+    # only the first viscosity's sweeps at the other shares are new), then the fitted twin
+    # run at 120 N: prediction.csv is the run's own curve with its band
+    assert main(["fit", str(case), *files, "-o", str(out), "--no-progress", "--params",
+                 "boundary_friction,temperature,load_share"]) == 0
+    fit = json.loads((out / "fit.json").read_text())
+    assert fit["load_share"]["value"] == pytest.approx(1.0, abs=1e-3)
+    assert fit["boundary_friction"]["value"] == pytest.approx(0.15, rel=2e-3)
+    case120 = tmp_path / "case120.toml"
+    case120.write_text(case.read_text().replace("load = 150.0 ", "load = 120.0 "))
+    assert main(["run", str(case120), "-o", str(tmp_path / "o120"), "--no-progress",
+                 "--from-fit", str(out / "fit.json")]) == 0
+    pred = list(csv.DictReader(open(tmp_path / "o120" / "prediction.csv")))
+    run120 = list(csv.DictReader(open(tmp_path / "o120" / "stribeck.csv")))
+    for p, r in zip(pred, run120, strict=True):       # the run's C_f is over the balanced
+        assert float(p["friction_coefficient"]) == pytest.approx(     # load (eq 28, tol 1e-6)
+            float(r["friction_coefficient"]), rel=1e-6)
+        assert float(p["cf_low"]) < float(p["friction_coefficient"]) < float(p["cf_high"])
+    assert main(["run", str(case120), "-o", str(tmp_path / "y"), "--from-fit",
+                 str(files[0])]) == 2                                  # not a fit.json

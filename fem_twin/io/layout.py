@@ -175,9 +175,16 @@ class RunLayout:
     def fit_png(self) -> Path:
         return self.root / "fit.png"
 
-    def prediction(self, temperature: float) -> Path:
-        """``fem-twin fit --predict T``: the curve predicted for the oil at ``T`` [C]."""
-        return self.root / f"prediction_{temperature:g}C.csv"
+    def prediction(self, temperature: float | None = None) -> Path:
+        """``fem-twin fit --predict T``: the curve predicted for the oil at ``T`` [C];
+        without ``T``, the band of ``fem-twin run --from-fit`` around the run's curves."""
+        name = "prediction.csv" if temperature is None else f"prediction_{temperature:g}C.csv"
+        return self.root / name
+
+    @property
+    def fit_points(self) -> Path:
+        """The checkpoints of the sweeps at other load shares (``load_share`` fits)."""
+        return self.root / "fit" / "checkpoints"
 
     @property
     def report(self) -> Path:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import csv
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -37,7 +37,8 @@ class StribeckCurve:
 
     speed [m/s], hersey [-], friction_coefficient [-], viscosity mu_0 [Pa s] (scalar),
     hydrodynamic_friction and boundary_friction: F_T parts [N], contact_load_fraction:
-    share of F_N carried by p_con, h_d [m], iterations of the macro solver;
+    share of the face's load (F_N times ``load_share``) carried by p_con, h_d [m],
+    iterations of the macro solver;
     friction_error: the estimated discretisation error of C_f [-] (absolute, both scales,
     :mod:`fem_twin.macro.estimate`) and friction_error_parts its parts by name, when the
     sweep estimated them (None otherwise).
@@ -54,6 +55,20 @@ class StribeckCurve:
     iterations: np.ndarray
     friction_error: np.ndarray | None = None
     friction_error_parts: dict | None = None
+
+    def with_load_share(self, share: float) -> "StribeckCurve":
+        """This curve, swept at ``share`` F_N,imp on the pin face, referred to the imposed
+        load F_N,imp: C_f, its error estimates and the Hersey number (eq 46) times ``share``
+        (the friction forces and the contact's share of the face load stay)."""
+        if share == 1.0:
+            return self
+        parts = (None if self.friction_error_parts is None else
+                 {k: share * v for k, v in self.friction_error_parts.items()})
+        return replace(self, hersey=share * self.hersey,
+                       friction_coefficient=share * self.friction_coefficient,
+                       friction_error=(None if self.friction_error is None
+                                       else share * self.friction_error),
+                       friction_error_parts=parts)
 
     def at_hersey(self, hersey):
         """C_f interpolated (monotone cubic, PCHIP, in log H) at Hersey numbers inside this

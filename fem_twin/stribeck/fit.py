@@ -12,6 +12,14 @@ Parameters, named by their case-file keys:
     viscosities and temperatures).  By the Hersey collapse (eq 46; 0.1 % C_f,b between the
     bundled case's two viscosities) the simulated curve at ``mu_S`` gives the curve at
     ``mu`` at the speeds ``U mu / mu_S``: the micro and macro stages are not run again.
+``load_share``
+    the share of the imposed load the pin face carries (``[tribometer] load_share``, in
+    [0.5, 1] here; the rest goes elsewhere, e.g. an edge of the holder or the load path's
+    friction), C_f still referred to the imposed load.  The load does not collapse with
+    the Hersey number in mixed lubrication, so the macro stage sweeps the first viscosity
+    once at each of :data:`LOAD_SHARES` (the micro stage is not run again) and C_f is
+    interpolated between them (PCHIP in the share, at each speed), added to each curve as
+    the change from its own share.
 
 Least squares on C_f,dev (eq 35) at the measured speeds (the simulated curve interpolated
 by PCHIP in log speed).  Weights: where the measured CSV gives ``cf_min``/``cf_max`` (the
@@ -34,24 +42,47 @@ from ..macro.viscosity import WaltherLaw
 from .curve import MeasuredCurve, StribeckCurve
 
 #: the parameters :func:`fit_curves` can fit (case-file keys)
-PARAMETERS = ("boundary_friction", "temperature")
+PARAMETERS = ("boundary_friction", "temperature", "load_share")
+#: the face's shares of the imposed load swept for a ``load_share`` fit (its bounds)
+LOAD_SHARES = (0.5, 0.625, 0.75, 0.875, 1.0)
+#: a fitted contact temperature this far [K] from its curve's oil temperature is flagged
+TEMPERATURE_OFFSET = 15.0
 #: expected range of three normal samples in standard deviations (d2 of n = 3)
 RANGE_OF_THREE = 1.693
 
 
 @dataclass(frozen=True)
 class FitModel:
-    """C_f of simulated curves at other C_f,b and oil temperatures (module docstring)."""
+    """C_f of simulated curves at other C_f,b, oil temperatures and load shares (module
+    docstring).  ``curves``: a StribeckCurve per measured curve, swept at ``load_share`` of
+    the imposed ``load`` [N]; ``law``: the lubricant's viscosity-temperature law (None
+    without temperatures); ``share_curves``: ``((share, StribeckCurve), ...)`` swept at one
+    viscosity, ascending, that bracket ``load_share`` (empty: the share is not a parameter).
+    """
 
-    curves: tuple                 # StribeckCurve per measured curve
+    curves: tuple
     boundary_friction: float      # C_f,b of the simulated curves
-    load: float                   # F_N [N]
-    law: WaltherLaw
+    load: float                   # F_N,imp [N]
+    law: WaltherLaw | None
+    load_share: float = 1.0
+    share_curves: tuple = ()
 
-    def friction(self, k: int, speed, boundary_friction: float, viscosity: float):
-        """C_f of curve ``k`` at ``speed`` [m/s] for C_f,b and mu_0 [Pa s]; and the mask of
-        speeds whose Hersey number lies inside the simulated range (ends held outside)."""
-        c = self.curves[k]
+    def friction(self, k: int, speed, boundary_friction: float, viscosity: float,
+                 share: float | None = None):
+        """C_f of curve ``k`` at ``speed`` [m/s] for C_f,b, mu_0 [Pa s] and the face's
+        ``share`` of the load (None: the curves' own); and the mask of speeds whose Hersey
+        number lies inside the simulated range (ends held outside)."""
+        cf, inside = self._at(self.curves[k], speed, boundary_friction, viscosity)
+        if share is None or share == self.load_share or not self.share_curves:
+            return cf, inside
+        shares = [s for s, _ in self.share_curves]
+        values = [self._at(c, speed, boundary_friction, viscosity) for _, c in
+                  self.share_curves]
+        grid = PchipInterpolator(shares, np.stack([v[0] for v in values]), axis=0)
+        return cf + grid(share) - grid(self.load_share), inside & np.all(
+            [v[1] for v in values], axis=0)
+
+    def _at(self, c: StribeckCurve, speed, boundary_friction: float, viscosity: float):
         order = np.argsort(c.speed)
         x = np.log(c.speed[order])
         u = np.log(np.asarray(speed, float) * viscosity / c.viscosity)
@@ -70,39 +101,45 @@ def check_parameters(params) -> None:
                          f"{list(PARAMETERS)}")
 
 
-def fit_curves(model: FitModel, measured, params, *, start_temperatures) -> dict:
+def fit_curves(model: FitModel, measured, params, *, start_temperatures,
+               verbose: bool = False) -> dict:
     """Fit ``params`` (a subset of :data:`PARAMETERS`) to the ``measured`` curves
     (:class:`MeasuredCurve`, one per ``model.curves``); ``start_temperatures`` [C] start the
     temperature of each curve; without ``temperature`` they are the known temperatures, or,
     when None, each simulated curve keeps its own viscosity (``model.law`` may be None).
     Returns ``{name: {"value", "low", "high"}}`` (``temperature_K`` and its
-    ``viscosity_K`` per curve K from 1) with the residuals and the fit's statistics."""
+    ``viscosity_K`` per curve K from 1) with the residuals and the fit's statistics.
+    ``verbose``: a line per iteration (scipy's).  Raises :class:`~fem_twin.errors.InputError`
+    when no parameter set fits (:func:`check_misfit`)."""
     check_parameters(params)
     if len(measured) != len(model.curves):
         raise InputError(f"{len(measured)} measured curves for {len(model.curves)} simulated")
-    names = (["boundary_friction"] if "boundary_friction" in params else []) + (
-        [f"temperature_{k + 1}" for k in range(len(measured))] if "temperature" in params
-        else [])
     if "temperature" in params and start_temperatures is None:
         raise InputError("fitting the temperature needs start temperatures [C]")
-    x0 = np.array([model.boundary_friction] * ("boundary_friction" in params)
-                  + list(start_temperatures or []) * ("temperature" in params), float)
+    if "load_share" in params and len(model.share_curves) < 2:
+        raise InputError("fitting the load share needs sweeps at two or more load shares "
+                         "(FitModel.share_curves)")
+    names, x0, lower, upper = _unknowns(model, params, len(measured), start_temperatures)
     sigma = [_sigma(m) for m in measured]
     weighted = all(s is not None for s in sigma)
 
     def unpack(x):
-        """C_f,b and the viscosity [Pa s] of each curve."""
-        cfb = x[0] if "boundary_friction" in params else model.boundary_friction
-        if "temperature" not in params:               # known temperatures, or the curves'
-            return cfb, ([c.viscosity for c in model.curves] if start_temperatures is None
-                         else [float(model.law.viscosity(t)) for t in start_temperatures])
-        return cfb, [float(model.law.viscosity(t)) for t in x[-len(measured):]]
+        """C_f,b, the viscosity [Pa s] of each curve and the face's load share."""
+        v = dict(zip(names, x))
+        cfb = v.get("boundary_friction", model.boundary_friction)
+        temps = [v.get(f"temperature_{k + 1}") for k in range(len(measured))]
+        if temps[0] is None:                          # known temperatures, or the curves'
+            mus = ([c.viscosity for c in model.curves] if start_temperatures is None
+                   else [float(model.law.viscosity(t)) for t in start_temperatures])
+        else:
+            mus = [float(model.law.viscosity(t)) for t in temps]
+        return cfb, mus, v.get("load_share")
 
     def residuals(x):
-        cfb, mus = unpack(x)
+        cfb, mus, share = unpack(x)
         out = []
         for k, m in enumerate(measured):
-            cf, _ = model.friction(k, m.speed, cfb, mus[k])
+            cf, _ = model.friction(k, m.speed, cfb, mus[k], share)
             r = (cf - m.friction_coefficient) / model.boundary_friction
             out.append(r / (sigma[k] / model.boundary_friction) if weighted else r)
         return np.concatenate(out)
@@ -110,12 +147,58 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures) -> dict
     n = sum(m.speed.size for m in measured)
     if n <= x0.size:
         raise InputError(f"{n} measured points cannot fit {x0.size} parameters")
-    nb = int("boundary_friction" in params)          # C_f,b in (0, 1], T in [-30, 250] C
-    lower, upper = [1e-4] * nb + [-30.0] * (x0.size - nb), [1.0] * nb + [250.0] * (x0.size - nb)
-    sol = optimize.least_squares(residuals, x0, bounds=(lower, upper), x_scale="jac")
+    sol = optimize.least_squares(residuals, x0, bounds=(lower, upper), x_scale="jac",
+                                 verbose=2 if verbose else 0)
     if not sol.success:
         raise NotConverged(f"fit did not converge: {sol.message}", [float(sol.cost)])
-    return _summary(model, measured, names, sol, weighted, unpack)
+    out = _summary(model, measured, names, sol, weighted, unpack)
+    check_misfit(out, names, sol.x, lower, upper)
+    return out
+
+
+def _unknowns(model, params, n_curves, start_temperatures):
+    """Names, start values and bounds of the unknowns: C_f,b in [1e-4, 1], a temperature
+    per curve in [-30, 250] C, the load share over :attr:`FitModel.share_curves`."""
+    rows = []
+    if "boundary_friction" in params:
+        rows.append(("boundary_friction", model.boundary_friction, 1e-4, 1.0))
+    if "temperature" in params:
+        rows += [(f"temperature_{k + 1}", float(t), -30.0, 250.0)
+                 for k, t in zip(range(n_curves), start_temperatures)]
+    if "load_share" in params:
+        lo, hi = model.share_curves[0][0], model.share_curves[-1][0]
+        rows.append(("load_share", min(max(model.load_share, lo), hi), lo, hi))
+    names, x0, lower, upper = zip(*rows)
+    return list(names), np.array(x0, float), list(lower), list(upper)
+
+
+#: a fit is refused when its rms C_f,dev exceeds this share of C_f,b without measured
+#: scatter (the paper's repeated tests scatter by about +-10 %)
+MISFIT_RMS = 0.05
+#: ... or, with the measured scatter as weights, when chi^2 is this improbable
+MISFIT_P = 1e-3
+
+
+def check_misfit(result: dict, names, x, lower, upper) -> None:
+    """Refuse a fit that no parameter set achieves: C_f,b or a temperature pinned at its
+    bound, or residuals beyond the measured scatter (chi^2 p-value below
+    :data:`MISFIT_P`), or, without scatter, an rms C_f,dev above :data:`MISFIT_RMS`."""
+    f = result["fit"]
+    worst = max(((abs(d), r["curve"], u, d) for r in result["residuals"]
+                 for u, d in zip(r["speed_m_s"], r["cf_dev"])))
+    where = (f"rms C_f,dev {f['rms_cf_dev']:.1%} of C_f,b, largest {worst[3]:+.1%} at "
+             f"{worst[2]:.3g} m/s on curve {worst[1]}")
+    pinned = [n for n, v, lo, hi in zip(names, x, lower, upper)
+              if n != "load_share" and min(v - lo, hi - v) <= 1e-6 * (hi - lo)]
+    if f["weights"] == "equal":
+        bad = f["rms_cf_dev"] > MISFIT_RMS
+    else:
+        bad = stats.chi2.sf(f["chi2"], f["degrees_of_freedom"]) < MISFIT_P
+    if pinned or bad:
+        raise InputError(f"no parameter set fits the measured curve(s): {where}"
+                         + (f"; {', '.join(pinned)} at the bound of its range" if pinned
+                            else "") + "; was it measured at the case's load, in m/s, with "
+                         "the case's lubricant?")
 
 
 def _sigma(m: MeasuredCurve):
@@ -128,12 +211,11 @@ def _sigma(m: MeasuredCurve):
 def _summary(model, measured, names, sol, weighted, unpack) -> dict:
     n, p = sol.fun.size, sol.x.size
     dof = n - p
-    scale = 1.0 if weighted else float(sol.fun @ sol.fun / dof)
-    cov = np.linalg.pinv(sol.jac.T @ sol.jac) * scale
+    cov = _covariance(sol.jac, sol.fun, weighted)
     half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
     out = {name: {"value": float(v), "low": float(v - h), "high": float(v + h)}
            for name, v, h in zip(names, sol.x, half)}
-    cfb, mus = unpack(sol.x)
+    cfb, mus, share = unpack(sol.x)
     for k in range(len(measured)):
         t = out.get(f"temperature_{k + 1}")
         if t is not None:                       # viscosity falls as temperature rises
@@ -142,7 +224,7 @@ def _summary(model, measured, names, sol, weighted, unpack) -> dict:
                                          "high": float(mu[2])}
     rows, outside = [], 0
     for k, m in enumerate(measured):
-        cf, inside = model.friction(k, m.speed, cfb, mus[k])
+        cf, inside = model.friction(k, m.speed, cfb, mus[k], share)
         outside += int((~inside).sum())
         rows.append({"curve": k + 1, "speed_m_s": m.speed.tolist(),
                      "measured_cf": m.friction_coefficient.tolist(), "fitted_cf": cf.tolist(),
@@ -150,6 +232,7 @@ def _summary(model, measured, names, sol, weighted, unpack) -> dict:
                                 / model.boundary_friction).tolist()})
     dev = np.concatenate([r["cf_dev"] for r in rows])
     out["fit"] = {"parameters": names, "points": n, "degrees_of_freedom": dof,
+                  "chi2": float(sol.fun @ sol.fun),
                   "weights": "measured scatter (cf_min/cf_max)" if weighted else "equal",
                   "rms_cf_dev": float(np.sqrt(np.mean(dev ** 2))),
                   "max_abs_cf_dev": float(np.abs(dev).max()),
@@ -157,37 +240,49 @@ def _summary(model, measured, names, sol, weighted, unpack) -> dict:
                   "correlation": _correlation(cov).tolist(), "covariance": cov.tolist(),
                   "t_factor": float(stats.t.ppf(0.975, dof))}
     out["residuals"] = rows
+    out["fit"]["warnings"] = [
+        f"curve {k + 1}: the fitted contact temperature is {out[f'temperature_{k + 1}']['value']:.1f} C "
+        f"({model.law.temperature(model.curves[k].viscosity):.1f} C in the case): "
+        "frictional heating of a few K is usual; a larger offset may stand for another "
+        "load or lubricant (the Hersey collapse trades the two)"
+        for k in range(len(measured)) if f"temperature_{k + 1}" in out and abs(
+            out[f"temperature_{k + 1}"]["value"]
+            - model.law.temperature(model.curves[k].viscosity)) > TEMPERATURE_OFFSET]
     return out
 
 
-def predict(model: FitModel, result: dict, speeds, temperature: float,
-            nominal=None) -> dict:
+def predict(model: FitModel, result: dict, speeds, temperature: float | None,
+            nominal=None, *, curve: int | None = None) -> dict:
     """C_f at ``speeds`` [m/s] for the oil at ``temperature`` [C] with the fitted parameters
     of ``result`` (:func:`fit_curves`), and its 95 % band from their covariance.
 
     With fitted temperatures and the ``nominal`` oil temperatures of the measured curves
     [C], the contact runs at ``temperature`` plus their mean offset (fitted minus nominal,
     e.g. frictional heating), whose uncertainty joins the band; without, at
-    ``temperature``.  The simulated curve of the nearest viscosity is rescaled (Hersey);
+    ``temperature`` (None: at the viscosity of the simulated ``curve``).  The simulated
+    curve of the nearest viscosity, or ``curve``, is rescaled (Hersey); without ``curve``
     the band adds the spread of all the simulated curves so rescaled (the Hersey collapse's
-    own error, when there are two or more) and their C_f error estimates (``cf_err``)."""
+    own error, when there are two or more); it adds their C_f error estimates
+    (``cf_err``).  A fitted load share moves C_f along ``model.share_curves``."""
     names = result["fit"]["parameters"]
     x = np.array([result[n]["value"] for n in names])
     cov = np.asarray(result["fit"]["covariance"])
     temps = [i for i, n in enumerate(names) if n.startswith("temperature_")]
 
-    def cf(x, k=None):
-        cfb = x[names.index("boundary_friction")] if "boundary_friction" in names \
-            else model.boundary_friction
+    def cf(x, k=curve):
+        v = dict(zip(names, x))
         offset = (np.mean([x[i] - t for i, t in zip(temps, nominal)])
                   if temps and nominal is not None else 0.0)
-        mu = float(model.law.viscosity(temperature + offset))
+        mu = (model.curves[k].viscosity if temperature is None
+              else float(model.law.viscosity(temperature + offset)))
         if k is None:
             k = int(np.argmin([abs(np.log(c.viscosity / mu)) for c in model.curves]))
-        return model.friction(k, speeds, cfb, mu)
+        return model.friction(k, speeds, v.get("boundary_friction", model.boundary_friction),
+                              mu, v.get("load_share"))
 
     value, inside = cf(x)
-    discretisation = _error_at(model, speeds) + _collapse_error(model, cf, x)
+    discretisation = _error_at(model, speeds) + (_collapse_error(model, cf, x)
+                                                 if curve is None else 0.0)
     grad = np.stack([(cf(x + step)[0] - value) / step[i]
                      for i, step in enumerate(np.diag(np.maximum(1e-6 * np.abs(x), 1e-6)))],
                     axis=1)
@@ -219,9 +314,25 @@ def _error_at(model: FitModel, speeds) -> np.ndarray:
     return np.max(out, axis=0)
 
 
+def _covariance(jac, res, weighted: bool):
+    """Covariance of the fitted parameters: ``(J^T J)^-1`` for residuals weighted by the
+    measured scatter; without it, the heteroscedasticity-consistent sandwich estimator HC3
+    (MacKinnon and White 1985), ``(J^T J)^-1 J^T diag(r_i^2 / (1 - h_i)^2) J (J^T J)^-1``
+    with the leverages ``h_i``: the scatter of a measured C_f grows with C_f (a per cent of
+    it), and one variance from all the residuals understates it where the parameters are
+    decided (the boundary regime)."""
+    inv = np.linalg.pinv(jac.T @ jac)
+    if weighted:
+        return inv
+    leverage = np.einsum("ij,jk,ik->i", jac, inv, jac)
+    meat = jac.T @ (jac * (res / np.maximum(1 - leverage, 1e-3))[:, None] ** 2)
+    return inv @ meat @ inv
+
+
 def _correlation(cov):
     d = np.sqrt(np.diag(cov))
-    return cov / np.outer(d, d)
+    outer = np.outer(d, d)
+    return np.divide(cov, outer, out=np.zeros_like(cov), where=outer > 0)
 
 
 def plot_fit(result: dict, path, labels=None):
