@@ -111,6 +111,8 @@ def fit(args):
               f"{v['high']:.5g})")
     print(f"  rms C_f,dev {result['fit']['rms_cf_dev']:.2%} over {result['fit']['points']} "
           f"points; {RunLayout(args.output).fit} and fit.png")
+    for warning in result["fit"]["warnings"]:
+        print(f"  warning: {warning}")
     return 0
 
 

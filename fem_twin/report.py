@@ -116,7 +116,8 @@ def fit_section(out: RunLayout) -> str:
                      f"{fit[k]['high']:.4g})" for k in names)
     return figure_section("Fitted to measured curves", [out.fit_png],
                           f"{text}; rms C_f,dev {fit['fit']['rms_cf_dev']:.2%} (eq 35) over "
-                          f"{fit['fit']['points']} points, weights: {fit['fit']['weights']}.")
+                          f"{fit['fit']['points']} points, weights: {fit['fit']['weights']}."
+                          + "".join(f" {w}." for w in fit["fit"].get("warnings", [])))
 
 
 def calibration_section(out: RunLayout) -> str:
