@@ -240,15 +240,22 @@ def _summary(model, measured, names, sol, weighted, unpack) -> dict:
                   "correlation": _correlation(cov).tolist(), "covariance": cov.tolist(),
                   "t_factor": float(stats.t.ppf(0.975, dof))}
     out["residuals"] = rows
-    out["fit"]["warnings"] = [
-        f"curve {k + 1}: the fitted contact temperature is {out[f'temperature_{k + 1}']['value']:.1f} C "
-        f"({model.law.temperature(model.curves[k].viscosity):.1f} C in the case): "
-        "frictional heating of a few K is usual; a larger offset may stand for another "
-        "load or lubricant (the Hersey collapse trades the two)"
-        for k in range(len(measured)) if f"temperature_{k + 1}" in out and abs(
-            out[f"temperature_{k + 1}"]["value"]
-            - model.law.temperature(model.curves[k].viscosity)) > TEMPERATURE_OFFSET]
+    out["fit"]["warnings"] = _temperature_warnings(model, out, len(measured))
     return out
+
+
+def _temperature_warnings(model: FitModel, out: dict, n: int) -> list[str]:
+    """Fitted contact temperatures more than :data:`TEMPERATURE_OFFSET` from their curve's."""
+    warnings = []
+    for k in range(n):
+        fitted = out.get(f"temperature_{k + 1}", {}).get("value")
+        oil = None if fitted is None else float(model.law.temperature(model.curves[k].viscosity))
+        if fitted is not None and abs(fitted - oil) > TEMPERATURE_OFFSET:
+            warnings.append(f"curve {k + 1}: the fitted contact temperature is {fitted:.1f} C "
+                            f"({oil:.1f} C in the case): frictional heating of a few K is "
+                            "usual; a larger offset may stand for another load or lubricant "
+                            "(the Hersey collapse trades the two)")
+    return warnings
 
 
 def predict(model: FitModel, result: dict, speeds, temperature: float | None,
