@@ -8,7 +8,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from . import tables as T
-from .checks import QUANTITIES
+from .checks import QUANTITIES, setting
 from .errors import InputError
 from .topography.prepare import MacroOptions
 
@@ -19,33 +19,46 @@ class CaseError(InputError):
 
 @dataclass(frozen=True)
 class Geometry:
-    """Measured topography files (paths relative to the case file are resolved)."""
+    """``[geometry]``: measured topography files (paths relative to the case file are
+    resolved) and the window the roughness patches are cut from."""
 
-    pins: tuple[Path, ...]
-    disks: tuple[Path, ...] = ()
-    patches: tuple[tuple[Path, Path], ...] = ()   # (pin patch, disk patch) pairs
-    patch_shape: tuple[int, int] = (256, 256)
-    patch_start: tuple[int, int] = (0, 0)
+    pins: tuple[Path, ...] = setting(
+        (), "macro pin maps (8 x 8 mm), one file per pin; the set average is the macro pin",
+        unit="file paths")
+    disks: tuple[Path, ...] = setting(
+        (), "the disk map measured with each pin (none: a flat disk)", unit="file paths")
+    patches: tuple[tuple[Path, Path], ...] = setting(
+        (), "roughness patch pairs [pin patch, disk patch], one micro problem each",
+        unit="file path pairs")
+    patch_shape: tuple[int, int] = setting(
+        (256, 256), "rows and columns of each patch, cut without interpolation", unit="px")
+    patch_start: tuple[int, int] = setting((0, 0), "first row and column of the cut",
+                                           unit="px")
 
 
 @dataclass(frozen=True)
 class Tribometer:
-    """Operating conditions (Tables 1 and 6): imposed load [N], pin diameter [m], sliding
-    radius [m] (recorded; speeds are given in m/s), boundary friction coefficient C_f,b of
-    eq 32 [-], ``load_share``: the share of the imposed load the pin face carries (film and
-    contact, eq 28; 1 in the paper; C_f stays the friction force over the imposed load).  ``kind = "ball-on-disk"``: a ball of ``ball_radius`` [m] on the disk at
-    ``slide_to_roll`` = u_r / u_m (MTM convention, in (0, 2]; the sweep's speeds are then
-    entrainment speeds u_m), on a track of ``track_radius`` [m] (recorded)."""
+    """``[tribometer]``: operating conditions (Tables 1 and 6).  ``kind = "ball-on-disk"``:
+    a ball on the disk at ``slide_to_roll`` = u_r / u_m (MTM convention; the sweep's speeds
+    are then entrainment speeds u_m)."""
 
-    load: float = T.LOAD
-    pin_diameter: float = 8e-3
-    sliding_radius: float = 30e-3
-    boundary_friction: float = T.BOUNDARY_FRICTION        # the paper's C_f,b, eq 32
-    load_share: float = 1.0                               # of `load` on the pin face
-    kind: str = "pin-on-disk"                             # or "ball-on-disk"
-    ball_radius: float = 12.5e-3
-    slide_to_roll: float = 0.5
-    track_radius: float = 20e-3
+    load: float = setting(T.LOAD, "imposed normal load F_N,imp (Table 6)", "load")
+    pin_diameter: float = setting(8e-3, "pin diameter D of the Hersey number (eq 46)",
+                                  "pin_diameter")
+    sliding_radius: float = setting(30e-3, "radius of the sliding track (recorded; speeds "
+                                    "are given in m/s)", "length")
+    boundary_friction: float = setting(
+        T.BOUNDARY_FRICTION, "C_f,b of eq 32 (the paper's 1/(3 sqrt 3)); also the scale of "
+        "C_f,dev (eq 35)", "friction")
+    load_share: float = setting(
+        1.0, "share of the load the pin face carries (film and contact, eq 28); C_f stays "
+        "the friction force over the imposed load (1: the paper)", "load_share")
+    kind: str = setting("pin-on-disk", "the tribometer", choices=("pin-on-disk",
+                                                                  "ball-on-disk"))
+    ball_radius: float = setting(12.5e-3, "radius of a ball-on-disk's ball", "length")
+    slide_to_roll: float = setting(0.5, "slide-to-roll ratio u_r / u_m of a ball (2: a "
+                                   "stationary ball)", "slide_to_roll")
+    track_radius: float = setting(20e-3, "radius of a ball's track (recorded)", "length")
 
     @property
     def ball(self) -> bool:
@@ -54,16 +67,24 @@ class Tribometer:
 
 @dataclass(frozen=True)
 class LubricantSpec:
-    """mu_0 per temperature (Table 3) and the constants of eqs 23-24 (Table 6)."""
+    """``[lubricant]``: mu_0 per temperature (Table 3) and the constants of eqs 23-24
+    (Table 6)."""
 
-    viscosities: tuple[float, ...] = (0.066, 0.024)
-    temperatures: tuple[float, ...] = (24.0, 50.0)
-    density: float = T.DENSITY
-    roelands_alpha: float = T.ROELANDS_ALPHA
-    roelands_p0: float = T.ROELANDS_P0
-    dh_c1: float = T.DH_C1
-    dh_c2: float = T.DH_C2
-    eyring_stress: float = 0.0       # tau_0 [Pa] of Eyring shear thinning (0: Newtonian)
+    viscosities: tuple[float, ...] = setting(
+        (0.066, 0.024), "mu_0 at ambient pressure, one Stribeck curve each (Table 3)",
+        "viscosity")
+    temperatures: tuple[float, ...] = setting(
+        (24.0, 50.0), "oil temperature of each viscosity: curve labels, and the Walther law "
+        "of fem-twin fit", unit="C")
+    density: float = setting(T.DENSITY, "rho_0 at ambient pressure (eq 24)", "density")
+    roelands_alpha: float = setting(T.ROELANDS_ALPHA, "pressure-viscosity coefficient of "
+                                    "Roelands (eq 23)", "pressure_viscosity")
+    roelands_p0: float = setting(T.ROELANDS_P0, "Roelands reference pressure p_0 (eq 23)",
+                                 unit="Pa")
+    dh_c1: float = setting(T.DH_C1, "Dowson-Higginson C_1 (eq 24)", unit="Pa")
+    dh_c2: float = setting(T.DH_C2, "Dowson-Higginson C_2 (eq 24)", unit="-")
+    eyring_stress: float = setting(0.0, "tau_0 of Eyring shear thinning (0: Newtonian; "
+                                   "needed for EHL traction)", "eyring_stress")
 
     def lubricants(self) -> list:
         """One :class:`fem_twin.macro.Lubricant` per viscosity."""
@@ -76,13 +97,14 @@ class LubricantSpec:
 
 @dataclass(frozen=True)
 class Materials:
-    """Elastic constants of pin and disk (Table 4) and the hardness cap [Pa]."""
+    """``[materials]``: elastic constants of pin and disk (Table 4) and the hardness cap."""
 
-    e_pin: float = T.E_STEEL
-    nu_pin: float = T.NU_STEEL
-    e_disk: float = T.E_STEEL
-    nu_disk: float = T.NU_STEEL
-    hardness: float = T.HARDNESS
+    e_pin: float = setting(T.E_STEEL, "Young's modulus of the pin (or ball)", "modulus")
+    nu_pin: float = setting(T.NU_STEEL, "Poisson ratio of the pin (or ball)", "poisson")
+    e_disk: float = setting(T.E_STEEL, "Young's modulus of the disk", "modulus")
+    nu_disk: float = setting(T.NU_STEEL, "Poisson ratio of the disk", "poisson")
+    hardness: float = setting(T.HARDNESS, "hardness: the cap on the contact pressure",
+                              "hardness")
 
     @property
     def e_reduced(self) -> float:
@@ -99,52 +121,62 @@ ADAPTIVE_H0 = 28
 
 @dataclass(frozen=True)
 class MicroSpec:
-    """Micro scale: patch resolution (resampled), h0 range [m] and count, time steps, the
-    squeeze term (``"exact"`` or the paper's ``"backward"``), adaptive instants and h0."""
+    """``[micro]``: the roughness scale (eqs 8-16): patch resolution, h0 candidates, time
+    steps, the squeeze term, adaptive instants and h0."""
 
-    resolution: tuple[int, int] = (256, 256)
-    h0_min: float = 1e-7
-    h0_max: float = 1e-6
-    h0_count: int = 100
-    steps: int = 32
-    method: str = "fe"
-    time_derivative: str = "exact"
-    time_tol: float = 0.0            # > 0: adaptive instants per h0 (homogenise time_tol)
-    h0_tol: float = 0.01             # > 0: adaptive h0, a subset of the h0_count candidates
-                                     # (homogenise h0_tol); 0: all of them (the paper)
+    resolution: tuple[int, int] = setting((256, 256), "patches resampled (periodically) to "
+                                          "this grid, at least 8 each", unit="px")
+    h0_min: float = setting(1e-7, "smallest separation h0", "separation")
+    h0_max: float = setting(1e-6, "largest separation h0 (above: the paper's rules)",
+                            "separation")
+    h0_count: int = setting(100, "h0 candidates, log-spaced (the paper: 100)", unit="-")
+    steps: int = setting(32, "sliding time steps over one pass of the disk patch",
+                         unit="-")
+    method: str = setting("fe", "cell problems by finite elements or the paper's finite "
+                          "volumes", choices=("fe", "fvm"))
+    time_derivative: str = setting("exact", "squeeze term: exact, or the paper's implicit "
+                                   "Euler", choices=("exact", "backward"))
+    time_tol: float = setting(0.0, "adaptive instants: midpoints added at an h0 while A11 "
+                              "or b1 change by more (0: off)", unit="fraction")
+    h0_tol: float = setting(0.01, "adaptive h0: solve the candidates the log-h0 "
+                            "interpolant needs to read the others within this (0: all, the "
+                            "paper)", unit="fraction")
 
 
 @dataclass(frozen=True)
 class MacroSpec:
-    """Macro scale: which pin ("average" of the set or 1-based index), FE/FVM, coupling
-    (``auto``: Anderson on conformal pins, Newton on concentrated contacts), and the nodes
-    per side of a ball's grid over [-4a, 2a] x [-3a, 3a] (``grid - 1`` divisible by 6 puts
-    a node on the contact centre)."""
+    """``[macro]``: the homogenised Reynolds scale (eqs 17-34)."""
 
-    pin: str | int = "average"
-    method: str = "fe"
-    coupling: str = "auto"
-    grid: int = 97
-    inner_steps: int = 1             # Newton steps per Reynolds solve far from the fixed
-                                     # point (MacroSettings.inner_steps; 0: exact solves)
-    couette: str = "central"         # Couette flux of eq 17: second order, or "upwind"
-                                     # (the paper's first order); fem_twin.macro.couette
+    pin: str | int = setting("average", "the macro pin: the levelled set's average, or a "
+                             "pin number from 1", unit='"average" or a number')
+    method: str = setting("fe", "Reynolds by finite elements or the paper's finite volumes",
+                          choices=("fe", "fvm"))
+    coupling: str = setting("auto", "pressure-deformation-load coupling (auto: Anderson, "
+                            "Newton for concentrated contacts or when it fails; pid: the "
+                            "paper's)", choices=("auto", "anderson", "newton", "pid"))
+    grid: int = setting(97, "nodes per side of a ball's grid over [-4a, 2a] x [-3a, 3a]",
+                        unit="-")
+    inner_steps: int = setting(1, "Newton steps per Reynolds solve far from the fixed "
+                               "point (0: exact solves)", unit="-")
+    couette: str = setting("central", "Couette flux of eq 17: second order, or the paper's "
+                           "first-order upwind", choices=("central", "upwind"))
 
 
 @dataclass(frozen=True)
 class SweepSpec:
-    """Speeds from ``speed_max`` down to ``speed_min`` [m/s], ``count`` log-spaced, then
-    ``refine`` passes that add the geometric midpoints where C_f jumps by more than
-    ``refine_step`` C_f,b (the transition from full film to boundary friction); the run warns
-    where a point's estimated discretisation error of C_f exceeds ``error_tolerance`` C_f,b."""
+    """``[sweep]``: speeds from ``speed_max`` down to ``speed_min``, ``count`` log-spaced,
+    then ``refine`` passes that add midpoints where C_f jumps."""
 
-    speed_max: float = 2.0
-    speed_min: float = 0.01
-    count: int = 25
-    refine: int = 1             # passes adding midpoints where C_f jumps (0: off)
-    refine_step: float = 0.1    # ... by more than this fraction of C_f,b
-    error_tolerance: float = 0.005   # warn where the estimated discretisation error of C_f
-                                     # exceeds this fraction of C_f,b (fem_twin.macro.estimate)
+    speed_max: float = setting(2.0, "fastest sliding speed (the paper: 2 m/s)", "speed")
+    speed_min: float = setting(0.01, "slowest sliding speed (the paper: 0.01 m/s)", "speed")
+    count: int = setting(25, "speeds, log-spaced from fast to slow", unit="-")
+    refine: int = setting(1, "passes adding midpoints where C_f jumps (0: off, at most 4)",
+                          unit="-")
+    refine_step: float = setting(0.1, "... by more than this share of C_f,b",
+                                 unit="fraction")
+    error_tolerance: float = setting(0.005, "warn where a point's estimated discretisation "
+                                     "error of C_f exceeds this share of C_f,b",
+                                     unit="fraction")
 
     @property
     def speeds(self):
@@ -154,13 +186,15 @@ class SweepSpec:
 
 @dataclass(frozen=True)
 class RunSpec:
-    """Where independent work runs: local processes, or a Dask scheduler address; whether
-    the main job adds the patch scatter band (one Stribeck sweep per patch's flow factors
-    beside the patch average, min/max C_f per speed)."""
+    """``[run]``: where independent work runs, and whether the main job adds the patch
+    scatter band."""
 
-    workers: int = 0                 # 0: all cores
-    scheduler: str | None = None     # e.g. "tcp://10.0.0.1:8786"
-    patch_band: bool = True          # one sweep per patch: the scatter band (Figure 13)
+    workers: int = setting(0, "local processes (0: all cores)", unit="-")
+    scheduler: str | None = setting(None, "a Dask scheduler's address instead, e.g. "
+                                    '"tcp://10.0.0.1:8786" (the cluster extra)',
+                                    unit="address")
+    patch_band: bool = setting(True, "one more sweep per patch: the roughness scatter band "
+                               "(Figure 13)", unit="true or false")
 
 
 @dataclass(frozen=True)
@@ -226,7 +260,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
         raise CaseError(f"{where}: missing [geometry] section")
     tribometer = _tribometer(data, where)
     geometry = _geometry(data["geometry"], base, where, tribometer.ball)
-    macro_geometry = _preprocessing(data.get("preprocessing", {}), where)
+    macro_geometry = _preprocessing(data, where)
     lubricant = _lubricant(data, where)
     materials = _section(data, "materials", Materials, where, positive=True)
     micro = _micro(data, where)
@@ -255,9 +289,6 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
 
 def _tribometer(data, where) -> Tribometer:
     tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
-    if tribometer.kind not in ("pin-on-disk", "ball-on-disk"):
-        raise CaseError(f"{where} [tribometer] kind: 'pin-on-disk' or 'ball-on-disk', got "
-                        f"{tribometer.kind!r}")
     if tribometer.ball and tribometer.load_share != 1.0:
         raise CaseError(f"{where} [tribometer] load_share: a ball carries the whole load "
                         "(load_share = 1); it is a pin face's share")
@@ -296,28 +327,16 @@ def _geometry(g, base, where, ball) -> Geometry:
     return geometry
 
 
-def _preprocessing(pre, where) -> MacroOptions:
+def _preprocessing(data, where) -> MacroOptions:
     """[preprocessing]: the macro geometry's options, lengths in metres."""
-    _only(pre, {f.name for f in fields(MacroOptions)}, f"{where} [preprocessing]")
-    opts = dict(pre)
-    if "resolution" in opts:
-        opts["resolution"] = _int_pair(opts["resolution"], f"{where} [preprocessing] resolution")
-    for key in ("fwhm_px", "clip", "truncation", "holder_height", "level_radius"):
-        if key in opts and (not isinstance(opts[key], (int, float))
-                            or not math.isfinite(opts[key])):
-            raise CaseError(f"{where} [preprocessing] {key}: expected a finite number (SI "
-                            "units)")
-        _plausible("preprocessing", key, opts.get(key), where)
-    if opts.get("clip", 1) <= 0 or opts.get("clip", 0) > 1e-3:
+    opts = _section(data, "preprocessing", MacroOptions, where)
+    _int_pair(list(opts.resolution), f"{where} [preprocessing] resolution")
+    if not 0 < opts.clip <= 1e-3:
         raise CaseError(f"{where} [preprocessing] clip: expected metres in (0, 1e-3], "
-                        f"got {opts['clip']} (20 um is 20e-6)")
-    if opts.get("sliding_direction", "+x1") not in ("+x1", "-x1", "+x2", "-x2"):
-        raise CaseError(f"{where} [preprocessing] sliding_direction: one of +x1, -x1, +x2, "
-                        f"-x2 (the measured axis along the disk velocity), got "
-                        f"{opts['sliding_direction']!r}")
-    if opts.get("fwhm_px", 0) < 0:
+                        f"got {opts.clip} (20 um is 20e-6)")
+    if opts.fwhm_px < 0:
         raise CaseError(f"{where} [preprocessing] fwhm_px must be >= 0 pixels")
-    return MacroOptions(**opts)
+    return opts
 
 
 def _lubricant(data, where) -> LubricantSpec:
@@ -338,10 +357,6 @@ def _micro(data, where) -> MicroSpec:
                         "the estimated error of C_f as a fraction of C_f,b (e.g. 0.005); the "
                         "flow factors' own estimates are in summary.json")
     micro = _section(data, "micro", MicroSpec, where)
-    if micro.method not in ("fe", "fvm"):
-        raise CaseError(f"{where} [micro] method: 'fe' or 'fvm'")
-    if micro.time_derivative not in ("exact", "backward"):
-        raise CaseError(f"{where} [micro] time_derivative: 'exact' or 'backward' (paper)")
     if not 0 <= micro.time_tol < 1 or (micro.time_tol and micro.time_derivative != "exact"):
         raise CaseError(f"{where} [micro] time_tol: 0 (off) or a fraction in (0, 1), with "
                         "time_derivative = 'exact'")
@@ -360,13 +375,6 @@ def _micro(data, where) -> MicroSpec:
 
 def _macro(data, where, tribometer, geometry) -> MacroSpec:
     macro = _section(data, "macro", MacroSpec, where)
-    if macro.method not in ("fe", "fvm") or macro.coupling not in ("auto", "anderson",
-                                                                    "newton", "pid"):
-        raise CaseError(f"{where} [macro]: method 'fe'|'fvm', coupling "
-                        "'auto'|'anderson'|'newton'|'pid'")
-    if macro.couette not in ("central", "upwind"):
-        raise CaseError(f"{where} [macro] couette: 'central' (second order) or 'upwind' (the "
-                        f"paper's first order), got {macro.couette!r}")
     if not (isinstance(macro.inner_steps, int) and macro.inner_steps >= 0):
         raise CaseError(f"{where} [macro] inner_steps: an integer >= 0 (1: one Newton step "
                         "per Reynolds solve far from convergence, 0: exact), got "
@@ -416,7 +424,8 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
     for f in fields(cls):
         if f.name not in table:
             continue
-        _plausible(name, f.name, table[f.name], where)
+        _plausible(name, f, table[f.name], where)
+        _choice(name, f, table[f.name], where)
         v = table[f.name]
         default = getattr(cls(), f.name)
         if isinstance(default, tuple):
@@ -450,46 +459,29 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
     return cls(**values)
 
 
-#: (section, key) -> the quantity of :data:`fem_twin.checks.QUANTITIES` (range, unit hint)
-PLAUSIBLE = {
-    ("tribometer", "load"): "load",
-    ("tribometer", "pin_diameter"): "pin_diameter",
-    ("tribometer", "sliding_radius"): "length",
-    ("tribometer", "boundary_friction"): "friction",
-    ("tribometer", "load_share"): "load_share",
-    ("tribometer", "ball_radius"): "length",
-    ("tribometer", "slide_to_roll"): "slide_to_roll",
-    ("tribometer", "track_radius"): "length",
-    ("lubricant", "viscosities"): "viscosity",
-    ("lubricant", "density"): "density",
-    ("lubricant", "roelands_alpha"): "pressure_viscosity",
-    ("lubricant", "eyring_stress"): "eyring_stress",
-    ("materials", "e_pin"): "modulus",
-    ("materials", "e_disk"): "modulus",
-    ("materials", "nu_pin"): "poisson",
-    ("materials", "nu_disk"): "poisson",
-    ("materials", "hardness"): "hardness",
-    ("micro", "h0_min"): "separation",
-    ("micro", "h0_max"): "separation",
-    ("sweep", "speed_max"): "speed",
-    ("sweep", "speed_min"): "speed",
-    ("preprocessing", "fwhm_px"): "fwhm_px",
-}
-
-
-def _plausible(section, key, value, where):
-    """Refuse a value outside the plausible SI range of ``PLAUSIBLE``, naming the key."""
-    if (section, key) not in PLAUSIBLE or isinstance(value, bool):
+def _plausible(section: str, f, value, where):
+    """Refuse a value outside the plausible SI range its declaration names
+    (:func:`fem_twin.checks.setting`), naming the key."""
+    quantity = f.metadata.get("quantity")
+    if quantity is None or isinstance(value, bool):
         return
-    lo, hi, unit = QUANTITIES[PLAUSIBLE[(section, key)]]
+    lo, hi, unit = QUANTITIES[quantity]
     values = value if isinstance(value, list) else [value]
     for v in values:
         if isinstance(v, (int, float)) and math.isfinite(v) and not lo <= v <= hi:
-            raise CaseError(f"{where} [{section}] {key} = {v}: implausible; expected "
+            raise CaseError(f"{where} [{section}] {f.name} = {v}: implausible; expected "
                             f"{lo:g} to {hi:g} {unit}")
-    if key == "fwhm_px" and isinstance(value, (int, float)) and 0 < value < 1:
+    if f.name == "fwhm_px" and isinstance(value, (int, float)) and 0 < value < 1:
         raise CaseError(f"{where} [preprocessing] fwhm_px = {value}: the filter width is in "
                         "pixels (0: no filter, else at least 1; the paper's is 9)")
+
+
+def _choice(section: str, f, value, where):
+    """Refuse a text setting outside its declared choices."""
+    choices = f.metadata.get("choices")
+    if choices and value not in choices:
+        raise CaseError(f"{where} [{section}] {f.name}: one of "
+                        f"{', '.join(repr(c) for c in choices)}, got {value!r}")
 
 
 def _only(section, allowed: set, where: str):

@@ -11,6 +11,7 @@ an example in SI units; the case parser (:mod:`fem_twin.case`) and the public en
 from __future__ import annotations
 
 import math
+from dataclasses import field
 
 import numpy as np
 
@@ -60,3 +61,24 @@ def _numeric(value) -> bool:
     except (TypeError, ValueError):
         return False
     return array.dtype.kind in "iuf" and array.dtype != bool
+
+
+def setting(default, doc: str, quantity: str | None = None, *, unit: str = "",
+            choices: tuple = ()):
+    """The one declaration of a case-file setting (a dataclass field of its section):
+    its default, a one-line ``doc``, the ``quantity`` of :data:`QUANTITIES` whose plausible
+    range and unit the parser enforces (or a ``unit`` of its own), and the ``choices`` of
+    a text setting.  The case parser, the API's checks and the documentation's case-file
+    reference all read it (:func:`describe`)."""
+    return field(default=default, metadata={"doc": doc, "quantity": quantity, "unit": unit,
+                                            "choices": tuple(choices)})
+
+
+def describe(f) -> dict:
+    """What :func:`setting` declared of the dataclass field ``f``: ``doc``, ``unit``,
+    ``range`` (lowest, highest, or None) and ``choices``."""
+    meta = f.metadata
+    quantity = meta.get("quantity")
+    lo, hi, hint = QUANTITIES[quantity] if quantity else (None, None, meta.get("unit", ""))
+    return {"doc": meta.get("doc", ""), "unit": hint, "choices": meta.get("choices", ()),
+            "range": None if quantity is None else (lo, hi)}

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..checks import setting
 from ..errors import InputError
 from .core import Topography
 from .filling import fill_defects
@@ -17,26 +18,23 @@ from .resampling import resample
 
 @dataclass(frozen=True)
 class MacroOptions:
-    """Settings of the macroscopic reconstruction (SI units; defaults from the paper).
+    """``[preprocessing]``: the macroscopic reconstruction (paper 2.2.1; SI units, defaults
+    from the paper)."""
 
-    fwhm_px : Gaussian filter FWHM in pixels of the measured map (0: unfiltered).
-    clip : height range limit [m] (heights clipped to +-clip).
-    resolution : (ny, nx) of the virtual geometry, or None to keep the measured grid.
-    resample_method : "linear" or "cubic".
-    truncation : below this height [m] a pin pixel belongs to the holder.
-    holder_height : holder surface [m] (pin height 1 mm).
-    level_radius : radius [m] about the pin centre of the final mean-plane fit.
-    sliding_direction : measured axis along the disk velocity (+x1, -x1, +x2, -x2).
-    """
-
-    fwhm_px: float = 9.0
-    clip: float = 20e-6
-    resolution: tuple[int, int] | None = (256, 256)
-    resample_method: str = "linear"
-    truncation: float = -20e-6
-    holder_height: float = -1e-3
-    level_radius: float = 3e-3
-    sliding_direction: str = "+x1"
+    fwhm_px: float = setting(9.0, "Gaussian filter FWHM in pixels of the measured map (0: "
+                             "unfiltered; the paper's calibrated value is 9)", "fwhm_px")
+    clip: float = setting(20e-6, "heights clipped to +-clip", unit="m")
+    resolution: tuple[int, int] | None = setting(
+        (256, 256), "rows and columns of the virtual geometry (the macro grid)", unit="px")
+    resample_method: str = setting("linear", "resampling interpolation",
+                                   choices=("linear", "cubic"))
+    truncation: float = setting(-20e-6, "below this height a pin pixel belongs to the "
+                                "holder", unit="m")
+    holder_height: float = setting(-1e-3, "the holder surface (pin height 1 mm)", unit="m")
+    level_radius: float = setting(3e-3, "radius about the pin centre of the final "
+                                  "mean-plane fit", unit="m")
+    sliding_direction: str = setting("+x1", "measured axis along the disk velocity",
+                                     choices=("+x1", "-x1", "+x2", "-x2"))
 
 
 def pin_face_guess(topo: Topography) -> np.ndarray:
