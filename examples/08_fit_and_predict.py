@@ -19,7 +19,7 @@ Then, as a tribologist with one measured curve would:
    offset carried to 50 C, the Hersey collapse's own error and the C_f error estimate.
 
 Prints the fitted values against the truth and how many 50 C "measured" points fall
-inside the predicted band; ends in ``OUT/fit_and_predict.png``.  About 5 minutes on 2
+inside the predicted band; ends in ``OUT/fit_and_predict.png``.  About 4 minutes on 2
 cores at the bundled size; ``--quick``: a reduced case (48^2 macro, 16^2 micro) in about
 a minute.  From the shell: ``fem-twin fit CASE m24.csv -o OUT --predict 50``.
 """
