@@ -225,7 +225,7 @@ def _patch_pair(n=256):
 def _amg_rows(cs, gap):
     """The FE cell step with smoothed-aggregation AMG (pyamg) as the CG preconditioner,
     setup included, to tol 1e-10, against the direct solution of the production step: why
-    the cell problems are solved directly (README, Notes)."""
+    the cell problems are solved directly (docs/user_guide.md)."""
     import pyamg
     import scipy.sparse.linalg as spla
     h_q = cs.at_quadrature(gap)

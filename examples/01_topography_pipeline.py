@@ -1,4 +1,8 @@
-"""Reconstruct the virtual macroscopic pins of the sample twin and plot their centre lines
+"""
+Topography pipeline: the virtual macro pins
+===========================================
+
+Reconstruct the virtual macroscopic pins of the sample twin and plot their centre lines
 (like the paper's Figure 3), using the Python API step by step.
 
     python examples/01_topography_pipeline.py [OUT.png] [--quick]

@@ -1,4 +1,8 @@
-"""Dry contact on the regular grid against Hertz: a 10 mm sphere on a flat at 150 N, the
+"""
+Dry contact against Hertz
+=========================
+
+Dry contact on the regular grid against Hertz: a 10 mm sphere on a flat at 150 N, the
 pressure along the centre line with and without the hardness cap (the paper's H).
 
     python examples/02_hertz_contact.py [OUT.png] [--quick]

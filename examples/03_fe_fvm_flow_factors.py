@@ -1,4 +1,8 @@
-"""FE against FVM flow factors on the bundled roughness patches at full resolution (issue 6).
+"""
+FE against FVM flow factors
+===========================
+
+FE against FVM flow factors on the bundled roughness patches at full resolution (issue 6).
 
     python examples/03_fe_fvm_flow_factors.py [OUT] [--steps N] [--workers W] [--quick]
 
@@ -6,8 +10,8 @@ Homogenises each of the six bundled patch pairs (256 x 256 px cut, as the bundle
 with both methods at h0 = 0.1, 0.15, 0.3, 0.6, 1 um and N sliding steps (default 8), and
 writes OUT/fe_fvm_flow_factors.csv with, per patch (and for the patch average) and h0,
 the differences of
-:func:`fem_twin.compare.flow_factor_differences`: max |Delta A| / max |A| (likewise b, C),
-|Delta d| (absolute, d is O(1) and crosses zero) and |Delta h_m| / h0.  About 2 minutes on
+:func:`fem_twin.compare.flow_factor_differences`: ``max |Delta A| / max |A|`` (likewise b, C),
+``|Delta d|`` (absolute, d is O(1) and crosses zero) and ``|Delta h_m| / h0``.  About 2 minutes on
 2 cores with 8 steps, 10 minutes with the paper's 32.  The factors themselves are kept as
 OUT/patch_<k>_<method>.npz (``FlowFactors.load``), so a rerun only recomputes what is
 missing.

@@ -1,14 +1,20 @@
-"""Convergence of the flow factors on the bundled sample patches: time steps and grid.
+"""
+Convergence of the flow factors
+===============================
+
+Convergence of the flow factors on the bundled sample patches: time steps and grid.
 
     python examples/04_micro_convergence.py [OUT] [--patches 1 3] [--workers 2] [--quick]
 
 For each patch pair, at h0 = 0.1, 0.14, 0.3, 0.6 um:
+
 - time: N_t = 4, 8, 16, 32, 64 at 128 px with the exact squeeze term (the default), against
   N_t = 128 (every pixel translation of the 128 px cell);
 - grid: the periodic patches resampled to 32, 64, 128 px (N_t = 16) against the measured
   256 px, with the observed order from the last three grids;
 - schemes: the paper's backward difference (32, 128 steps), the exact squeeze term (32) and
   the adaptive instants (time_tol 0.005) against the exact scheme at 128 steps, with times.
+
 Prints relative differences of A11, b1, d1, C11, p_con, h_m and writes them to
 ``OUT/micro_convergence.json`` (default ``out/micro_convergence``) and ends in
 ``OUT/micro_convergence.png`` (largest error over h0 versus N_t and versus the grid).  About

@@ -1,12 +1,16 @@
-"""Calibration studies of paper section 3.2 on the bundled sample case (Figures 9-13).
+"""
+The paper's calibration studies
+===============================
+
+Calibration studies of paper section 3.2 on the bundled sample case (Figures 9-13).
 
     python examples/05_calibration_studies.py [OUT] [--quick]
 
 Runs, at 0.066 Pa s, the filter-size study (unfiltered and 3-11 px against 11 px), the
 measured-versus-flat disk study, single pins against the set average and single patches
-against the patch average.  Each writes OUT/<study>/calibration.json (max |C_f,dev| per
+against the patch average.  Each writes OUT/<study>/calibration.json (max ``|C_f,dev|`` per
 variant), stribeck.csv, stribeck_speed.png and cf_dev.png; the example ends in
-OUT/calibration_summary.png (max |C_f,dev| of every variant, eq 35).  About 10 minutes on 2
+OUT/calibration_summary.png (max ``|C_f,dev|`` of every variant, eq 35).  About 10 minutes on 2
 cores; interrupted studies resume.  ``--quick`` (smoke test): the pins and patches studies
 of a reduced case (48^2 macro, 16^2 micro x 4 steps, 2 patches, 4 speeds).  The same from
 the shell: ``fem-twin calibrate examples/pin_on_disk.toml --study filter -o OUT/filter``.

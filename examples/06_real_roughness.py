@@ -1,4 +1,8 @@
-"""A twin of real measured roughness: x3p and MountainsMap patches on the bundled macro pin.
+"""
+Real measured roughness
+=======================
+
+A twin of real measured roughness: x3p and MountainsMap patches on the bundled macro pin.
 
     python examples/06_real_roughness.py [OUT] [--quick]
 
@@ -10,7 +14,7 @@ the main job on the bundled case with these two patch pairs instead of the synth
 patches: micro stage at the crops' own pixels, then a Stribeck sweep at mu_0 = 0.066 Pa s on
 the bundled macro pins.  The same job with the first two synthetic sample patches (cut at
 256 px and resampled to N) is the comparison.  Prints what the measured roughness changes
-(Sq, flow factors, where the Stribeck curve turns, max |C_f,dev| of eq 35) and ends in
+(Sq, flow factors, where the Stribeck curve turns, max ``|C_f,dev|`` of eq 35) and ends in
 ``OUT/real_roughness.png``.  N = 128 (about 3 minutes on 2 cores); ``--quick``: N = 32 and a
 smoke-test sweep.
 """

@@ -1,4 +1,8 @@
-"""The smooth ball-on-disk EHL contact: films against Hamrock-Dowson over a Moes range, and
+"""
+EHL point contacts against Hamrock-Dowson
+=========================================
+
+The smooth ball-on-disk EHL contact: films against Hamrock-Dowson over a Moes range, and
 the centre-line film of Mourier et al. (2006) against their interferometry and the EHL-FBNS
 simulation of Hansen et al. (2022), with a grid study of the central film.
 

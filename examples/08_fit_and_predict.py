@@ -1,4 +1,8 @@
-"""Fit the twin to a measured Stribeck curve at 24 C, then predict the curve at 50 C.
+"""
+Fit to a measured curve, predict the next
+=========================================
+
+Fit the twin to a measured Stribeck curve at 24 C, then predict the curve at 50 C.
 
     python examples/08_fit_and_predict.py [OUT] [--quick]
 

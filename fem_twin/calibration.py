@@ -3,12 +3,16 @@
 Each study runs variants of a case and reports C_f,dev (eq 35) of every variant against a
 reference curve, at the case's first viscosity:
 
-``filter``      Gaussian FWHM of the macro geometry [px] (0: unfiltered); reference 11 px
-``resolution``  macro grid size [px]; reference: the largest
-``disk``        measured disks against a flat disk; reference: measured
-``pins``        every single levelled pin against the set average; reference: average
-``patches``     flow factors of every single patch against the patch average; reference:
-                the average
+``filter``
+    Gaussian FWHM of the macro geometry [px] (0: unfiltered); reference 11 px
+``resolution``
+    macro grid size [px]; reference: the largest
+``disk``
+    measured disks against a flat disk; reference: measured
+``pins``
+    every single levelled pin against the set average; reference: average
+``patches``
+    flow factors of every single patch against the patch average; reference: the average
 
 The micro scale is computed once (it does not depend on the macro choices) and shared by
 the variants; every variant keeps its own checkpoints, so an interrupted study resumes.

@@ -239,6 +239,13 @@ class Case:
         return micro + macro
 
 
+#: the case file's sections and the dataclass that declares each one's keys
+#: (``[validation]`` has one key, ``measured``; ``name`` is top-level)
+SECTIONS = {"geometry": Geometry, "preprocessing": MacroOptions, "tribometer": Tribometer,
+            "lubricant": LubricantSpec, "materials": Materials, "micro": MicroSpec,
+            "macro": MacroSpec, "sweep": SweepSpec, "run": RunSpec}
+
+
 def load_case(path) -> Case:
     """Read and validate a TOML case file."""
     path = Path(path)
@@ -254,8 +261,7 @@ def load_case(path) -> Case:
 def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -> Case:
     """Validate a case given as a dict (as read from TOML); file paths relative to ``base``."""
     where = str(source or "case")
-    _only(data, {"name", "geometry", "preprocessing", "tribometer", "lubricant", "materials",
-                 "micro", "macro", "sweep", "run", "validation"}, where)
+    _only(data, {"name", "validation", *SECTIONS}, where)
     if "geometry" not in data:
         raise CaseError(f"{where}: missing [geometry] section")
     tribometer = _tribometer(data, where)
@@ -278,9 +284,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if not geometry.patches:
         raise CaseError(f"{where} [geometry]: at least one roughness patch pair is required")
     measured = _measured(data.get("validation", {}), base, where, lubricant)
-    defaulted = tuple(name for name in ("preprocessing", "tribometer", "lubricant",
-                                        "materials", "micro", "macro", "sweep", "run")
-                      if name not in data)
+    defaulted = tuple(name for name in SECTIONS if name != "geometry" and name not in data)
     return Case(name=str(data.get("name", source.stem if source else "case")),
                 geometry=geometry, macro_geometry=macro_geometry, tribometer=tribometer,
                 lubricant=lubricant, materials=materials, micro=micro, macro=macro,

@@ -34,11 +34,12 @@ _STEPS = {
 }
 
 
-#: exit codes (README "When something goes wrong"): exception types -> (code, label, advice)
+#: exit codes (docs/troubleshooting.md): exception types -> (code, label, advice)
 EXIT_CODES = (
     ((ValueError, FileNotFoundError, IsADirectoryError, NotADirectoryError), 2, "error",
      "check the input named above"),
-    ((NotConverged,), 3, "not converged", "the residual history is in run.log; see README"),
+    ((NotConverged,), 3, "not converged",
+     "the residual history is in run.log; see docs/troubleshooting.md"),
     ((OSError,), 4, "file system", "check free space and write permission of the folder"),
     ((SchedulerUnreachable,), 5, "cluster", "start the scheduler or remove [run] scheduler"),
     ((RunLocked,), 6, "busy", ""),
@@ -110,7 +111,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Digital twin of a pin-on-disk tribometer in mixed lubrication. "
                     "Stages: topography -> contact -> homogenise -> macro; 'run' executes "
                     "the whole pipeline of a case file (up to the Stribeck curve). Exit "
-                    "codes: README, 'When something goes wrong'.")
+                    "codes: docs/troubleshooting.md.")
     p.add_argument("--version", action="version", version=f"fem-twin {__version__}")
     p.add_argument("-v", "--verbose", action="store_true",
                    help="print every logged step (stages, points) on the terminal")

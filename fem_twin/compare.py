@@ -30,8 +30,8 @@ from .stribeck.sweep import point_files
 
 
 def flow_factor_differences(fe: FlowFactors, fvm: FlowFactors) -> dict:
-    """Per-h0 differences [-]: max |Delta A| / max |A| (likewise b, C), |Delta h_m| / h0,
-    |Delta d|, and |Delta p_con| / max p_con."""
+    """Per-h0 differences [-]: ``max |Delta A| / max |A|`` (likewise b, C),
+    ``|Delta h_m| / h0``, ``|Delta d|``, and ``|Delta p_con| / max p_con``."""
     if not np.allclose(fe.h0, fvm.h0):
         raise InputError("flow factors to compare must share their h0 values")
 
@@ -69,7 +69,8 @@ def reference_factors(case: Case, outdir: Path, h0, *, executor=None,
 
 
 def field_differences(fe: MixedResult, fvm: MixedResult) -> dict:
-    """max |Delta p_hd| / max(p_hd - p_amb) and max |Delta theta| of two operating points."""
+    """``max |Delta p_hd| / max(p_hd - p_amb)`` and ``max |Delta theta|`` of two operating
+    points."""
     p_amb = fe.meta.get("settings", {}).get("ambient_pressure", 0.0)
     return {"pressure": float(np.abs(fe.pressure - fvm.pressure).max()
                               / max(float((fvm.pressure - p_amb).max()), 1e-300)),

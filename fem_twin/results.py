@@ -28,7 +28,8 @@ STRIBECK_UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
                   "friction_coefficient": ("1", "C_f (eq 34)"),
                   "hydrodynamic_friction": ("N", "hydrodynamic part of F_T (eq 33)"),
                   "boundary_friction": ("N", "boundary part of F_T (eq 33)"),
-                  "contact_load_fraction": ("1", "share of F_N carried by p_con"),
+                  "contact_load_fraction": ("1", "share of the face load (F_N times "
+                                            "load_share) carried by p_con"),
                   "h_d": ("m", "rigid-body separation h_d"),
                   "iterations": ("1", "macro solver iterations"),
                   "cf_min": ("1", "lowest C_f of the single-patch sweeps"),
@@ -160,8 +161,8 @@ def write_netcdf(path, groups: dict, attrs: dict | None = None) -> Path:
 
 
 def open_run(outdir) -> RunResults:
-    """The results of ``fem-twin run ... -o OUTDIR`` as xarray Datasets (loaded in memory;
-    the fields lazily)."""
+    """The results of a run's output folder as xarray Datasets (loaded in memory; the fields
+    lazily): what ``fem-twin run CASE -o OUTDIR`` wrote."""
     import xarray as xr
     out = RunLayout(outdir)
     path = out.results

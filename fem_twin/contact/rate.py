@@ -4,7 +4,7 @@ At imposed separation the deformed gap ``g = h0 + shape + K p`` is zero on the e
 contact set ``C = {p_min < p < H}``; the pressure stays at ``p_min`` where the gap is open and
 at ``H`` where it is plastic.  When the shape changes at the rate ``shape'`` the pressure
 changes at the rate ``p'`` that keeps these conditions (almost every instant, the sets are
-fixed):
+fixed)::
 
     (K p')|_C = -shape'|_C,    p' = 0 off C,
 

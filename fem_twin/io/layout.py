@@ -1,6 +1,6 @@
 """The output folder of a run: every file and folder it writes and reads, named once.
 
-``fem-twin run CASE -o OUT`` writes (see the README's outputs section)::
+``fem-twin run CASE -o OUT`` writes (see docs/reference/outputs.md)::
 
     OUT/summary.json, run.log, stage_keys.json, .lock
     OUT/geometry/    pin_K.npz, disk_K.npz, macro_K.vtu, patch_K_low.npz, patch_K_up.npz,

@@ -22,7 +22,7 @@ schemes differ in the face value ``q_f`` of the Couette coefficient ``q = rho h_
     0.09004, 0.08905, 0.08880 on 128, 255, 509 px (order 1.97; upwind 0.49); the Mourier
     EHL ball's central film 207.7 nm at 97^2 against 210 nm measured (upwind 228.4 nm).
     On very coarse grids of heavily loaded balls (< 60 nodes per side) it underestimates
-    the film more than upwind overestimates it (README, Accuracy).  A van Albada-limited
+    the film more than upwind overestimates it (docs/accuracy.md).  A van Albada-limited
     upwind reconstruction of ``q_f`` was measured too and is not offered: it equals the
     central scheme in EHL and falls to first order where a pocket's wall meets the land
     (it upwinds at every kink of ``q``, right at the rupture).

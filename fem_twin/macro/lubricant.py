@@ -19,15 +19,23 @@ from ..errors import InputError
 class Lubricant:
     """An isothermal lubricant (SI units).
 
-    viscosity : mu_0 at ambient pressure [Pa s]
-    density : rho_0 at ambient pressure [kg/m^3] (cancels from eq 17; kept for output)
-    roelands_alpha, roelands_p0 : alpha_R [1/Pa] and p_0,R [Pa] of eq 23
-    dh_c1, dh_c2 : C_1 [Pa] and C_2 [-] of eq 24
-    piezoviscosity : ``"roelands"`` (eq 23) or ``"barus"`` (``mu_0 exp(alpha p)`` with
+    Attributes
+    ----------
+    viscosity
+        mu_0 at ambient pressure [Pa s]
+    density
+        rho_0 at ambient pressure [kg/m^3] (cancels from eq 17; kept for output)
+    roelands_alpha, roelands_p0
+        alpha_R [1/Pa] and p_0,R [Pa] of eq 23
+    dh_c1, dh_c2
+        C_1 [Pa] and C_2 [-] of eq 24
+    piezoviscosity
+        ``"roelands"`` (eq 23) or ``"barus"`` (``mu_0 exp(alpha p)`` with
         ``alpha = roelands_alpha``, the law of the Hamrock-Dowson fits and of many EHL papers)
-    eyring_stress : Eyring stress tau_0 [Pa] of the shear-thinning film: the Couette shear of
-        eq 31 becomes ``tau_0 asinh(tau_Newton / tau_0)`` (None: Newtonian, the paper's; an
-        EHL contact needs it, its Newtonian shear at GPa viscosities is unphysical)
+    eyring_stress
+        Eyring stress tau_0 [Pa] of the shear-thinning film: the Couette shear of eq 31
+        becomes ``tau_0 asinh(tau_Newton / tau_0)`` (None: Newtonian, the paper's; an EHL
+        contact needs it, its Newtonian shear at GPa viscosities is unphysical)
     """
 
     viscosity: float

@@ -64,8 +64,12 @@ def squeeze_form(v, w):
 class CellSolution:
     """The three cell solutions at one time step, as grid fields ``(ny, nx)``.
 
-    chi : (3, ny, nx); chi_1 [1/m], chi_2 and chi_3 [m]; zero at the pinned pixel
-    moments : dict of the cell averages that eqs 11-16 need at this step (see
+    Attributes
+    ----------
+    chi
+        (3, ny, nx); chi_1 [1/m], chi_2 and chi_3 [m]; zero at the pinned pixel
+    moments
+        dict of the cell averages that eqs 11-16 need at this step (see
         :meth:`CellSolver.moments`)
     """
 

@@ -363,12 +363,18 @@ def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
 class SlidingPass:
     """One periodic pass of the moving surface over the cell, in ``N_t`` instants.
 
-    shapes : undeformed gap geometry ``z_up - z_low`` at each instant [m]
-    moving : the moving surface's part of that geometry at each instant (``z_up`` shifted
-        for the disk, ``-z_low`` shifted for the pin in the disk's frame) [m]
-    um_dt : ``u_m dt`` between instants [m], ``+s/2`` (disk moving) or ``-s/2`` (pin)
-    rigid_rate : ``-2 d(moving)/dx1`` at each instant, the rigid part of the squeeze term
-        of eq 8 (central difference, the discrete derivative of the Couette flux) [-]
+    Attributes
+    ----------
+    shapes
+        undeformed gap geometry ``z_up - z_low`` at each instant [m]
+    moving
+        the moving surface's part of that geometry at each instant (``z_up`` shifted for
+        the disk, ``-z_low`` shifted for the pin in the disk's frame) [m]
+    um_dt
+        ``u_m dt`` between instants [m], ``+s/2`` (disk moving) or ``-s/2`` (pin)
+    rigid_rate
+        ``-2 d(moving)/dx1`` at each instant, the rigid part of the squeeze term of eq 8
+        (central difference, the discrete derivative of the Couette flux) [-]
     """
 
     shapes: list

@@ -34,7 +34,7 @@ from .flow_factors import ARRAYS
 
 #: separations of the coarse start (8 intervals: 17 points after the first bisection)
 START = 9
-#: misses are relative to max(|f|, FLOOR max |f|) per quantity ...
+#: misses are relative to ``max(|f|, FLOOR max |f|)`` per quantity ...
 FLOOR = 0.01
 #: ... and for d1 to at least 1/3, its weight beside the sliding term of eq 31
 #: (-6 u_m d + u_r e1 with u_r = 2 u_m on a pin-on-disk: 3 (1/3 - d))
