@@ -195,7 +195,7 @@ def _warm_patch_sweep(e_red):
     0.4 to 0.1 um, each warm-started from the same instant at the previous h0 (hardness
     cap on); time per CG iteration in units of one rfft2+irfft2 pair at 256^2."""
     from fem_twin import contact
-    from fem_twin.micro.homogenisation import CellSettings, sliding_pass
+    from fem_twin.micro.sliding import CellSettings, sliding_pass
     pin, disk = _patch_pair()
     shapes = sliding_pass(pin.heights, disk.heights, pin.spacing, CellSettings(n_steps=8)).shapes
     z = np.random.default_rng(0).random(pin.shape)

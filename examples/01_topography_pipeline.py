@@ -20,7 +20,7 @@ import fem_twin
 from fem_twin import topography as tp
 from fem_twin.topography.prepare import pin_face_guess
 
-SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "sample"
+SAMPLE = Path(sys.argv[0]).resolve().parents[1] / "meshes" / "sample"
 args = [a for a in sys.argv[1:] if a != "--quick"]
 n = 64 if "--quick" in sys.argv else 256
 out = Path(args[0] if args else "pin_centre_lines.png")

@@ -26,6 +26,7 @@ rules compare (``face="bilinear"``, the default, against the two-point ``"arithm
 """
 
 import argparse
+import sys
 import time
 from pathlib import Path
 
@@ -37,11 +38,11 @@ from fem_twin.fvm import CellSolverFV
 from fem_twin.io.files import read_topography
 from fem_twin.io.table import write_csv
 from fem_twin.micro import CellSolver, FlowFactors, average, homogenise
-from fem_twin.micro.homogenisation import CellSettings, sliding_contacts, sliding_pass
+from fem_twin.micro.sliding import CellSettings, sliding_contacts, sliding_pass
 from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import prepare_patch
 
-SAMPLE = Path(__file__).resolve().parent.parent / "meshes" / "sample"
+SAMPLE = Path(sys.argv[0]).resolve().parent.parent / "meshes" / "sample"
 H0 = np.array([0.1e-6, 0.15e-6, 0.3e-6, 0.6e-6, 1e-6])
 
 
@@ -91,7 +92,7 @@ def refinement_study(k=3, h0=0.15e-6):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().split("\n")[0])
     parser.add_argument("out", nargs="?", default="fe_fvm")
     parser.add_argument("--steps", type=int, default=8)
     parser.add_argument("--workers", type=int, default=2)

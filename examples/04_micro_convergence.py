@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
@@ -37,7 +38,7 @@ from fem_twin.micro import homogenise
 from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import prepare_patch
 
-SAMPLE = Path(__file__).resolve().parent.parent / "meshes" / "sample"
+SAMPLE = Path(sys.argv[0]).resolve().parent.parent / "meshes" / "sample"
 H0 = np.array([0.1e-6, 0.14e-6, 0.3e-6, 0.6e-6])
 NAMES = ("A11", "b1", "d1", "C11", "p_con", "h_m")
 FULL = dict(cell=128, steps=(4, 8, 16, 32, 64), ref_steps=128, grids=(32, 64, 128),
@@ -143,7 +144,7 @@ def _row(rel):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().split("\n")[0])
     parser.add_argument("out", nargs="?", default="out/micro_convergence", type=Path)
     parser.add_argument("--patches", type=int, nargs="+", default=[1, 3])
     parser.add_argument("--workers", type=int, default=2)

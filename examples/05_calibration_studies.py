@@ -26,7 +26,7 @@ import matplotlib.pyplot as plt
 from fem_twin.calibration import calibrate
 from fem_twin.case import load_case
 
-HERE = Path(__file__).resolve().parent
+HERE = Path(sys.argv[0]).resolve().parent
 
 
 def reduced(case):

@@ -33,7 +33,7 @@ from fem_twin.stribeck import friction_deviation, read_stribeck_csv
 from fem_twin.micro import FlowFactors
 from fem_twin.topography import extract_patch, fill_defects
 
-HERE = Path(__file__).resolve().parent
+HERE = Path(sys.argv[0]).resolve().parent
 SHARED = HERE.parents[1] / "shared" / "topographies"
 FILES = {"x3p-2.x3p": ((0, 0), (300, 300)), "mnt-2.mnt": ((0, 0), (500, 700))}
 

@@ -29,7 +29,7 @@ args = [a for a in sys.argv[1:] if a != "--quick"]
 quick = "--quick" in sys.argv
 out = Path(args[0] if args else "ehl_point_contact")
 out.mkdir(parents=True, exist_ok=True)
-EHL = Path(__file__).resolve().parents[2] / "shared" / "references" / "ehl" / "Mourier_2006"
+EHL = Path(sys.argv[0]).resolve().parents[2] / "shared" / "references" / "ehl" / "Mourier_2006"
 
 
 def solve(contact, n):

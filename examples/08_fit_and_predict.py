@@ -43,7 +43,7 @@ from fem_twin.macro.viscosity import WaltherLaw
 from fem_twin.pipeline import run
 from fem_twin.stribeck.curve import read_stribeck_csv
 
-HERE = Path(__file__).resolve().parent
+HERE = Path(sys.argv[0]).resolve().parent
 TRUE_CFB, HEATING = 0.15, 3.0          # the synthetic truth: C_f,b and the contact's +3 K
 
 

@@ -34,7 +34,7 @@ from .macro import MacroSettings, MixedResult
 from .macro.figures import plot_point_fields
 from .macro.point_contact import PointContact, film_thickness
 from .micro import FlowFactors, average, homogenise
-from .micro.homogenisation import prune_checkpoints
+from .micro.store import prune_checkpoints
 from .micro.output import plot_flow_factors
 from .stribeck import (deviation_from_measured, plot_stribeck,
                        read_measured_csv, stribeck_sweep, write_stribeck_csv)

@@ -301,7 +301,7 @@ def test_fvm_face_integral_tracks_the_bilinear_gap_in_heavy_contact():
     from pathlib import Path
 
     from fem_twin.io.files import read_topography
-    from fem_twin.micro.homogenisation import CellSettings, sliding_contacts
+    from fem_twin.micro.sliding import CellSettings, sliding_contacts
     from fem_twin.topography.prepare import prepare_patch
     sample = Path(__file__).resolve().parent.parent / "meshes" / "sample"
     pin = prepare_patch(read_topography(sample / "patch_3_pin.npz"))

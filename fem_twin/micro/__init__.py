@@ -5,7 +5,8 @@
 
 from .cell import CellSolution, CellSolver
 from .flow_factors import FlowFactors, LocalFactors, average
-from .homogenisation import DEFAULT_H0, CellSettings, homogenise, sliding_pass
+from .homogenisation import DEFAULT_H0, homogenise
+from .sliding import CellSettings, sliding_pass
 
 __all__ = ["CellSolution", "CellSolver", "FlowFactors", "LocalFactors", "average", "DEFAULT_H0",
            "CellSettings", "homogenise", "sliding_pass"]

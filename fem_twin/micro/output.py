@@ -9,8 +9,9 @@ import numpy as np
 from ..io.figure import save_figure
 from ..io.mesh import grid_mesh, write_pvd, write_vtu
 from .flow_factors import FlowFactors
-from .homogenisation import (CellSettings, _cell_solver, _check_patches, sliding_cells,
-                             sliding_contacts, sliding_pass, sliding_squeeze)
+from .homogenisation import _check_patches
+from .sliding import (CellSettings, cell_solver, sliding_cells, sliding_contacts, sliding_pass,
+                      sliding_squeeze)
 
 
 def plot_flow_factors(factors, path, labels=None) -> Path:
@@ -72,7 +73,7 @@ def cell_fields(pin, disk, h0: float, *, n_steps: int = 32, method: str = "fe",
                             time_derivative=time_derivative, **materials)
     z_low, z_up, spacing = _check_patches(pin, disk)
     sliding = sliding_pass(z_low, z_up, spacing, settings)
-    solver = _cell_solver(z_low.shape, spacing, method)
+    solver = cell_solver(z_low.shape, spacing, method)
     contacts = sliding_contacts(sliding.shapes, spacing, settings, h0)
     squeezes = sliding_squeeze(contacts, sliding, spacing, settings)
     cells = sliding_cells([r.gap for r in contacts], squeezes, solver)

@@ -1,0 +1,272 @@
+"""One sliding pass of a roughness cell at one separation: contact, squeeze term and the
+three cell problems at each instant, and their time average (paper eqs 8-16).
+
+Kinematics.  The pin is at rest and the disk moves at ``U = 2 u_m``.  One pass of the disk
+over the period ``L_r1`` takes ``T_r = L_r1 / U``; in ``N_t`` instants the disk patch shifts
+by ``s = L_r1 / N_t`` each.  The gap is ``h = h0 + z_up(x1 - U t, x2) - z_low + w`` with the
+contact deformation ``w``, so the time term of eq 8 is, exactly,
+
+    tau = (1 / u_m) dh/dt = -2 d z_up / dx1 + (1 / u_m) dw/dt,
+
+free of u_m.  The default ``time_derivative="exact"`` evaluates it at every instant (the
+deformation rate from the tangent of the contact problem), so only the quadrature of the
+time average over the ``N_t`` instants remains: the trapezoidal rule of a periodic function.
+The paper's implicit Euler ``2 (h^n - h^(n-1)) / s`` (``time_derivative="backward"``) is
+first order in ``1 / N_t`` and kept to reproduce the paper.  (The paper's
+``dt = L_r1 / (N_t u_m)`` with a shift of ``L_r1 / N_t`` would be a disk moving at ``u_m``,
+i.e. half the squeeze term.)
+
+Frame identities (tested).  ``moving="lower"`` computes the same physics in the disk's frame:
+the pin slides at ``-U`` and ``u_m -> -u_m``, and ``tau = -2 d(-z_low)/dx1 + ...``.  In that
+frame the right-hand side of eq 8 is ``dh/dx1 + tau' = -(dh/dx1 + tau)`` (the sum is
+``2 d h/dx1 - 2 d(h_rigid + w)/dx1 = 0``), so ``chi_1' = -chi_1`` and
+
+    A' = A,  C' = C,  h_m' = h_m,  p_con' = p_con  (eqs 9, 10 do not see the motion),
+    b' = 2 e1 - b  (from eq 14: <h (1 + h^2 d chi_1/dx1)> / h_m = 2 e1 - b),
+    d' = -d        (eq 16 is linear in chi_1).
+
+The same holds for a rough surface moving over a smooth one against the same surface at
+rest under the smooth one.  Without contact the FVM satisfies these identities to
+round-off (its Couette flux difference is the central difference used for ``tau``), the FE
+to its second-order spatial error; with contact, to the discretisation of the contact edge.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..contact import contact_rate
+from ..contact import solve as contact_solve
+from ..contact.levelling import TABLE4
+from ..errors import InputError
+from .cell_fv import CellSolverFV
+from .flow_factors import FlowFactors
+
+
+@dataclass(frozen=True)
+class CellSettings:
+    """Everything besides the surfaces and h0 that the result depends on (SI units)."""
+
+    n_steps: int = 32
+    e_reduced: float = TABLE4["e_reduced"]
+    hardness: float = TABLE4["hardness"]
+    gap_floor: float = 1e-9
+    method: str = "fe"
+    moving: str = "upper"
+    first_step: str = "steady"
+    contact_tol: float = 1e-10
+    time_derivative: str = "exact"
+    rate_tol: float = 1e-6      # contact-rate CG: tau to 1e-6, far below time and grid errors
+    time_tol: float | None = None   # adaptive instants per h0 (exact scheme), see refine_instants
+
+    def __post_init__(self):
+        if int(self.n_steps) != self.n_steps or self.n_steps < 1:
+            raise InputError(f"n_steps must be a positive integer, got {self.n_steps}")
+        if self.method not in ("fe", "fvm"):
+            raise InputError(f"method must be 'fe' or 'fvm', got {self.method!r}")
+        if self.moving not in ("upper", "lower"):
+            raise InputError(f"moving must be 'upper' (disk) or 'lower' (pin), got "
+                             f"{self.moving!r}")
+        if self.time_derivative not in ("exact", "backward"):
+            raise InputError("time_derivative must be 'exact' or 'backward' (paper), got "
+                             f"{self.time_derivative!r}")
+        if self.time_tol is not None and not (0 < self.time_tol < 1
+                                              and self.time_derivative == "exact"):
+            raise InputError("time_tol is a relative tolerance in (0, 1), with "
+                             "time_derivative='exact' only")
+        if self.first_step not in ("steady", "periodic"):
+            raise InputError(f"first_step must be 'steady' or 'periodic', got {self.first_step!r}")
+        if not (self.e_reduced > 0 and self.hardness > 0 and self.gap_floor > 0):
+            raise InputError("e_reduced, hardness and gap_floor must be positive (Pa, Pa, m)")
+
+
+@dataclass(frozen=True, eq=False)
+class SlidingPass:
+    """One periodic pass of the moving surface over the cell, in ``N_t`` instants.
+
+    Attributes
+    ----------
+    shapes
+        undeformed gap geometry ``z_up - z_low`` at each instant [m]
+    moving
+        the moving surface's part of that geometry at each instant (``z_up`` shifted for
+        the disk, ``-z_low`` shifted for the pin in the disk's frame) [m]
+    um_dt
+        ``u_m dt`` between instants [m], ``+s/2`` (disk moving) or ``-s/2`` (pin)
+    rigid_rate
+        ``-2 d(moving)/dx1`` at each instant, the rigid part of the squeeze term of eq 8
+        (central difference, the discrete derivative of the Couette flux) [-]
+    """
+
+    shapes: list
+    moving: list
+    um_dt: float
+    rigid_rate: list
+
+
+def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | None = None,
+                 offset: float = 0.0) -> SlidingPass:
+    """The moving surface shifts by ``s = L_r1 / N_t`` per step (``+s`` for the disk, ``-s``
+    for the pin in the disk's frame); ``u_m dt = (shift_up + shift_low) / 2``.  The instants
+    are ``(k + offset) s`` for ``k < N_t`` (``offset = 1/2``: the midpoints)."""
+    nx = z_low.shape[1]
+    n_steps = settings.n_steps if n_steps is None else n_steps
+    px = nx / n_steps                            # pixels per step
+    n = [(k + offset) * px for k in range(n_steps)]
+    if settings.moving == "upper":
+        moving = [_shift(z_up, k) for k in n]
+        shapes, um_dt = [m - z_low for m in moving], px * spacing[0] / 2
+    else:
+        moving = [-_shift(z_low, -k) for k in n]
+        shapes, um_dt = [z_up + m for m in moving], -px * spacing[0] / 2
+    return SlidingPass(shapes, moving, um_dt, [-2.0 * _d_dx1(m, spacing[0]) for m in moving])
+
+
+def _shift(z, px):
+    """Periodic translation of ``z`` by ``px`` pixels along x1 (Fourier for fractions)."""
+    if px == 0:
+        return z
+    if float(px).is_integer():
+        return np.roll(z, int(px), axis=1)
+    k = np.fft.rfftfreq(z.shape[1])
+    return np.fft.irfft(np.fft.rfft(z, axis=1) * np.exp(-2j * np.pi * k * px), n=z.shape[1],
+                        axis=1)
+
+
+def _d_dx1(z, dx1):
+    """Periodic central difference along x1 (the Couette flux difference of the FVM)."""
+    return (np.roll(z, -1, axis=1) - np.roll(z, 1, axis=1)) / (2 * dx1)
+
+
+def cell_solver(shape, spacing, method):
+    if method == "fe":
+        from .cell import CellSolver
+        return CellSolver(shape, spacing)
+    return CellSolverFV(shape, spacing)
+
+
+def sliding_contacts(shapes, spacing, settings: CellSettings, h0: float, warm=None):
+    """Periodic contact at imposed ``h0`` for each step's shape; ``warm`` (a list, one
+    pressure or None per step) is used as the initial guess and updated in place."""
+    warm = [None] * len(shapes) if warm is None else warm
+    results = []
+    for n, s in enumerate(shapes):
+        r = contact_solve(s, spacing, settings.e_reduced, separation=h0,
+                          hardness=settings.hardness, periodic=True,
+                          gap_floor=settings.gap_floor, initial_pressure=warm[n],
+                          tol=settings.contact_tol)
+        warm[n] = r.pressure if r.load > 0 else None
+        results.append(r)
+    return results
+
+
+def sliding_squeeze(contacts, sliding: SlidingPass, spacing, settings: CellSettings):
+    """The squeeze term ``tau = (1/u_m) dh/dt`` of eq 8 at each instant (None: steady).
+
+    ``"exact"``: the moving surface translates at ``V = 2 u_m``, so the rate of the rigid
+    geometry is ``sliding.rigid_rate`` exactly at every instant; the contact deformation
+    adds ``K p'`` from
+    :func:`fem_twin.contact.contact_rate`; ``tau = 0`` where the gap sits at the floor.
+    No time-step error: the time average of eqs 11-16 over the ``N_t`` instants is then the
+    trapezoidal rule of a periodic function.
+    ``"backward"`` (paper): ``(h^n - h^(n-1)) / (u_m dt)``, the first step steady
+    (``first_step="steady"``) or preceded by the last (``"periodic"``); first order.
+    """
+    if settings.time_derivative == "backward":
+        gaps = [r.gap for r in contacts]
+        steady = settings.first_step == "steady"
+        return [None if (n == 0 and steady) else (h - gaps[n - 1]) / sliding.um_dt
+                for n, h in enumerate(gaps)]
+    out = []
+    for r, rigid in zip(contacts, sliding.rigid_rate):
+        _, elastic = contact_rate(r, rigid, spacing, settings.e_reduced,
+                                  hardness=settings.hardness, periodic=True,
+                                  tol=settings.rate_tol)
+        out.append(np.where(r.raw_gap > settings.gap_floor, rigid + elastic, 0.0))
+    return out
+
+
+def sliding_cells(gaps, squeezes, solver):
+    """Cell solutions of each step for its gap and squeeze term."""
+    for h, tau in zip(gaps, squeezes):
+        yield solver.solve(h, tau)
+
+
+def instants(sliding, h0, warm, solver, spacing, settings):
+    """Contacts and cell moments at the instants of ``sliding``; (contact, cell) seconds."""
+    t0 = time.perf_counter()
+    contacts = sliding_contacts(sliding.shapes, spacing, settings, h0, warm)
+    squeezes = sliding_squeeze(contacts, sliding, spacing, settings)
+    t1 = time.perf_counter()
+    steps = [cell.moments for cell in
+             sliding_cells([r.gap for r in contacts], squeezes, solver)]
+    for m, r in zip(steps, contacts):
+        m["p_con"], m["contact_fraction"] = float(r.pressure.mean()), r.contact_fraction
+    return contacts, steps, [t1 - t0, time.perf_counter() - t1]
+
+
+def _time_error(steps) -> float:
+    """Relative change of A11 and b1 (eqs 13, 14) from every other instant to all."""
+    def a11_b1(ms):
+        m = time_average(ms)
+        return np.array([m["h3_grad"][0, 0] / m["h"] ** 3, 1 - m["h3_g1"][0] / m["h"]])
+    full, half = a11_b1(steps), a11_b1(steps[::2])
+    return float(np.max(np.abs(full - half) / np.abs(full)))
+
+
+def refine_instants(contacts, steps, h0, z_low, z_up, solver, spacing, settings, midpoints):
+    """Adaptive instants (``settings.time_tol``, exact scheme): while A11 or b1 change by
+    more than the tolerance from every other instant to all, add the midpoints (the time
+    average is then over twice the instants), up to one pixel per step.  In heavy contact
+    the integrand jumps whenever a pixel enters contact, and a fixed N_t samples it
+    unevenly; light contact stops at ``n_steps``.  ``midpoints`` keeps each level's pass and
+    warm starts across the separations of a chunk."""
+    seconds = [0.0, 0.0]
+    while _time_error(steps) > settings.time_tol and 2 * len(steps) <= z_low.shape[1]:
+        n = len(steps)
+        if n not in midpoints:
+            midpoints[n] = (sliding_pass(z_low, z_up, spacing, settings, n_steps=n,
+                                         offset=0.5), [None] * n)
+        mid, warm = midpoints[n]
+        c, m, sec = instants(mid, h0, warm, solver, spacing, settings)
+        contacts = [x for pair in zip(contacts, c) for x in pair]
+        steps = [x for pair in zip(steps, m) for x in pair]
+        seconds = [a + b for a, b in zip(seconds, sec)]
+    return contacts, steps, seconds
+
+
+def half_pass_moments(steps, contacts, sliding, solver, spacing, settings):
+    """Moments of the pass with ``N_t / 2`` instants: every other instant; the backward
+    difference quotient is redone over the doubled step (its error is not in the sampling)."""
+    if settings.time_derivative == "exact":
+        return steps[::2]
+    half = SlidingPass(sliding.shapes[::2], sliding.moving[::2], 2 * sliding.um_dt,
+                       sliding.rigid_rate[::2])
+    squeezes = sliding_squeeze(contacts[::2], half, spacing, settings)
+    out = [cell.moments for cell in
+           sliding_cells([r.gap for r in contacts[::2]], squeezes, solver)]
+    for m, full in zip(out, steps[::2]):
+        m["p_con"], m["contact_fraction"] = full["p_con"], full["contact_fraction"]
+    return out
+
+
+def time_average(steps):
+    """Mean of each moment over the instants (the trapezoidal rule of a periodic function)."""
+    return {k: sum(m[k] for m in steps) / len(steps) for k in steps[0]}
+
+
+def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
+    """Eqs 11-16 from space-time averaged moments (see :meth:`CellSolver.moments`);
+    ``prefix="half_"`` takes the averages over every other instant."""
+    def get(key):
+        return np.array([m[prefix + key] for m in moments])
+
+    h_m = get("h")
+    return FlowFactors(h0=np.asarray(h0, float), h_m=h_m, p_con=get("p_con"),
+                       A=get("h3_grad") / h_m[:, None, None] ** 3,
+                       b=np.array([1.0, 0.0]) - get("h3_g1") / h_m[:, None],
+                       C=get("h_grad") / h_m[:, None, None], d=get("h_g1") * h_m[:, None],
+                       contact_fraction=get("contact_fraction"), meta=meta)

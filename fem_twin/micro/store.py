@@ -1,0 +1,59 @@
+"""The checkpoints of the roughness scale: one JSON file of space-time moments per h0,
+named by a hash of the surfaces and the cell settings (written atomically; an unreadable one
+is recomputed)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..io.atomic import atomic_path
+from ..io.checkpoint import input_key, load_or_none
+
+
+def cell_key(z_low, z_up, spacing, settings) -> str:
+    return input_key(np.asarray(z_low), np.asarray(z_up), list(spacing), settings.__dict__)
+
+
+def point_path(folder: Path, key: str, h0: float) -> Path:
+    return folder / f"{key}_h0_{h0:.9e}.json"
+
+
+def save_point(folder, key, h0, moments):
+    data = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in moments.items()}
+    path = point_path(folder, key, h0)
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps({"h0": float(h0), "moments": data}))
+
+
+#: the moments a checkpoint must hold (eqs 11-16)
+MOMENTS = ("h", "h3_grad", "h3_g1", "h_grad", "h_g1", "p_con", "contact_fraction")
+
+
+def read_point(path):
+    data = json.loads(path.read_text())
+    moments = {k: (np.array(v) if isinstance(v, list) else v)
+               for k, v in data["moments"].items()}
+    missing = [k for k in MOMENTS if k not in moments]
+    if missing or not np.all([np.all(np.isfinite(moments[k])) for k in MOMENTS]):
+        raise InputError(f"checkpoint lacks or has non-finite moments {missing or ''}")
+    return moments
+
+
+def load_point(folder, key, h0):
+    return load_or_none(point_path(folder, key, h0), read_point)
+
+
+def prune_checkpoints(folder, keep) -> int:
+    """Delete the h0 checkpoints in ``folder`` (and ``folder/coarse``) whose key is not in
+    ``keep`` (``FlowFactors.meta["checkpoint_keys"]``): left by other settings or surfaces.
+    Returns the number of files removed."""
+    removed = 0
+    for path in (*Path(folder).glob("*_h0_*.json"), *Path(folder).glob("coarse/*_h0_*.json")):
+        if path.name.split("_h0_")[0] not in keep:
+            path.unlink()
+            removed += 1
+    return removed
