@@ -31,7 +31,11 @@ from .io.atomic import atomic_path
 from .io.figure import save_figure
 from .io.layout import RunLayout
 from .micro import FlowFactors
+from .stages.curves import macro_settings
+from .stages.factors import homogenise_patches
+from .stages.geometry import face_load, level_pins, macro_geometry, reconstruct_geometry
 from .stribeck import friction_deviation, plot_stribeck, stribeck_sweep, write_stribeck_csv
+from .threads import executor_for
 
 STUDIES = ("filter", "resolution", "disk", "pins", "patches")
 
@@ -71,13 +75,11 @@ def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
 def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = True) -> dict:
     """Run a study into ``outdir``; write ``calibration.json``, ``stribeck.csv`` (all
     variants) and plots of C_f and C_f,dev versus speed.  Returns the summary."""
-    from .pipeline import (executor_for, face_load, homogenise_patches, level_pins,
-                           macro_geometry, macro_settings, reconstruct_geometry)
     out = RunLayout(outdir)
     out.root.mkdir(parents=True, exist_ok=True)
     cases, ref_label = variants(case, study, values)
     reconstruct_geometry(case, out, progress)
-    with executor_for(case) as executor:
+    with executor_for(case.run.workers, case.run.scheduler) as executor:
         homogenise_patches(case, out, executor, progress)
     lub = case.lubricant.lubricants()[0]
     curves = {}

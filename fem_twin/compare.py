@@ -26,7 +26,11 @@ from .macro import MixedResult
 from .micro import FlowFactors
 from .micro.estimate import discrepancy, grid_separations
 from .stribeck import friction_deviation, stribeck_sweep
+from .stages.curves import macro_settings
+from .stages.factors import homogenise_patches
+from .stages.geometry import face_load, level_pins, macro_geometry, reconstruct_geometry
 from .stribeck.sweep import point_files
+from .threads import executor_for
 
 
 def flow_factor_differences(fe: FlowFactors, fvm: FlowFactors) -> dict:
@@ -51,7 +55,6 @@ def reference_factors(case: Case, outdir: Path, h0, *, executor=None,
     time steps, at the smallest, middle and largest ``h0``; the patch average.  Both
     refinements halve the first-order grid error and the time error of the case's
     settings, so ``|f - f_ref|`` measures each method's own discretisation error."""
-    from .pipeline import homogenise_patches
     mc = case.micro
     fine = replace(case, micro=replace(mc, method="fe", steps=2 * mc.steps, h0_tol=0.0,
                                        resolution=tuple(2 * n for n in mc.resolution)))
@@ -81,14 +84,12 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     """Run the case's micro and macro stages with both methods, each at every h0 of the case
     (no adaptive subset, so that they meet at the same separations); write ``compare.json``,
     ``compare_flow_factors.csv``, ``compare_stribeck.csv`` and ``compare.png``."""
-    from .pipeline import (executor_for, face_load, homogenise_patches, level_pins,
-                           macro_geometry, macro_settings, reconstruct_geometry)
     out = RunLayout(outdir)
     out.root.mkdir(parents=True, exist_ok=True)
     reconstruct_geometry(case, out, progress)
     level_pins(case, out, progress)
     factors = {}
-    with executor_for(case) as executor:
+    with executor_for(case.run.workers, case.run.scheduler) as executor:
         for method in ("fe", "fvm"):
             sub = out.sub(method)
             sub.root.mkdir(exist_ok=True)

@@ -17,10 +17,15 @@ from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .io.table import write_csv
 from .macro.viscosity import WaltherLaw
+from .micro import FlowFactors
+from .stages.curves import macro_settings, run_sweeps
+from .stages.geometry import hersey_length, macro_geometry
+from .stages.provenance import stage_keys
 from .stribeck import read_measured_csv
 from .stribeck.curve import read_stribeck_csv
 from .stribeck.fit import (LOAD_SHARES, FitModel, check_parameters, fit_curves, plot_fit,
                            predict)
+from .threads import executor_for
 
 
 def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: bool = True,
@@ -77,9 +82,6 @@ def share_curves(case: Case, out: RunLayout, curve, progress: bool = True,
     """``((share, StribeckCurve), ...)``: the case's first viscosity swept at ``shares`` of
     its load over the speeds of ``curve`` (the case's own share is ``curve``), checkpointed
     in ``OUT/fit/checkpoints``; the micro stage's flow factors are reused."""
-    from .micro import FlowFactors
-    from .pipeline import (executor_for, hersey_length, macro_geometry, macro_settings,
-                           run_sweeps, stage_keys)
     tr = case.tribometer
     gap, spacing, face, _ = macro_geometry(case, out)
     common = dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
@@ -88,7 +90,7 @@ def share_curves(case: Case, out: RunLayout, curve, progress: bool = True,
                   factors_key=stage_keys(case)["micro"])
     lub = case.lubricant.lubricants()[0]
     todo = sorted(s for s in shares if not np.isclose(s, tr.load_share, rtol=1e-9))
-    with executor_for(case) as executor:
+    with executor_for(case.run.workers, case.run.scheduler) as executor:
         swept = run_sweeps([(dict(common, load=tr.load * s), lub) for s in todo], executor,
                            progress, desc="load-share points")
     return tuple(sorted([*zip(todo, swept), (tr.load_share, curve)], key=lambda p: p[0]))

@@ -18,8 +18,9 @@ import os
 import signal
 import sys
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 
-from .errors import InputError
+from .errors import InputError, SchedulerUnreachable
 
 
 def thread_limit() -> int:
@@ -87,3 +88,35 @@ def stop_pool(pool: ProcessPoolExecutor, failed: bool = False) -> None:
     for process in list((getattr(pool, "_processes", None) or {}).values()):
         process.terminate()
     pool.shutdown(wait=False, cancel_futures=True)
+
+
+@contextmanager
+def executor_for(workers: int = 0, scheduler: str | None = None):
+    """Local process pool of ``workers`` processes (0 = all cores; ``[run] workers``) or the
+    executor of the Dask cluster at ``scheduler`` (``[run] scheduler``); None for one
+    worker.  ``executor.n_workers``: how many
+    processes serve it (the micro stage cuts its h0 values into 4 tasks per worker)."""
+    if scheduler:
+        from distributed import Client
+        try:
+            client = Client(scheduler, timeout="5s")
+        except (OSError, TimeoutError) as err:
+            raise SchedulerUnreachable(f"could not reach the Dask scheduler "
+                                       f"{scheduler} ([run] scheduler): {err}") from err
+        with client:
+            executor = client.get_executor()
+            executor.n_workers = max(1, len(client.scheduler_info()["workers"]))
+            yield executor
+        return
+    workers = workers or os.cpu_count() or 1
+    if workers <= 1:
+        yield None
+        return
+    pool = process_pool(workers)
+    pool.n_workers = workers
+    try:
+        yield pool
+    except BaseException:
+        stop_pool(pool, failed=True)
+        raise
+    stop_pool(pool)

@@ -85,3 +85,35 @@ def test_run_files_are_named_only_by_the_run_layout():
                  if path.name not in ("layout.py", "samples.py") for name in names
                  if f'"{name}"' in path.read_text()]
     assert not elsewhere, elsewhere
+
+
+#: the pipeline's order: a module imports only from its own layer or an earlier one.
+#: Shared plumbing (errors, checks, tables, threads, linalg, io/ ...) is layer 0; io.files
+#: reads and writes the Topography value, so it sits with the topography stage.
+LAYERS = {"topography": 1, "io.files": 1, "io": 1, "contact": 2, "micro": 3, "macro": 4,
+          "stribeck": 5, "case": 6, "stages": 6, "pipeline": 6, "compare": 6,
+          "calibration": 6, "fitting": 6, "results": 6, "report": 6, "samples": 6, "fvm": 6,
+          "cli": 7, "cli_runs": 7, "cli_stages": 7}
+
+
+def _layer(module: str) -> int:
+    parts = module.split(".")[1:]
+    for n in (2, 1):
+        key = ".".join(parts[:n])
+        if len(parts) >= n and key in LAYERS:
+            return LAYERS[key]
+    return 0
+
+
+def test_imports_run_down_the_pipeline():
+    """Issue 31 item 6: topography -> contact -> micro -> macro -> stribeck -> the workflow
+    (case, stages, pipeline, studies, results) -> the CLI: no stage imports a later one,
+    and the workflow never imports from the CLI."""
+    up = []
+    for path in PACKAGE.rglob("*.py"):
+        m = _module(path)
+        if m == "fem_twin":
+            continue
+        up += [f"{m} -> {d}" for d in _imports(path)
+               if d != "fem_twin" and _layer(d) > _layer(m)]
+    assert not up, "imports against the pipeline's order:\n" + "\n".join(sorted(up))

@@ -9,7 +9,7 @@ import pytest
 from fem_twin.case import CaseError, load_case
 from fem_twin.cli import main
 from fem_twin.macro import MixedResult
-from fem_twin.pipeline import ball_contact
+from fem_twin.stages.geometry import ball_contact
 
 from conftest import ROOT
 

@@ -9,7 +9,7 @@ from fem_twin import Topography
 from fem_twin.io.files import read_topography
 from fem_twin.macro import Lubricant
 from fem_twin.micro import homogenise
-from fem_twin.pipeline import run_sweeps
+from fem_twin.stages.curves import run_sweeps
 from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 

@@ -57,15 +57,9 @@ def read_topography(path, *, spacing=None, unit: str = "m") -> Topography:
         raise MissingFile(f"no such topography file: {path}")
     if unit not in UNITS:
         raise InputError(f"unknown unit {unit!r}; use one of {sorted(UNITS)}")
-    suffix = path.suffix.lower()
+    reader = READERS.get(path.suffix.lower(), _read_instrument)
     try:
-        if suffix == ".npz":
-            return _read_npz(path, spacing, UNITS[unit])
-        if suffix == ".npy":
-            return _read_npy(path, spacing, UNITS[unit])
-        if suffix in ASCII_SUFFIXES:
-            return _read_ascii(path, spacing, UNITS[unit])
-        return _read_instrument(path, spacing)
+        return reader(path, spacing, UNITS[unit])
     except TopographyFileError:
         raise
     except (ValueError, OSError, KeyError, EOFError, zipfile.BadZipFile) as err:
@@ -198,7 +192,9 @@ def _need_spacing(path: Path, spacing):
 
 
 # -- instrument formats via SurfaceTopography ----------------------------------------------
-def _read_instrument(path: Path, spacing) -> Topography:
+def _read_instrument(path: Path, spacing, scale=None) -> Topography:
+    """Any instrument format SurfaceTopography reads; the file carries its own units (the
+    ``scale`` of plain formats does not apply)."""
     try:
         from SurfaceTopography import open_topography
         from SurfaceTopography.Exceptions import CannotDetectFileFormat, CorruptFile, ReadFileError
@@ -232,3 +228,9 @@ def _read_instrument(path: Path, spacing) -> Topography:
     sx, sy = t.physical_sizes
     meta = {"source": str(path), "reader": type(reader).__name__, "file_unit": unit}
     return Topography(h * s, (sx * s / nx, sy * s / ny), meta=meta)
+
+
+#: file suffix -> reader ``(path, spacing, height scale) -> Topography``; any other suffix
+#: goes to the instrument readers of SurfaceTopography (the ``instruments`` extra)
+READERS = {".npz": _read_npz, ".npy": _read_npy,
+           **{suffix: _read_ascii for suffix in ASCII_SUFFIXES}}

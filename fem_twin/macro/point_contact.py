@@ -129,3 +129,13 @@ def film_thickness(result, x1, x2) -> tuple:
     from scipy.interpolate import RegularGridInterpolator
     h = RegularGridInterpolator((x2, x1), result.h0)([[0.0, 0.0]])[0]
     return float(h), float(result.h0.min())
+
+
+def film_against_hamrock_dowson(contact: PointContact, result, x1, x2) -> dict:
+    """The film of a solved point (``result`` on the grid ``x1, x2`` of ``contact.grid``)
+    beside the Hamrock-Dowson films of the smooth ball at the same viscosity and entrainment
+    speed: ``h_c_m``, ``h_min_m``, ``hamrock_dowson_h_c_m``, ``hamrock_dowson_h_min_m`` [m]."""
+    h_c, h_min = film_thickness(result, x1, x2)
+    hd_c, hd_min = contact.hamrock_dowson()
+    return {"entrainment_m_s": contact.entrainment, "h_c_m": h_c, "h_min_m": h_min,
+            "hamrock_dowson_h_c_m": float(hd_c), "hamrock_dowson_h_min_m": float(hd_min)}

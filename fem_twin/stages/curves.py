@@ -1,0 +1,263 @@
+"""The Stribeck side of the main job: one warm-started sweep per viscosity with the C_f
+error estimates, refinement passes where the curve turns, the patch scatter band, and what
+is written of them (CSV, plots, fields, ``results.nc``, ``fields.nc``, validation)."""
+
+from __future__ import annotations
+
+import json
+import logging
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ..case import Case
+from ..io.layout import RunLayout
+from ..macro import MacroSettings, MixedResult
+from ..macro.figures import plot_point_fields
+from ..macro.point_contact import film_against_hamrock_dowson
+from ..micro import FlowFactors
+from ..stribeck import plot_stribeck, read_measured_csv, stribeck_sweep, write_stribeck_csv
+from ..stribeck.accuracy import error_summary
+from ..stribeck.analysis import hersey_collapse, patch_band, transition_speeds
+from ..stribeck.sweep import point_files, point_key, sweep_key
+from ..stribeck.validation import validate_curves
+from ..threads import worker_heap
+from .geometry import ball_contact, face_load, hersey_length, macro_geometry
+from .provenance import provenance, stage_keys
+
+log = logging.getLogger("fem_twin")
+
+
+def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
+    """The macro solver settings of a case (``method`` overrides ``[macro] method``).
+
+    A ball's contact cavitates at the ambient pressure: the 0.2 bar between p_amb and p_cav
+    of Table 6 is nothing beside its GPa, and the thin pressurised layer it forces along
+    the sides of the outlet cavity makes the Newton coupling cycle between two states."""
+    settings = MacroSettings(e_reduced=case.materials.e_reduced,
+                             boundary_friction=case.tribometer.boundary_friction,
+                             method=method or case.macro.method, coupling=case.macro.coupling,
+                             inner_steps=case.macro.inner_steps, couette=case.macro.couette)
+    if case.tribometer.ball:
+        settings = replace(settings, cavitation_pressure=settings.ambient_pressure)
+    return settings
+
+
+def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = True) -> dict:
+    """One Stribeck sweep per viscosity (in parallel on ``executor``), refined where the
+    curve turns, and the patch scatter band (``[run] patch_band``); CSV, plots, fields,
+    ``results.nc`` and ``fields.nc``.  Returns the stage's summary."""
+    gap, spacing, face, origin = macro_geometry(case, out)
+    tr = case.tribometer
+    ball = dict(slide_to_roll=tr.slide_to_roll) if tr.ball else {}
+    common = dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
+                  speeds=case.sweep.speeds, load=face_load(case), diameter=hersey_length(case),
+                  face=face, **ball, settings=macro_settings(case), checkpoint=out.points,
+                  fields=out.fields, origin=origin, factors_key=stage_keys(case)["micro"])
+    curves, speeds = refined_curves(case, common, executor, progress)
+    tasks = [(dict(common, speeds=speeds, error_estimate=True), lub)
+             for lub in case.lubricant.lubricants()]
+    patch_curves, band_tasks = band_curves(case, out, dict(common, speeds=speeds), executor,
+                                           progress)
+    band = patch_band(patch_curves) if patch_curves else None
+    _prune_points(common["checkpoint"], tasks + band_tasks)
+    write_stribeck_csv(out.stribeck_csv, curves, band)
+    summary = _summary(case, out, curves, band)
+    plot_curves(case, curves, band, out)
+    points = sweep_points(common["checkpoint"], tasks)
+    _plot_fields(out, points, case.lubricant.viscosities)
+    _log_points(curves)
+    if len(curves) > 1:
+        summary["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, tr.boundary_friction)
+    if tr.ball:
+        summary["ehl_film"] = ehl_film(case, points)
+    if any(case.measured):
+        summary["validation"] = validate_curves(
+            curves, case.measured, tr.boundary_friction, curve_labels(case, curves),
+            out.validation_csv, out.validation_png)
+    write_run_results(case, out, curves, patch_curves, points, origin)
+    return summary
+
+
+def refined_curves(case: Case, common: dict, executor=None, progress: bool = True):
+    """The main curves (with their C_f error estimates) over the case's speeds, then
+    ``[sweep] refine`` passes adding the midpoints where C_f jumps; ``(curves, speeds)``."""
+    tr, step = case.tribometer, case.sweep.refine_step * case.tribometer.boundary_friction
+    lubricants = case.lubricant.lubricants()
+    speeds = case.sweep.speeds
+    for level in range(case.sweep.refine + 1):
+        curves = [c.with_load_share(tr.load_share) for c in run_sweeps(
+            [(dict(common, speeds=speeds, error_estimate=True), lub) for lub in lubricants],
+            executor, progress)]
+        extra = transition_speeds(curves, step)
+        if level == case.sweep.refine or extra.size == 0:
+            break
+        log.info("sweep refinement %d: %d speeds added where C_f changes by more than "
+                 "%.3g", level + 1, extra.size, step)
+        speeds = np.unique(np.r_[speeds, extra])[::-1]
+    return curves, speeds
+
+
+def band_curves(case: Case, out: RunLayout, common: dict, executor=None,
+                progress: bool = True):
+    """The single-patch curves of the scatter band (``[run] patch_band``), one list per
+    patch over the viscosities, and their sweep tasks."""
+    lubricants = case.lubricant.lubricants()
+    tasks = [(kw, lub) for kw in band_sweeps(case, out, common)
+             for lub in lubricants] if case.run.patch_band else []
+    curves = [c.with_load_share(case.tribometer.load_share) for c in run_sweeps(
+        tasks, executor, progress, desc="patch band points")]
+    n = len(lubricants)
+    return [curves[i:i + n] for i in range(0, len(curves), n)], tasks
+
+
+def _summary(case: Case, out: RunLayout, curves, band) -> dict:
+    summary = {"curves": [{"viscosity_Pa_s": c.viscosity, "friction_coefficient_range": [
+        float(c.friction_coefficient.min()), float(c.friction_coefficient.max())]}
+        for c in curves],
+        "files": [p.name for p in (out.stribeck_csv, out.stribeck_png("speed"),
+                                   out.stribeck_png("hersey"), out.results, out.fields_nc,
+                                   out.fields, *(out.fields_png(c.viscosity) for c in curves))]}
+    if band is not None:
+        summary["patch_band_max_width"] = float(max(np.max(hi - lo) for lo, hi in band))
+    summary["cf_error"] = error_summary(curves, case.tribometer.boundary_friction,
+                                        case.sweep.error_tolerance)
+    return summary
+
+
+def _plot_fields(out: RunLayout, points, viscosities) -> None:
+    """The fields of the fastest, a middle and the slowest point of each curve."""
+    for mu in viscosities:
+        u = sorted((v for m, v in points if m == mu), reverse=True)      # fast to slow
+        res = [points[mu, u[i]] for i in sorted({0, len(u) // 2, len(u) - 1})]
+        plot_point_fields(res, out.fields_png(mu), titles=[
+            f"$\\mu_0$ = {mu:g} Pa s, U = {r.speed:.3g} m/s, "
+            f"$C_f$ = {r.friction_coefficient:.4f}" for r in res])
+
+
+def _log_points(curves) -> None:
+    for c in curves:
+        for u, cf, it, share in zip(c.speed, c.friction_coefficient, c.iterations,
+                                    c.contact_load_fraction):
+            log.info("point mu_0 = %g Pa s, U = %.4g m/s: C_f = %.5f, contact share %.3f, "
+                     "%d iterations", c.viscosity, u, cf, share, it)
+
+
+def band_sweeps(case: Case, out: RunLayout, common: dict) -> list[dict]:
+    """Sweep arguments of every single patch's flow factors (the scatter band, Figure 13)."""
+    n = len(case.geometry.patches)
+    if n < 2:
+        return []
+    return [dict(common, factors=FlowFactors.load(out.patch_factors(i + 1)),
+                 factors_key=f"{common['factors_key']}-patch{i + 1}", fields=None)
+            for i in range(n)]
+
+
+def curve_labels(case: Case, curves) -> list[str]:
+    return [f"{t:g} °C, $\\mu_0$ = {c.viscosity:g} Pa s"
+            for t, c in zip(case.lubricant.temperatures, curves)]
+
+
+def ehl_film(case: Case, points) -> dict:
+    """The film of a ball-on-disk sweep's fastest point (first viscosity) beside the
+    Hamrock-Dowson films of the smooth ball at the same u_m: the full-film end of the curve."""
+    mu = case.lubricant.viscosities[0]
+    u_m = max(u for m, u in points if m == mu)
+    _, _, x1, x2 = ball_contact(case).grid(case.macro.grid)
+    film = film_against_hamrock_dowson(replace(ball_contact(case), viscosity=mu,
+                                               entrainment=u_m), points[mu, u_m], x1, x2)
+    log.info("EHL film at u_m = %g m/s: h_c %.4g m, h_min %.4g m; Hamrock-Dowson %.4g m, "
+             "%.4g m", u_m, film["h_c_m"], film["h_min_m"], film["hamrock_dowson_h_c_m"],
+             film["hamrock_dowson_h_min_m"])
+    return film
+
+
+def plot_curves(case: Case, curves, band, out: RunLayout) -> None:
+    """C_f versus speed and versus Hersey number, with the band and measured curves."""
+    measured = [read_measured_csv(m) if m is not None else None for m in case.measured]
+    measured += [None] * (len(curves) - len(measured))
+    tr = case.tribometer
+    for x in ("speed", "hersey"):
+        plot_stribeck(curves, out.stribeck_png(x), x=x,
+                      labels=curve_labels(case, curves), boundary=tr.boundary_friction,
+                      bands=band, measured=measured, diameter=hersey_length(case),
+                      load=tr.load, speed_label=("entrainment speed $u_m$ [m/s], SRR "
+                                                 f"{tr.slide_to_roll:g}" if tr.ball else
+                                                 "sliding speed $U$ [m/s]"))
+
+
+def sweep_points(folder: Path, tasks) -> dict:
+    """{(viscosity, speed): MixedResult} of the checkpoints of the sweeps ``tasks``."""
+    points = {}
+    for kw, lub in tasks:
+        for path in point_files(folder, _sweep_key(kw, lub)):
+            res = MixedResult.load(path)
+            speed = res.speed if kw.get("slide_to_roll") is None else res.meta["entrainment"]
+            points[lub.viscosity, speed] = res
+    return points
+
+
+def write_run_results(case: Case, out: RunLayout, curves, patch_curves, points, origin) -> None:
+    """``results.nc`` (flow factors per patch and average, Stribeck curves with the band,
+    settings and error estimates) and ``fields.nc`` (the macro fields of ``points``)."""
+    from dataclasses import asdict
+
+    from ..results import fields_dataset, flow_factor_dataset, stribeck_dataset, write_netcdf
+    n = len(case.geometry.patches)
+    factors = [FlowFactors.load(out.patch_factors(k)) for k in [*range(1, n + 1), None]]
+    attrs = {"case": json.dumps(asdict(case), default=str), "case_name": case.name,
+             "provenance": json.dumps(provenance(case))}
+    write_netcdf(out.results,
+                 {"flow_factors": flow_factor_dataset(factors, [str(i + 1) for i in range(n)]
+                                                      + ["average"]),
+                  "stribeck": stribeck_dataset(curves, patch_curves)}, attrs)
+    write_netcdf(out.fields_nc, {None: fields_dataset(points, origin)}, attrs)
+
+
+def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points"):
+    """Sweeps ``tasks`` [(sweep kwargs, lubricant)]: serial, or one process task each on
+    ``executor``.
+
+    In parallel the bar counts the finished points of all sweeps (their checkpoint files,
+    written as each point finishes in its worker)."""
+    if executor is None or len(tasks) <= 1:
+        return [_sweep_task((dict(kw, progress=progress), lub)) for kw, lub in tasks]
+    futures = [executor.submit(_sweep_task, (dict(kw, progress=False), lub))
+               for kw, lub in tasks]
+    total = sum(len(kw["speeds"]) for kw, _ in tasks)
+    keys = {_sweep_key(kw, lub) for kw, lub in tasks if kw.get("factors_key")}
+    folder = tasks[0][0].get("checkpoint")
+    with tqdm(total=total, desc=desc, unit="point", disable=not progress) as bar:
+        while not all(f.done() for f in futures):
+            if folder is not None and keys:                   # points finished so far
+                bar.update(sum(point_key(p) in keys for p in point_files(folder)) - bar.n)
+            time.sleep(0.5)
+        bar.update(total - bar.n)
+    return [f.result() for f in futures]
+
+
+def _sweep_task(args):
+    """One viscosity's sweep (a picklable unit of work for process pools and Dask)."""
+    worker_heap()
+    kwargs, lub = args
+    return stribeck_sweep(lubricant=lub, **kwargs)
+
+
+def _sweep_key(kwargs: dict, lubricant) -> str:
+    """Checkpoint key of one sweep task (:func:`~fem_twin.stribeck.sweep.point_file`)."""
+    return sweep_key(kwargs["gap"], kwargs["spacing"], kwargs["factors_key"], kwargs["load"],
+                     lubricant, kwargs["settings"], kwargs["face"],
+                     kwargs.get("slide_to_roll"))
+
+
+def _prune_points(folder: Path, tasks) -> None:
+    """Remove the Stribeck checkpoints of no current sweep (changed inputs)."""
+    keys = {_sweep_key(kw, lub) for kw, lub in tasks}
+    stale = [p for p in point_files(folder) if point_key(p) not in keys]
+    for p in stale:
+        p.unlink()
+    if stale:
+        log.info("%d stale Stribeck checkpoints removed", len(stale))

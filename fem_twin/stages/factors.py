@@ -1,0 +1,85 @@
+"""The roughness side of the main job: the flow factors of every patch pair (eqs 8-16),
+checkpointed per h0, side by side on the shared pool, and their average."""
+
+from __future__ import annotations
+
+import logging
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+from tqdm import tqdm
+
+from ..case import Case
+from ..io.checkpoint import load_or_none
+from ..io.files import read_topography
+from ..io.layout import RunLayout
+from ..micro import FlowFactors, average, homogenise
+from ..micro.output import plot_flow_factors
+from ..micro.store import prune_checkpoints
+from ..topography import resample_cell
+
+log = logging.getLogger("fem_twin")
+
+
+def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool = True,
+                       h0=None):
+    """Flow factors of every patch pair (checkpointed per h0) and their average (``h0``:
+    the case's range unless given).  With an executor the patches run side by side (a
+    thread each hands its h0 tasks to the shared pool), so the pool is not left idle at
+    the end of a patch or of a round of adaptive h0, and a cluster gets every patch's
+    tasks at once."""
+    out.micro.mkdir(parents=True, exist_ok=True)
+    mc = case.micro
+    h0 = np.geomspace(mc.h0_min, mc.h0_max, mc.h0_count) if h0 is None else np.asarray(h0)
+    n = len(case.geometry.patches)
+    bar = tqdm(total=n * len(h0), desc="flow factors", unit="h0", disable=not progress
+               or os.environ.get("FEM_TWIN_NO_PROGRESS") == "1")
+    try:
+        if executor is None:
+            factors = [_patch_factors(case, out, i, h0, None, bar) for i in range(n)]
+        else:
+            with ThreadPoolExecutor(n) as threads:
+                factors = list(threads.map(
+                    lambda i: _patch_factors(case, out, i, h0, executor, bar), range(n)))
+    finally:
+        bar.close()
+    mean = average(factors)
+    mean.save(out.flow_factors)
+    mean.write_csv(out.flow_factors_csv)
+    plot_flow_factors([*factors, mean], out.flow_factors_png,
+                      labels=[f"patch {i + 1}" for i in range(len(factors))] + ["average"])
+    estimate = mean.meta.get("error_estimate", {})
+    return {"patches": len(factors), "h0_m": [float(h0[0]), float(h0[-1]), len(h0)],
+            "h0_solved": [len(f) for f in factors], "h0_tol": mc.h0_tol,
+            "grid": list(mc.resolution), "steps": mc.steps,
+            "time_derivative": mc.time_derivative,
+            "error_estimate": estimate,
+            "p_con_max_Pa": float(mean.p_con.max()),
+            "files": [out.flow_factors_csv.name, out.flow_factors_png.name]}
+
+
+def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> FlowFactors:
+    """Flow factors of patch pair ``i`` (0-based): its file if present, else computed."""
+    mc, m = case.micro, case.materials
+    path, checkpoints = out.patch_factors(i + 1), out.patch_checkpoints(i + 1)
+    ff = load_or_none(path, FlowFactors.load)
+    if ff is not None:
+        bar.update(len(h0))
+        return ff
+    low = read_topography(out.patch(i + 1, "low"))
+    up = read_topography(out.patch(i + 1, "up"))
+    if low.shape != tuple(mc.resolution):
+        low, up = resample_cell(low, mc.resolution), resample_cell(up, mc.resolution)
+    ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=m.e_reduced,
+                    hardness=m.hardness, method=mc.method,
+                    time_derivative=mc.time_derivative, time_tol=mc.time_tol,
+                    h0_tol=mc.h0_tol, executor=executor,
+                    workers=getattr(executor, "n_workers", 1),
+                    checkpoint=checkpoints, progress=bar,
+                    patch_id=f"patch {i + 1}")
+    ff.save(path)
+    stale = prune_checkpoints(checkpoints, ff.meta["checkpoint_keys"])
+    if stale:
+        log.info("patch %d: %d stale h0 checkpoints removed", i + 1, stale)
+    return ff

@@ -1,0 +1,162 @@
+"""The macro side of the main job: the virtual geometry of every pin, disk and patch pair
+(paper 2.2.1), the pin levelling by torque balance (eqs 1-7), and the macro gap the
+Reynolds scale solves on (the levelled set average, or a ball's sphere)."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ..case import Case
+from ..contact.levelling import average_pins, level_pin
+from ..errors import InputError
+from ..io.checkpoint import load_or_none
+from ..io.files import read_topography, write_topography
+from ..io.layout import RunLayout
+from ..io.mesh import grid_mesh, write_vtu
+from ..macro.point_contact import PointContact
+from ..topography.plausibility import check_patch, check_pin
+from ..topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
+
+log = logging.getLogger("fem_twin")
+
+
+def reconstruct_geometry(case: Case, out: RunLayout, progress: bool = True) -> dict:
+    """Prepare every pin (with its disk, or a flat one) and patch pair; write npz + VTU."""
+    out.geometry.mkdir(parents=True, exist_ok=True)
+    opts = case.macro_geometry
+    jobs = [] if case.tribometer.ball else [("pin", i) for i in range(len(case.geometry.pins))]
+    jobs += [("patch", i) for i in range(len(case.geometry.patches))]
+    result = {"pins": [], "patches": []}
+    for kind, i in tqdm(jobs, desc="geometry", disable=not progress, unit="surface"):
+        if kind == "pin":
+            pin_out, disk_out = out.pin(i + 1), out.disk(i + 1)
+            if not all(load_or_none(f, read_topography) for f in (pin_out, disk_out)):
+                raw = read_topography(case.geometry.pins[i])
+                check_pin(raw, case.geometry.pins[i].name, case.tribometer.pin_diameter)
+                pin = prepare_pin(raw, opts)
+                disk = (prepare_disk(read_topography(case.geometry.disks[i]), opts)
+                        if case.geometry.disks else flat_disk(pin))
+                if disk.shape != pin.shape:
+                    raise InputError(f"pin {i + 1} and its disk differ in resolution "
+                                     f"{pin.shape} vs {disk.shape}")
+                write_vtu(out.macro_vtu(i + 1),
+                          grid_mesh(pin.shape, pin.spacing, pin.origin),
+                          {"x3_low": pin.heights, "x3_up": disk.heights,
+                           "pin_face": (pin.heights > opts.holder_height).astype(float)})
+                write_topography(disk_out, disk)
+                write_topography(pin_out, pin)
+            pin = read_topography(pin_out)
+            face = pin.heights > opts.holder_height
+            result["pins"].append({"file": pin_out.name, "grid": list(pin.shape),
+                                   "spacing_m": list(pin.spacing),
+                                   "face_fraction": float(face.mean()),
+                                   "face_range_m": [float(pin.heights[face].min()),
+                                                    float(pin.heights[face].max())]})
+        else:
+            low_out, up_out = out.patch(i + 1, "low"), out.patch(i + 1, "up")
+            if not all(load_or_none(f, read_topography) for f in (low_out, up_out)):
+                src_pin, src_disk = case.geometry.patches[i]
+                axis = case.macro_geometry.sliding_direction
+                low = prepare_patch(read_topography(src_pin), case.geometry.patch_shape,
+                                    case.geometry.patch_start, sliding_direction=axis)
+                up = prepare_patch(read_topography(src_disk), case.geometry.patch_shape,
+                                   case.geometry.patch_start, upper=True,
+                                   sliding_direction=axis)
+                for t, src in ((low, src_pin), (up, src_disk)):
+                    for warning in check_patch(t, src.name, case.tribometer.pin_diameter):
+                        log.warning("%s", warning)
+                write_vtu(out.patch_vtu(i + 1),
+                          grid_mesh(low.shape, low.spacing, periodic=True),
+                          {"x3_low": low.heights, "x3_up": up.heights})
+                write_topography(up_out, up)
+                write_topography(low_out, low)
+            sq_low = read_topography(low_out).rms_height()
+            sq_up = read_topography(up_out).rms_height()
+            result["patches"].append({"files": [low_out.name, up_out.name], "sq_low_m": sq_low,
+                                      "sq_up_m": sq_up, "sq_m": float(np.hypot(sq_low, sq_up))})
+    return result
+
+
+def level_pins(case: Case, out: RunLayout, progress: bool = True) -> dict:
+    """Level every pin against its disk (torque balance, Table 4 at 50 N); average the
+    levelled set and level the average (paper 2.2.1).  Writes ``levelling/``."""
+    if case.tribometer.ball:
+        return {"skipped": "ball-on-disk: the macro gap is the ball's sphere"}
+    out.levelling.mkdir(parents=True, exist_ok=True)
+    m = case.materials
+    e_red = m.e_reduced
+    holder = case.macro_geometry.holder_height
+    result = {"pins": []}
+    levelled = []
+    n = len(case.geometry.pins)
+    for i in tqdm(range(n), desc="levelling", disable=not progress, unit="pin"):
+        path = out.levelled_pin(i + 1)
+        if load_or_none(path, read_topography) is None:
+            lev = level_pin(read_topography(out.pin(i + 1)), read_topography(out.disk(i + 1)),
+                            e_reduced=e_red, hardness=m.hardness, holder_height=holder)
+            write_topography(path, lev.pin.with_heights(lev.pin.heights, meta={
+                **lev.pin.meta, "tilt_rad": list(lev.tilt),
+                "torque_residuals": list(lev.residuals)}))
+        pin = read_topography(path)
+        levelled.append(pin)
+        result["pins"].append({"file": path.name, "tilt_rad": pin.meta.get("tilt_rad")})
+    avg_out = out.levelled_pin("average")
+    if n > 1 and load_or_none(avg_out, read_topography) is None:
+        lev = level_pin(average_pins(levelled, radius=case.macro_geometry.level_radius,
+                                     truncation=case.macro_geometry.truncation,
+                                     holder_height=holder),
+                        read_topography(out.disk(1)), e_reduced=e_red,
+                        hardness=m.hardness, holder_height=holder)
+        write_topography(avg_out, lev.pin)
+    result["macro_pin"] = macro_pin_file(case, out).name
+    return result
+
+
+def macro_pin_number(case: Case) -> int | str:
+    """The pin of the macro scale: ``"average"`` (the levelled set's average, when the set
+    has more than one pin) or its number, counted from 1 (its disk serves the average)."""
+    if case.macro.pin == "average":
+        return "average" if len(case.geometry.pins) > 1 else 1
+    return case.macro.pin
+
+
+def macro_pin_file(case: Case, out: RunLayout) -> Path:
+    """The levelled pin of the macro scale (:func:`macro_pin_number`)."""
+    return out.levelled_pin(macro_pin_number(case))
+
+
+def macro_geometry(case: Case, out: RunLayout):
+    """Gap ``h_g = x3_up - x3_low``, spacing, pin-face mask and origin of the macro pin, or
+    of the ball's sphere over [-4a, 2a] x [-3a, 3a] (a the Hertz radius; face: all)."""
+    if case.tribometer.ball:
+        gap, spacing, x1, x2 = ball_contact(case).grid(case.macro.grid)
+        return gap, spacing, np.ones(gap.shape, bool), (float(x1[0]), float(x2[0]))
+    pin = read_topography(macro_pin_file(case, out))
+    k = macro_pin_number(case)
+    disk = read_topography(out.disk(1 if k == "average" else k))
+    face = pin.heights > case.macro_geometry.holder_height / 2
+    return disk.heights - pin.heights, pin.spacing, face, pin.origin
+
+
+def face_load(case: Case) -> float:
+    """The load the macro scale balances (eq 28) [N]: ``[tribometer] load_share`` of the
+    imposed load (C_f is referred to the imposed load, ``StribeckCurve.with_load_share``)."""
+    return case.tribometer.load * case.tribometer.load_share
+
+
+def ball_contact(case: Case) -> PointContact:
+    """The smooth ball of a ball-on-disk case (Hertz radius, Hamrock-Dowson films) at the
+    first viscosity and the sweep's fastest entrainment speed."""
+    tr, lb = case.tribometer, case.lubricant
+    return PointContact(tr.ball_radius, tr.load, case.materials.e_reduced, lb.viscosities[0],
+                        lb.roelands_alpha, case.sweep.speed_max)
+
+
+def hersey_length(case: Case) -> float:
+    """D of the Hersey number (eq 46) [m]: the pin diameter, or a ball's Hertz diameter."""
+    return (2 * ball_contact(case).hertz_radius if case.tribometer.ball
+            else case.tribometer.pin_diameter)
