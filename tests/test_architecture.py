@@ -91,7 +91,7 @@ def test_run_files_are_named_only_by_the_run_layout():
 #: Shared plumbing (errors, checks, tables, threads, linalg, io/ ...) is layer 0; io.files
 #: reads and writes the Topography value, so it sits with the topography stage.
 LAYERS = {"topography": 1, "io.files": 1, "io": 1, "contact": 2, "micro": 3, "macro": 4,
-          "stribeck": 5, "case": 6, "stages": 6, "pipeline": 6, "compare": 6,
+          "stribeck": 5, "case": 6, "sections": 6, "stages": 6, "pipeline": 6, "compare": 6,
           "calibration": 6, "fitting": 6, "results": 6, "report": 6, "samples": 6, "fvm": 6,
           "cli": 7, "cli_runs": 7, "cli_stages": 7}
 

@@ -12,14 +12,9 @@ deformation ``w = h_el`` (all nodes) and ``h_d``; the equations, all fully impli
 * ``G = w - E (p + p_cav + p_con(h0) - p_amb) = 0`` (eqs 20-22, ``E`` the FFT half-space);
 * ``L = sum(a (p + p_cav + p_con - p_amb)) - F_N,imp = 0`` (eq 28).
 
-The Jacobian is exact (the ``h0``-derivatives of the flow factors by central differences of
-their interpolation, the Poiseuille operator's coefficient derivatives by probing it with
-nine colourings of the grid).  Each Newton step is solved by
-right-preconditioned GMRES with the exact Jacobian action (``E`` by FFT); the preconditioner
-is the Jacobian with the elastic coupling kept, as a dense block, on the set ``S`` of nodes
-where it outweighs the pressure flow (the loaded zone of the contact), and dropped
-elsewhere; ``S`` is eliminated by a Schur complement on a sparse LU of the rest.  Steps are
-limited so no film thins by more than half, then backtracked on the scaled residual.
+The Jacobian is exact, and each Newton step is solved by preconditioned GMRES
+(:mod:`.jacobian`).  Steps are limited so no film thins by more than half, then backtracked
+on the scaled residual.
 """
 
 from __future__ import annotations
@@ -27,17 +22,12 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.linalg as la
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..errors import MixedNotConverged
 from .couette import couette, couette_matrix
-from .problem import MAX_COEFFICIENT_PRESSURE, Problem
+from .jacobian import newton_step, scales
+from .problem import Problem
 
-#: a node joins the dense elastic block when its elastic coupling exceeds this fraction of
-#: its pressure-flow coupling
-DENSE_THRESHOLD = 0.02
 #: halvings of a Newton step in its line search
 HALVINGS = 30
 #: ``STALL`` line-search steps in a row shorter than ``SHORT_STEP`` (a stall at a kink)
@@ -48,8 +38,6 @@ STALL = 3
 WATCHDOG = 8
 #: the preconditioner is kept from step to step until GMRES needs more iterations than this
 REBUILD_AFTER = 6
-#: most nodes in the dense block (a 4000^2 LU takes about 2 s here)
-MAX_DENSE = 4000
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,223 +70,6 @@ def evaluate(P: Problem, x: State, load: float) -> dict:
                 G=x.w - P.elastic(p_tot), F=F,
                 F_hd=float(np.sum(P.area * (p + s.cavitation_pressure - s.ambient_pressure))),
                 L=F - load)
-
-
-def _probe(P: Problem, coefficients, p) -> sp.csr_matrix:
-    """The matrix ``M`` with ``M[:, k] = K(*coefficients(e_k)) p``, where ``K`` (the
-    Poiseuille operator, bilinear in its nodal coefficient fields) takes the fields that
-    ``coefficients(mask)`` returns for a node mask: probed with nine colourings of the grid
-    (the 3 x 3 stencil of a node's coefficient never overlaps its colour mates)."""
-    ny, nx = P.shape
-    i, j = np.divmod(np.arange(ny * nx), nx)
-    rows, cols, vals = [], [], []
-    for ci in range(3):
-        for cj in range(3):
-            colour = ((i % 3 == ci) & (j % 3 == cj)).astype(float).reshape(ny, nx)
-            v = P.poiseuille(*coefficients(colour)) @ p
-            # the node of this colour in each row's 3 x 3 neighbourhood
-            ni = i + (ci - i) % 3 - np.where((ci - i) % 3 == 2, 3, 0)
-            nj = j + (cj - j) % 3 - np.where((cj - j) % 3 == 2, 3, 0)
-            ok = (ni >= 0) & (ni < ny) & (nj >= 0) & (nj < nx) & (v != 0)
-            rows.append(np.flatnonzero(ok))
-            cols.append((ni * nx + nj)[ok])
-            vals.append(v[ok])
-    n = ny * nx
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(n, n))
-
-
-def jacobian(P: Problem, ev: dict) -> dict:
-    """The sparse blocks of the Jacobian: ``J_pp = dR/dphi`` (interior x interior),
-    ``J_ph = dR/dh0`` (interior x all, through h_m, A and b), ``pos`` (dp/dphi) and
-    ``dpc = dp_con/dh0``."""
-    lub, I = P.lubricant, P.interior
-    pos = ev["p"].ravel() > 0
-    p_coef = np.minimum(ev["p"], MAX_COEFFICIENT_PRESSURE)
-    unclipped = ev["p"] < MAX_COEFFICIENT_PRESSURE
-    dlnrho = lub.density_log_slope(p_coef) * unclipped
-    dlnmu = lub.viscosity_log_slope(p_coef) * unclipped
-    d = P.factors.slopes(ev["h0"])
-    free = ~ev["touching"]
-    g, q, loc, p = ev["g"], ev["q"], ev["loc"], ev["p"].ravel()
-    Kg = _probe(P, lambda c: (c, loc.A), p)
-    KA = _probe(P, lambda c: (g, c[..., None, None] * d["A"] * free[..., None, None]), p)
-    Q1, Q2 = ev["couette"].q_derivatives(1 - ev["theta"].ravel())
-    b1, b2 = loc.b[..., 0].ravel(), loc.b[..., 1].ravel()
-    Bq = Q1 @ sp.diags(b1) + Q2 @ sp.diags(b2)
-    Bb = (Q1 @ sp.diags(q.ravel() * d["b"][..., 0].ravel())
-          + Q2 @ sp.diags(q.ravel() * d["b"][..., 1].ravel()))
-    dg_dp, dq_dp = (g * (dlnrho - dlnmu)).ravel(), (q * dlnrho).ravel()
-    dhm = d["h_m"] * free
-    dg_dh, dq_dh = (3 * g * dhm / loc.h_m).ravel(), (q * dhm / loc.h_m).ravel()
-    dtheta = np.where(pos, 0.0, 1.0 / P.settings.p_ref)
-    J_p = (ev["K"] @ sp.diags(pos * 1.0) + ev["B"] @ sp.diags(dtheta)
-           + (Kg @ sp.diags(dg_dp) + Bq @ sp.diags(dq_dp)) @ sp.diags(pos * 1.0))
-    J_h = Kg @ sp.diags(dg_dh) + Bq @ sp.diags(dq_dh) + KA + Bb @ sp.diags(free.ravel() * 1.0)
-    J_p, J_h = J_p.tocsr()[I], J_h.tocsr()[I]
-    return dict(J_pp=J_p[:, I].tocsc(), J_ph=J_h.tocsr(), pos=pos,
-                dpc=(d["p_con"] * free).ravel())
-
-
-class Preconditioner:
-    """Approximate inverse of the Newton matrix: the Jacobian with ``E`` kept on ``S x S``.
-
-    Outside ``S`` the deformation update is the elastic residual alone; on ``S`` it is
-    eliminated exactly (``dw_S = M_S (r_G + E_SS (D dphi + p_con' dh))``,
-    ``M_S = (I - E_SS p_con')^-1``), which leaves the pressure system ``J_pp + J_ph[:, S] W``
-    bordered by the load row; that is solved with a sparse LU outside ``S`` and a dense LU of
-    the Schur complement on ``S``.
-    """
-
-    def __init__(self, P: Problem, jac: dict):
-        I, n = P.interior, P.gap.size
-        J_pp, J_ph, pos, dpc = jac["J_pp"], jac["J_ph"], jac["pos"], jac["dpc"]
-        sI = dense_set(P, jac)
-        S = I[sI]
-        self.P, self.jac, self.sI, self.S = P, jac, sI, S
-        E = P.dense_elastic(S)
-        if np.any(dpc[S]):                                # contact stiffness on S
-            self.M = la.inv(np.eye(S.size) - E * dpc[S])
-            self.ME = self.M @ E                          # M_S E_SS
-        else:
-            self.M, self.ME = None, E
-        W = self.ME * pos[S]                              # M_S E_SS D_S
-        self.JphS = J_ph[:, S].tocsr()
-        a = P.area.ravel()
-        self.v = self._M(a[S] * dpc[S], transpose=True)
-        l = a[I] * pos[I]
-        l[sI] += pos[S] * (E.T @ self.v)
-        self.l = l
-        self.delta = float(a @ dpc + self.v @ (E @ dpc[S]))
-        self._factor(J_pp, W)
-        c = J_ph @ np.ones(n) + self.JphS @ (self.ME @ dpc[S])
-        self.y2 = self.solve_pressure(c)
-
-    def _factor(self, J_pp, W):
-        nI = J_pp.shape[0]
-        sI = self.sI
-        O = np.setdiff1d(np.arange(nI), sI)
-        self.O = O
-        J = J_pp.tocsr()
-        self.lu = spla.splu(J[O][:, O].tocsc())
-        if sI.size == 0:
-            return
-        JOS = J[O][:, sI]
-        CsO = self.JphS[O]
-        ring = np.flatnonzero(np.asarray(abs(JOS).sum(axis=1)).ravel()
-                              + np.asarray(abs(CsO).sum(axis=1)).ravel())
-        self.B_ring = JOS[ring].toarray() + CsO[ring] @ W
-        unit = np.zeros((O.size, ring.size))
-        unit[ring, np.arange(ring.size)] = 1.0
-        self.Z = self.lu.solve(unit)
-        self.C = J[sI][:, O].tocsr()
-        D = J[sI][:, sI].toarray() + self.JphS[sI] @ W
-        self.schur = la.lu_factor(D - (self.C @ self.Z) @ self.B_ring)
-
-    def _M(self, r, transpose=False):
-        if self.M is None:
-            return r
-        return (self.M.T if transpose else self.M) @ r
-
-    def solve_pressure(self, r):
-        """``(J_pp + J_ph[:, S] W)^-1 r`` by the block elimination."""
-        x = np.empty_like(r)
-        yO = self.lu.solve(r[self.O])
-        if self.sI.size == 0:
-            x[self.O] = yO
-            return x
-        xS = la.lu_solve(self.schur, r[self.sI] - self.C @ yO)
-        x[self.O] = yO - self.Z @ (self.B_ring @ xS)
-        x[self.sI] = xS
-        return x
-
-    def __call__(self, r_R, r_G, r_L):
-        S, sI = self.S, self.sI
-        dpc = self.jac["dpc"]
-        a = self.P.area.ravel()
-        r_GO = r_G.copy()
-        r_GO[S] = 0.0
-        MrS = self._M(r_G[S])
-        r_t = r_R - self.jac["J_ph"] @ r_GO - self.JphS @ MrS
-        r_tL = r_L - float(np.sum(a * dpc * r_GO)) - float(self.v @ r_G[S])
-        y1 = self.solve_pressure(r_t)
-        dhd = (r_tL - self.l @ y1) / (self.delta - self.l @ self.y2)
-        dphi = y1 - self.y2 * dhd
-        dw = r_GO
-        dw[S] = MrS + self.ME @ (self.jac["pos"][S] * dphi[sI] + dpc[S] * dhd)
-        return dphi, dw, dhd
-
-
-def dense_set(P: Problem, jac: dict) -> np.ndarray:
-    """Interior positions where the elastic coupling of a node's own deformation outweighs
-    ``DENSE_THRESHOLD`` of its pressure coupling (or of its contact stiffness), grown by two
-    nodes; at most ``MAX_DENSE``, the strongest first."""
-    from scipy.ndimage import maximum_filter
-    e0 = float(P.kernel()[0, 0])
-    I = P.interior
-    diag = np.abs(jac["J_pp"].diagonal())
-    row = np.asarray(abs(jac["J_ph"]).sum(axis=1)).ravel()
-    score = np.zeros(P.gap.size)
-    score[I] = e0 * row / np.maximum(diag, 1e-300 + 1e-12 * diag.max())
-    score = np.maximum(score, e0 * np.abs(jac["dpc"]))
-    score = maximum_filter(score.reshape(P.shape), size=5, mode="constant").ravel()[I]
-    chosen = np.flatnonzero(score > DENSE_THRESHOLD)
-    if chosen.size > MAX_DENSE:
-        chosen = np.sort(chosen[np.argsort(score[chosen])[-MAX_DENSE:]])
-    return chosen
-
-
-def apply_jacobian(P: Problem, jac: dict, dphi, dw, dhd):
-    """The exact Jacobian action (``E`` by FFT) on an update ``(dphi, dw, dhd)``."""
-    dp = np.zeros(P.gap.size)
-    dp[P.interior] = jac["pos"][P.interior] * dphi
-    dh = dw + dhd
-    dpt = dp + jac["dpc"] * dh
-    return (jac["J_pp"] @ dphi + jac["J_ph"] @ dh,
-            dw - P.elastic(dpt.reshape(P.shape)).ravel(), float(P.area.ravel() @ dpt))
-
-
-def newton_step(P: Problem, ev: dict, load: float, rtol: float, pre=None):
-    """The Newton update ``(dphi, dw, dhd)``, the GMRES iteration count and the
-    preconditioner (built from this step's Jacobian unless ``pre`` is given).  GMRES runs on
-    the system scaled by the residuals' natural sizes (:func:`scales`) to ``rtol``."""
-    s = P.settings
-    jac = jacobian(P, ev)
-    pre = Preconditioner(P, jac) if pre is None else pre
-    nI, n = P.interior.size, P.gap.size
-    size, h_s, _ = scales(ev, s, load)
-    row = np.r_[1 / size, np.full(n, 1 / h_s), 1 / load]                 # residual scales
-
-    def split(v):
-        return v[:nI], v[nI:nI + n], v[-1]
-
-    def precondition(y):
-        r = y / row
-        dphi, dw, dhd = pre(*split(r))
-        return np.r_[dphi, dw, dhd]
-
-    def matvec(y):
-        return _stack(apply_jacobian(P, jac, *split(precondition(y)))) * row
-
-    b = -_stack((ev["R"], ev["G"].ravel(), ev["L"])) * row
-    op = spla.LinearOperator((b.size, b.size), matvec=matvec)
-    count = [0]
-    y, info = spla.gmres(op, b, rtol=rtol, atol=0.0, restart=60, maxiter=4,
-                         callback=lambda _: count.__setitem__(0, count[0] + 1),
-                         callback_type="pr_norm")
-    return split(precondition(y)), count[0], pre
-
-
-def _stack(parts):
-    return np.concatenate([np.atleast_1d(np.asarray(v, float)).ravel() for v in parts])
-
-
-def scales(ev: dict, s, load: float) -> tuple:
-    """Natural sizes of the residuals ``(R, G, L)``: each node's flux magnitude, the
-    thinnest loaded film (at most h_ref) and the load."""
-    loaded = ev["p"] > 0
-    film = float(ev["h0"][loaded].min()) if loaded.any() else s.h_ref
-    return ev["size"], min(s.h_ref, max(film, 10 * s.gap_floor)), load
 
 
 def merit(ev: dict, sizes: tuple) -> float:

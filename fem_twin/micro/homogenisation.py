@@ -118,17 +118,9 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     finally:
         if own_bar:
             bar.close()
-    meta = {"patch_id": patch_id, "shape": list(z_low.shape), "spacing": list(spacing),
-            "e_reduced": settings.e_reduced, "hardness": settings.hardness,
-            "gap_floor": settings.gap_floor, "n_steps": settings.n_steps,
-            "method": settings.method, "moving": settings.moving,
-            "first_step": settings.first_step, "time_derivative": settings.time_derivative,
-            "version": __version__, "checkpoint_keys": [key], "time_tol": settings.time_tol,
-            "h0_tol": h0_tol, "h0_candidates": len(h0),
+    meta = {**_meta(settings, pin, disk, spacing), "patch_id": patch_id,
+            "checkpoint_keys": [key], "h0_tol": h0_tol, "h0_candidates": len(h0),
             "steps_used": [int(m.get("n_steps", settings.n_steps)) for m in moments],
-            "sq": float(np.hypot(z_low.std(), z_up.std())),
-            "pin": pin.meta.get("sample", pin.meta.get("source")),
-            "disk": disk.meta.get("sample", disk.meta.get("source")),
             "seconds": points.seconds()}
     factors = factors_from_moments(h0[chosen], moments, meta)
     if not error_estimate:
@@ -140,6 +132,19 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     moved = estimate.pop("variants")
     return replace(factors, meta={**meta, "error_estimate": estimate, "checkpoint_keys": keys,
                                   "variants": moved})
+
+
+def _meta(settings: CellSettings, pin, disk, spacing) -> dict:
+    """What flow factors record of their cell and settings."""
+    return {"shape": list(pin.shape), "spacing": list(spacing),
+            "e_reduced": settings.e_reduced, "hardness": settings.hardness,
+            "gap_floor": settings.gap_floor, "n_steps": settings.n_steps,
+            "method": settings.method, "moving": settings.moving,
+            "first_step": settings.first_step, "time_derivative": settings.time_derivative,
+            "version": __version__, "time_tol": settings.time_tol,
+            "sq": float(np.hypot(pin.heights.std(), disk.heights.std())),
+            "pin": pin.meta.get("sample", pin.meta.get("source")),
+            "disk": disk.meta.get("sample", disk.meta.get("source"))}
 
 
 def _check_separations(h0) -> np.ndarray:

@@ -1,0 +1,195 @@
+"""The case file's sections, one frozen dataclass each: every key declared once
+(:func:`fem_twin.checks.setting`: default, one-line doc, plausible range or unit, choices).
+The parser (:mod:`fem_twin.case`), the stages and the documentation's case-file reference
+read these declarations; ``[preprocessing]`` is
+:class:`fem_twin.topography.prepare.MacroOptions`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import tables as T
+from .checks import setting
+from .topography.prepare import MacroOptions
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """``[geometry]``: measured topography files (paths relative to the case file are
+    resolved) and the window the roughness patches are cut from."""
+
+    pins: tuple[Path, ...] = setting(
+        (), "macro pin maps (8 x 8 mm), one file per pin; the set average is the macro pin",
+        unit="file paths")
+    disks: tuple[Path, ...] = setting(
+        (), "the disk map measured with each pin (none: a flat disk)", unit="file paths")
+    patches: tuple[tuple[Path, Path], ...] = setting(
+        (), "roughness patch pairs [pin patch, disk patch], one micro problem each",
+        unit="file path pairs")
+    patch_shape: tuple[int, int] = setting(
+        (256, 256), "rows and columns of each patch, cut without interpolation", unit="px")
+    patch_start: tuple[int, int] = setting((0, 0), "first row and column of the cut",
+                                           unit="px")
+
+
+@dataclass(frozen=True)
+class Tribometer:
+    """``[tribometer]``: operating conditions (Tables 1 and 6).  ``kind = "ball-on-disk"``:
+    a ball on the disk at ``slide_to_roll`` = u_r / u_m (MTM convention; the sweep's speeds
+    are then entrainment speeds u_m)."""
+
+    load: float = setting(T.LOAD, "imposed normal load F_N,imp (Table 6)", "load")
+    pin_diameter: float = setting(8e-3, "pin diameter D of the Hersey number (eq 46)",
+                                  "pin_diameter")
+    sliding_radius: float = setting(30e-3, "radius of the sliding track (recorded; speeds "
+                                    "are given in m/s)", "length")
+    boundary_friction: float = setting(
+        T.BOUNDARY_FRICTION, "C_f,b of eq 32 (the paper's 1/(3 sqrt 3)); also the scale of "
+        "C_f,dev (eq 35)", "friction")
+    load_share: float = setting(
+        1.0, "share of the load the pin face carries (film and contact, eq 28); C_f stays "
+        "the friction force over the imposed load (1: the paper)", "load_share")
+    kind: str = setting("pin-on-disk", "the tribometer", choices=("pin-on-disk",
+                                                                  "ball-on-disk"))
+    ball_radius: float = setting(12.5e-3, "radius of a ball-on-disk's ball", "length")
+    slide_to_roll: float = setting(0.5, "slide-to-roll ratio u_r / u_m of a ball (2: a "
+                                   "stationary ball)", "slide_to_roll")
+    track_radius: float = setting(20e-3, "radius of a ball's track (recorded)", "length")
+
+    @property
+    def ball(self) -> bool:
+        return self.kind == "ball-on-disk"
+
+
+@dataclass(frozen=True)
+class LubricantSpec:
+    """``[lubricant]``: mu_0 per temperature (Table 3) and the constants of eqs 23-24
+    (Table 6)."""
+
+    viscosities: tuple[float, ...] = setting(
+        (0.066, 0.024), "mu_0 at ambient pressure, one Stribeck curve each (Table 3)",
+        "viscosity")
+    temperatures: tuple[float, ...] = setting(
+        (24.0, 50.0), "oil temperature of each viscosity: curve labels, and the Walther law "
+        "of fem-twin fit", unit="C")
+    density: float = setting(T.DENSITY, "rho_0 at ambient pressure (eq 24)", "density")
+    roelands_alpha: float = setting(T.ROELANDS_ALPHA, "pressure-viscosity coefficient of "
+                                    "Roelands (eq 23)", "pressure_viscosity")
+    roelands_p0: float = setting(T.ROELANDS_P0, "Roelands reference pressure p_0 (eq 23)",
+                                 unit="Pa")
+    dh_c1: float = setting(T.DH_C1, "Dowson-Higginson C_1 (eq 24)", unit="Pa")
+    dh_c2: float = setting(T.DH_C2, "Dowson-Higginson C_2 (eq 24)", unit="-")
+    eyring_stress: float = setting(0.0, "tau_0 of Eyring shear thinning (0: Newtonian; "
+                                   "needed for EHL traction)", "eyring_stress")
+
+    def lubricants(self) -> list:
+        """One :class:`fem_twin.macro.Lubricant` per viscosity."""
+        from .macro.lubricant import Lubricant
+        return [Lubricant(mu, density=self.density, roelands_alpha=self.roelands_alpha,
+                          roelands_p0=self.roelands_p0, dh_c1=self.dh_c1, dh_c2=self.dh_c2,
+                          eyring_stress=self.eyring_stress or None)
+                for mu in self.viscosities]
+
+
+@dataclass(frozen=True)
+class Materials:
+    """``[materials]``: elastic constants of pin and disk (Table 4) and the hardness cap."""
+
+    e_pin: float = setting(T.E_STEEL, "Young's modulus of the pin (or ball)", "modulus")
+    nu_pin: float = setting(T.NU_STEEL, "Poisson ratio of the pin (or ball)", "poisson")
+    e_disk: float = setting(T.E_STEEL, "Young's modulus of the disk", "modulus")
+    nu_disk: float = setting(T.NU_STEEL, "Poisson ratio of the disk", "poisson")
+    hardness: float = setting(T.HARDNESS, "hardness: the cap on the contact pressure",
+                              "hardness")
+
+    @property
+    def e_reduced(self) -> float:
+        """E' of eq 22 [Pa]."""
+        from .contact.elastic import reduced_modulus
+        return reduced_modulus(self.e_pin, self.nu_pin, self.e_disk, self.nu_disk)
+
+
+@dataclass(frozen=True)
+class MicroSpec:
+    """``[micro]``: the roughness scale (eqs 8-16): patch resolution, h0 candidates, time
+    steps, the squeeze term, adaptive instants and h0."""
+
+    resolution: tuple[int, int] = setting((256, 256), "patches resampled (periodically) to "
+                                          "this grid, at least 8 each", unit="px")
+    h0_min: float = setting(1e-7, "smallest separation h0", "separation")
+    h0_max: float = setting(1e-6, "largest separation h0 (above: the paper's rules)",
+                            "separation")
+    h0_count: int = setting(100, "h0 candidates, log-spaced (the paper: 100)", unit="-")
+    steps: int = setting(32, "sliding time steps over one pass of the disk patch",
+                         unit="-")
+    method: str = setting("fe", "cell problems by finite elements or the paper's finite "
+                          "volumes", choices=("fe", "fvm"))
+    time_derivative: str = setting("exact", "squeeze term: exact, or the paper's implicit "
+                                   "Euler", choices=("exact", "backward"))
+    time_tol: float = setting(0.0, "adaptive instants: midpoints added at an h0 while A11 "
+                              "or b1 change by more (0: off)", unit="fraction")
+    h0_tol: float = setting(0.01, "adaptive h0: solve the candidates the log-h0 "
+                            "interpolant needs to read the others within this (0: all, the "
+                            "paper)", unit="fraction")
+
+
+@dataclass(frozen=True)
+class MacroSpec:
+    """``[macro]``: the homogenised Reynolds scale (eqs 17-34)."""
+
+    pin: str | int = setting("average", "the macro pin: the levelled set's average, or a "
+                             "pin number from 1", unit='"average" or a number')
+    method: str = setting("fe", "Reynolds by finite elements or the paper's finite volumes",
+                          choices=("fe", "fvm"))
+    coupling: str = setting("auto", "pressure-deformation-load coupling (auto: Anderson, "
+                            "Newton for concentrated contacts or when it fails; pid: the "
+                            "paper's)", choices=("auto", "anderson", "newton", "pid"))
+    grid: int = setting(97, "nodes per side of a ball's grid over [-4a, 2a] x [-3a, 3a]",
+                        unit="-")
+    inner_steps: int = setting(1, "Newton steps per Reynolds solve far from the fixed "
+                               "point (0: exact solves)", unit="-")
+    couette: str = setting("central", "Couette flux of eq 17: second order, or the paper's "
+                           "first-order upwind", choices=("central", "upwind"))
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """``[sweep]``: speeds from ``speed_max`` down to ``speed_min``, ``count`` log-spaced,
+    then ``refine`` passes that add midpoints where C_f jumps."""
+
+    speed_max: float = setting(2.0, "fastest sliding speed (the paper: 2 m/s)", "speed")
+    speed_min: float = setting(0.01, "slowest sliding speed (the paper: 0.01 m/s)", "speed")
+    count: int = setting(25, "speeds, log-spaced from fast to slow", unit="-")
+    refine: int = setting(1, "passes adding midpoints where C_f jumps (0: off, at most 4)",
+                          unit="-")
+    refine_step: float = setting(0.1, "... by more than this share of C_f,b",
+                                 unit="fraction")
+    error_tolerance: float = setting(0.005, "warn where a point's estimated discretisation "
+                                     "error of C_f exceeds this share of C_f,b",
+                                     unit="fraction")
+
+    @property
+    def speeds(self):
+        import numpy as np
+        return np.geomspace(self.speed_max, self.speed_min, self.count)
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """``[run]``: where independent work runs, and whether the main job adds the patch
+    scatter band."""
+
+    workers: int = setting(0, "local processes (0: all cores)", unit="-")
+    scheduler: str | None = setting(None, "a Dask scheduler's address instead, e.g. "
+                                    '"tcp://10.0.0.1:8786" (the cluster extra)',
+                                    unit="address")
+    patch_band: bool = setting(True, "one more sweep per patch: the roughness scatter band "
+                               "(Figure 13)", unit="true or false")
+
+
+#: the case file's sections and the dataclass that declares each one's keys
+#: (``[validation]`` has one key, ``measured``; ``name`` is top-level)
+SECTIONS = {"geometry": Geometry, "preprocessing": MacroOptions, "tribometer": Tribometer,
+            "lubricant": LubricantSpec, "materials": Materials, "micro": MicroSpec,
+            "macro": MacroSpec, "sweep": SweepSpec, "run": RunSpec}
