@@ -129,6 +129,43 @@ def test_paper_pid_coupling_reaches_the_same_state(case32, factors):
     assert pid.friction_coefficient == pytest.approx(fast.friction_coefficient, rel=1e-4)
 
 
+def test_every_coupling_takes_its_cavitation_model_from_the_registry(case32, factors,
+                                                                     monkeypatch):
+    """Issue 31 item 4: a cavitation model registered in macro/cavitation.MODELS is used by
+    solve_reynolds, the fixed point and the Newton coupling (its inner solve, split and
+    derivatives), so adding one touches that module and a test only.  A counting copy of
+    the switch gives the switch's state."""
+    from fem_twin.macro import cavitation
+    from fem_twin.macro import solve_reynolds
+    calls = {"solve": 0, "split": 0, "unknown": 0, "derivatives": 0}
+
+    class Counting(cavitation.PThetaSwitch):
+        name = "counting"
+
+    for method in calls:
+        def counted(*args, _name=method, **kwargs):
+            calls[_name] += 1
+            return getattr(cavitation.PThetaSwitch, _name)(*args, **kwargs)
+        setattr(Counting, method, staticmethod(counted))
+    monkeypatch.setitem(cavitation.MODELS, "counting", Counting())
+    gap, spacing, face = case32
+    kw = dict(load=150.0, speed=0.03, lubricant=Lubricant(0.066), face=face)
+    ref = solve_mixed(gap, spacing, factors, **kw)
+    for coupling in ("anderson", "newton"):
+        before = dict(calls)
+        res = solve_mixed(gap, spacing, factors, **kw, settings=MacroSettings(
+            coupling=coupling, complementarity="counting"))
+        assert res.friction_coefficient == pytest.approx(ref.friction_coefficient, rel=1e-5)
+        used = {k for k in calls if calls[k] > before[k]}
+        assert used >= ({"solve", "split"} if coupling == "anderson" else
+                        {"solve", "split", "derivatives"}), (coupling, calls)
+    before = calls["solve"]
+    solve_reynolds(np.full((5, 9), 1e-5), (1e-4, 1e-4), 1.0, 0.066, complementarity="counting")
+    assert calls["solve"] > before
+    with pytest.raises(ValueError, match="complementarity"):          # an InputError
+        MacroSettings(complementarity="unknown")
+
+
 @pytest.mark.parametrize("speed", [1.0, 0.003])
 def test_newton_coupling_reaches_the_same_state_on_the_pin(case32, factors, speed):
     """The monolithic Newton coupling of concentrated contacts on the conformal pin, full
@@ -263,8 +300,8 @@ def test_newton_jacobian_is_exact(case32, factors):
             phi[interior] += sign * dphi
             e = newton.evaluate(P, newton.State(phi, x.w + sign * dw.reshape(gap.shape),
                                                 x.h_d + sign * dhd), 150.0)
-            sides.append((e["R"], e["G"].ravel(), e["L"]))
-        for k, scale in enumerate((ev["size"], 1.0, 1.0)):
+            sides.append((e.R, e.G.ravel(), e.L))
+        for k, scale in enumerate((ev.size, 1.0, 1.0)):
             fd = (np.asarray(sides[0][k]) - np.asarray(sides[1][k])) / 2 / scale
             assert np.abs(exact[k] / scale - fd).max() <= 1e-6 * np.abs(fd).max() + 1e-30
 

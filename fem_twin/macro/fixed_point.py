@@ -30,7 +30,9 @@ import numpy as np
 from ..anderson import Anderson
 from ..errors import MixedNotConverged
 from .couette import couette_matrix
-from .reynolds import ReynoldsNotConverged, complementarity_solver
+from .cavitation import cavitation_model
+from .evaluation import FixedPointEvaluation
+from .reynolds import ReynoldsNotConverged
 from .start import dry_separation, rigid_separation
 
 #: ``coupling="auto"`` takes the Newton coupling when the first iterate's elastic
@@ -78,7 +80,7 @@ def solve_fixed_point(P, load: float, face, initial=None, progress=None):
         retries = 0
         if it == 1 and s.coupling == "auto" and elastic_ratio(ev, P.elastic, s) > ELASTIC_RATIO:
             raise Concentrated
-        good = (h_el, h_d, inner.phi, ev["p_prev"])
+        good = (h_el, h_d, inner.phi, ev.p_prev)
         row = _changes(ev, h_el, p_con, load, s)
         res = max(map(abs, row))
         history.append((it, *row, h_d, inner.newton))
@@ -96,10 +98,10 @@ def solve_fixed_point(P, load: float, face, initial=None, progress=None):
 def _changes(ev, h_el, p_con, load, s) -> tuple:
     """``(r_hel, r_pcon, r_p, r_F)``: the changes of ``h_el`` / h_ref, ``p_con`` / p_ref
     (eq 27) and ``p`` / p_ref in this iteration, and the load residual (eq 30)."""
-    return (float(np.abs(ev["h_el_new"] - h_el).max() / s.h_ref),
-            float(np.abs(ev["p_con_target"] - p_con).max() / s.p_ref),
-            float(np.abs(ev["p"] - ev["p_prev"]).max() / s.p_ref),
-            (ev["F"] - load) / load)
+    return (float(np.abs(ev.h_el_new - h_el).max() / s.h_ref),
+            float(np.abs(ev.p_con_target - p_con).max() / s.p_ref),
+            float(np.abs(ev.p - ev.p_prev).max() / s.p_ref),
+            (ev.F - load) / load)
 
 
 class _Reynolds:
@@ -108,19 +110,18 @@ class _Reynolds:
 
     def __init__(self, P, initial):
         s = P.settings
-        self.P, self.solver = P, complementarity_solver(s.complementarity)
+        self.P, self.model = P, cavitation_model(s.complementarity)
         self.p_amb_rel = s.ambient_pressure - s.cavitation_pressure
         self.phi, self.p, self.newton = None, np.full(P.shape, self.p_amb_rel), 0
         if initial is not None:
             self.p = initial.pressure - s.cavitation_pressure
-            theta0 = initial.cavity_fraction
-            self.phi = np.where(theta0 > 0, -theta0 * s.p_ref, np.maximum(self.p, 0)).ravel()
+            self.phi = self.model.unknown(self.p, initial.cavity_fraction, s.p_ref).ravel()
 
     def reset(self):
         """A cold inner start (the state is far from the last one)."""
         self.phi, self.p = None, np.full(self.P.shape, self.p_amb_rel)
 
-    def evaluate(self, h_el, h_d, p_con=None, steps=None) -> dict:
+    def evaluate(self, h_el, h_d, p_con=None, steps=None) -> FixedPointEvaluation:
         """Solve at ``h0 = h_d + h_g + h_el`` (eq 19); ``p_con`` [Pa] is used in the load and
         the deformation when given (``"pid"``), else ``p_con(h0)``; ``steps`` cuts the solve
         to that many Newton steps (an inexact inner solve).  Returns every field the updates
@@ -131,20 +132,19 @@ class _Reynolds:
         loc, mu, rho, g, q = P.coefficients(p_prev, h0)
         B = couette_matrix(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing, s.couette)
         cut = {} if steps is None else dict(max_iter=steps, inexact=True)
-        phi, its, _ = self.solver(P.poiseuille(g, loc.A), B, P.boundary, self.p_amb_rel,
-                                  s.p_ref, phi0=self.phi, **cut)
+        phi, its, _ = self.model.solve(P.poiseuille(g, loc.A), B, P.boundary,
+                                       self.p_amb_rel, s.p_ref, phi0=self.phi, **cut)
         self.phi, self.newton = phi, its
-        p = np.maximum(phi, 0).reshape(P.shape)
+        p, theta = (v.reshape(P.shape) for v in self.model.split(phi, s.p_ref))
         self.p = p
         p_con_used = loc.p_con if p_con is None else p_con
         p_tot = p + s.cavitation_pressure + p_con_used
-        return dict(h0=h0, loc=loc, mu=mu, rho=rho, p=p, p_prev=p_prev,
-                    theta=(np.maximum(-phi, 0) / s.p_ref).reshape(P.shape),
-                    p_con_target=loc.p_con, p_con=p_con_used,
-                    F=float(np.sum(P.area * (p_tot - s.ambient_pressure))),
-                    F_hd=float(np.sum(P.area * (p + s.cavitation_pressure
-                                                - s.ambient_pressure))),
-                    h_el_new=P.elastic(p_tot - s.ambient_pressure))
+        return FixedPointEvaluation(
+            h0=h0, loc=loc, mu=mu, rho=rho, p=p, p_prev=p_prev, theta=theta,
+            p_con_target=loc.p_con, p_con=p_con_used,
+            F=float(np.sum(P.area * (p_tot - s.ambient_pressure))),
+            F_hd=float(np.sum(P.area * (p + s.cavitation_pressure - s.ambient_pressure))),
+            h_el_new=P.elastic(p_tot - s.ambient_pressure))
 
 
 def _start(P, inner, load, face, initial):
@@ -158,7 +158,7 @@ def _start(P, inner, load, face, initial):
 
     def excess(h_d):
         inner.reset()
-        return inner.evaluate(h_el, h_d)["F"] - load
+        return inner.evaluate(h_el, h_d).F - load
 
     h_free = float(factors.h0[-1]) - float(h_g[face].min())
     h_d = rigid_separation(excess, h_free, dry_separation(factors, h_g, P.area, load, s),
@@ -179,12 +179,12 @@ class _Pid:
 
     def update(self, ev, h_el, h_d, p_con, row, res):
         s, r_F = self.s, row[3]
-        p_con = p_con + s.relaxation_pcon * (ev["p_con_target"] - p_con)       # eq 26
+        p_con = p_con + s.relaxation_pcon * (ev.p_con_target - p_con)       # eq 26
         kp, ki, kd = s.gains
         r1, r2 = self.r_prev
         h_d += (kp * (r_F - r1) + ki * r_F + kd * (r_F - 2 * r1 + r2)) * 1e-6   # eq 29
         self.r_prev = (r_F, r1)
-        return h_el + s.relaxation_elastic * (ev["h_el_new"] - h_el), h_d, p_con
+        return h_el + s.relaxation_elastic * (ev.h_el_new - h_el), h_d, p_con
 
 
 class _Mixing:
@@ -209,32 +209,32 @@ class _Mixing:
             self.best, self.stall = res, 0
         k = _load_stiffness(P.factors, ev, P.area, s)
         x = np.r_[h_el.ravel(), h_d] / s.h_ref
-        f = np.r_[ev["h_el_new"].ravel(), h_d + (ev["F"] - self.load) / k] / s.h_ref - x
+        f = np.r_[ev.h_el_new.ravel(), h_d + (ev.F - self.load) / k] / s.h_ref - x
         step = self.mixer.step(x, f) - x
-        bound = 0.5 * max(float(ev["h0"][self.face].min()), 1e-8) / s.h_ref
+        bound = 0.5 * max(float(ev.h0[self.face].min()), 1e-8) / s.h_ref
         step *= min(1.0, bound / max(float(np.abs(step).max()), 1e-300))
         x = (x + step) * s.h_ref
-        return x[:-1].reshape(P.shape), float(x[-1]), ev["p_con_target"]
+        return x[:-1].reshape(P.shape), float(x[-1]), ev.p_con_target
 
 
 def elastic_ratio(ev, op, s) -> float:
     """Largest elastic deformation by the film pressure over the thinnest film under
     pressure, at the first iterate: large for a concentrated contact (smooth balls:
     25-4000), small for a conformal pin (0.2-6.4)."""
-    p_gauge = ev["p"] + s.cavitation_pressure - s.ambient_pressure
+    p_gauge = ev.p + s.cavitation_pressure - s.ambient_pressure
     loaded = p_gauge > 0
     if not loaded.any():
         return 0.0
-    return float(np.abs(op(np.maximum(p_gauge, 0))).max()) / float(ev["h0"][loaded].min())
+    return float(np.abs(op(np.maximum(p_gauge, 0))).max()) / float(ev.h0[loaded].min())
 
 
 def _load_stiffness(factors, ev, area, s):
     """-dF/dh_d estimate [N/m]: contact slope of p_con(h0) plus 2 F_hd / h (hydrodynamic)."""
-    h0 = ev["h0"]
+    h0 = ev.h0
     eps = 1e-3 * h0
     dp = (factors.contact_pressure(h0 - eps) - factors.contact_pressure(h0 + eps)) / (2 * eps)
     k_con = float(np.sum(area * np.maximum(dp, 0)))
-    loaded = ev["p"] > ev["p"].max() * 0.1 if ev["p"].max() > 0 else np.ones(h0.shape, bool)
-    h_char = float(np.average(h0[loaded], weights=ev["p"][loaded] + 1e-30))
-    k_hd = 2 * max(ev["F_hd"], 0.0) / max(h_char, s.gap_floor)
-    return max(k_con + k_hd, 1e-3 * abs(ev["F"]) / s.h_ref + 1e-300)
+    loaded = ev.p > ev.p.max() * 0.1 if ev.p.max() > 0 else np.ones(h0.shape, bool)
+    h_char = float(np.average(h0[loaded], weights=ev.p[loaded] + 1e-30))
+    k_hd = 2 * max(ev.F_hd, 0.0) / max(h_char, s.gap_floor)
+    return max(k_con + k_hd, 1e-3 * abs(ev.F) / s.h_ref + 1e-300)

@@ -16,6 +16,8 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .cavitation import cavitation_model
+from .evaluation import NewtonEvaluation
 from .problem import MAX_COEFFICIENT_PRESSURE, Problem
 
 
@@ -52,22 +54,23 @@ def _probe(P: Problem, coefficients, p) -> sp.csr_matrix:
                          shape=(n, n))
 
 
-def jacobian(P: Problem, ev: dict) -> dict:
+def jacobian(P: Problem, ev: NewtonEvaluation) -> dict:
     """The sparse blocks of the Jacobian: ``J_pp = dR/dphi`` (interior x interior),
     ``J_ph = dR/dh0`` (interior x all, through h_m, A and b), ``pos`` (dp/dphi) and
     ``dpc = dp_con/dh0``."""
     lub, I = P.lubricant, P.interior
-    pos = ev["p"].ravel() > 0
-    p_coef = np.minimum(ev["p"], MAX_COEFFICIENT_PRESSURE)
-    unclipped = ev["p"] < MAX_COEFFICIENT_PRESSURE
+    pos, dtheta = cavitation_model(P.settings.complementarity).derivatives(
+        ev.phi.ravel(), P.settings.p_ref)
+    p_coef = np.minimum(ev.p, MAX_COEFFICIENT_PRESSURE)
+    unclipped = ev.p < MAX_COEFFICIENT_PRESSURE
     dlnrho = lub.density_log_slope(p_coef) * unclipped
     dlnmu = lub.viscosity_log_slope(p_coef) * unclipped
-    d = P.factors.slopes(ev["h0"])
-    free = ~ev["touching"]
-    g, q, loc, p = ev["g"], ev["q"], ev["loc"], ev["p"].ravel()
+    d = P.factors.slopes(ev.h0)
+    free = ~ev.touching
+    g, q, loc, p = ev.g, ev.q, ev.loc, ev.p.ravel()
     Kg = _probe(P, lambda c: (c, loc.A), p)
     KA = _probe(P, lambda c: (g, c[..., None, None] * d["A"] * free[..., None, None]), p)
-    Q1, Q2 = ev["couette"].q_derivatives(1 - ev["theta"].ravel())
+    Q1, Q2 = ev.couette.q_derivatives(1 - ev.theta.ravel())
     b1, b2 = loc.b[..., 0].ravel(), loc.b[..., 1].ravel()
     Bq = Q1 @ sp.diags(b1) + Q2 @ sp.diags(b2)
     Bb = (Q1 @ sp.diags(q.ravel() * d["b"][..., 0].ravel())
@@ -75,9 +78,8 @@ def jacobian(P: Problem, ev: dict) -> dict:
     dg_dp, dq_dp = (g * (dlnrho - dlnmu)).ravel(), (q * dlnrho).ravel()
     dhm = d["h_m"] * free
     dg_dh, dq_dh = (3 * g * dhm / loc.h_m).ravel(), (q * dhm / loc.h_m).ravel()
-    dtheta = np.where(pos, 0.0, 1.0 / P.settings.p_ref)
-    J_p = (ev["K"] @ sp.diags(pos * 1.0) + ev["B"] @ sp.diags(dtheta)
-           + (Kg @ sp.diags(dg_dp) + Bq @ sp.diags(dq_dp)) @ sp.diags(pos * 1.0))
+    J_p = (ev.K @ sp.diags(pos) + ev.B @ sp.diags(dtheta)
+           + (Kg @ sp.diags(dg_dp) + Bq @ sp.diags(dq_dp)) @ sp.diags(pos))
     J_h = Kg @ sp.diags(dg_dh) + Bq @ sp.diags(dq_dh) + KA + Bb @ sp.diags(free.ravel() * 1.0)
     J_p, J_h = J_p.tocsr()[I], J_h.tocsr()[I]
     return dict(J_pp=J_p[:, I].tocsc(), J_ph=J_h.tocsr(), pos=pos,
@@ -202,7 +204,7 @@ def apply_jacobian(P: Problem, jac: dict, dphi, dw, dhd):
             dw - P.elastic(dpt.reshape(P.shape)).ravel(), float(P.area.ravel() @ dpt))
 
 
-def newton_step(P: Problem, ev: dict, load: float, rtol: float, pre=None):
+def newton_step(P: Problem, ev: NewtonEvaluation, load: float, rtol: float, pre=None):
     """The Newton update ``(dphi, dw, dhd)``, the GMRES iteration count and the
     preconditioner (built from this step's Jacobian unless ``pre`` is given).  GMRES runs on
     the system scaled by the residuals' natural sizes (:func:`scales`) to ``rtol``."""
@@ -224,7 +226,7 @@ def newton_step(P: Problem, ev: dict, load: float, rtol: float, pre=None):
     def matvec(y):
         return _stack(apply_jacobian(P, jac, *split(precondition(y)))) * row
 
-    b = -_stack((ev["R"], ev["G"].ravel(), ev["L"])) * row
+    b = -_stack((ev.R, ev.G.ravel(), ev.L)) * row
     op = spla.LinearOperator((b.size, b.size), matvec=matvec)
     count = [0]
     y, info = spla.gmres(op, b, rtol=rtol, atol=0.0, restart=60, maxiter=4,
@@ -237,9 +239,9 @@ def _stack(parts):
     return np.concatenate([np.atleast_1d(np.asarray(v, float)).ravel() for v in parts])
 
 
-def scales(ev: dict, s, load: float) -> tuple:
+def scales(ev: NewtonEvaluation, s, load: float) -> tuple:
     """Natural sizes of the residuals ``(R, G, L)``: each node's flux magnitude, the
     thinnest loaded film (at most h_ref) and the load."""
-    loaded = ev["p"] > 0
-    film = float(ev["h0"][loaded].min()) if loaded.any() else s.h_ref
-    return ev["size"], min(s.h_ref, max(film, 10 * s.gap_floor)), load
+    loaded = ev.p > 0
+    film = float(ev.h0[loaded].min()) if loaded.any() else s.h_ref
+    return ev.size, min(s.h_ref, max(film, 10 * s.gap_floor)), load

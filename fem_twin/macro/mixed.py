@@ -36,6 +36,7 @@ from ..errors import InputError, MixedNotConverged
 from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from . import newton
+from .cavitation import cavitation_model
 from .couette import SCHEMES
 from .fixed_point import Concentrated, solve_fixed_point
 from .friction import BOUNDARY_FRICTION
@@ -63,7 +64,8 @@ class MacroSettings:
     boundary_friction: float = BOUNDARY_FRICTION
     method: str = "fe"                       # Poiseuille term: "fe" or "fvm"
     coupling: str = "auto"                   # "anderson", "newton" or "pid" (the paper's)
-    complementarity: str = "switch"          # or "fb" (the paper's FBNS; slower)
+    complementarity: str = "switch"          # cavitation model (.cavitation.MODELS): or
+    #                                          "fb", the paper's FBNS (slower)
     couette: str = "central"                 # Couette flux: second order, or "upwind" (the
     #                                          paper's first order), :mod:`.couette`
     relaxation_pcon: float = T.RELAXATION_PCON   # alpha_pcon of eq 26 ("pid")
@@ -86,9 +88,7 @@ class MacroSettings:
                              f"{self.coupling!r}")
         if self.ambient_pressure < self.cavitation_pressure:
             raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
-        if self.complementarity not in ("switch", "fb"):
-            raise InputError(f"complementarity must be 'switch' or 'fb', got "
-                             f"{self.complementarity!r}")
+        cavitation_model(self.complementarity)              # a registered model
         if self.couette not in SCHEMES:
             raise InputError(f"couette must be one of {SCHEMES}, got {self.couette!r}")
         if not (isinstance(self.inner_steps, int) and self.inner_steps >= 0):

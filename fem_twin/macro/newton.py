@@ -24,7 +24,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import MixedNotConverged
+from .cavitation import cavitation_model
 from .couette import couette, couette_matrix
+from .evaluation import NewtonEvaluation
 from .jacobian import newton_step, scales
 from .problem import Problem
 
@@ -47,12 +49,12 @@ class State:
     h_d: float                 # rigid-body separation [m]
 
 
-def evaluate(P: Problem, x: State, load: float) -> dict:
+def evaluate(P: Problem, x: State, load: float) -> NewtonEvaluation:
     """Residuals ``R, G, L`` and every field the Jacobian and the result need."""
     s = P.settings
     shape = P.shape
-    p = np.maximum(x.phi, 0).reshape(shape)
-    theta = (np.maximum(-x.phi, 0) / s.p_ref).reshape(shape)
+    p, theta = (v.reshape(shape) for v in
+                cavitation_model(s.complementarity).split(x.phi, s.p_ref))
     h_raw = x.h_d + P.gap + x.w
     h0 = np.maximum(h_raw, s.gap_floor)
     loc, mu, rho, g, q = P.coefficients(p, h0)
@@ -64,19 +66,19 @@ def evaluate(P: Problem, x: State, load: float) -> dict:
     size = abs(K) @ p.ravel() + C.size()
     p_tot = p + s.cavitation_pressure + loc.p_con - s.ambient_pressure
     F = float(np.sum(P.area * p_tot))
-    return dict(p=p, theta=theta, h0=h0, touching=h_raw <= s.gap_floor, loc=loc, mu=mu,
-                rho=rho, g=g, q=q, K=K, B=B, couette=C, p_con=loc.p_con,
-                R=flux[P.interior], size=size[P.interior] + 1e-300,
-                G=x.w - P.elastic(p_tot), F=F,
-                F_hd=float(np.sum(P.area * (p + s.cavitation_pressure - s.ambient_pressure))),
-                L=F - load)
+    return NewtonEvaluation(
+        p=p, theta=theta, h0=h0, loc=loc, mu=mu, rho=rho, p_con=loc.p_con, F=F,
+        F_hd=float(np.sum(P.area * (p + s.cavitation_pressure - s.ambient_pressure))),
+        phi=x.phi, touching=h_raw <= s.gap_floor, g=g, q=q, K=K, B=B, couette=C,
+        R=flux[P.interior], size=size[P.interior] + 1e-300, G=x.w - P.elastic(p_tot),
+        L=F - load)
 
 
-def merit(ev: dict, sizes: tuple) -> float:
+def merit(ev: NewtonEvaluation, sizes: tuple) -> float:
     """Scaled residual norm: root of the summed mean squares of ``R``, ``G`` and ``L``, each
     divided by its size from :func:`scales` (held fixed over a line search)."""
-    return float(np.sqrt(np.mean((ev["R"] / sizes[0]) ** 2)
-                         + np.mean((ev["G"] / sizes[1]) ** 2) + (ev["L"] / sizes[2]) ** 2))
+    return float(np.sqrt(np.mean((ev.R / sizes[0]) ** 2)
+                         + np.mean((ev.G / sizes[1]) ** 2) + (ev.L / sizes[2]) ** 2))
 
 
 def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progress=None):
@@ -108,8 +110,8 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
             raise MixedNotConverged(f"Newton coupling: the residual did not decrease in "
                                     f"{uphill} steps up to iteration {it}", history)
         changes = (float(np.abs(trial.w - x.w).max() / s.h_ref),
-                   float(np.abs(ev_t["p_con"] - ev["p_con"]).max() / s.p_ref),
-                   float(np.abs(ev_t["p"] - ev["p"]).max() / s.p_ref), ev_t["L"] / load)
+                   float(np.abs(ev_t.p_con - ev.p_con).max() / s.p_ref),
+                   float(np.abs(ev_t.p - ev.p).max() / s.p_ref), ev_t.L / load)
         history.append((it, *changes, trial.h_d, gm))
         x, ev = trial, ev_t
         if progress is not None:
@@ -140,7 +142,7 @@ def clamped_step(P: Problem, x: State, dphi, load: float, sizes):
     return trial, ev_t, merit(ev_t, sizes), 1.0
 
 
-def line_search(P: Problem, x: State, ev: dict, step, load: float, sizes, f: float):
+def line_search(P: Problem, x: State, ev: NewtonEvaluation, step, load: float, sizes, f: float):
     """The accepted trial ``(state, ev, merit, alpha, decreased)`` along a Newton step.
 
     The step is first shortened so that no film thins by more than half.  If the merit
@@ -154,8 +156,8 @@ def line_search(P: Problem, x: State, ev: dict, step, load: float, sizes, f: flo
     dphi, dw, dhd = step
     I = P.interior
     dh = (dw + dhd).reshape(P.shape)
-    thinning = (dh < 0) & ~ev["touching"]
-    alpha = min(1.0, float(np.min(0.5 * ev["h0"][thinning] / -dh[thinning], initial=np.inf)))
+    thinning = (dh < 0) & ~ev.touching
+    alpha = min(1.0, float(np.min(0.5 * ev.h0[thinning] / -dh[thinning], initial=np.inf)))
     fallback = None
     for trial_no in range(2 + HALVINGS):
         phi = x.phi.copy()
@@ -177,9 +179,9 @@ def line_search(P: Problem, x: State, ev: dict, step, load: float, sizes, f: flo
 
 def state_from(result, settings) -> State:
     """The Newton state of a converged :class:`MixedResult` (a warm start)."""
-    p = (result.pressure - settings.cavitation_pressure).ravel()
-    theta = result.cavity_fraction.ravel()
-    phi = np.where(theta > 0, -theta * settings.p_ref, np.maximum(p, 0))
+    phi = cavitation_model(settings.complementarity).unknown(
+        (result.pressure - settings.cavitation_pressure).ravel(),
+        result.cavity_fraction.ravel(), settings.p_ref)
     return State(phi, np.asarray(result.elastic_deformation, float).copy(), float(result.h_d))
 
 
@@ -188,8 +190,8 @@ def rigid_start(P: Problem, load: float, ratio: float):
     (halving ``h_d - h_touch`` from the first-contact separation) whose load reaches
     ``load`` or whose elastic deformation reaches ``ratio`` of its thinnest loaded film.
     Returns the state and the load it carries (at most ``load``)."""
-    from .reynolds import solve_complementarity
     s = P.settings
+    model = cavitation_model(s.complementarity)
     touch = s.gap_floor - float(P.gap.min())
     t = float(P.factors.h0[-1]) - float(P.gap.min()) - touch
     for _ in range(80):
@@ -197,16 +199,16 @@ def rigid_start(P: Problem, load: float, ratio: float):
         loc, _, _, g, q = P.coefficients(np.zeros(P.shape), np.maximum(h_d + P.gap,
                                                                          s.gap_floor))
         B = couette_matrix(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing, s.couette)
-        phi, _, _ = solve_complementarity(P.poiseuille(g, loc.A), B, P.boundary,
-                                          s.ambient_pressure - s.cavitation_pressure, s.p_ref)
+        phi, _, _ = model.solve(P.poiseuille(g, loc.A), B, P.boundary,
+                                s.ambient_pressure - s.cavitation_pressure, s.p_ref)
         x = State(phi, np.zeros(P.shape), h_d)
         ev = evaluate(P, x, load)
-        loaded = ev["p"] > 0
-        if ev["F"] >= load or (loaded.any() and np.abs(ev["G"]).max()
-                               >= ratio * float(ev["h0"][loaded].min())):
+        loaded = ev.p > 0
+        if ev.F >= load or (loaded.any() and np.abs(ev.G).max()
+                               >= ratio * float(ev.h0[loaded].min())):
             break
         t /= 2
-    return x, min(ev["F"], load)
+    return x, min(ev.F, load)
 
 
 def continuation(P: Problem, load: float, *, tol: float, max_iter: int, progress=None,

@@ -95,27 +95,27 @@ class MixedResult:
 def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
                  coupling=None) -> MixedResult:
     """The :class:`MixedResult` of a converged state of ``P`` (a :class:`.problem.Problem`):
-    ``ev`` its evaluation (``p``, ``theta``, ``loc``, ``mu``, ``rho``, ``h0``, ``p_con``,
-    ``F``), with the friction of eqs 31-34 over the pin ``face``."""
+    ``ev`` its :class:`.evaluation.Evaluation`, with the friction of eqs 31-34 over the pin
+    ``face``."""
     s, dx, area, speed, lubricant = P.settings, P.spacing, P.area, P.speed, P.lubricant
-    loc = ev["loc"]
-    p_hd = ev["p"] + s.cavitation_pressure
-    tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev["theta"], ev["mu"], loc.C, loc.d, dx, speed,
+    loc = ev.loc
+    p_hd = ev.p + s.cavitation_pressure
+    tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev.theta, ev.mu, loc.C, loc.d, dx, speed,
                                 entrainment=P.entrainment,
                                 eyring_stress=lubricant.eyring_stress)
-    tau_con = boundary_shear(ev["p_con"], s.boundary_friction)
+    tau_con = boundary_shear(ev.p_con, s.boundary_friction)
     cell = dx[0] * dx[1]
     F_hd = float(tau_hd[face].sum() * cell)
     F_con = float(tau_con[face].sum() * cell)
-    F_N = ev["F"]
+    F_N = ev.F
     return MixedResult(
         speed=float(speed), imposed_load=float(load), normal_load=F_N, h_d=float(h_d),
         friction_force=F_hd + F_con, hydrodynamic_friction=F_hd, boundary_friction=F_con,
         friction_coefficient=(F_hd + F_con) / F_N,
-        contact_load=float(np.sum(area * ev["p_con"])), spacing=dx,
-        pressure=p_hd, contact_pressure=ev["p_con"], cavity_fraction=ev["theta"],
-        h0=ev["h0"], mean_gap=loc.h_m, elastic_deformation=h_el,
-        viscosity=ev["mu"], density_ratio=ev["rho"], shear_stress=tau_hd + tau_con,
+        contact_load=float(np.sum(area * ev.p_con)), spacing=dx,
+        pressure=p_hd, contact_pressure=ev.p_con, cavity_fraction=ev.theta,
+        h0=ev.h0, mean_gap=loc.h_m, elastic_deformation=h_el,
+        viscosity=ev.mu, density_ratio=ev.rho, shear_stress=tau_hd + tau_con,
         face=face, iterations=it, history=np.array(history),
         meta={"settings": {k: (list(v) if isinstance(v, tuple) else v)
                            for k, v in s.__dict__.items()},

@@ -1,0 +1,169 @@
+"""The p-theta switch solver of the JFO complementarity problem (eqs 17-18).
+
+One unknown per node, ``phi``: ``p = max(phi, 0)``, ``theta = max(-phi, 0) / s`` (the p-theta
+switch), which makes ``p theta = 0`` exact.  The residual is piecewise linear in ``phi``;
+semismooth Newton (primal-dual active set) solves it and stops when the active set no
+longer changes and the mass residual is below ``tol``.  Each Newton matrix is factorised
+by PARDISO on the fixed 3x3-stencil pattern of the grid (analysis once per grid) or, without
+MKL, by SuperLU in a nested-dissection order.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..errors import ReynoldsNotConverged
+from ..linalg import SPDSolver, default_backend
+from ..ordering import nested_dissection
+
+
+#: relative mass residual at which Newton steps can no longer improve the solution
+ROUND_OFF = 1e3 * np.finfo(float).eps
+
+
+def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=1e-10,
+                          max_iter=200, inexact=False):
+    """Semismooth Newton on ``K p + B (1 - theta) = 0`` with the p-theta switch ``phi``.
+
+    Dirichlet nodes keep ``p = p_boundary``, ``theta = 0``.  ``phi0`` warm-starts the
+    interior; ``inexact`` returns the iterate after ``max_iter`` steps instead of raising (a
+    truncated inner solve of a fixed point that ends on an exact one).
+    Returns ``phi``, the number of iterations and the residual history (scaled by
+    the size of each node's fluxes, ``|K| p + |B| 1``).  Each Newton matrix is factorised by SuperLU in a
+    nested-dissection order of the grid (computed once per grid).
+    """
+    n = K.shape[0]
+    interior = np.flatnonzero(~dirichlet)
+    phi = np.full(n, float(p_boundary))
+    if phi0 is not None:
+        phi[interior] = np.asarray(phi0, float).ravel()[interior]
+    ones = np.ones(n)
+    absK, absB = abs(K[interior]), abs(B[interior])
+    couette_size = absB @ ones
+    floor = 1e-300 + 1e-12 * float(couette_size.max())
+    order = _interior_order(tuple(dirichlet.shape) if dirichlet.ndim == 2 else None,
+                            dirichlet.ravel(), interior)
+    KI, BI = K[interior], B[interior]
+
+    def residual(phi):
+        pos = phi >= 0
+        p = np.where(pos, phi, 0.0)
+        r = KI @ p + BI @ (ones - np.where(pos, 0.0, -phi / scale))
+        # each node's mass residual relative to the size of its own fluxes
+        res = float(np.max(np.abs(r) / (absK @ p + couette_size + floor)))
+        return r, pos, res
+
+    newton = _newton_solver(tuple(dirichlet.shape) if dirichlet.ndim == 2 else None,
+                            dirichlet.ravel(), interior, K, B)
+    history, active_old = [], None
+    r, pos, res = residual(phi)
+    for it in range(1, max_iter + 1):
+        history.append(res)
+        # converged: the active set is settled, or the residual is at round-off (nodes with
+        # p = 0 exactly, e.g. a pocket at p_cav, can flip sign from one step to the next)
+        if res < tol and active_old is not None and (np.array_equal(pos, active_old)
+                                                     or res < ROUND_OFF):
+            return phi, it, history
+        active_old = pos
+        dtheta = np.where(pos, 0.0, 1.0 / scale)       # d(1 - theta)/dphi = +1/scale
+        step = None if newton is None else newton(pos[interior], dtheta[interior], -r)
+        if step is not None:
+            phi[interior] += step
+            r, pos, res = residual(phi)
+            continue
+        J = (KI @ sp.diags(pos.astype(float)) + BI @ sp.diags(dtheta))[:, interior]
+        step = np.empty(interior.size)
+        try:
+            lu = spla.splu(J[order][:, order].tocsc(), permc_spec="NATURAL",
+                           diag_pivot_thresh=0.1, options={"SymmetricMode": True})
+            step[order] = lu.solve(-r[order])
+        except RuntimeError as err:               # exactly singular
+            raise ReynoldsNotConverged(f"singular Newton matrix in the cavitation loop: {err}",
+                                       history) from err
+        if not np.all(np.isfinite(step)):
+            raise ReynoldsNotConverged("singular Newton matrix in the cavitation loop", history)
+        phi[interior] += step
+        r, pos, res = residual(phi)
+    if inexact:
+        return phi, max_iter + 1, history
+    raise ReynoldsNotConverged(f"no convergence in {max_iter} Newton steps (tol {tol})", history)
+
+
+def _newton_solver(shape, dirichlet, interior, K, B):
+    """``step(pos, dtheta, rhs)`` solving the Newton system ``(K diag(pos) + B diag(dtheta))
+    step = rhs`` on the interior with PARDISO, whose ordering and symbolic factorisation
+    are kept per grid (the pattern: the 3x3 stencil, which holds K and every upwind B);
+    None without PARDISO.  A step returns None (the caller then uses SuperLU) when pivots
+    were perturbed or the step does not solve the system to 1e-8."""
+    if shape is None or default_backend() != "pardiso":
+        return None
+    key = (shape, dirichlet.tobytes())
+    if _NEWTON_CACHE.get("key") != key:
+        _NEWTON_CACHE.update(key=key, pattern=_stencil_pattern(shape, interior))
+    indptr, indices, keys, solver = _NEWTON_CACHE["pattern"]
+    n = interior.size
+    parts = []
+    for M in (K, B):
+        M = M[interior][:, interior].tocoo()
+        entries = M.row.astype(np.int64) * n + M.col
+        at = np.searchsorted(keys, entries)
+        if not np.array_equal(keys[np.minimum(at, keys.size - 1)], entries):
+            return None                           # not a stencil matrix: the general path
+        parts.append((at, M.data, M.col))
+
+    def step(pos, dtheta, rhs):
+        values = sum(np.bincount(at, data * w[col], minlength=keys.size)
+                     for (at, data, col), w in zip(parts, (pos.astype(float), dtheta)))
+        size = float(np.abs(values).max())            # PARDISO's pivot threshold is absolute
+        x = solver.factor(values / size).solve(rhs / size)
+        J = sp.csr_matrix((values, indices, indptr), shape=(n, n))
+        if solver.perturbed or not np.all(np.isfinite(x)) or (
+                np.linalg.norm(J @ x - rhs) > 1e-8 * np.linalg.norm(rhs)):
+            return None
+        return x
+    return step
+
+
+def _stencil_pattern(shape, interior):
+    """CSR pattern of the 3x3 stencil on the interior nodes, its sorted keys row * n + col,
+    and a PARDISO LU solver on it (analysis once)."""
+    ny, nx = shape
+    position = np.full(ny * nx, -1)
+    position[interior] = np.arange(interior.size)
+    idx = np.arange(ny * nx).reshape(ny, nx)
+    rows, cols = [], []
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            a = idx[max(0, -di):ny - max(0, di), max(0, -dj):nx - max(0, dj)]
+            b = idx[max(0, di):ny - max(0, -di), max(0, dj):nx - max(0, -dj)]
+            rows.append(position[a.ravel()])
+            cols.append(position[b.ravel()])
+    rows, cols = np.concatenate(rows), np.concatenate(cols)
+    keep = (rows >= 0) & (cols >= 0)
+    n = interior.size
+    P = sp.csr_matrix((np.ones(keep.sum()), (rows[keep], cols[keep])), shape=(n, n))
+    P.sort_indices()
+    keys = np.repeat(np.arange(n, dtype=np.int64), np.diff(P.indptr)) * n + P.indices
+    return P.indptr, P.indices, keys, SPDSolver(P.indptr, P.indices, "pardiso",
+                                                symmetric=False)
+
+
+_NEWTON_CACHE: dict = {}
+
+
+def _interior_order(shape, dirichlet, interior):
+    """Nested-dissection order of the interior unknowns (COLAMD-like fallback: identity)."""
+    if shape is None:
+        return np.arange(interior.size)
+    key = (shape, dirichlet.tobytes())
+    if _ORDER_CACHE.get("key") != key:
+        full = nested_dissection(shape)
+        position = np.full(dirichlet.size, -1)
+        position[interior] = np.arange(interior.size)
+        _ORDER_CACHE.update(key=key, order=position[full][position[full] >= 0])
+    return _ORDER_CACHE["order"]
+
+
+_ORDER_CACHE: dict = {}
