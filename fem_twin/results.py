@@ -19,22 +19,14 @@ from .errors import MissingFile
 from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .macro.estimate import PARTS
+from .macro.result import FIELDS
+from .stribeck.curve import UNITS
 
 ENGINE = "h5netcdf"
-FIELD_UNITS = {"pressure": "Pa", "contact_pressure": "Pa", "cavity_fraction": "1", "h0": "m",
-               "mean_gap": "m", "elastic_deformation": "m", "local_viscosity": "Pa s",
-               "density_ratio": "1", "shear_stress": "Pa", "face": "1"}
-STRIBECK_UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
-                  "friction_coefficient": ("1", "C_f (eq 34)"),
-                  "hydrodynamic_friction": ("N", "hydrodynamic part of F_T (eq 33)"),
-                  "boundary_friction": ("N", "boundary part of F_T (eq 33)"),
-                  "contact_load_fraction": ("1", "share of the face load (F_N times "
-                                            "load_share) carried by p_con"),
-                  "h_d": ("m", "rigid-body separation h_d"),
-                  "iterations": ("1", "macro solver iterations"),
-                  "cf_min": ("1", "lowest C_f of the single-patch sweeps"),
-                  "cf_max": ("1", "highest C_f of the single-patch sweeps")}
-
+#: ``fields.nc``'s variables and units: an operating point's fields
+#: (:data:`fem_twin.macro.result.FIELDS`), its piezoviscous viscosity as ``local_viscosity``
+#: (``viscosity`` is the coordinate mu_0 of the sweep)
+FIELD_UNITS = {("local_viscosity" if k == "viscosity" else k): u for k, u in FIELDS.items()}
 
 @dataclass(frozen=True)
 class RunResults:
@@ -88,7 +80,7 @@ def stribeck_dataset(curves, patch_curves=None):
     speed = np.unique(np.concatenate([c.speed for c in curves]))
     mu = np.array([c.viscosity for c in curves])
     out = {}
-    for k in STRIBECK_UNITS:
+    for k in UNITS:
         if k not in ("cf_min", "cf_max"):
             out[k] = np.full((mu.size, speed.size), np.nan)
             for i, c in enumerate(curves):
@@ -102,8 +94,8 @@ def stribeck_dataset(curves, patch_curves=None):
                 cf[p, i, np.searchsorted(speed, c.speed)] = c.friction_coefficient
         out["cf_min"], out["cf_max"] = cf.min(axis=0), cf.max(axis=0)
         coords["patch"] = [str(p + 1) for p in range(len(patch_curves))]
-    ds = xr.Dataset({k: (("viscosity", "speed"), v, {"units": STRIBECK_UNITS[k][0],
-                                                     "long_name": STRIBECK_UNITS[k][1]})
+    ds = xr.Dataset({k: (("viscosity", "speed"), v, {"units": UNITS[k][0],
+                                                     "long_name": UNITS[k][1]})
                      for k, v in out.items()}, coords=coords)
     if patch_curves:
         ds["patch_friction_coefficient"] = (("patch", "viscosity", "speed"), cf, {

@@ -117,3 +117,23 @@ def test_imports_run_down_the_pipeline():
         up += [f"{m} -> {d}" for d in _imports(path)
                if d != "fem_twin" and _layer(d) > _layer(m)]
     assert not up, "imports against the pipeline's order:\n" + "\n".join(sorted(up))
+
+
+def test_result_variables_are_declared_once():
+    """Issue 31 item 6: an output variable is declared in one place, so adding one touches
+    at most two files: an operating point's grid fields are MixedResult's arrays, each with
+    its unit in macro/result.FIELDS (checkpoints, VTU, fields.nc and the docs read it); a
+    Stribeck curve's are StribeckCurve's arrays, each a column of stribeck/curve.COLUMNS with
+    its CSV header and its results.nc unit (UNITS)."""
+    from dataclasses import fields
+
+    from fem_twin.macro.result import FIELDS, MixedResult
+    from fem_twin.results import FIELD_UNITS
+    from fem_twin.stribeck.curve import COLUMNS, HEADERS, UNITS, StribeckCurve
+    arrays = {f.name for f in fields(MixedResult) if f.type == "np.ndarray"} - {"history"}
+    assert arrays == set(FIELDS), arrays ^ set(FIELDS)
+    assert len(FIELD_UNITS) == len(FIELDS)
+    curve = {f.name for f in fields(StribeckCurve)
+             if f.type == "np.ndarray" or f.name == "viscosity"}
+    assert curve == set(COLUMNS) == set(HEADERS), curve ^ set(COLUMNS)
+    assert set(COLUMNS) - {"speed", "viscosity"} <= set(UNITS)

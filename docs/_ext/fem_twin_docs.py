@@ -68,13 +68,13 @@ def outputs() -> str:
     """The columns of ``stribeck.csv`` and the variables of ``results.nc`` and ``fields.nc``
     with their units, from the writers' own tables."""
     from fem_twin.macro.estimate import PARTS
-    from fem_twin.results import FIELD_UNITS, STRIBECK_UNITS
-    from fem_twin.stribeck.curve import HEADERS
+    from fem_twin.results import FIELD_UNITS
+    from fem_twin.stribeck.curve import HEADERS, UNITS
     lines = ["## `stribeck.csv`", "", "One row per point, curves one after another.", "",
              "| column | meaning |", "|---|---|"]
     for key, header in HEADERS.items():
         meaning = {"speed": "sliding speed U (a ball: entrainment speed u_m)",
-                   "viscosity": "mu_0 of the curve"}.get(key, STRIBECK_UNITS.get(key, ("", ""))[1])
+                   "viscosity": "mu_0 of the curve"}.get(key, UNITS.get(key, ("", ""))[1])
         lines.append(f"| `{header}` | {meaning} |")
     lines += ["| `cf_err` | estimated discretisation error of C_f (both scales, "
               "{doc}`/accuracy`) |",
@@ -82,7 +82,7 @@ def outputs() -> str:
               "## `results.nc`", "",
               "Group `stribeck`, over (viscosity [Pa s], speed [m/s]):", "",
               "| variable | unit | meaning |", "|---|---|---|"]
-    lines += [f"| `{k}` | {u} | {m} |" for k, (u, m) in STRIBECK_UNITS.items()]
+    lines += [f"| `{k}` | {u} | {m} |" for k, (u, m) in UNITS.items()]
     lines += ["| `cf_err` | 1 | estimated discretisation error of C_f |"]
     lines += [f"| `cf_err_{p}` | 1 | its {p} part |" for p in PARTS]
     lines += ["| `patch_friction_coefficient` | 1 | C_f with one patch's flow factors, over "

@@ -11,8 +11,11 @@ import numpy as np
 from ..io.atomic import atomic_path
 from .friction import boundary_shear, hydrodynamic_shear
 
-_FIELDS = ("pressure", "contact_pressure", "cavity_fraction", "h0", "mean_gap",
-           "elastic_deformation", "viscosity", "density_ratio", "shear_stress", "face")
+#: the grid fields of an operating point and their SI units: declared once, for the
+#: checkpoints, VTU files and ``fields.nc`` (:func:`fem_twin.results.fields_dataset`)
+FIELDS = {"pressure": "Pa", "contact_pressure": "Pa", "cavity_fraction": "1", "h0": "m",
+          "mean_gap": "m", "elastic_deformation": "m", "viscosity": "Pa s",
+          "density_ratio": "1", "shear_stress": "Pa", "face": "1"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -55,11 +58,11 @@ class MixedResult:
 
     def fields(self) -> dict:
         """The grid fields by name (for VTU output)."""
-        return {k: np.asarray(getattr(self, k), float) for k in _FIELDS}
+        return {k: np.asarray(getattr(self, k), float) for k in FIELDS}
 
     def scalars(self) -> dict:
         return {f.name: getattr(self, f.name) for f in fields(self)
-                if f.name not in _FIELDS and f.name not in ("history", "meta")}
+                if f.name not in FIELDS and f.name not in ("history", "meta")}
 
     def save(self, path) -> Path:
         """Write ``.npz`` (fields, history, scalars and meta as JSON) atomically."""
@@ -76,7 +79,7 @@ class MixedResult:
         with np.load(path) as data:
             scalars = json.loads(str(data["scalars"]))
             scalars["spacing"] = tuple(scalars["spacing"])
-            arrays = {k: data[k] for k in _FIELDS}
+            arrays = {k: data[k] for k in FIELDS}
             arrays["face"] = arrays["face"].astype(bool)
             return cls(**scalars, **arrays, history=data["history"],
                        meta=json.loads(str(data["meta"])))
@@ -137,5 +140,5 @@ def on_grid(result: MixedResult, shape, dx) -> MixedResult:
         return map_coordinates(np.asarray(f, float), where, order=1, mode="nearest")
 
     return replace(result, spacing=tuple(dx), **{k: interp(getattr(result, k))
-                                                 for k in _FIELDS if k != "face"},
+                                                 for k in FIELDS if k != "face"},
                    face=interp(result.face) > 0.5)

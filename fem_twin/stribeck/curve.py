@@ -19,6 +19,18 @@ COLUMNS = ("speed", "hersey", "friction_coefficient", "viscosity", "hydrodynamic
 HEADERS = dict(zip(COLUMNS, ("speed_m_s", "hersey", "friction_coefficient", "viscosity_Pa_s",
                              "hydrodynamic_friction_N", "boundary_friction_N",
                              "contact_load_fraction", "h_d_m", "iterations")))
+#: the unit and meaning of each variable over (viscosity, speed) in ``results.nc``
+#: (:func:`fem_twin.results.stribeck_dataset`; speed and viscosity are its coordinates)
+UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
+         "friction_coefficient": ("1", "C_f (eq 34)"),
+         "hydrodynamic_friction": ("N", "hydrodynamic part of F_T (eq 33)"),
+         "boundary_friction": ("N", "boundary part of F_T (eq 33)"),
+         "contact_load_fraction": ("1", "share of the face load (F_N times load_share) "
+                                        "carried by p_con"),
+         "h_d": ("m", "rigid-body separation h_d"),
+         "iterations": ("1", "macro solver iterations"),
+         "cf_min": ("1", "lowest C_f of the single-patch sweeps"),
+         "cf_max": ("1", "highest C_f of the single-patch sweeps")}
 
 
 def hersey_number(viscosity, speed, diameter: float, load: float):
