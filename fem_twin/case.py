@@ -248,6 +248,9 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
     for f in fields(cls):
         if f.name not in table:
             continue
+        if f.metadata.get("section"):
+            raise CaseError(f"{where} [{name}] {f.name}: set by [{f.metadata['section']}], "
+                            "not here")
         _plausible(name, f, table[f.name], where)
         _choice(name, f, table[f.name], where)
         v = table[f.name]

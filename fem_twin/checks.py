@@ -64,14 +64,27 @@ def _numeric(value) -> bool:
 
 
 def setting(default, doc: str, quantity: str | None = None, *, unit: str = "",
-            choices: tuple = ()):
-    """The one declaration of a case-file setting (a dataclass field of its section):
-    its default, a one-line ``doc``, the ``quantity`` of :data:`QUANTITIES` whose plausible
-    range and unit the parser enforces (or a ``unit`` of its own), and the ``choices`` of
-    a text setting.  The case parser, the API's checks and the documentation's case-file
-    reference all read it (:func:`describe`)."""
+            choices: tuple = (), section: str | None = None):
+    """The one declaration of a setting (a dataclass field of its settings object): its
+    default, a one-line ``doc``, the ``quantity`` of :data:`QUANTITIES` whose plausible
+    range and unit the parser enforces (or a ``unit`` of its own), the ``choices`` of a
+    text setting, and the case-file ``section`` that sets it when that is another one (a
+    value the stage takes from elsewhere in the case).  The case parser, the API's checks
+    (:func:`check_choices`) and the documentation's case-file reference read it
+    (:func:`describe`)."""
     return field(default=default, metadata={"doc": doc, "quantity": quantity, "unit": unit,
-                                            "choices": tuple(choices)})
+                                            "choices": tuple(choices), "section": section})
+
+
+def check_choices(settings) -> None:
+    """Refuse a text setting of the dataclass ``settings`` outside its declared choices."""
+    from dataclasses import fields
+    for f in fields(settings):
+        choices = f.metadata.get("choices")
+        value = getattr(settings, f.name)
+        if choices and value not in choices:
+            raise InputError(f"{f.name} must be one of {', '.join(map(repr, choices))}, got "
+                             f"{value!r}")
 
 
 def describe(f) -> dict:

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from . import tables as T
 from .checks import setting
+from .macro.settings import MacroSettings
 from .topography.prepare import MacroOptions
 
 
@@ -135,22 +136,15 @@ class MicroSpec:
 
 
 @dataclass(frozen=True)
-class MacroSpec:
-    """``[macro]``: the homogenised Reynolds scale (eqs 17-34)."""
+class MacroSpec(MacroSettings):
+    """``[macro]``: the homogenised Reynolds scale (eqs 17-34): every setting of the macro
+    solver (:class:`fem_twin.macro.settings.MacroSettings`, declared there once), the macro
+    pin and a ball's grid."""
 
     pin: str | int = setting("average", "the macro pin: the levelled set's average, or a "
                              "pin number from 1", unit='"average" or a number')
-    method: str = setting("fe", "Reynolds by finite elements or the paper's finite volumes",
-                          choices=("fe", "fvm"))
-    coupling: str = setting("auto", "pressure-deformation-load coupling (auto: Anderson, "
-                            "Newton for concentrated contacts or when it fails; pid: the "
-                            "paper's)", choices=("auto", "anderson", "newton", "pid"))
     grid: int = setting(97, "nodes per side of a ball's grid over [-4a, 2a] x [-3a, 3a]",
                         unit="-")
-    inner_steps: int = setting(1, "Newton steps per Reynolds solve far from the fixed "
-                               "point (0: exact solves)", unit="-")
-    couette: str = setting("central", "Couette flux of eq 17: second order, or the paper's "
-                           "first-order upwind", choices=("central", "upwind"))
 
 
 @dataclass(frozen=True)

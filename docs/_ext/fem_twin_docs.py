@@ -34,6 +34,8 @@ def case_keys() -> str:
         lines += [f"## `[{name}]`", "", doc, "",
                   "| key | default | unit, plausible range | meaning |", "|---|---|---|---|"]
         for f in fields(cls):
+            if f.metadata.get("section"):              # a value another section sets
+                continue
             d = describe(f)
             unit = d["unit"] or "-"
             if d["range"] is not None:

@@ -26,23 +26,20 @@ the change of ``h_el`` / h_ref, the update of ``p_con`` / p_ref (eq 27), the cha
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
-from .. import tables as T
 from ..checks import plausible
 from ..errors import InputError, MixedNotConverged
 from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from . import newton
-from .cavitation import cavitation_model
-from .couette import SCHEMES
 from .fixed_point import Concentrated, solve_fixed_point
-from .friction import BOUNDARY_FRICTION
 from .lubricant import Lubricant
 from .problem import macro_problem
 from .result import MixedResult, mixed_result, on_grid
+from .settings import MacroSettings
 
 __all__ = ["MacroSettings", "MixedNotConverged", "MixedResult", "solve_mixed"]
 
@@ -52,49 +49,6 @@ NEWTON_MAX_ITER = 60
 
 #: Cold starts on grids of at least twice this size begin with a solve on the coarser grid.
 COARSE_START = 48
-
-
-@dataclass(frozen=True)
-class MacroSettings:
-    """Settings of the macro solver (Table 6 defaults, SI units)."""
-
-    ambient_pressure: float = T.AMBIENT_PRESSURE
-    cavitation_pressure: float = T.CAVITATION_PRESSURE
-    e_reduced: float = T.E_REDUCED
-    boundary_friction: float = BOUNDARY_FRICTION
-    method: str = "fe"                       # Poiseuille term: "fe" or "fvm"
-    coupling: str = "auto"                   # "anderson", "newton" or "pid" (the paper's)
-    complementarity: str = "switch"          # cavitation model (.cavitation.MODELS): or
-    #                                          "fb", the paper's FBNS (slower)
-    couette: str = "central"                 # Couette flux: second order, or "upwind" (the
-    #                                          paper's first order), :mod:`.couette`
-    relaxation_pcon: float = T.RELAXATION_PCON   # alpha_pcon of eq 26 ("pid")
-    relaxation_elastic: float = 0.1          # under-relaxation of h_el ("pid")
-    gains: tuple = T.MACRO_GAINS             # K_P, K_I, K_D of eq 29 ("pid")
-    anderson_depth: int = 8
-    inner_steps: int = 1                     # Newton steps per Reynolds solve while far from
-    #                                          the fixed point (0: every one to convergence)
-    p_ref: float = 100e6
-    h_ref: float = 1e-6
-    tol: float = 1e-6
-    max_iter: int = 300
-    gap_floor: float = 1e-9                  # h0 passed to the flow factors [m]
-
-    def __post_init__(self):
-        if self.method not in ("fe", "fvm"):
-            raise InputError(f"method must be 'fe' or 'fvm', got {self.method!r}")
-        if self.coupling not in ("auto", "anderson", "pid", "newton"):
-            raise InputError("coupling must be 'auto', 'anderson', 'pid' or 'newton', got "
-                             f"{self.coupling!r}")
-        if self.ambient_pressure < self.cavitation_pressure:
-            raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
-        cavitation_model(self.complementarity)              # a registered model
-        if self.couette not in SCHEMES:
-            raise InputError(f"couette must be one of {SCHEMES}, got {self.couette!r}")
-        if not (isinstance(self.inner_steps, int) and self.inner_steps >= 0):
-            raise InputError(f"inner_steps must be an integer >= 0, got {self.inner_steps!r}")
-        if not 0 < self.relaxation_pcon <= 1:
-            raise InputError("relaxation_pcon must be in (0, 1]")
 
 
 @one_thread

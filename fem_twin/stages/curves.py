@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 import logging
 import time
-from dataclasses import replace
+from dataclasses import fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -37,10 +37,10 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
     A ball's contact cavitates at the ambient pressure: the 0.2 bar between p_amb and p_cav
     of Table 6 is nothing beside its GPa, and the thin pressurised layer it forces along
     the sides of the outlet cavity makes the Newton coupling cycle between two states."""
-    settings = MacroSettings(e_reduced=case.materials.e_reduced,
-                             boundary_friction=case.tribometer.boundary_friction,
-                             method=method or case.macro.method, coupling=case.macro.coupling,
-                             inner_steps=case.macro.inner_steps, couette=case.macro.couette)
+    own = {f.name: getattr(case.macro, f.name) for f in fields(MacroSettings)}
+    settings = MacroSettings(**{**own, "e_reduced": case.materials.e_reduced,
+                                "boundary_friction": case.tribometer.boundary_friction,
+                                **({"method": method} if method else {})})
     if case.tribometer.ball:
         settings = replace(settings, cavitation_pressure=settings.ambient_pressure)
     return settings

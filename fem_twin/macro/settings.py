@@ -1,0 +1,69 @@
+"""The macro solver's settings, one declaration each (:func:`fem_twin.checks.setting`):
+the case file's ``[macro]`` section is this dataclass (with the macro pin and a ball's grid,
+:class:`fem_twin.sections.MacroSpec`), its reference page is generated from it, and
+:func:`fem_twin.macro.solve_mixed` takes it.  Table 6 defaults, SI units."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .. import tables as T
+from ..checks import check_choices, setting
+from ..errors import InputError
+from .cavitation import MODELS, cavitation_model
+from .couette import SCHEMES
+from .friction import BOUNDARY_FRICTION
+
+
+@dataclass(frozen=True)
+class MacroSettings:
+    """Settings of the macro solver (Table 6 defaults, SI units)."""
+
+    ambient_pressure: float = setting(T.AMBIENT_PRESSURE, "ambient pressure p_amb on the "
+                                      "edges of the pin (Table 6)", unit="Pa")
+    cavitation_pressure: float = setting(T.CAVITATION_PRESSURE, "cavitation pressure p_cav "
+                                         "(Table 6)", unit="Pa")
+    e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", unit="Pa", section="materials")
+    boundary_friction: float = setting(BOUNDARY_FRICTION, "C_f,b of eq 32", unit="-",
+                                       section="tribometer")
+    method: str = setting("fe", "Poiseuille term by finite elements or the paper's finite "
+                          "volumes", choices=("fe", "fvm"))
+    coupling: str = setting("auto", "pressure-deformation-load coupling (auto: Anderson, "
+                            "Newton for concentrated contacts or when it fails; pid: the "
+                            "paper's)", choices=("auto", "anderson", "newton", "pid"))
+    complementarity: str = setting("switch", "cavitation model (fem_twin.macro.cavitation): "
+                                   + ", ".join(f'"{m}"' for m in MODELS) + " (fb: the paper's "
+                                   "FBNS, slower)", unit="a registered model")
+    couette: str = setting("central", "Couette flux of eq 17: second order, or the paper's "
+                           "first-order upwind", choices=SCHEMES)
+    relaxation_pcon: float = setting(T.RELAXATION_PCON, "under-relaxation alpha_pcon of "
+                                     "p_con, eq 26 (pid coupling)", unit="-")
+    relaxation_elastic: float = setting(0.1, "under-relaxation of h_el (pid coupling)",
+                                        unit="-")
+    gains: tuple = setting(T.MACRO_GAINS, "K_P, K_I, K_D of the PID on h_d, eq 29 (pid "
+                           "coupling)", unit="-")
+    anderson_depth: int = setting(8, "iterates the Anderson acceleration keeps", unit="-")
+    inner_steps: int = setting(1, "Newton steps per Reynolds solve while far from the fixed "
+                               "point (0: every solve to convergence)", unit="-")
+    p_ref: float = setting(100e6, "pressure scale of the residuals and of theta", unit="Pa")
+    h_ref: float = setting(1e-6, "length scale of the residuals", unit="m")
+    tol: float = setting(1e-6, "convergence tolerance of the coupling (scaled residuals)",
+                         unit="-")
+    max_iter: int = setting(300, "iterations of the coupling before it gives up", unit="-")
+    gap_floor: float = setting(1e-9, "smallest h0 passed to the flow factors", unit="m")
+
+    def __post_init__(self):
+        check_choices(self)
+        if self.ambient_pressure < self.cavitation_pressure:
+            raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
+        cavitation_model(self.complementarity)              # a registered model
+        if not (isinstance(self.inner_steps, int) and self.inner_steps >= 0):
+            raise InputError(f"inner_steps must be an integer >= 0, got {self.inner_steps!r}")
+        if not 0 < self.relaxation_pcon <= 1 or not 0 < self.relaxation_elastic <= 1:
+            raise InputError("relaxation_pcon and relaxation_elastic must be in (0, 1]")
+        scales = ("p_ref", "h_ref", "tol", "max_iter", "gap_floor", "anderson_depth",
+                  "e_reduced")
+        bad = [k for k in scales if not getattr(self, k) > 0]
+        if bad or len(self.gains) != 3:
+            raise InputError(f"{', '.join(bad) or 'gains'}: must be positive (gains: K_P, "
+                             "K_I, K_D)")
