@@ -7,7 +7,7 @@ import pytest
 
 from fem_twin import Topography
 from fem_twin.fvm import CellSolverFV
-from fem_twin.micro import CellSolver, FlowFactors, average, homogenise
+from fem_twin.micro import CellSettings, CellSolver, FlowFactors, average, homogenise
 from fem_twin.micro.cell import couette_form, flow_form, pressure_form_1, squeeze_form
 from fem_twin.micro.flow_factors import ARRAYS
 from fem_twin.topography.synthetic import self_affine
@@ -456,6 +456,12 @@ def test_bad_input_is_refused():
         homogenise(pin, disk, [1e-6, -1e-7])
     with pytest.raises(ValueError, match="method"):
         homogenise(pin, disk, [1e-6], method="fdm")
+    with pytest.raises(ValueError, match="unknown setting.*n_step"):        # a typo
+        homogenise(pin, disk, [1e-6], n_step=4)
+    # every cell setting is reachable, whole or by keyword, and 0 means off for time_tol
+    loose = homogenise(pin, disk, [1e-6], settings=CellSettings(n_steps=2, contact_tol=1e-6),
+                       time_tol=0, error_estimate=False)
+    assert loose.meta["n_steps"] == 2 and loose.meta["time_tol"] is None
     with pytest.raises(ValueError, match="truncate"):
         CellSolver((8, 8), (1e-7, 1e-7)).solve(np.zeros((8, 8)))
 

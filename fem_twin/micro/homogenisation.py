@@ -12,12 +12,11 @@ the per-h0 checkpoints, in :mod:`fem_twin.micro.store`.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import numpy as np
 
 from .. import __version__
-from ..contact.levelling import TABLE4
 from ..checks import plausible
 from ..errors import InputError
 from ..threads import one_thread
@@ -35,13 +34,11 @@ DEFAULT_H0 = np.geomspace(1e-7, 1e-6, 100)
 
 
 @one_thread
-def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
-               e_reduced: float = TABLE4["e_reduced"], hardness: float = TABLE4["hardness"],
-               method: str = "fe", moving: str = "upper", time_derivative: str = "exact",
-               first_step: str = "steady", gap_floor: float = 1e-9, workers: int = 1,
-               executor=None, checkpoint=None, progress: bool = False, patch_id=None,
-               error_estimate: bool = True, time_tol: float | None = None,
-               h0_tol: float | None = None) -> FlowFactors:
+def homogenise(pin: Topography, disk: Topography, h0=None, *,
+               settings: CellSettings | None = None, workers: int = 1, executor=None,
+               checkpoint=None, progress: bool = False, patch_id=None,
+               error_estimate: bool = True, h0_tol: float | None = None,
+               **shortcuts) -> FlowFactors:
     """Flow factors of a roughness patch pair versus h0 (eqs 11-16).
 
     Parameters
@@ -52,16 +49,18 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
         :func:`fem_twin.topography.prepare.prepare_patch` with ``upper=True`` gives).  The gap
         is ``h0 + disk - pin + deformation``.
     h0 : rigid-body separations [m] (default: 100 values geometrically in [0.1, 1] um).
-    n_steps : time steps N_t of one sliding pass (paper: 32).
-    e_reduced, hardness : E' of eq 22 and the pressure cap H [Pa] (Table 4).
-    method : ``"fe"`` (Q1 finite elements) or ``"fvm"`` (the paper's finite volumes).
-    moving : ``"upper"``: the disk slides at ``+U`` over the pin at rest (the tribometer);
-        ``"lower"``: the same seen from the disk (the pin slides at ``-U``).
-    time_derivative : ``"exact"`` (default): the squeeze term of eq 8 at every instant from
-        the translating surface and the contact rate, no time-step error (see
-        :func:`sliding_squeeze`); ``"backward"``: the paper's implicit Euler difference.
-    first_step : with ``"backward"`` only: ``"steady"`` (paper: no time term at the first
-        step) or ``"periodic"`` (the last configuration precedes the first).
+    settings : :class:`~fem_twin.micro.CellSettings`, everything of the cell problems the
+        result depends on (default: ``CellSettings()``); ``**shortcuts``, any of its fields
+        by keyword, replace its values: ``n_steps`` (N_t, paper 32), ``e_reduced`` and
+        ``hardness`` [Pa] (Table 4), ``method`` (``"fe"`` or the paper's ``"fvm"``),
+        ``moving`` (``"upper"``: the disk slides at ``+U`` over the pin at rest; ``"lower"``:
+        the same seen from the disk), ``time_derivative`` (``"exact"``: the squeeze term of
+        eq 8 at every instant, no time-step error, :func:`.sliding.sliding_squeeze`;
+        ``"backward"``: the paper's implicit Euler), ``first_step`` (``"backward"`` only),
+        ``gap_floor`` [m], ``contact_tol``, ``rate_tol``, ``time_tol`` (adaptive instants,
+        exact scheme: at each h0 the midpoints are added while A11 or b1 change by more than
+        this relative tolerance from every other instant to all, up to one pixel per step;
+        ``meta["steps_used"]`` per h0; 0 or None: off, as in the case file).
     workers : processes for the h0 values (1: in this process); ``executor``: any
         ``concurrent.futures``-style executor instead (e.g. ``dask.distributed``'s), with
         ``workers`` the processes serving it.  The h0 values go out as ``4 workers`` tasks
@@ -73,24 +72,21 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *, n_steps: int = 32,
     patch_id : recorded in the metadata.
     error_estimate : estimate the time and grid errors (``meta["error_estimate"]``, see
         :mod:`fem_twin.micro.estimate`; about ``3 / (4 len(h0))`` of the run's cost).
-    time_tol : adaptive instants (exact scheme): at each h0 the midpoints are added while
-        A11 or b1 change by more than this relative tolerance from every other instant to
-        all, up to one pixel per step; ``n_steps`` is then the smallest count
-        (``meta["steps_used"]`` per h0).  0 or None (off, as in the case file): ``n_steps``
-        everywhere.
     h0_tol : adaptive separations: ``h0`` is the dense candidate set and only the subset
         :func:`fem_twin.micro.sampling.adaptive_separations` needs is solved, so that the
         interpolant in log h0 misses the factors at the skipped candidates by less than
         this relative tolerance (its bound: ``meta["error_estimate"]["h0"]``).  0 or None
         (off, as in the case file): every ``h0``.
     """
-    time_tol, h0_tol = time_tol or None, h0_tol or None       # 0 means off, as in the case
-    settings = CellSettings(int(n_steps), float(e_reduced), float(hardness), float(gap_floor),
-                            method, moving, first_step, time_derivative=time_derivative,
-                            time_tol=time_tol)
+    unknown = set(shortcuts) - {f.name for f in fields(CellSettings)}
+    if unknown:
+        raise InputError(f"homogenise: unknown setting(s) {sorted(unknown)}; the cell "
+                         f"settings are {[f.name for f in fields(CellSettings)]}")
+    settings = replace(settings or CellSettings(), **shortcuts)
+    h0_tol = h0_tol or None                                  # 0 means off, as in the case
     z_low, z_up, spacing = _check_patches(pin, disk)
-    plausible("reduced modulus e_reduced [Pa]", e_reduced, "reduced_modulus")
-    plausible("hardness [Pa]", hardness, "hardness")
+    plausible("reduced modulus e_reduced [Pa]", settings.e_reduced, "reduced_modulus")
+    plausible("hardness [Pa]", settings.hardness, "hardness")
     h0 = _check_separations(DEFAULT_H0 if h0 is None else h0)
     if h0_tol is not None and not 0 < h0_tol < 1:
         raise InputError(f"h0_tol is a relative tolerance in (0, 1), got {h0_tol}")

@@ -41,6 +41,7 @@ import numpy as np
 from ..contact import contact_rate
 from ..contact import solve as contact_solve
 from ..contact.levelling import TABLE4
+from ..checks import check_choices, setting
 from ..errors import InputError
 from .cell_fv import CellSolverFV
 from .flow_factors import FlowFactors
@@ -48,39 +49,52 @@ from .flow_factors import FlowFactors
 
 @dataclass(frozen=True)
 class CellSettings:
-    """Everything besides the surfaces and h0 that the result depends on (SI units)."""
+    """Everything besides the surfaces and h0 that the flow factors depend on (SI units),
+    each declared once (:func:`fem_twin.checks.setting`); :func:`~fem_twin.micro.homogenise`
+    takes it whole (``settings=``) or field by field as keyword shortcuts."""
 
-    n_steps: int = 32
-    e_reduced: float = TABLE4["e_reduced"]
-    hardness: float = TABLE4["hardness"]
-    gap_floor: float = 1e-9
-    method: str = "fe"
-    moving: str = "upper"
-    first_step: str = "steady"
-    contact_tol: float = 1e-10
-    time_derivative: str = "exact"
-    rate_tol: float = 1e-6      # contact-rate CG: tau to 1e-6, far below time and grid errors
-    time_tol: float | None = None   # adaptive instants per h0 (exact scheme), see refine_instants
+    n_steps: int = setting(32, "time steps N_t of one sliding pass (paper: 32)", unit="-")
+    e_reduced: float = setting(TABLE4["e_reduced"], "E' of eq 22", "reduced_modulus",
+                               section="materials")
+    hardness: float = setting(TABLE4["hardness"], "the cap on the contact pressure",
+                              "hardness", section="materials")
+    gap_floor: float = setting(1e-9, "smallest film of the cell problems (a contact spot)",
+                               unit="m")
+    method: str = setting("fe", "cell problems by Q1 finite elements or the paper's finite "
+                          "volumes", choices=("fe", "fvm"))
+    moving: str = setting("upper", "the sliding surface: the disk at +U over the pin at rest "
+                          "(the tribometer), or the pin at -U (the disk's frame)",
+                          choices=("upper", "lower"))
+    first_step: str = setting("steady", "backward scheme only: no time term at the first "
+                              "step (the paper), or the last instant before the first",
+                              choices=("steady", "periodic"))
+    contact_tol: float = setting(1e-10, "tolerance of the periodic contact at each instant",
+                                 unit="-")
+    time_derivative: str = setting("exact", "squeeze term of eq 8: exact at every instant, or "
+                                   "the paper's implicit Euler", choices=("exact", "backward"))
+    rate_tol: float = setting(1e-6, "tolerance of the contact rate (the squeeze term), far "
+                              "below the time and grid errors", unit="-")
+    time_tol: float | None = setting(None, "adaptive instants per h0 (exact scheme): "
+                                     "midpoints while A11 or b1 change by more (0 or None: "
+                                     "off)", unit="fraction")
 
     def __post_init__(self):
+        if not self.time_tol:                          # 0 means off, as in the case file
+            object.__setattr__(self, "time_tol", None)
+        check_choices(self)
         if int(self.n_steps) != self.n_steps or self.n_steps < 1:
             raise InputError(f"n_steps must be a positive integer, got {self.n_steps}")
-        if self.method not in ("fe", "fvm"):
-            raise InputError(f"method must be 'fe' or 'fvm', got {self.method!r}")
-        if self.moving not in ("upper", "lower"):
-            raise InputError(f"moving must be 'upper' (disk) or 'lower' (pin), got "
-                             f"{self.moving!r}")
-        if self.time_derivative not in ("exact", "backward"):
-            raise InputError("time_derivative must be 'exact' or 'backward' (paper), got "
-                             f"{self.time_derivative!r}")
         if self.time_tol is not None and not (0 < self.time_tol < 1
                                               and self.time_derivative == "exact"):
             raise InputError("time_tol is a relative tolerance in (0, 1), with "
                              "time_derivative='exact' only")
-        if self.first_step not in ("steady", "periodic"):
-            raise InputError(f"first_step must be 'steady' or 'periodic', got {self.first_step!r}")
-        if not (self.e_reduced > 0 and self.hardness > 0 and self.gap_floor > 0):
-            raise InputError("e_reduced, hardness and gap_floor must be positive (Pa, Pa, m)")
+        if not (self.e_reduced > 0 and self.hardness > 0 and self.gap_floor > 0
+                and self.contact_tol > 0 and self.rate_tol > 0):
+            raise InputError("e_reduced, hardness, gap_floor, contact_tol and rate_tol must "
+                             "be positive (Pa, Pa, m, -, -)")
+        for name in ("e_reduced", "hardness", "gap_floor"):    # one key for 2e11 and 2e11.0
+            object.__setattr__(self, name, float(getattr(self, name)))
+        object.__setattr__(self, "n_steps", int(self.n_steps))
 
 
 @dataclass(frozen=True, eq=False)

@@ -14,7 +14,7 @@ from ..case import Case
 from ..io.checkpoint import load_or_none
 from ..io.files import read_topography
 from ..io.layout import RunLayout
-from ..micro import FlowFactors, average, homogenise
+from ..micro import CellSettings, FlowFactors, average, homogenise
 from ..micro.output import plot_flow_factors
 from ..micro.store import prune_checkpoints
 from ..topography import resample_cell
@@ -61,7 +61,7 @@ def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool
 
 def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> FlowFactors:
     """Flow factors of patch pair ``i`` (0-based): its file if present, else computed."""
-    mc, m = case.micro, case.materials
+    mc = case.micro
     path, checkpoints = out.patch_factors(i + 1), out.patch_checkpoints(i + 1)
     ff = load_or_none(path, FlowFactors.load)
     if ff is not None:
@@ -71,10 +71,8 @@ def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> Flo
     up = read_topography(out.patch(i + 1, "up"))
     if low.shape != tuple(mc.resolution):
         low, up = resample_cell(low, mc.resolution), resample_cell(up, mc.resolution)
-    ff = homogenise(low, up, h0, n_steps=mc.steps, e_reduced=m.e_reduced,
-                    hardness=m.hardness, method=mc.method,
-                    time_derivative=mc.time_derivative, time_tol=mc.time_tol,
-                    h0_tol=mc.h0_tol, executor=executor,
+    ff = homogenise(low, up, h0, settings=cell_settings(case), h0_tol=mc.h0_tol,
+                    executor=executor,
                     workers=getattr(executor, "n_workers", 1),
                     checkpoint=checkpoints, progress=bar,
                     patch_id=f"patch {i + 1}")
@@ -83,3 +81,11 @@ def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> Flo
     if stale:
         log.info("patch %d: %d stale h0 checkpoints removed", i + 1, stale)
     return ff
+
+
+def cell_settings(case: Case) -> CellSettings:
+    """The cell settings of a case: ``[micro]`` and the materials' E' and hardness."""
+    mc, m = case.micro, case.materials
+    return CellSettings(n_steps=mc.steps, e_reduced=m.e_reduced, hardness=m.hardness,
+                        method=mc.method, time_derivative=mc.time_derivative,
+                        time_tol=mc.time_tol)
