@@ -239,15 +239,8 @@ def _add_homogenise(sub):
     hr.add_argument("--h0", type=float, nargs=3, default=(1e-7, 1e-6, 100),
                     metavar=("MIN", "MAX", "N"), help="geometric h0 range [m] and count "
                     "(default: 1e-7 1e-6 100, the paper's)")
-    hr.add_argument("--steps", type=int, default=32, help="time steps N_t of one sliding pass")
-    hr.add_argument("--method", choices=("fe", "fvm"), default="fe",
-                    help="Q1 finite elements or the paper's finite volumes")
-    hr.add_argument("--time-derivative", choices=("exact", "backward"), default="exact",
-                    help="squeeze term of eq 8: exact at every instant or the "
-                         "paper's backward difference")
-    hr.add_argument("--time-tol", type=float,
-                    help="adaptive instants: add midpoints at an h0 while A11 or b1 change by "
-                         "more than this fraction (exact scheme)")
+    from .micro import CellSettings
+    _settings_options(hr, CellSettings, stages.CELL_OPTIONS, {"n_steps": "--steps"})
     hr.add_argument("--h0-tol", type=float,
                     help="adaptive h0: solve only the subset of the N values the log-h0 "
                          "interpolant needs to miss the others by less than this fraction "
@@ -281,14 +274,28 @@ def _add_macro(sub):
     mp.add_argument("--load", type=float, default=150.0, help="imposed normal load [N]")
     mp.add_argument("--diameter", type=float, default=8e-3,
                     help="pin diameter D of the Hersey number, eq 46 [m]")
-    mp.add_argument("--method", choices=("fe", "fvm"), default="fe")
-    mp.add_argument("--coupling", choices=("auto", "anderson", "newton", "pid"),
-                    default="auto", help="macro coupling: Anderson, with Newton for "
-                    "elastically dominated contacts (auto), or one of them; pid is the paper's")
-    mp.add_argument("--couette", choices=("central", "upwind"), default="central",
-                    help="Couette flux of eq 17: second order (central) or the paper's "
-                    "first-order upwind")
+    from .macro import MacroSettings
+    _settings_options(mp, MacroSettings, stages.MACRO_OPTIONS)
     mp.set_defaults(func=stages.macro_point)
+
+
+def _settings_options(parser, cls, names, flags=None) -> None:
+    """An option per setting ``names`` of the dataclass ``cls``, with the default, choices,
+    doc and unit of its one declaration (:func:`fem_twin.checks.setting`)."""
+    from dataclasses import fields
+
+    from .checks import describe
+    declared = {f.name: f for f in fields(cls)}
+    for name in names:
+        f, d = declared[name], describe(declared[name])
+        unit = f" [{d['unit']}]" if d["unit"] and not d["choices"] else ""
+        kw = dict(dest=name, default=f.default, help=(d["doc"] + unit).replace("%", "%%")
+                  + " (default: %(default)s)")
+        if d["choices"]:
+            kw["choices"] = d["choices"]
+        else:
+            kw["type"] = type(f.default) if f.default is not None else float
+        parser.add_argument((flags or {}).get(name, "--" + name.replace("_", "-")), **kw)
 
 
 def _add_utilities(sub):

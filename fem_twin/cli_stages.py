@@ -87,25 +87,33 @@ def contact_average(args):
     return 0
 
 
+#: the cell settings ``homogenise run`` offers as options (``--steps`` is ``n_steps``)
+CELL_OPTIONS = ("n_steps", "method", "time_derivative", "time_tol", "contact_tol", "rate_tol")
+#: the macro settings ``macro point`` offers as options
+MACRO_OPTIONS = ("method", "coupling", "couette", "complementarity", "inner_steps", "tol",
+                 "max_iter")
+
+
 def homogenise_run(args):
     import numpy as np
 
     from .io.files import read_topography
-    from .micro import homogenise
+    from .micro import CellSettings, homogenise
     from .micro.output import write_cell_fields
     pin, disk = read_topography(args.pin), read_topography(args.disk)
     lo, hi, n = args.h0
     if int(n) != n or n < 1:
         raise InputError(f"the number of h0 values must be a positive integer, got {n}")
-    ff = homogenise(pin, disk, np.geomspace(lo, hi, int(n)), n_steps=args.steps,
-                    method=args.method, time_derivative=args.time_derivative,
-                    time_tol=args.time_tol, h0_tol=args.h0_tol, workers=args.workers,
+    settings = CellSettings(**{k: getattr(args, k) for k in CELL_OPTIONS})
+    ff = homogenise(pin, disk, np.geomspace(lo, hi, int(n)), settings=settings,
+                    h0_tol=args.h0_tol, workers=args.workers,
                     checkpoint=args.output / "checkpoints", progress=not args.no_progress,
                     patch_id=f"{args.pin.stem}/{args.disk.stem}")
     _write_factors(args.output, ff)
     for h0 in args.fields:
-        print(write_cell_fields(args.output / "fields", pin, disk, h0, n_steps=args.steps,
-                                method=args.method, time_derivative=args.time_derivative))
+        print(write_cell_fields(args.output / "fields", pin, disk, h0,
+                                n_steps=settings.n_steps, method=settings.method,
+                                time_derivative=settings.time_derivative))
     return 0
 
 
@@ -147,9 +155,8 @@ def macro_point(args):
     face = pin.heights > -0.5e-3                 # the holder sits 1 mm below the face
     res = solve_mixed(upper - pin.heights, pin.spacing, FlowFactors.load(args.factors),
                       load=args.load, speed=args.speed, lubricant=Lubricant(args.viscosity),
-                      face=face, settings=MacroSettings(method=args.method,
-                                                        coupling=args.coupling,
-                                                        couette=args.couette))
+                      face=face, settings=MacroSettings(
+                          **{k: getattr(args, k) for k in MACRO_OPTIONS}))
     args.output.mkdir(parents=True, exist_ok=True)
     res.save(args.output / "point.npz")
     res.write_vtu(args.output / "point.vtu", origin=pin.origin)
