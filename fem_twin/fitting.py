@@ -46,6 +46,10 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
         raise InputError(f"{len(paths)} measured curves for the case's {len(lb.viscosities)} "
                          "viscosities ([lubricant] viscosities): give one CSV per viscosity, "
                          "in their order")
+    bad = [t for t in predict_at if not -30.0 <= float(t) <= 250.0]
+    if bad:
+        raise InputError(f"--predict {bad}: oil temperatures in C, from -30 to 250 (the range "
+                         "of the fitted contact temperatures)")
     if (predict_at or "temperature" in params) and len(set(lb.temperatures)) < 2:
         raise InputError("fitting or predicting a temperature needs viscosities at two "
                          "temperatures in [lubricant] (the Walther law of ASTM D341)")

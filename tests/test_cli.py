@@ -791,6 +791,8 @@ def test_fit_a_case_to_measured_curves(tmp_path, capsys):
                for r in pred)
     assert main(["fit", str(case), files[0], "-o", str(tmp_path / "x"), "--params",
                  "load"]) == 2
+    assert main(["fit", str(case), files[0], "-o", str(tmp_path / "x"), "--predict",
+                 "323"]) == 2                                     # kelvin typed as C
     assert not (tmp_path / "x").exists()
     # the face's load share too (curves made at share 1, the upper bound; the case resumes,
     # only the first viscosity's sweeps at the other shares are new), then the fitted twin
