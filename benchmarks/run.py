@@ -197,7 +197,7 @@ def _warm_patch_sweep(e_red):
     from fem_twin import contact
     from fem_twin.micro.sliding import CellSettings, sliding_pass
     pin, disk = _patch_pair()
-    shapes = sliding_pass(pin.heights, disk.heights, pin.spacing, CellSettings(n_steps=8)).shapes
+    shapes = sliding_pass(pin.heights, disk.heights, pin.spacing, CellSettings(steps=8)).shapes
     z = np.random.default_rng(0).random(pin.shape)
     t_fft, _ = best_of(lambda: np.fft.irfft2(np.fft.rfft2(z), s=z.shape), 5)
 

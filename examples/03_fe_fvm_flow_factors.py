@@ -74,7 +74,7 @@ def factors(moments):
 
 def refinement_study(k=3, h0=0.15e-6):
     pin, disk = patch_pair(k)
-    settings = CellSettings(n_steps=8)
+    settings = CellSettings(steps=8)
     shapes = sliding_pass(pin.heights, disk.heights, pin.spacing, settings).shapes
     contact = sliding_contacts(shapes[:1], pin.spacing, settings, h0)[0]
     print(f"\npatch {k}, h0 = {h0 * 1e6:.2f} um, first step, "

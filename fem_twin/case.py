@@ -181,9 +181,6 @@ def _micro(data, where) -> MicroSpec:
                         "the estimated error of C_f as a fraction of C_f,b (e.g. 0.005); the "
                         "flow factors' own estimates are in summary.json")
     micro = _section(data, "micro", MicroSpec, where)
-    if not 0 <= micro.time_tol < 1 or (micro.time_tol and micro.time_derivative != "exact"):
-        raise CaseError(f"{where} [micro] time_tol: 0 (off) or a fraction in (0, 1), with "
-                        "time_derivative = 'exact'")
     if not 0 <= micro.h0_tol < 1:
         raise CaseError(f"{where} [micro] h0_tol: 0 (every h0) or a fraction in (0, 1), "
                         "e.g. 0.005")
@@ -283,7 +280,12 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
                 raise CaseError(f"{where} [{name}] {f.name}: must be positive (SI units)")
             v = type(default)(v) if isinstance(default, float) else v
         values[f.name] = v
-    return cls(**values)
+    try:
+        return cls(**values)
+    except CaseError:
+        raise
+    except InputError as err:            # a rule of the settings themselves (__post_init__)
+        raise CaseError(f"{where} [{name}]: {err}") from err
 
 
 def _plausible(section: str, f, value, where):

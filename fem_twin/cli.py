@@ -240,7 +240,7 @@ def _add_homogenise(sub):
                     metavar=("MIN", "MAX", "N"), help="geometric h0 range [m] and count "
                     "(default: 1e-7 1e-6 100, the paper's)")
     from .micro import CellSettings
-    _settings_options(hr, CellSettings, stages.CELL_OPTIONS, {"n_steps": "--steps"})
+    _settings_options(hr, CellSettings, stages.CELL_OPTIONS)
     hr.add_argument("--h0-tol", type=float,
                     help="adaptive h0: solve only the subset of the N values the log-h0 "
                          "interpolant needs to miss the others by less than this fraction "

@@ -87,8 +87,8 @@ def contact_average(args):
     return 0
 
 
-#: the cell settings ``homogenise run`` offers as options (``--steps`` is ``n_steps``)
-CELL_OPTIONS = ("n_steps", "method", "time_derivative", "time_tol", "contact_tol", "rate_tol")
+#: the cell settings ``homogenise run`` offers as options
+CELL_OPTIONS = ("steps", "method", "time_derivative", "time_tol", "contact_tol", "rate_tol")
 #: the macro settings ``macro point`` offers as options
 MACRO_OPTIONS = ("method", "coupling", "couette", "complementarity", "inner_steps", "tol",
                  "max_iter")
@@ -112,7 +112,7 @@ def homogenise_run(args):
     _write_factors(args.output, ff)
     for h0 in args.fields:
         print(write_cell_fields(args.output / "fields", pin, disk, h0,
-                                n_steps=settings.n_steps, method=settings.method,
+                                n_steps=settings.steps, method=settings.method,
                                 time_derivative=settings.time_derivative))
     return 0
 

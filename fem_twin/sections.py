@@ -12,6 +12,7 @@ from pathlib import Path
 from . import tables as T
 from .checks import setting
 from .macro.settings import MacroSettings
+from .micro.sliding import CellSettings
 from .topography.prepare import MacroOptions
 
 
@@ -112,9 +113,10 @@ class Materials:
 
 
 @dataclass(frozen=True)
-class MicroSpec:
-    """``[micro]``: the roughness scale (eqs 8-16): patch resolution, h0 candidates, time
-    steps, the squeeze term, adaptive instants and h0."""
+class MicroSpec(CellSettings):
+    """``[micro]``: the roughness scale (eqs 8-16): every setting of the cell problems
+    (:class:`fem_twin.micro.CellSettings`, declared there once: time steps, method, squeeze
+    term, adaptive instants, tolerances), the patches' resolution and the h0 candidates."""
 
     resolution: tuple[int, int] = setting((256, 256), "patches resampled (periodically) to "
                                           "this grid, at least 8 each", unit="px")
@@ -122,14 +124,6 @@ class MicroSpec:
     h0_max: float = setting(1e-6, "largest separation h0 (above: the paper's rules)",
                             "separation")
     h0_count: int = setting(100, "h0 candidates, log-spaced (the paper: 100)", unit="-")
-    steps: int = setting(32, "sliding time steps over one pass of the disk patch",
-                         unit="-")
-    method: str = setting("fe", "cell problems by finite elements or the paper's finite "
-                          "volumes", choices=("fe", "fvm"))
-    time_derivative: str = setting("exact", "squeeze term: exact, or the paper's implicit "
-                                   "Euler", choices=("exact", "backward"))
-    time_tol: float = setting(0.0, "adaptive instants: midpoints added at an h0 while A11 "
-                              "or b1 change by more (0: off)", unit="fraction")
     h0_tol: float = setting(0.01, "adaptive h0: solve the candidates the log-h0 "
                             "interpolant needs to read the others within this (0: all, the "
                             "paper)", unit="fraction")

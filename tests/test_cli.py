@@ -779,12 +779,15 @@ def test_fit_a_case_to_measured_curves(tmp_path, capsys):
         path.write_text("speed,friction_coefficient\n" + "".join(
             f"{float(u)!r},{float(f)!r}\n" for u, f in zip(c.speed[1:-1], cf[1:-1])))
         files.append(str(path))
-    assert main(["fit", str(case), *files, "-o", str(out), "--no-progress",
-                 "--predict", "37"]) == 0
+    assert main(["fit", str(case), *files, "-o", str(out), "--no-progress", "--predict", "37",
+                 "--params", "boundary_friction,temperature,load_share"]) == 0
     fit = json.loads((out / "fit.json").read_text())
     assert fit["boundary_friction"]["value"] == pytest.approx(0.15, rel=2e-3)
     for k, t in ((1, 24.0), (2, 50.0)):
         assert abs(fit[f"temperature_{k}"]["value"] - t) < 0.5
+    # the curves were made at load share 1, the upper bound of the fit (the case resumes;
+    # only the first viscosity's sweeps at the other shares are new)
+    assert fit["load_share"]["value"] == pytest.approx(1.0, abs=1e-3)
     assert (out / "fit.png").is_file() and "boundary_friction = 0.15" in capsys.readouterr().out
     pred = list(csv.DictReader(open(out / "prediction_37C.csv")))
     assert all(float(r["cf_low"]) < float(r["friction_coefficient"]) < float(r["cf_high"])
@@ -794,14 +797,7 @@ def test_fit_a_case_to_measured_curves(tmp_path, capsys):
     assert main(["fit", str(case), files[0], "-o", str(tmp_path / "x"), "--predict",
                  "323"]) == 2                                     # kelvin typed as C
     assert not (tmp_path / "x").exists()
-    # the face's load share too (curves made at share 1, the upper bound; the case resumes,
-    # only the first viscosity's sweeps at the other shares are new), then the fitted twin
-    # run at 120 N: prediction.csv is the run's own curve with its band
-    assert main(["fit", str(case), *files, "-o", str(out), "--no-progress", "--params",
-                 "boundary_friction,temperature,load_share"]) == 0
-    fit = json.loads((out / "fit.json").read_text())
-    assert fit["load_share"]["value"] == pytest.approx(1.0, abs=1e-3)
-    assert fit["boundary_friction"]["value"] == pytest.approx(0.15, rel=2e-3)
+    # the fitted twin run at 120 N: prediction.csv is the run's own curve with its band
     case120 = tmp_path / "case120.toml"
     case120.write_text(case.read_text().replace("load = 150.0 ", "load = 120.0 "))
     assert main(["run", str(case120), "-o", str(tmp_path / "o120"), "--no-progress",

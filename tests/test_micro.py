@@ -459,7 +459,7 @@ def test_bad_input_is_refused():
     with pytest.raises(ValueError, match="unknown setting.*n_step"):        # a typo
         homogenise(pin, disk, [1e-6], n_step=4)
     # every cell setting is reachable, whole or by keyword, and 0 means off for time_tol
-    loose = homogenise(pin, disk, [1e-6], settings=CellSettings(n_steps=2, contact_tol=1e-6),
+    loose = homogenise(pin, disk, [1e-6], settings=CellSettings(steps=2, contact_tol=1e-6),
                        time_tol=0, error_estimate=False)
     assert loose.meta["n_steps"] == 2 and loose.meta["time_tol"] is None
     with pytest.raises(ValueError, match="truncate"):

@@ -1,7 +1,7 @@
 """Roughness-scale homogenisation of one pin/disk patch pair (paper 2.2.1, eqs 8-16).
 
 For every rigid-body separation h0 the disk patch slides periodically along x1 over the pin
-patch in ``n_steps`` time steps; at each step a periodic dry contact at imposed h0 gives the
+patch in ``steps`` time steps; at each step a periodic dry contact at imposed h0 gives the
 asperity pressure and the deformed gap, then the three cell problems are solved and their
 averages accumulated over space and time.
 
@@ -51,7 +51,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
     h0 : rigid-body separations [m] (default: 100 values geometrically in [0.1, 1] um).
     settings : :class:`~fem_twin.micro.CellSettings`, everything of the cell problems the
         result depends on (default: ``CellSettings()``); ``**shortcuts``, any of its fields
-        by keyword, replace its values: ``n_steps`` (N_t, paper 32), ``e_reduced`` and
+        by keyword, replace its values: ``steps`` (N_t, paper 32; ``n_steps`` is its
+        historical keyword), ``e_reduced`` and
         ``hardness`` [Pa] (Table 4), ``method`` (``"fe"`` or the paper's ``"fvm"``),
         ``moving`` (``"upper"``: the disk slides at ``+U`` over the pin at rest; ``"lower"``:
         the same seen from the disk), ``time_derivative`` (``"exact"``: the squeeze term of
@@ -78,6 +79,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
         this relative tolerance (its bound: ``meta["error_estimate"]["h0"]``).  0 or None
         (off, as in the case file): every ``h0``.
     """
+    if "n_steps" in shortcuts:                               # the historical keyword
+        shortcuts["steps"] = shortcuts.pop("n_steps")
     unknown = set(shortcuts) - {f.name for f in fields(CellSettings)}
     if unknown:
         raise InputError(f"homogenise: unknown setting(s) {sorted(unknown)}; the cell "
@@ -116,7 +119,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
             bar.close()
     meta = {**_meta(settings, pin, disk, spacing), "patch_id": patch_id,
             "checkpoint_keys": [key], "h0_tol": h0_tol, "h0_candidates": len(h0),
-            "steps_used": [int(m.get("n_steps", settings.n_steps)) for m in moments],
+            "steps_used": [int(m.get("n_steps", settings.steps)) for m in moments],
             "seconds": points.seconds()}
     factors = factors_from_moments(h0[chosen], moments, meta)
     if not error_estimate:
@@ -134,7 +137,7 @@ def _meta(settings: CellSettings, pin, disk, spacing) -> dict:
     """What flow factors record of their cell and settings."""
     return {"shape": list(pin.shape), "spacing": list(spacing),
             "e_reduced": settings.e_reduced, "hardness": settings.hardness,
-            "gap_floor": settings.gap_floor, "n_steps": settings.n_steps,
+            "gap_floor": settings.gap_floor, "n_steps": settings.steps,
             "method": settings.method, "moving": settings.moving,
             "first_step": settings.first_step, "time_derivative": settings.time_derivative,
             "version": __version__, "time_tol": settings.time_tol,
@@ -161,13 +164,13 @@ def estimate_errors(factors, moments, coarse, settings) -> dict:
     if all("half_h" in m for m in moments):
         half = factors_from_moments(factors.h0, moments, {}, prefix="half_")
         out["time"] = discrepancy(factors, half)
-        out["time_steps"] = [settings.n_steps, settings.n_steps // 2]
+        out["time_steps"] = [settings.steps, settings.steps // 2]
     if coarse is not None:
         coarse_moments, coarse_settings, key, shape = coarse
         other = factors_from_moments(factors.h0, coarse_moments, {})
-        same = half if coarse_settings.n_steps != settings.n_steps else factors
+        same = half if coarse_settings.steps != settings.steps else factors
         out["grid"] = discrepancy(same, other)
-        out["grid_shape"], out["grid_steps"] = shape, coarse_settings.n_steps
+        out["grid_shape"], out["grid_steps"] = shape, coarse_settings.steps
         grid = replace(factors, meta={}, **{k: getattr(factors, k) + getattr(other, k)
                                             - getattr(same, k) for k in ARRAYS[1:]})
         out["checkpoint_keys"] = [key]

@@ -69,7 +69,7 @@ def cell_fields(pin, disk, h0: float, *, n_steps: int = 32, method: str = "fe",
 
     ``materials`` are ``e_reduced``, ``hardness``, ``gap_floor`` as in :func:`homogenise`.
     """
-    settings = CellSettings(n_steps=n_steps, method=method, moving=moving, first_step=first_step,
+    settings = CellSettings(steps=n_steps, method=method, moving=moving, first_step=first_step,
                             time_derivative=time_derivative, **materials)
     z_low, z_up, spacing = _check_patches(pin, disk)
     sliding = sliding_pass(z_low, z_up, spacing, settings)

@@ -96,7 +96,7 @@ def run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=Fal
     """Moments for ``points = [(index, h0), ...]`` in order, warm-starting contact."""
     solver = cell_solver(z_low.shape, spacing, settings.method)
     sliding = sliding_pass(z_low, z_up, spacing, settings)
-    warm, midpoints = [None] * settings.n_steps, {}
+    warm, midpoints = [None] * settings.steps, {}
     out = []
     for i, h0 in points:
         if resume and folder is not None:
@@ -111,7 +111,7 @@ def run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=Fal
             seconds = [a + b for a, b in zip(seconds, more)]
         moments = time_average(steps)
         moments["n_steps"] = len(steps)
-        if half_pass and settings.n_steps % 2 == 0:   # N_t / 2 instants: time-error estimate
+        if half_pass and settings.steps % 2 == 0:   # N_t / 2 instants: time-error estimate
             half = half_pass_moments(steps, contacts, sliding, solver, spacing, settings)
             moments.update({"half_" + k: v for k, v in time_average(half).items()})
         moments["seconds_contact"], moments["seconds_cell"] = seconds
@@ -142,8 +142,8 @@ def coarse_moments(points, indices, z_low, z_up, spacing, settings, checkpoint):
         return None
     low, up = z_low[::2, ::2].copy(), z_up[::2, ::2].copy()
     wide = (2 * spacing[0], 2 * spacing[1])
-    if settings.n_steps % 2 == 0:
-        settings = replace(settings, n_steps=settings.n_steps // 2)
+    if settings.steps % 2 == 0:
+        settings = replace(settings, steps=settings.steps // 2)
     key = cell_key(low, up, wide, settings)
     args = dict(z_low=low, z_up=up, spacing=wide, settings=settings, key=key,
                 folder=None if checkpoint is None else str(Path(checkpoint) / "coarse"),

@@ -53,7 +53,7 @@ class CellSettings:
     each declared once (:func:`fem_twin.checks.setting`); :func:`~fem_twin.micro.homogenise`
     takes it whole (``settings=``) or field by field as keyword shortcuts."""
 
-    n_steps: int = setting(32, "time steps N_t of one sliding pass (paper: 32)", unit="-")
+    steps: int = setting(32, "time steps N_t of one sliding pass (paper: 32)", unit="-")
     e_reduced: float = setting(TABLE4["e_reduced"], "E' of eq 22", "reduced_modulus",
                                section="materials")
     hardness: float = setting(TABLE4["hardness"], "the cap on the contact pressure",
@@ -74,7 +74,7 @@ class CellSettings:
                                    "the paper's implicit Euler", choices=("exact", "backward"))
     rate_tol: float = setting(1e-6, "tolerance of the contact rate (the squeeze term), far "
                               "below the time and grid errors", unit="-")
-    time_tol: float | None = setting(None, "adaptive instants per h0 (exact scheme): "
+    time_tol: float | None = setting(0.0, "adaptive instants per h0 (exact scheme): "
                                      "midpoints while A11 or b1 change by more (0 or None: "
                                      "off)", unit="fraction")
 
@@ -82,8 +82,8 @@ class CellSettings:
         if not self.time_tol:                          # 0 means off, as in the case file
             object.__setattr__(self, "time_tol", None)
         check_choices(self)
-        if int(self.n_steps) != self.n_steps or self.n_steps < 1:
-            raise InputError(f"n_steps must be a positive integer, got {self.n_steps}")
+        if int(self.steps) != self.steps or self.steps < 1:
+            raise InputError(f"steps must be a positive integer, got {self.steps}")
         if self.time_tol is not None and not (0 < self.time_tol < 1
                                               and self.time_derivative == "exact"):
             raise InputError("time_tol is a relative tolerance in (0, 1), with "
@@ -94,7 +94,7 @@ class CellSettings:
                              "be positive (Pa, Pa, m, -, -)")
         for name in ("e_reduced", "hardness", "gap_floor"):    # one key for 2e11 and 2e11.0
             object.__setattr__(self, name, float(getattr(self, name)))
-        object.__setattr__(self, "n_steps", int(self.n_steps))
+        object.__setattr__(self, "steps", int(self.steps))
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,7 +127,7 @@ def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | No
     for the pin in the disk's frame); ``u_m dt = (shift_up + shift_low) / 2``.  The instants
     are ``(k + offset) s`` for ``k < N_t`` (``offset = 1/2``: the midpoints)."""
     nx = z_low.shape[1]
-    n_steps = settings.n_steps if n_steps is None else n_steps
+    n_steps = settings.steps if n_steps is None else n_steps
     px = nx / n_steps                            # pixels per step
     n = [(k + offset) * px for k in range(n_steps)]
     if settings.moving == "upper":
@@ -236,7 +236,7 @@ def refine_instants(contacts, steps, h0, z_low, z_up, solver, spacing, settings,
     more than the tolerance from every other instant to all, add the midpoints (the time
     average is then over twice the instants), up to one pixel per step.  In heavy contact
     the integrand jumps whenever a pixel enters contact, and a fixed N_t samples it
-    unevenly; light contact stops at ``n_steps``.  ``midpoints`` keeps each level's pass and
+    unevenly; light contact stops at ``steps``.  ``midpoints`` keeps each level's pass and
     warm starts across the separations of a chunk."""
     seconds = [0.0, 0.0]
     while _time_error(steps) > settings.time_tol and 2 * len(steps) <= z_low.shape[1]:

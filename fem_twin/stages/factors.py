@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import os
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import fields
 
 import numpy as np
 from tqdm import tqdm
@@ -84,8 +85,8 @@ def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> Flo
 
 
 def cell_settings(case: Case) -> CellSettings:
-    """The cell settings of a case: ``[micro]`` and the materials' E' and hardness."""
-    mc, m = case.micro, case.materials
-    return CellSettings(n_steps=mc.steps, e_reduced=m.e_reduced, hardness=m.hardness,
-                        method=mc.method, time_derivative=mc.time_derivative,
-                        time_tol=mc.time_tol)
+    """The cell settings of a case: its ``[micro]`` settings with the materials' E' and
+    hardness."""
+    own = {f.name: getattr(case.micro, f.name) for f in fields(CellSettings)}
+    return CellSettings(**{**own, "e_reduced": case.materials.e_reduced,
+                           "hardness": case.materials.hardness})
