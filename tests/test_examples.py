@@ -17,8 +17,12 @@ def test_the_gallery_is_numbered_and_complete():
     assert [p.name[:2] for p in EXAMPLES] == [f"{i + 1:02d}" for i in range(len(EXAMPLES))]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("script", EXAMPLES, ids=[p.stem for p in EXAMPLES])
 def test_example_runs_and_ends_in_a_figure(script, tmp_path):
+    """Each example at --quick size writes its figure last.  CI runs every example once, at
+    this size, in the documentation build (.ci/run: sphinx-gallery, which stops on an
+    example's error); ``pytest -m slow`` runs them here (about 4 minutes)."""
     if "real_roughness" in script.name:
         if not SHARED.is_dir():
             pytest.skip(f"{SHARED} absent (a fresh clone): the real instrument files live "

@@ -5,6 +5,7 @@
 ``reference/_generated/cli.md``: every command's ``--help`` from the CLI's parser.
 """
 
+import re
 from dataclasses import MISSING, fields
 from pathlib import Path
 
@@ -108,6 +109,22 @@ def generate(app, config=None) -> None:
             path.write_text(text)
 
 
+def check_gallery(app, exception) -> None:
+    """Every numbered example of the gallery, when it ran, drew at least one figure (the
+    examples' promise; tests/test_examples.py checks the same with ``-m slow``)."""
+    conf = app.config.sphinx_gallery_conf
+    if exception is not None or not conf.get("plot_gallery", True):
+        return
+    images = Path(app.srcdir) / "auto_examples" / "images"
+    skipped = conf.get("ignore_pattern", "")
+    missing = [p.stem for p in sorted(Path(conf["examples_dirs"]).glob("[0-9][0-9]_*.py"))
+               if not re.search(skipped, p.name)
+               and not (images / f"sphx_glr_{p.stem}_001.png").is_file()]
+    if missing:
+        raise RuntimeError(f"gallery examples without a figure: {missing}")
+
+
 def setup(app):
     app.connect("config-inited", generate)
+    app.connect("build-finished", check_gallery)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
