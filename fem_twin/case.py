@@ -18,6 +18,11 @@ class CaseError(InputError):
     """A case file that is missing, malformed or inconsistent."""
 
 
+#: a warm Stribeck point of a pin at 128^2 [s], its growth with the pixels, and the cost of
+#: a main-curve point with its C_f error estimate in plain points: fitted to the bundled
+#: case (276 s without the estimates, 288 s with them) and the paper case (sweeps and band
+#: 1069 s at 256^2), 2026-11-24
+POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 1.85, 0.55, 1.37
 #: separations an adaptive h0 sample solves, for the time estimate (measured at h0_tol =
 #: 0.01: 20-26 of the paper's 100 on sample patches 1 and 3 at 128^2 x 16, 24-39 over the
 #: six at 256^2 x 32)
@@ -45,24 +50,27 @@ class Case:
     def estimated_seconds(self, cores: int = 2) -> float:
         """Rough wall time of ``fem-twin run`` on ``cores`` cores [s], from the costs measured
         on this project's 2-core machine: ~3 us per cell pixel and time step of the micro
-        stage on one core, ~2 s per Stribeck point at 128^2 (bundled case: 276 s measured
-        for 288 s estimated) growing as N^1.2 (pixels), ~2.5 s at 73^2 for a ball (67 s
-        measured for examples/ball_on_disk.toml), one sweep
-        per viscosity and, with ``[run] patch_band``, one more per patch.  Adaptive h0
-        (``h0_tol``) solves about ``ADAPTIVE_H0`` of the candidates."""
+        stage on one core (adaptive h0 solves about ``ADAPTIVE_H0`` of the candidates); a
+        warm Stribeck point of a pin ``POINT_SECONDS`` at 128^2 growing as
+        N^``POINT_GROWTH`` (pixels), ``ESTIMATE_COST`` times that on the main curves (their
+        C_f error estimates), one sweep per viscosity and, with ``[run] patch_band``, one
+        more per patch; a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured against
+        it: the bundled case 288-349 s (estimated 283 s), the paper case 25.5 min with the
+        band and 13.4 without (estimated 27.1 and 12.2)."""
         patches = len(self.geometry.patches)
         h0 = min(self.micro.h0_count, ADAPTIVE_H0) if self.micro.h0_tol else self.micro.h0_count
         micro = (3e-6 * self.micro.resolution[0] * self.micro.resolution[1] * self.micro.steps
                  * h0 * patches / max(cores, 1))
         if self.tribometer.ball:         # Newton coupling: ~2.5 s a point at 73^2 measured
-            point = 2.5 * (self.macro.grid / 73) ** 2.4
+            point, estimate = 2.5 * (self.macro.grid / 73) ** 2.4, 1.0
         else:
             res = self.macro_geometry.resolution or (256, 256)
-            point = 2.0 * ((res[0] * res[1]) / 128 ** 2) ** 1.2
+            point = POINT_SECONDS * ((res[0] * res[1]) / 128 ** 2) ** POINT_GROWTH
+            estimate = ESTIMATE_COST
         n_mu = len(self.lubricant.viscosities)
         points = self.sweep.count * (1 + 0.5 * self.sweep.refine)   # refinement: ~+50 %
-        sweeps = n_mu * (1 + (patches if self.run.patch_band and patches > 1 else 0))
-        macro = point * points * sweeps / max(1, min(cores, sweeps))
+        band = patches if self.run.patch_band and patches > 1 else 0
+        macro = point * points * n_mu * (estimate + band) / max(1, min(cores, n_mu * (1 + band)))
         return micro + macro
 
 
