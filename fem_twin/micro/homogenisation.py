@@ -79,13 +79,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
         this relative tolerance (its bound: ``meta["error_estimate"]["h0"]``).  0 or None
         (off, as in the case file): every ``h0``.
     """
-    if "n_steps" in shortcuts:                               # the historical keyword
-        shortcuts["steps"] = shortcuts.pop("n_steps")
-    unknown = set(shortcuts) - {f.name for f in fields(CellSettings)}
-    if unknown:
-        raise InputError(f"homogenise: unknown setting(s) {sorted(unknown)}; the cell "
-                         f"settings are {[f.name for f in fields(CellSettings)]}")
-    settings = replace(settings or CellSettings(), **shortcuts)
+    settings = _settings(settings, shortcuts)
     h0_tol = h0_tol or None                                  # 0 means off, as in the case
     z_low, z_up, spacing = _check_patches(pin, disk)
     plausible("reduced modulus e_reduced [Pa]", settings.e_reduced, "reduced_modulus")
@@ -131,6 +125,20 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
     moved = estimate.pop("variants")
     return replace(factors, meta={**meta, "error_estimate": estimate, "checkpoint_keys": keys,
                                   "variants": moved})
+
+
+def _settings(settings: CellSettings | None, shortcuts: dict) -> CellSettings:
+    """``settings`` (default ``CellSettings()``) with the keyword ``shortcuts`` replacing
+    its fields (``n_steps``: the historical keyword of ``steps``); a typo is refused."""
+    if "n_steps" in shortcuts:
+        shortcuts = {**shortcuts, "steps": shortcuts["n_steps"]}
+        del shortcuts["n_steps"]
+    names = [f.name for f in fields(CellSettings)]
+    unknown = set(shortcuts) - set(names)
+    if unknown:
+        raise InputError(f"homogenise: unknown setting(s) {sorted(unknown)}; the cell "
+                         f"settings are {names}")
+    return replace(settings or CellSettings(), **shortcuts)
 
 
 def _meta(settings: CellSettings, pin, disk, spacing) -> dict:
