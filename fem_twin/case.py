@@ -203,11 +203,7 @@ def _micro(data, where) -> MicroSpec:
 
 
 def _macro(data, where, tribometer, geometry) -> MacroSpec:
-    macro = _section(data, "macro", MacroSpec, where)
-    if not (isinstance(macro.inner_steps, int) and macro.inner_steps >= 0):
-        raise CaseError(f"{where} [macro] inner_steps: an integer >= 0 (1: one Newton step "
-                        "per Reynolds solve far from convergence, 0: exact), got "
-                        f"{macro.inner_steps!r}")
+    macro = _section(data, "macro", MacroSpec, where)       # MacroSettings' own rules too
     if not 9 <= macro.grid <= 1025:
         raise CaseError(f"{where} [macro] grid: nodes per side of the ball's grid, 9 to 1025 "
                         f"(e.g. 97), got {macro.grid}")

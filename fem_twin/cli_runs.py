@@ -46,16 +46,16 @@ def run(args):
         raise MissingFile(f"case file not found: {args.case} (give the case file as "
                                 "the first argument)")
     case = load_case(args.case)
+    fitted = case
     if args.from_fit is not None:
         from .fitting import apply_fit, read_fit, run_from_fit
-        case = apply_fit(case, read_fit(args.from_fit))          # checked before any work
-    if not _confirm_cost(case, args.yes):
+        fitted = apply_fit(case, read_fit(args.from_fit))        # checked before any work
+    if not _confirm_cost(fitted, args.yes):
         return 2
     if args.from_fit is None:
         summary = run(case, args.output, progress=not args.no_progress)
     else:
-        summary = run_from_fit(load_case(args.case), args.from_fit, args.output,
-                               progress=not args.no_progress)
+        summary = run_from_fit(case, args.from_fit, args.output, progress=not args.no_progress)
     print(_short_summary(summary, args.output))
     if "prediction" in summary:
         p = summary["prediction"]
