@@ -23,6 +23,9 @@ class CaseError(InputError):
 #: case (276 s without the estimates, 288 s with them) and the paper case (sweeps and band
 #: 1069 s at 256^2), 2026-11-24
 POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 1.85, 0.55, 1.37
+#: a band point on the coarsened grid ([run] band_grid = "coarse") in full-grid points:
+#: 0.32 s against 1.28 s on the bundled case (64^2 against 128^2, 2026-11-25)
+COARSE_BAND_COST = 0.25
 #: separations an adaptive h0 sample solves, for the time estimate (measured at h0_tol =
 #: 0.01: 20-26 of the paper's 100 on sample patches 1 and 3 at 128^2 x 16, 24-39 over the
 #: six at 256^2 x 32)
@@ -54,7 +57,8 @@ class Case:
         warm Stribeck point of a pin ``POINT_SECONDS`` at 128^2 growing as
         N^``POINT_GROWTH`` (pixels), ``ESTIMATE_COST`` times that on the main curves (their
         C_f error estimates), one sweep per viscosity and, with ``[run] patch_band``, one
-        more per patch; a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured against
+        more per patch (and the average's, at ``COARSE_BAND_COST`` on the coarse grid of
+        ``[run] band_grid``); a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured against
         it: the bundled case 288-349 s (estimated 283 s), the paper case 25.5 min with the
         band and 13.4 without (estimated 27.1 and 12.2)."""
         patches = len(self.geometry.patches)
@@ -70,7 +74,10 @@ class Case:
         n_mu = len(self.lubricant.viscosities)
         points = self.sweep.count * (1 + 0.5 * self.sweep.refine)   # refinement: ~+50 %
         band = patches if self.run.patch_band and patches > 1 else 0
-        macro = point * points * n_mu * (estimate + band) / max(1, min(cores, n_mu * (1 + band)))
+        if band and self.run.band_grid == "coarse":        # and the average on that grid
+            band = (band + 1) * COARSE_BAND_COST
+        sweeps = n_mu * (1 + (patches if band else 0))
+        macro = point * points * n_mu * (estimate + band) / max(1, min(cores, sweeps))
         return micro + macro
 
 

@@ -174,6 +174,10 @@ class RunSpec:
                                     unit="address")
     patch_band: bool = setting(True, "one more sweep per patch: the roughness scatter band "
                                "(Figure 13)", unit="true or false")
+    band_grid: str = setting("coarse", 'the band\'s macro grid: "coarse" (every other node, '
+                             "C_f corrected by the average curve's change to the full grid; "
+                             '4x cheaper) or "full"', unit="coarse or full",
+                             choices=("coarse", "full"))
 
 
 #: the case file's sections and the dataclass that declares each one's keys

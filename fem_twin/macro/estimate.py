@@ -48,9 +48,9 @@ PARTS = ("macro", "time", "grid", "h0")
 
 
 def coarsened(gap, spacing, face):
-    """``(gap, spacing, face)`` on every other node of the grid [m]."""
+    """``(gap, spacing, face)`` on every other node of the grid [m] (``face`` None: None)."""
     return (np.asarray(gap)[::2, ::2], (2 * spacing[0], 2 * spacing[1]),
-            np.asarray(face, bool)[::2, ::2])
+            None if face is None else np.asarray(face, bool)[::2, ::2])
 
 
 def friction_error(result, gap, spacing, factors, *, load: float, lubricant, face=None,

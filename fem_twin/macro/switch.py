@@ -3,9 +3,10 @@
 One unknown per node, ``phi``: ``p = max(phi, 0)``, ``theta = max(-phi, 0) / s`` (the p-theta
 switch), which makes ``p theta = 0`` exact.  The residual is piecewise linear in ``phi``;
 semismooth Newton (primal-dual active set) solves it and stops when the active set no
-longer changes and the mass residual is below ``tol``.  Each Newton matrix is factorised
-by PARDISO on the fixed 3x3-stencil pattern of the grid (analysis once per grid) or, without
-MKL, by SuperLU in a nested-dissection order.
+longer changes and the mass residual is below ``tol``.  Each Newton step is solved by
+PARDISO on the fixed 3x3-stencil pattern of the grid, its last factorisation reused as a
+preconditioner (:mod:`.stencil_solver`), or, without MKL, by SuperLU in a
+nested-dissection order.
 """
 
 from __future__ import annotations
@@ -15,8 +16,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import ReynoldsNotConverged
-from ..linalg import SPDSolver, default_backend
 from ..ordering import nested_dissection
+from .stencil_solver import newton_solver
 
 
 #: relative mass residual at which Newton steps can no longer improve the solution
@@ -55,7 +56,7 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
         res = float(np.max(np.abs(r) / (absK @ p + couette_size + floor)))
         return r, pos, res
 
-    newton = _newton_solver(tuple(dirichlet.shape) if dirichlet.ndim == 2 else None,
+    newton = newton_solver(tuple(dirichlet.shape) if dirichlet.ndim == 2 else None,
                             dirichlet.ravel(), interior, K, B)
     history, active_old = [], None
     r, pos, res = residual(phi)
@@ -89,68 +90,6 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
     if inexact:
         return phi, max_iter + 1, history
     raise ReynoldsNotConverged(f"no convergence in {max_iter} Newton steps (tol {tol})", history)
-
-
-def _newton_solver(shape, dirichlet, interior, K, B):
-    """``step(pos, dtheta, rhs)`` solving the Newton system ``(K diag(pos) + B diag(dtheta))
-    step = rhs`` on the interior with PARDISO, whose ordering and symbolic factorisation
-    are kept per grid (the pattern: the 3x3 stencil, which holds K and every upwind B);
-    None without PARDISO.  A step returns None (the caller then uses SuperLU) when pivots
-    were perturbed or the step does not solve the system to 1e-8."""
-    if shape is None or default_backend() != "pardiso":
-        return None
-    key = (shape, dirichlet.tobytes())
-    if _NEWTON_CACHE.get("key") != key:
-        _NEWTON_CACHE.update(key=key, pattern=_stencil_pattern(shape, interior))
-    indptr, indices, keys, solver = _NEWTON_CACHE["pattern"]
-    n = interior.size
-    parts = []
-    for M in (K, B):
-        M = M[interior][:, interior].tocoo()
-        entries = M.row.astype(np.int64) * n + M.col
-        at = np.searchsorted(keys, entries)
-        if not np.array_equal(keys[np.minimum(at, keys.size - 1)], entries):
-            return None                           # not a stencil matrix: the general path
-        parts.append((at, M.data, M.col))
-
-    def step(pos, dtheta, rhs):
-        values = sum(np.bincount(at, data * w[col], minlength=keys.size)
-                     for (at, data, col), w in zip(parts, (pos.astype(float), dtheta)))
-        size = float(np.abs(values).max())            # PARDISO's pivot threshold is absolute
-        x = solver.factor(values / size).solve(rhs / size)
-        J = sp.csr_matrix((values, indices, indptr), shape=(n, n))
-        if solver.perturbed or not np.all(np.isfinite(x)) or (
-                np.linalg.norm(J @ x - rhs) > 1e-8 * np.linalg.norm(rhs)):
-            return None
-        return x
-    return step
-
-
-def _stencil_pattern(shape, interior):
-    """CSR pattern of the 3x3 stencil on the interior nodes, its sorted keys row * n + col,
-    and a PARDISO LU solver on it (analysis once)."""
-    ny, nx = shape
-    position = np.full(ny * nx, -1)
-    position[interior] = np.arange(interior.size)
-    idx = np.arange(ny * nx).reshape(ny, nx)
-    rows, cols = [], []
-    for di in (-1, 0, 1):
-        for dj in (-1, 0, 1):
-            a = idx[max(0, -di):ny - max(0, di), max(0, -dj):nx - max(0, dj)]
-            b = idx[max(0, di):ny - max(0, -di), max(0, dj):nx - max(0, -dj)]
-            rows.append(position[a.ravel()])
-            cols.append(position[b.ravel()])
-    rows, cols = np.concatenate(rows), np.concatenate(cols)
-    keep = (rows >= 0) & (cols >= 0)
-    n = interior.size
-    P = sp.csr_matrix((np.ones(keep.sum()), (rows[keep], cols[keep])), shape=(n, n))
-    P.sort_indices()
-    keys = np.repeat(np.arange(n, dtype=np.int64), np.diff(P.indptr)) * n + P.indices
-    return P.indptr, P.indices, keys, SPDSolver(P.indptr, P.indices, "pardiso",
-                                                symmetric=False)
-
-
-_NEWTON_CACHE: dict = {}
 
 
 def _interior_order(shape, dirichlet, interior):

@@ -16,12 +16,14 @@ from tqdm import tqdm
 from ..case import Case
 from ..io.layout import RunLayout
 from ..macro import MacroSettings, MixedResult
+from ..macro.estimate import coarsened
 from ..macro.figures import plot_point_fields
 from ..macro.point_contact import film_against_hamrock_dowson
 from ..micro import FlowFactors
 from ..stribeck import plot_stribeck, read_measured_csv, stribeck_sweep, write_stribeck_csv
 from ..stribeck.accuracy import error_summary
-from ..stribeck.analysis import hersey_collapse, patch_band, transition_speeds
+from ..stribeck.analysis import (defect_corrected, hersey_collapse, patch_band,
+                                 transition_speeds)
 from ..stribeck.sweep import point_files, point_key, sweep_key
 from ..stribeck.validation import validate_curves
 from ..threads import worker_heap
@@ -60,8 +62,8 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     curves, speeds = refined_curves(case, common, executor, progress)
     tasks = [(dict(common, speeds=speeds, error_estimate=True), lub)
              for lub in case.lubricant.lubricants()]
-    patch_curves, band_tasks = band_curves(case, out, dict(common, speeds=speeds), executor,
-                                           progress)
+    patch_curves, band_tasks = band_curves(case, out, dict(common, speeds=speeds), curves,
+                                           executor, progress)
     band = patch_band(patch_curves) if patch_curves else None
     _prune_points(common["checkpoint"], tasks + band_tasks)
     write_stribeck_csv(out.stribeck_csv, curves, band)
@@ -101,17 +103,28 @@ def refined_curves(case: Case, common: dict, executor=None, progress: bool = Tru
     return curves, speeds
 
 
-def band_curves(case: Case, out: RunLayout, common: dict, executor=None,
+def band_curves(case: Case, out: RunLayout, common: dict, curves, executor=None,
                 progress: bool = True):
     """The single-patch curves of the scatter band (``[run] patch_band``), one list per
-    patch over the viscosities, and their sweep tasks."""
+    patch over the viscosities, and their sweep tasks.  With ``[run] band_grid = "coarse"``
+    they are swept on the macro grid coarsened by two beside the average factors' curves,
+    and corrected by the main ``curves``' change to the full grid
+    (:func:`~fem_twin.stribeck.analysis.defect_corrected`)."""
     lubricants = case.lubricant.lubricants()
-    tasks = [(kw, lub) for kw in band_sweeps(case, out, common)
-             for lub in lubricants] if case.run.patch_band else []
-    curves = [c.with_load_share(case.tribometer.load_share) for c in run_sweeps(
+    sweeps = band_sweeps(case, out, common) if case.run.patch_band else []
+    coarse = bool(sweeps) and case.run.band_grid == "coarse"
+    if coarse:
+        gap, spacing, face = coarsened(common["gap"], common["spacing"], common["face"])
+        sweeps = [dict(kw, gap=gap, spacing=spacing, face=face)
+                  for kw in [*sweeps, dict(common, fields=None)]]
+    tasks = [(kw, lub) for kw in sweeps for lub in lubricants]
+    swept = [c.with_load_share(case.tribometer.load_share) for c in run_sweeps(
         tasks, executor, progress, desc="patch band points")]
     n = len(lubricants)
-    return [curves[i:i + n] for i in range(0, len(curves), n)], tasks
+    per_patch = [swept[i:i + n] for i in range(0, len(swept), n)]
+    if coarse:
+        per_patch = defect_corrected(per_patch[:-1], curves, per_patch[-1])
+    return per_patch, tasks
 
 
 def _summary(case: Case, out: RunLayout, curves, band) -> dict:

@@ -3,6 +3,8 @@ turns (for refinement) and the Hersey collapse of curves at several viscosities 
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..macro.friction import BOUNDARY_FRICTION
@@ -13,6 +15,20 @@ def patch_band(patch_curves) -> list:
     """(cf_min, cf_max) per lubricant over single-patch curves [patch][lubricant]."""
     cf = np.array([[c.friction_coefficient for c in per_mu] for per_mu in patch_curves])
     return [(cf[:, k].min(axis=0), cf[:, k].max(axis=0)) for k in range(cf.shape[1])]
+
+
+def defect_corrected(patch_curves, fine, coarse) -> list:
+    """Single-patch curves swept on the macro grid coarsened by two, each brought to the
+    fine grid by the average curve's grid change: ``C_f,i(h) ~ C_f,i(2h) + C_f(h) -
+    C_f(2h)`` (a defect correction; ``fine`` and ``coarse`` are the average-factor curves
+    per lubricant on the two grids, at the patch curves' speeds).  Only C_f is corrected:
+    the band (:func:`patch_band`) reads nothing else."""
+    out = []
+    for per_mu in patch_curves:
+        out.append([replace(c, friction_coefficient=c.friction_coefficient
+                            + f.friction_coefficient - g.friction_coefficient)
+                    for c, f, g in zip(per_mu, fine, coarse, strict=True)])
+    return out
 
 
 def transition_speeds(curves, step: float) -> np.ndarray:
