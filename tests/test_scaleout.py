@@ -68,3 +68,53 @@ def test_micro_tasks_follow_the_cluster_size():
         homogenise(low, up, h0, n_steps=2, executor=Recorder(), workers=workers,
                    error_estimate=False)
         assert len(Recorder.sizes) == tasks and sum(Recorder.sizes) == h0.size
+
+
+def test_the_schedule_of_a_task_graph():
+    """fem_twin.taskgraph.makespan: one worker runs the sum of the tasks, unlimited workers
+    the critical path; a diamond a -> (b, c) -> d of 1, 2, 3 and 1 s takes 7 s on one
+    worker, 5 s on two (b and c side by side) and on more."""
+    from fem_twin.taskgraph import Task, critical_path, makespan
+    tasks = [Task("a", 1.0), Task("b", 2.0, ("a",)), Task("c", 3.0, ("a",)),
+             Task("d", 1.0, ("b", "c"))]
+    assert makespan(tasks, 1) == 7.0 and makespan(tasks, 2) == 5.0
+    assert makespan(tasks, 8) == critical_path(tasks) == 5.0
+    rng = np.random.default_rng(0)
+    many = [Task(f"t{i}", float(s)) for i, s in enumerate(rng.uniform(1, 2, 40))]
+    total = sum(t.seconds for t in many)
+    assert makespan(many, 1) == pytest.approx(total)
+    for w in (2, 4, 8):                           # greedy: within one task of the ideal
+        assert total / w <= makespan(many, w) <= total / w + 2.0
+    with pytest.raises(ValueError, match="cycle"):          # an InputError
+        makespan([Task("x", 1.0, ("y",)), Task("y", 1.0, ("x",))], 2)
+
+
+def test_the_task_graph_of_a_finished_run(tmp_path):
+    """Issue 28 item 4: the graph read back from a run's checkpoints holds every h0 the
+    micro stage solved (round by round, the rounds replayed from the checkpoints), the
+    coarse cells of the grid estimate and one task per sweep; on one worker it takes the
+    CPU time the run measured for them, on the run's own 2 workers no longer than the
+    run's wall time."""
+    import json
+
+    from fem_twin.case import load_case
+    from fem_twin.cli import main
+    from fem_twin.taskgraph import critical_path, makespan, run_task_graph
+    from test_cli import small_case
+    path = small_case(tmp_path, workers=2, band=True)
+    path.write_text(path.read_text().replace("h0_count = 6", "h0_count = 24"))  # 2+ rounds
+    out = tmp_path / "out"
+    assert main(["run", str(path), "-o", str(out), "--no-progress"]) == 0
+    tasks = run_task_graph(load_case(path), out)
+    summary = json.loads((out / "summary.json").read_text())
+    solved = summary["stages"]["micro"]["h0_solved"]
+    for k, n in enumerate(solved, start=1):
+        assert sum(t.name.startswith(f"patch {k} round") for t in tasks) == n
+        assert sum(t.name.startswith(f"patch {k} coarse") for t in tasks) == n
+        assert sum(t.name.startswith(f"patch {k} round 1 ") for t in tasks) == 17 < n
+    sweeps = [t for t in tasks if "sweep" in t.name]
+    assert len(sweeps) == 2 + 3 * 2               # average, two patches and the coarse average
+    assert all(t.seconds > 0 for t in tasks if not t.name.startswith("refinement"))
+    cpu = sum(t.seconds for t in tasks)
+    assert makespan(tasks, 1) == pytest.approx(cpu)
+    assert critical_path(tasks) <= makespan(tasks, 2) <= summary["wall_time_s"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -81,9 +82,12 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
             if path is not None:
                 res.save(path)
         if error_estimate and "error_estimate" not in res.meta:
-            res = replace(res, meta={**res.meta, "error_estimate": friction_error(
-                res, gap, spacing, factors, load=load, lubricant=lubricant, face=face,
-                settings=settings, entrainment=res.meta.get("entrainment"))})
+            t0 = time.perf_counter()
+            estimate = friction_error(res, gap, spacing, factors, load=load,
+                                      lubricant=lubricant, face=face, settings=settings,
+                                      entrainment=res.meta.get("entrainment"))
+            res = replace(res, meta={**res.meta, "error_estimate": estimate,
+                                     "seconds_estimate": time.perf_counter() - t0})
             if path is not None:
                 res.save(path)
         results.append(res)

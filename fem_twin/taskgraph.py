@@ -1,0 +1,155 @@
+"""The task graph of a finished run, and what it would take on more workers.
+
+A run's independent work is a graph of tasks, each timed as it ran:
+
+* the roughness scale, per patch pair: rounds of separations h0 (the adaptive sampler of
+  :mod:`fem_twin.micro.sampling` asks for a round only after the previous one; each h0 a
+  task, its time the contact and cell seconds in its checkpoint), then the coarsened cell's
+  pass for the grid-error estimate at the chosen h0;
+* the macro scale, after every patch: one sweep per viscosity over the case's speeds (a
+  chain of warm-started points: one task, the sum of its points' solve and error-estimate
+  seconds), the refinement's added speeds of each (after all first passes), and the
+  patch band's sweeps (after the refinement).
+
+The rounds are replayed from the checkpoints (the sampler is deterministic), so the graph
+of any finished run can be read back.  :func:`makespan` schedules the graph greedily on
+``workers`` processes (a task starts on the first free worker once what it depends on has
+finished), :func:`critical_path` is the bound no number of workers beats.  Left out: the
+geometry, levelling and result writing (serial, in the main process), and the cost of one
+h0 per task: a chunk of several h0 warm-starts contact along them, which one-h0 tasks on
+a large cluster cannot (contact is about half of an h0's time, cold starts cost about 20 %
+more of it).
+"""
+
+from __future__ import annotations
+
+import heapq
+import json
+from collections import defaultdict
+from dataclasses import dataclass
+
+import numpy as np
+
+from .case import Case
+from .errors import InputError, MissingFile
+from .io.layout import RunLayout
+from .micro import FlowFactors
+from .micro.sampling import adaptive_separations
+from .micro.sliding import factors_from_moments
+from .micro.store import load_point
+from .stribeck.sweep import point_files, point_key
+
+
+@dataclass(frozen=True)
+class Task:
+    """One unit of work: its ``name``, measured ``seconds`` and the tasks it waits for."""
+
+    name: str
+    seconds: float
+    after: tuple[str, ...] = ()
+
+
+def run_task_graph(case: Case, outdir) -> list[Task]:
+    """The tasks of the finished run of ``case`` in ``outdir``, in submission order."""
+    out = RunLayout(outdir)
+    micro = [t for k in range(1, len(case.geometry.patches) + 1)
+             for t in patch_tasks(case, out, k)]
+    return micro + sweep_tasks(case, out, tuple(t.name for t in micro))
+
+
+def patch_tasks(case: Case, out: RunLayout, k: int) -> list[Task]:
+    """The h0 tasks of patch pair ``k``, round by round, then its coarse-cell pass."""
+    ff = FlowFactors.load(out.patch_factors(k))
+    folder, keys = out.patch_checkpoints(k), ff.meta["checkpoint_keys"]
+    mc = case.micro
+    h0 = np.geomspace(mc.h0_min, mc.h0_max, ff.meta.get("h0_candidates", mc.h0_count))
+    rounds = _rounds(h0, folder, keys[0], ff.meta.get("h0_tol"))
+    tasks, before = [], ()
+    for r, indices in enumerate(rounds):
+        new = [Task(f"patch {k} round {r + 1} h0 {h0[i]:.4e}",
+                    _seconds(load_point(folder, keys[0], h0[i])), before) for i in indices]
+        tasks += new
+        before = tuple(t.name for t in new)
+    if len(keys) > 1:                                    # the coarse cell (grid estimate)
+        tasks += [Task(f"patch {k} coarse h0 {h:.4e}",
+                       _seconds(load_point(folder / "coarse", keys[1], h)), before)
+                  for h in ff.h0]
+    return tasks
+
+
+def _rounds(h0, folder, key, h0_tol) -> list[list[int]]:
+    """The h0 indices each round of the sampler asked for (one round without it)."""
+    if not h0_tol:
+        return [list(range(len(h0)))]
+    rounds, seen = [], set()
+
+    def factors_at(indices):
+        rounds.append(sorted(set(indices) - seen))
+        seen.update(indices)
+        moments = [load_point(folder, key, h0[i]) for i in indices]
+        if any(m is None for m in moments):
+            raise MissingFile(f"{folder}: an h0 checkpoint of the run is missing")
+        half = (factors_from_moments(h0[indices], moments, {}, prefix="half_")
+                if all("half_h" in m for m in moments) else None)
+        return factors_from_moments(h0[indices], moments, {}), half
+    adaptive_separations(h0, factors_at, h0_tol)
+    return [r for r in rounds if r]
+
+
+def _seconds(moments) -> float:
+    if moments is None:
+        raise MissingFile("an h0 checkpoint of the run is missing")
+    return float(moments.get("seconds_contact", 0.0) + moments.get("seconds_cell", 0.0))
+
+
+def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task]:
+    """The sweeps of the macro scale: first passes, refinements, then the band's."""
+    first = np.asarray(case.sweep.speeds, float)
+    sweeps = defaultdict(list)
+    for path in point_files(out.points):
+        with np.load(path) as data:
+            meta, scalars = json.loads(str(data["meta"])), json.loads(str(data["scalars"]))
+        speed = meta.get("entrainment") if case.tribometer.ball else scalars["speed"]
+        seconds = meta.get("seconds", 0.0) + meta.get("seconds_estimate", 0.0)
+        sweeps[point_key(path)].append((speed, seconds, "error_estimate" in meta))
+    main = {k: v for k, v in sweeps.items() if any(e for _, _, e in v)}
+    split = {}
+    for key, points in main.items():
+        mine = np.isclose([u for u, _, _ in points], first[:, None], rtol=1e-9).any(axis=0)
+        split[key] = [sum(s for (_, s, _), m in zip(points, mine) if m == want)
+                      for want in (True, False)]
+    passes = [Task(f"sweep {key}", s[0], micro) for key, s in split.items()]
+    refined = [Task(f"refinement {key}", s[1], tuple(t.name for t in passes))
+               for key, s in split.items()]
+    return passes + refined + [Task(f"band sweep {key}", sum(s for _, s, _ in v),
+                                    tuple(t.name for t in refined))
+                               for key, v in sweeps.items() if key not in main]
+
+
+def makespan(tasks, workers: int) -> float:
+    """Wall time [s] of ``tasks`` on ``workers`` processes, scheduled greedily: the ready
+    task that became ready first (then in submission order) starts on the first free
+    worker."""
+    if workers < 1:
+        raise InputError(f"workers must be at least 1, got {workers}")
+    finish, waiting = {}, list(tasks)
+    free = [0.0] * workers
+    while waiting:
+        ready = [(max((finish[d] for d in t.after), default=0.0), i)
+                 for i, t in enumerate(waiting) if all(d in finish for d in t.after)]
+        if not ready:
+            raise InputError("the task graph has a cycle or an unknown dependency")
+        at, i = min(ready)
+        task = waiting.pop(i)
+        start = max(heapq.heappop(free), at)
+        finish[task.name] = start + task.seconds
+        heapq.heappush(free, finish[task.name])
+    return max(finish.values(), default=0.0)
+
+
+def critical_path(tasks) -> float:
+    """The longest chain of dependent tasks [s]: the wall time on unlimited workers."""
+    done = {}
+    for t in tasks:                               # submission order is topological
+        done[t.name] = t.seconds + max((done[d] for d in t.after), default=0.0)
+    return max(done.values(), default=0.0)
