@@ -1,8 +1,8 @@
 """Run the benchmarks and print wall times with ratios to a same-run baseline.
 
     python benchmarks/run.py [GROUP ...]      # topography contact micro macro stribeck ...
-                                              # (micro-full: ~15 min, estimate: ~10 min;
-                                              #  both only when named)
+                                              # (micro-full: ~15 min, estimate: ~10 min,
+                                              #  scale: ~10 min; only when named)
 """
 
 from __future__ import annotations
@@ -551,14 +551,16 @@ def bench_estimate(viscosity=0.066):
     return times[0], rows
 
 
+from scale import bench_scale  # noqa: E402
+
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
           "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "paper": bench_paper, "stribeck": bench_stribeck,
-          "estimate": bench_estimate,
+          "estimate": bench_estimate, "scale": bench_scale,
           "micro-full": lambda: bench_micro(full=True)}
 
 
 def main(argv):
-    groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate")]
+    groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "scale")]
     for name in groups:
         base, rows = GROUPS[name]()
         print(f"\n## {name}")

@@ -88,6 +88,12 @@ def _short_summary(summary: dict, out: Path) -> str:
                          f"{k} {v:.2%}" for k, v in err["parts_max_relative"].items())
                      + f"; tolerance {err['tolerance']:.2%}; flow-factor estimates in "
                      "summary.json)")
+    graph = summary.get("task_graph")
+    if graph:
+        wall = graph["wall_s"]
+        lines.append(f"  its {graph['tasks']} tasks ({graph['cpu_s']:.0f} CPU s) would take "
+                     f"{wall['8']:.0f} s on 8 workers, {wall['64']:.0f} s on 64 (critical "
+                     f"path {graph['critical_path_s']:.0f} s; fem_twin.taskgraph)")
     lines.append(f"results in {out}/ (stribeck.csv, plots, results.nc and fields.nc for "
                  f"fem_twin.results.open_run, fields/ for ParaView, summary.json, run.log); "
                  f"the figures on one page: fem-twin report {out}")

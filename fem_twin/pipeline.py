@@ -65,9 +65,21 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
             summary["seconds"][name] = round(time.perf_counter() - t, 2)
             log.info("stage %s done in %.1f s", name, summary["seconds"][name])
     summary["wall_time_s"] = time.perf_counter() - t0
+    summary["task_graph"] = _task_graph(case, out)
     with atomic_path(out.summary) as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     return summary
+
+
+def _task_graph(case: Case, out: RunLayout) -> dict:
+    """The run's task graph and its wall time on more workers
+    (:func:`fem_twin.taskgraph.scaling`); an empty dict, logged, if it cannot be read."""
+    from .taskgraph import scaling
+    try:
+        return scaling(case, out.root)
+    except (OSError, ValueError, KeyError) as err:
+        log.warning("the run's task graph could not be read back: %s", err)
+        return {}
 
 
 def invalidate_changed_stages(case: Case, out: RunLayout) -> None:

@@ -131,6 +131,9 @@ def tables_section(summary: dict) -> str:
     micro = stages.get("micro", {})
     rows = [("wall time", f"{summary.get('wall_time_s', float('nan')):.1f} s")]
     rows += [(f"stage {k}", f"{v:.1f} s") for k, v in summary.get("seconds", {}).items()]
+    graph = summary.get("task_graph") or {}
+    rows += [(f"its {graph['tasks']} tasks on {w} workers (task graph)", f"{v:.1f} s")
+             for w, v in graph.get("wall_s", {}).items()]
     timing = _table(["", "time"], rows)
     est = micro.get("error_estimate", {})
     qs = sorted({q for kind in est.values() if isinstance(kind, dict) for q in kind

@@ -153,3 +153,17 @@ def critical_path(tasks) -> float:
     for t in tasks:                               # submission order is topological
         done[t.name] = t.seconds + max((done[d] for d in t.after), default=0.0)
     return max(done.values(), default=0.0)
+
+
+#: worker counts of :func:`scaling`'s estimates
+WORKERS = (1, 2, 4, 8, 16, 64)
+
+
+def scaling(case: Case, outdir) -> dict:
+    """The run's task graph in numbers (``summary.json`` ``"task_graph"``): task count, CPU
+    seconds, critical path and the wall time of its tasks on each of :data:`WORKERS`
+    processes [s] (the serial stages and the writing of results not included)."""
+    tasks = run_task_graph(case, outdir)
+    return {"tasks": len(tasks), "cpu_s": round(sum(t.seconds for t in tasks), 1),
+            "critical_path_s": round(critical_path(tasks), 1),
+            "wall_s": {str(w): round(makespan(tasks, w), 1) for w in WORKERS}}

@@ -118,3 +118,6 @@ def test_the_task_graph_of_a_finished_run(tmp_path):
     cpu = sum(t.seconds for t in tasks)
     assert makespan(tasks, 1) == pytest.approx(cpu)
     assert critical_path(tasks) <= makespan(tasks, 2) <= summary["wall_time_s"]
+    graph = summary["task_graph"]                 # the run's summary holds the same numbers
+    assert graph["tasks"] == len(tasks) and graph["cpu_s"] == pytest.approx(cpu, abs=0.1)
+    assert graph["wall_s"]["2"] == pytest.approx(makespan(tasks, 2), abs=0.1)

@@ -1,0 +1,73 @@
+"""Benchmark group ``scale``: one cold and one warm macro point from 128^2 up (issue 28 item 3).
+
+Sample pin 1 on disk 1 prepared at n^2 (``run._macro_gap``) with the macro groups' flow
+factors (sample patch 1 at 64^2, 30 h0 x 8 steps), 150 N, 0.066 Pa s: a cold point at
+0.03 m/s (mixed lubrication, the coarse-to-fine start included) and a warm one at
+0.025 m/s from it.  Each grid runs in a process of its own, so its peak memory (maximum
+resident set) is its own.  ``FEM_TWIN_SCALE_MAX`` (default 1024) is the largest grid:
+2048 takes the better part of an hour today.  Baseline: the cold point at 128^2.  The
+growth exponent is ``log(t_n / t_(n/2)) / log 4``, in the number of nodes N.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+COLD, WARM = 0.03, 0.025          # [m/s]
+
+
+def bench_scale():
+    from run import _macro_factors
+    top = int(os.environ.get("FEM_TWIN_SCALE_MAX", "1024"))
+    sizes = [n for n in (128, 256, 512, 1024, 2048) if n <= top]
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "factors.npz")
+        _macro_factors().save(path)
+        runs = [json.loads(subprocess.run(
+            [sys.executable, __file__, str(n), path], check=True, capture_output=True,
+            text=True).stdout.splitlines()[-1]) for n in sizes]
+    base, rows = runs[0]["cold"], []
+    for i, r in enumerate(runs):
+        growth = ("" if i == 0 else ", growth N^%.2f cold, N^%.2f warm" % tuple(
+            np.log(r[k] / runs[i - 1][k]) / np.log(4) for k in ("cold", "warm")))
+        rows.append((f"cold point {r['n']}^2, {COLD} m/s", r["cold"],
+                     f"{r['cold_iterations']} it, C_f {r['cf']:.5f}, peak memory "
+                     f"{r['rss_gib']:.2f} GiB{growth}"))
+        rows.append((f"warm point {r['n']}^2, {WARM} m/s", r["warm"],
+                     f"{r['warm_iterations']} it"))
+    return base, rows
+
+
+def _point(n: int, factors: str) -> dict:
+    """One grid's cold and warm points (in a process of its own)."""
+    from run import _macro_gap
+
+    from fem_twin.macro import Lubricant, solve_mixed
+    from fem_twin.micro import FlowFactors
+    ff = FlowFactors.load(factors)
+    gap, spacing, face = _macro_gap(n)
+    common = dict(load=150.0, face=face, lubricant=Lubricant(0.066))
+    t0 = time.perf_counter()
+    cold = solve_mixed(gap, spacing, ff, speed=COLD, **common)
+    t1 = time.perf_counter()
+    warm = solve_mixed(gap, spacing, ff, speed=WARM, initial=cold, **common)
+    t2 = time.perf_counter()
+    return {"n": n, "cold": t1 - t0, "warm": t2 - t1, "cf": cold.friction_coefficient,
+            "cold_iterations": cold.iterations, "warm_iterations": warm.iterations,
+            "rss_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20}
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    print(json.dumps(_point(int(sys.argv[1]), sys.argv[2])))
