@@ -59,8 +59,8 @@ class Case:
         C_f error estimates), one sweep per viscosity and, with ``[run] patch_band``, one
         more per patch (and the average's, at ``COARSE_BAND_COST`` on the coarse grid of
         ``[run] band_grid``); a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured against
-        it: the bundled case 288-349 s (estimated 283 s), the paper case 25.5 min with the
-        band and 13.4 without (estimated 27.1 and 12.2)."""
+        it: the bundled case 141 s (estimated 142 s), the paper case 20.0 min with the band
+        and 13.4 without (estimated 16.5 and 12.2)."""
         patches = len(self.geometry.patches)
         h0 = min(self.micro.h0_count, ADAPTIVE_H0) if self.micro.h0_tol else self.micro.h0_count
         micro = (3e-6 * self.micro.resolution[0] * self.micro.resolution[1] * self.micro.steps
