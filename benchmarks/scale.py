@@ -3,7 +3,8 @@
 Sample pin 1 on disk 1 prepared at n^2 (``run._macro_gap``) with the macro groups' flow
 factors (sample patch 1 at 64^2, 30 h0 x 8 steps), 150 N, 0.066 Pa s: a cold point at
 0.03 m/s (mixed lubrication, the coarse-to-fine start included) and a warm one at
-0.025 m/s from it.  Each grid runs in a process of its own, so its peak memory (maximum
+0.025 m/s from it, both as a sweep solves them (:func:`fem_twin.macro.nested.solve_nested`:
+the point on the coarsened grid first).  Each grid runs in a process of its own, so its peak memory (maximum
 resident set) is its own.  ``FEM_TWIN_SCALE_MAX`` (default 1024) is the largest grid:
 2048 takes the better part of an hour today.  Baseline: the cold point at 128^2.  The
 growth exponent is ``log(t_n / t_(n/2)) / log 4``, in the number of nodes N.
@@ -53,15 +54,17 @@ def _point(n: int, factors: str) -> dict:
     """One grid's cold and warm points (in a process of its own)."""
     from run import _macro_gap
 
-    from fem_twin.macro import Lubricant, solve_mixed
+    from fem_twin.macro import Lubricant
+    from fem_twin.macro.nested import solve_nested
     from fem_twin.micro import FlowFactors
     ff = FlowFactors.load(factors)
     gap, spacing, face = _macro_gap(n)
     common = dict(load=150.0, face=face, lubricant=Lubricant(0.066))
     t0 = time.perf_counter()
-    cold = solve_mixed(gap, spacing, ff, speed=COLD, **common)
+    cold, coarse = solve_nested(gap, spacing, ff, speed=COLD, **common)
     t1 = time.perf_counter()
-    warm = solve_mixed(gap, spacing, ff, speed=WARM, initial=cold, **common)
+    warm, _ = solve_nested(gap, spacing, ff, speed=WARM, previous=cold, previous_coarse=coarse,
+                           **common)
     t2 = time.perf_counter()
     return {"n": n, "cold": t1 - t0, "warm": t2 - t1, "cf": cold.friction_coefficient,
             "cold_iterations": cold.iterations, "warm_iterations": warm.iterations,

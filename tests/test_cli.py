@@ -173,7 +173,7 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     assert (ref / "validation_mu0.066.png").is_file()
 
     calls = {"n": 0}
-    real = sweep.solve_mixed
+    real = sweep.solve_nested
 
     def interrupted(*args, **kwargs):
         calls["n"] += 1
@@ -182,10 +182,10 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
         return real(*args, **kwargs)
 
     out = tmp_path / "out"
-    monkeypatch.setattr(sweep, "solve_mixed", interrupted)
+    monkeypatch.setattr(sweep, "solve_nested", interrupted)
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 130   # Ctrl-C
     assert not (out / "stribeck.csv").exists()
-    monkeypatch.setattr(sweep, "solve_mixed", real)
+    monkeypatch.setattr(sweep, "solve_nested", real)
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
     assert (out / "stribeck.csv").read_text() == (ref / "stribeck.csv").read_text()
     stamps = {p: p.stat().st_mtime_ns for p in (out / "stribeck" / "checkpoints").iterdir()}

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..errors import MixedNotConverged
 from .mixed import solve_mixed
+from .nested import coarsened
 
 #: the order assumed in ``|C_f(h) - C_f(2h)| / (2^p - 1)``.  The scheme's is 2 (bundled
 #: pin at 0.03 m/s: 1.97, 1.95 on 128 -> 255 -> 509 -> 1017 px refined in place), but
@@ -47,24 +48,20 @@ H0_SPACING_RATIO = 4.0
 PARTS = ("macro", "time", "grid", "h0")
 
 
-def coarsened(gap, spacing, face):
-    """``(gap, spacing, face)`` on every other node of the grid [m] (``face`` None: None)."""
-    return (np.asarray(gap)[::2, ::2], (2 * spacing[0], 2 * spacing[1]),
-            None if face is None else np.asarray(face, bool)[::2, ::2])
-
-
 def friction_error(result, gap, spacing, factors, *, load: float, lubricant, face=None,
-                   settings, entrainment: float | None = None) -> dict:
+                   settings, entrainment: float | None = None, coarse=None) -> dict:
     """Estimated discretisation error of ``result.friction_coefficient`` per part and in
     total (see the module docstring), for the point ``result`` that
-    :func:`~fem_twin.macro.solve_mixed` returned for these arguments."""
+    :func:`~fem_twin.macro.solve_mixed` returned for these arguments; ``coarse``: the same
+    point already solved on the coarsened grid (:func:`.nested.solve_nested`'s), which is
+    then not solved again."""
     face = np.ones(np.shape(gap), bool) if face is None else face
     gap2, spacing2, face2 = coarsened(gap, spacing, face)
     common = dict(load=load, speed=result.speed, entrainment=entrainment,
                   lubricant=lubricant, face=face2, settings=settings)
     out, failed = {}, []
     try:
-        base = solve_mixed(gap2, spacing2, factors, initial=result, **common)
+        base = coarse or solve_mixed(gap2, spacing2, factors, initial=result, **common)
     except MixedNotConverged as err:
         return {**{part: np.nan for part in PARTS}, "total": np.nan,
                 "failed": [f"coarse grid: {err.args[0]}"]}

@@ -131,14 +131,17 @@ def on_grid(result: MixedResult, shape, dx) -> MixedResult:
     """``result`` interpolated (linearly, by coordinates from the first node) onto a grid."""
     if result.pressure.shape == tuple(shape) and np.allclose(result.spacing, dx):
         return result
+    fields = {k: resampled(getattr(result, k), result.spacing, shape, dx)
+              for k in FIELDS if k != "face"}
+    return replace(result, spacing=tuple(dx), **fields,
+                   face=resampled(result.face, result.spacing, shape, dx) > 0.5)
+
+
+def resampled(field, spacing, shape, dx) -> np.ndarray:
+    """A nodal ``field`` on a grid of ``spacing`` interpolated (linearly, by coordinates from
+    the first node) onto the grid ``shape``, ``dx`` [m]."""
     from scipy.ndimage import map_coordinates
-    rows = np.arange(shape[0]) * dx[1] / result.spacing[1]
-    cols = np.arange(shape[1]) * dx[0] / result.spacing[0]
-    where = np.meshgrid(rows, cols, indexing="ij")
-
-    def interp(f):
-        return map_coordinates(np.asarray(f, float), where, order=1, mode="nearest")
-
-    return replace(result, spacing=tuple(dx), **{k: interp(getattr(result, k))
-                                                 for k in FIELDS if k != "face"},
-                   face=interp(result.face) > 0.5)
+    rows = np.arange(shape[0]) * dx[1] / spacing[1]
+    cols = np.arange(shape[1]) * dx[0] / spacing[0]
+    return map_coordinates(np.asarray(field, float), np.meshgrid(rows, cols, indexing="ij"),
+                           order=1, mode="nearest")

@@ -12,8 +12,9 @@ from tqdm import tqdm
 from ..errors import InputError
 from ..io.checkpoint import input_key, load_or_none
 from ..io.mesh import write_pvd
-from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
+from ..macro import Lubricant, MacroSettings, MixedResult
 from ..macro.estimate import PARTS, friction_error
+from ..macro.nested import solve_nested
 from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from .curve import StribeckCurve, hersey_number
@@ -68,30 +69,31 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     folder = Path(checkpoint) if checkpoint is not None else None
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
-    results, previous = [], None
+    results, previous, previous_coarse = [], None, None
     for i, speed in enumerate(tqdm(speeds, desc=f"Stribeck mu0={lubricant.viscosity:g}",
                                    disable=not progress, unit="speed")):
         path = None if folder is None else point_file(folder, key, speed)
-        res = None if path is None else load_or_none(path, MixedResult.load)
+        res, coarse = None if path is None else load_or_none(path, MixedResult.load), None
         if res is None:
             sliding = dict(speed=float(speed)) if slide_to_roll is None else dict(
                 speed=float(slide_to_roll * speed), entrainment=float(speed))
-            res = solve_mixed(gap, spacing, factors, load=load, **sliding,
-                              lubricant=lubricant, face=face, settings=settings,
-                              initial=previous)
+            res, coarse = solve_nested(gap, spacing, factors, load=load, **sliding,
+                                       lubricant=lubricant, face=face, settings=settings,
+                                       previous=previous, previous_coarse=previous_coarse)
             if path is not None:
                 res.save(path)
         if error_estimate and "error_estimate" not in res.meta:
             t0 = time.perf_counter()
             estimate = friction_error(res, gap, spacing, factors, load=load,
                                       lubricant=lubricant, face=face, settings=settings,
-                                      entrainment=res.meta.get("entrainment"))
+                                      entrainment=res.meta.get("entrainment"),
+                                      coarse=coarse)
             res = replace(res, meta={**res.meta, "error_estimate": estimate,
                                      "seconds_estimate": time.perf_counter() - t0})
             if path is not None:
                 res.save(path)
         results.append(res)
-        previous = res
+        previous, previous_coarse = res, coarse
     if fields is not None:
         fields = Path(fields)
         fields.mkdir(parents=True, exist_ok=True)
