@@ -444,7 +444,7 @@ def bench_paper():
     micro time of one h0."""
     from fem_twin.case import load_case
     from fem_twin.macro import Lubricant
-    from fem_twin.macro.estimate import coarsened
+    from fem_twin.macro.nested import coarsened
     from fem_twin.micro import DEFAULT_H0, homogenise
     from fem_twin.stribeck import stribeck_sweep
 

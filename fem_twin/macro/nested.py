@@ -13,7 +13,8 @@ for the pressure, cavity fraction, elastic deformation, contact pressure and ``h
 full approximation scheme's correction, Brandt 1977).  The fine grid keeps its own detail
 and needs 8-10 iterations instead of 19-26 (sample pin 1 at 256^2, 8 speeds of the paper's
 sweep: 33.5 s against 46.5 s, C_f the same to 7e-9 C_f,b).  The coarse solution is also
-the base of the point's macro error estimate (:mod:`.estimate`), which no longer solves it.
+the base of the point's macro error estimate (:mod:`fem_twin.macro.estimate`), which no
+longer solves it.
 """
 
 from __future__ import annotations

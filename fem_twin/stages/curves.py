@@ -16,7 +16,7 @@ from tqdm import tqdm
 from ..case import Case
 from ..io.layout import RunLayout
 from ..macro import MacroSettings, MixedResult
-from ..macro.estimate import coarsened
+from ..macro.nested import coarsened
 from ..macro.figures import plot_point_fields
 from ..macro.point_contact import film_against_hamrock_dowson
 from ..micro import FlowFactors
