@@ -67,12 +67,12 @@ def patch_tasks(case: Case, out: RunLayout, k: int) -> list[Task]:
     tasks, before = [], ()
     for r, indices in enumerate(rounds):
         new = [Task(f"patch {k} round {r + 1} h0 {h0[i]:.4e}",
-                    _seconds(load_point(folder, keys[0], h0[i])), before) for i in indices]
+                    _seconds(_moments(folder, keys[0], h0[i])), before) for i in indices]
         tasks += new
         before = tuple(t.name for t in new)
     if len(keys) > 1:                                    # the coarse cell (grid estimate)
         tasks += [Task(f"patch {k} coarse h0 {h:.4e}",
-                       _seconds(load_point(folder / "coarse", keys[1], h)), before)
+                       _seconds(_moments(folder / "coarse", keys[1], h)), before)
                   for h in ff.h0]
     return tasks
 
@@ -86,9 +86,7 @@ def _rounds(h0, folder, key, h0_tol) -> list[list[int]]:
     def factors_at(indices):
         rounds.append(sorted(set(indices) - seen))
         seen.update(indices)
-        moments = [load_point(folder, key, h0[i]) for i in indices]
-        if any(m is None for m in moments):
-            raise MissingFile(f"{folder}: an h0 checkpoint of the run is missing")
+        moments = [_moments(folder, key, h0[i]) for i in indices]
         half = (factors_from_moments(h0[indices], moments, {}, prefix="half_")
                 if all("half_h" in m for m in moments) else None)
         return factors_from_moments(h0[indices], moments, {}), half
@@ -96,9 +94,14 @@ def _rounds(h0, folder, key, h0_tol) -> list[list[int]]:
     return [r for r in rounds if r]
 
 
-def _seconds(moments) -> float:
+def _moments(folder, key, h0) -> dict:
+    moments = load_point(folder, key, h0)
     if moments is None:
-        raise MissingFile("an h0 checkpoint of the run is missing")
+        raise MissingFile(f"{folder}: the run's h0 checkpoint at {h0:.4e} m is missing")
+    return moments
+
+
+def _seconds(moments) -> float:
     return float(moments.get("seconds_contact", 0.0) + moments.get("seconds_cell", 0.0))
 
 

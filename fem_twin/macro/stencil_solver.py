@@ -32,8 +32,8 @@ GRIDS = 3
 def newton_solver(shape, dirichlet, interior, K, B):
     """``step(pos, dtheta, rhs)`` solving ``(K diag(pos) + B diag(dtheta)) x = rhs`` on the
     interior with PARDISO, or None without PARDISO or when ``K`` or ``B`` leave the 3x3
-    stencil.  A step returns None (the caller then uses
-    SuperLU) when pivots were perturbed or it does not reach ``STEP_RTOL``."""
+    stencil.  A step returns None (the caller then uses SuperLU) when pivots were perturbed
+    or it does not reach ``STEP_RTOL``."""
     if shape is None or default_backend() != "pardiso":
         return None
     grid = _grid(shape, dirichlet, interior)
@@ -53,10 +53,10 @@ class _Grid:
     """One grid's stencil pattern, its PARDISO solver and the maps of ``K`` and ``B``."""
 
     def __init__(self, shape, interior):
-        self.indptr, self.indices, self.keys = _stencil_pattern(shape, interior)
-        self.n = self.indptr.size - 1
         self.position = np.full(shape[0] * shape[1], -1)
         self.position[interior] = np.arange(interior.size)
+        self.n = interior.size
+        self.indptr, self.indices, self.keys = _stencil_pattern(shape, self.position, self.n)
         self.solver = SPDSolver(self.indptr, self.indices, "pardiso", symmetric=False)
         self._maps = []                       # [(indptr, indices, at, keep, col)]
 
@@ -102,12 +102,10 @@ def _grid(shape, dirichlet, interior) -> _Grid:
     return grid
 
 
-def _stencil_pattern(shape, interior):
-    """CSR pattern of the 3x3 stencil on the interior nodes and its sorted keys
-    ``row * n + col``."""
+def _stencil_pattern(shape, position, n):
+    """CSR pattern of the 3x3 stencil on the ``n`` interior nodes (``position``: each
+    node's interior number, -1 elsewhere) and its sorted keys ``row * n + col``."""
     ny, nx = shape
-    position = np.full(ny * nx, -1)
-    position[interior] = np.arange(interior.size)
     idx = np.arange(ny * nx).reshape(ny, nx)
     rows, cols = [], []
     for di in (-1, 0, 1):
@@ -118,7 +116,6 @@ def _stencil_pattern(shape, interior):
             cols.append(position[b.ravel()])
     rows, cols = np.concatenate(rows), np.concatenate(cols)
     keep = (rows >= 0) & (cols >= 0)
-    n = interior.size
     P = sp.csr_matrix((np.ones(keep.sum()), (rows[keep], cols[keep])), shape=(n, n))
     P.sort_indices()
     keys = np.repeat(np.arange(n, dtype=np.int64), np.diff(P.indptr)) * n + P.indices

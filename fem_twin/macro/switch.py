@@ -4,9 +4,8 @@ One unknown per node, ``phi``: ``p = max(phi, 0)``, ``theta = max(-phi, 0) / s``
 switch), which makes ``p theta = 0`` exact.  The residual is piecewise linear in ``phi``;
 semismooth Newton (primal-dual active set) solves it and stops when the active set no
 longer changes and the mass residual is below ``tol``.  Each Newton step is solved by
-PARDISO on the fixed 3x3-stencil pattern of the grid, its last factorisation reused as a
-preconditioner (:mod:`.stencil_solver`), or, without MKL, by SuperLU in a
-nested-dissection order.
+PARDISO on the fixed 3x3-stencil pattern of the grid (:mod:`.stencil_solver`) or, without
+MKL, by SuperLU in a nested-dissection order.
 """
 
 from __future__ import annotations
