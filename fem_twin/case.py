@@ -127,7 +127,8 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
 
 
 def _tribometer(data, where) -> Tribometer:
-    tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
+    tribometer = _section(data, "tribometer", Tribometer, where, positive=True,
+                          zero_ok=("slide_to_roll",))
     if tribometer.ball and tribometer.load_share != 1.0:
         raise CaseError(f"{where} [tribometer] load_share: a ball carries the whole load "
                         "(load_share = 1); it is a pin face's share")

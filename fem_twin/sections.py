@@ -55,8 +55,8 @@ class Tribometer:
     kind: str = setting("pin-on-disk", "the tribometer", choices=("pin-on-disk",
                                                                   "ball-on-disk"))
     ball_radius: float = setting(12.5e-3, "radius of a ball-on-disk's ball", "length")
-    slide_to_roll: float = setting(0.5, "slide-to-roll ratio u_r / u_m of a ball (2: a "
-                                   "stationary ball)", "slide_to_roll")
+    slide_to_roll: float = setting(0.5, "slide-to-roll ratio u_r / u_m of a ball, in [0, 2] "
+                                   "(0: pure rolling; 2: a stationary ball)", "slide_to_roll")
     track_radius: float = setting(20e-3, "radius of a ball's track (recorded)", "length")
 
     @property

@@ -15,7 +15,10 @@ def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, C, d, spa
     """tau_hd,31 of eq 31 on the lower surface [Pa], sliding speed ``speed`` along +x1.
 
     ``tau = -(h_m/2) (C grad p)_1 + (mu / h_m) (-6 u_m d_1 + u_r) (1 - theta)`` with
-    ``u_r = U`` and ``u_m = U/2`` (a stationary pin) or ``entrainment`` (a ball on a disk);
+    ``u_r = U`` and ``u_m = U/2`` (a stationary pin) or ``entrainment`` (a ball on a disk),
+    with ``d`` at that slide-to-roll ratio (:func:`fem_twin.micro.at_slide_to_roll`, as
+    :func:`~fem_twin.macro.solve_mixed` passes it): the Couette part is then
+    ``(mu u_r / h_m) (1 - 3 d_1)`` in the pin-at-rest ``d``, zero in pure rolling;
     ``grad p`` by second-order central differences on the grid.  ``eyring_stress`` tau_0
     [Pa]: the Couette (shear-driven) part becomes ``tau_0 asinh(tau / tau_0)`` (Eyring).
     """

@@ -33,6 +33,7 @@ import numpy as np
 from ..checks import plausible
 from ..errors import InputError, MixedNotConverged
 from ..micro.flow_factors import FlowFactors
+from ..micro.rolling import at_slide_to_roll
 from ..threads import one_thread
 from . import newton
 from .fixed_point import Concentrated, solve_fixed_point
@@ -67,8 +68,10 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
     load : imposed normal load F_N,imp [N]
     speed : sliding speed U of the disk [m/s] (``u_r = U``; ``u_m = U/2`` on a pin)
     entrainment : mean speed ``u_m`` of the surfaces [m/s] when it is not ``U/2``: a ball on
-        a disk at slide-to-roll ratio ``SRR = u_r / u_m`` has ``speed = SRR u_m`` (eq 17 takes
-        u_m, the shear of eq 31 both); a pure rolling contact is approached with a small SRR
+        a disk at slide-to-roll ratio ``SRR = u_r / u_m`` has ``speed = SRR u_m`` (0: pure
+        rolling).  The flow factors (computed with the pin at rest, SRR 2) are carried to
+        that SRR by :func:`fem_twin.micro.at_slide_to_roll` (the rolling-sliding Couette and
+        shear factors; :mod:`fem_twin.micro.rolling`)
     lubricant : mu_0 and the constants of eqs 23-24
     face : (ny, nx) bool, the pin face for the friction integral (eq 33); all if None
     initial : a result to warm-start from (e.g. the neighbouring speed of a sweep)
@@ -80,11 +83,13 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
     if not np.all(np.isfinite(h_g)):
         raise InputError("gap contains NaN or inf: repair the topography first")
     plausible("load [N]", load, "load")
-    plausible("speed [m/s]", speed, "speed")
+    if entrainment is None or speed != 0:                # 0 with u_m: pure rolling
+        plausible("speed [m/s]", speed, "speed")
     plausible("spacing [m]", spacing, "pitch")
     u_m = speed / 2 if entrainment is None else float(entrainment)
     if not (u_m > 0 and np.isfinite(u_m)):
         raise InputError(f"entrainment speed must be positive [m/s], got {entrainment}")
+    factors = at_slide_to_roll(factors, speed / u_m)
     dx = tuple(float(v) for v in np.broadcast_to(np.asarray(spacing, float), (2,)))
     face = np.ones(h_g.shape, bool) if face is None else np.asarray(face, bool)
     if face.shape != h_g.shape:

@@ -6,7 +6,9 @@
 from .cell import CellSolution, CellSolver
 from .flow_factors import FlowFactors, LocalFactors, average
 from .homogenisation import DEFAULT_H0, homogenise
+from .rolling import at_slide_to_roll
 from .sliding import CellSettings, sliding_pass
 
 __all__ = ["CellSolution", "CellSolver", "FlowFactors", "LocalFactors", "average", "DEFAULT_H0",
+           "at_slide_to_roll",
            "CellSettings", "homogenise", "sliding_pass"]

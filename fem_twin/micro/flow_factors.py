@@ -189,7 +189,9 @@ class FlowFactors:
         """``{kind: FlowFactors}``: these factors with each estimated discretisation error
         added (``"time"``, ``"grid"``, ``"h0"``; :func:`fem_twin.micro.estimate.variants`),
         for the macro scale's error estimate; empty when the micro stage kept none."""
-        return {kind: FlowFactors(**{k: np.asarray(v, float) for k, v in arrays.items()})
+        own = {k: self.meta[k] for k in ("slide_to_roll",) if k in self.meta}
+        return {kind: FlowFactors(**{k: np.asarray(v, float) for k, v in arrays.items()},
+                                  meta=dict(own))
                 for kind, arrays in self.meta.get("variants", {}).items()}
 
     def smooth_limit_error(self) -> float:
@@ -231,11 +233,15 @@ def average(factors) -> FlowFactors:
         if not np.allclose(f.h0[[0, -1]], h0[[0, -1]], rtol=1e-12, atol=0):
             raise InputError("flow factors to average must share the same h0 values "
                              "(or at least the same h0 range, when sampled adaptively)")
+    kinematics = {f.meta.get("slide_to_roll", 2.0) for f in factors}
+    if len(kinematics) > 1:
+        raise InputError(f"flow factors to average differ in slide_to_roll {kinematics}")
     local = [f if f.h0.size == h0.size else f.at(h0) for f in factors]
     mean = {k: np.mean([getattr(f, k) for f in local], axis=0) for k in ARRAYS if k != "h0"}
     meta = {"average_of": [{k: v for k, v in f.meta.items() if k != "variants"}
                            for f in factors],
             "method": factors[0].meta.get("method"), "version": factors[0].meta.get("version"),
+            "slide_to_roll": kinematics.pop(),
             "error_estimate": combine(f.meta.get("error_estimate") for f in factors),
             "variants": _average_variants(factors)}
     return FlowFactors(h0=h0, **mean, meta=meta)

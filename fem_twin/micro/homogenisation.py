@@ -55,7 +55,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
         historical keyword), ``e_reduced`` and
         ``hardness`` [Pa] (Table 4), ``method`` (``"fe"`` or the paper's ``"fvm"``),
         ``moving`` (``"upper"``: the disk slides at ``+U`` over the pin at rest; ``"lower"``:
-        the same seen from the disk), ``time_derivative`` (``"exact"``: the squeeze term of
+        the same seen from the disk), ``slide_to_roll`` (both surfaces moving, the pin at
+        ``u_m (1 - SRR/2)``: :mod:`fem_twin.micro.rolling`), ``time_derivative`` (``"exact"``: the squeeze term of
         eq 8 at every instant, no time-step error, :func:`.sliding.sliding_squeeze`;
         ``"backward"``: the paper's implicit Euler), ``first_step`` (``"backward"`` only),
         ``gap_floor`` [m], ``contact_tol``, ``rate_tol``, ``time_tol`` (adaptive instants,
@@ -147,6 +148,7 @@ def _meta(settings: CellSettings, pin, disk, spacing) -> dict:
             "e_reduced": settings.e_reduced, "hardness": settings.hardness,
             "gap_floor": settings.gap_floor, "n_steps": settings.steps,
             "method": settings.method, "moving": settings.moving,
+            "slide_to_roll": settings.slide_to_roll,
             "first_step": settings.first_step, "time_derivative": settings.time_derivative,
             "version": __version__, "time_tol": settings.time_tol,
             "sq": float(np.hypot(pin.heights.std(), disk.heights.std())),

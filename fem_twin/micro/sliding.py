@@ -41,7 +41,7 @@ import numpy as np
 from ..contact import contact_rate
 from ..contact import solve as contact_solve
 from ..contact.levelling import TABLE4
-from ..checks import check_choices, setting
+from ..checks import check_choices, plausible, setting
 from ..errors import InputError
 from .cell_fv import CellSolverFV
 from .flow_factors import FlowFactors
@@ -65,6 +65,10 @@ class CellSettings:
     moving: str = setting("upper", "the sliding surface: the disk at +U over the pin at rest "
                           "(the tribometer), or the pin at -U (the disk's frame)",
                           choices=("upper", "lower"))
+    slide_to_roll: float = setting(2.0, "SRR = u_r / u_m of the cell's kinematics: the pin or "
+                                   "ball at u_m (1 - SRR/2), the disk at u_m (1 + SRR/2) "
+                                   "(2: the pin at rest; exact squeeze term only)",
+                                   "slide_to_roll", section="tribometer")
     first_step: str = setting("steady", "backward scheme only: no time term at the first "
                               "step (the paper), or the last instant before the first",
                               choices=("steady", "periodic"))
@@ -84,6 +88,10 @@ class CellSettings:
         check_choices(self)
         if int(self.steps) != self.steps or self.steps < 1:
             raise InputError(f"steps must be a positive integer, got {self.steps}")
+        if self.slide_to_roll != 2 and not (self.moving == "upper"
+                                            and self.time_derivative == "exact"):
+            raise InputError("slide_to_roll other than 2 is computed in the pin's frame "
+                             "(moving='upper') with time_derivative='exact'")
         if self.time_tol is not None and not (0 < self.time_tol < 1
                                               and self.time_derivative == "exact"):
             raise InputError("time_tol is a relative tolerance in (0, 1), with "
@@ -92,7 +100,8 @@ class CellSettings:
                 and self.contact_tol > 0 and self.rate_tol > 0):
             raise InputError("e_reduced, hardness, gap_floor, contact_tol and rate_tol must "
                              "be positive (Pa, Pa, m, -, -)")
-        for name in ("e_reduced", "hardness", "gap_floor"):    # one key for 2e11 and 2e11.0
+        plausible("slide_to_roll", self.slide_to_roll, "slide_to_roll")
+        for name in ("e_reduced", "hardness", "gap_floor", "slide_to_roll"):  # 2e11 = 2e11.0
             object.__setattr__(self, name, float(getattr(self, name)))
         object.__setattr__(self, "steps", int(self.steps))
 
@@ -111,8 +120,10 @@ class SlidingPass:
     um_dt
         ``u_m dt`` between instants [m], ``+s/2`` (disk moving) or ``-s/2`` (pin)
     rigid_rate
-        ``-2 d(moving)/dx1`` at each instant, the rigid part of the squeeze term of eq 8
-        (central difference, the discrete derivative of the Couette flux) [-]
+        ``(1/u_m) d(z_up - z_low)/dt`` of the rigid surfaces at each instant, the rigid part
+        of the squeeze term of eq 8 (central differences, the discrete derivative of the
+        Couette flux) [-]: ``-2 d(moving)/dx1`` with one surface at rest,
+        ``-(1 + SRR/2) d z_up/dx1 + (1 - SRR/2) d z_low/dx1`` with both moving
     """
 
     shapes: list
@@ -125,7 +136,13 @@ def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | No
                  offset: float = 0.0) -> SlidingPass:
     """The moving surface shifts by ``s = L_r1 / N_t`` per step (``+s`` for the disk, ``-s``
     for the pin in the disk's frame); ``u_m dt = (shift_up + shift_low) / 2``.  The instants
-    are ``(k + offset) s`` for ``k < N_t`` (``offset = 1/2``: the midpoints)."""
+    are ``(k + offset) s`` for ``k < N_t`` (``offset = 1/2``: the midpoints).
+
+    Both surfaces moving (``settings.slide_to_roll`` = SRR < 2, :mod:`.rolling`): the pin at
+    ``u_1 = u_m (1 - SRR/2)`` and the disk at ``u_2 = u_m (1 + SRR/2)``.  The cell averages
+    see only the relative position, so the instants are the same relative shifts, the pin
+    kept in place (a common translation of both leaves every average unchanged), and the
+    squeeze term is that of both translations at each instant."""
     nx = z_low.shape[1]
     n_steps = settings.steps if n_steps is None else n_steps
     px = nx / n_steps                            # pixels per step
@@ -136,7 +153,12 @@ def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | No
     else:
         moving = [-_shift(z_low, -k) for k in n]
         shapes, um_dt = [z_up + m for m in moving], -px * spacing[0] / 2
-    return SlidingPass(shapes, moving, um_dt, [-2.0 * _d_dx1(m, spacing[0]) for m in moving])
+    rates = [-2.0 * _d_dx1(m, spacing[0]) for m in moving]
+    if settings.slide_to_roll != 2:
+        r = settings.slide_to_roll / 2
+        lower = (1 - r) * _d_dx1(z_low, spacing[0])
+        rates = [(1 + r) / 2 * rate + lower for rate in rates]
+    return SlidingPass(shapes, moving, um_dt, rates)
 
 
 def _shift(z, px):
