@@ -155,9 +155,11 @@ class CellSolver:
         n = self.shape[0] * self.shape[1]
         return np.bincount(self._pix.T.ravel(), weights=local.ravel(), minlength=n)[self._free]
 
-    def right_hand_sides(self, h_q: np.ndarray, a_q: np.ndarray, tau_q=None) -> np.ndarray:
-        """Load vectors of eqs 8, 9, 10 as columns ``(n - 1, 3)``."""
-        f1 = h_q @ self._g[0]
+    def right_hand_sides(self, h_q: np.ndarray, a_q: np.ndarray, tau_q=None,
+                         couette: bool = True) -> np.ndarray:
+        """Load vectors of eqs 8, 9, 10 as columns ``(n - 1, 3)`` (``couette=False``: eq 8
+        without its Couette term, the mean-speed frame)."""
+        f1 = h_q @ self._g[0] if couette else np.zeros_like(h_q @ self._m)
         if tau_q is not None:
             f1 = f1 - tau_q @ self._m
         f2 = -(a_q @ self._g[0])
@@ -165,12 +167,14 @@ class CellSolver:
         return np.column_stack([self._scatter(f1), self._scatter(f2), self._scatter(f3)])
 
     # -- solve ---------------------------------------------------------------------------
-    def solve(self, gap: np.ndarray, squeeze: np.ndarray | None = None) -> CellSolution:
+    def solve(self, gap: np.ndarray, squeeze: np.ndarray | None = None,
+              couette: bool = True) -> CellSolution:
         """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady).
 
         ``squeeze`` is ``(1/u_m) dh/dt`` on the grid, already discretised in time; its cell
         mean (non-zero only where the truncation at the gap floor changes the mean gap) is
-        removed, as the periodic problem requires.
+        removed, as the periodic problem requires.  ``couette=False``: eq 8 without its
+        Couette term (the mean-speed frame, :mod:`fem_twin.micro.sliding`).
         """
         h = np.asarray(gap, float)
         if h.shape != self.shape:
@@ -186,7 +190,7 @@ class CellSolver:
             tau_q = self.at_quadrature(squeeze)
             tau_q = tau_q - tau_q.mean()
         K = self.operator(a_q)
-        F = self.right_hand_sides(h_q, a_q, tau_q)
+        F = self.right_hand_sides(h_q, a_q, tau_q, couette)
         scale = a_q.mean()
         X = self._factor.factor(K.data / scale).solve(F / scale)
         n = self.shape[0] * self.shape[1]

@@ -115,8 +115,9 @@ class CellSolverFV:
         out += (flux[1] - np.roll(flux[1], 1, axis=0)) * dx1
         return out
 
-    def solve(self, gap, squeeze=None) -> CellSolution:
-        """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady)."""
+    def solve(self, gap, squeeze=None, couette: bool = True) -> CellSolution:
+        """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady);
+        ``couette=False``: eq 8 without its Couette term (the mean-speed frame)."""
         h = np.asarray(gap, float)
         if h.shape != self.shape:
             raise InputError(f"gap shape {h.shape} does not match the cell {self.shape}")
@@ -126,7 +127,7 @@ class CellSolverFV:
         hf = self.face_values(h)
         cf = self.face_conductance(h)
         zero = np.zeros_like(h)
-        f1 = -self._divergence(np.stack([hf[0], zero]))
+        f1 = -self._divergence(np.stack([hf[0], zero])) if couette else zero.copy()
         if squeeze is not None:                   # mean removed: see the FE CellSolver
             tau = np.asarray(squeeze, float)
             f1 = f1 - (tau - tau.mean()) * dx1 * dx2

@@ -62,7 +62,7 @@ def composite_sq(factors: FlowFactors) -> float | None:
 
 
 def cell_fields(pin, disk, h0: float, *, n_steps: int = 32, method: str = "fe",
-                moving: str = "upper", time_derivative: str = "exact",
+                moving: str = "both", time_derivative: str = "exact",
                 first_step: str = "steady", **materials) -> list[dict]:
     """Per time step: pin and disk heights, gap, asperity pressure, squeeze term ``tau`` of
     eq 8 and chi_1..3 (grid fields, SI units).
@@ -76,11 +76,11 @@ def cell_fields(pin, disk, h0: float, *, n_steps: int = 32, method: str = "fe",
     solver = cell_solver(z_low.shape, spacing, method)
     contacts = sliding_contacts(sliding.shapes, spacing, settings, h0)
     squeezes = sliding_squeeze(contacts, sliding, spacing, settings)
-    cells = sliding_cells([r.gap for r in contacts], squeezes, solver)
+    cells = sliding_cells([r.gap for r in contacts], squeezes, solver, sliding.couette)
     out = []
     for r, m, tau, cell in zip(contacts, sliding.moving, squeezes, cells):
-        out.append({"pin": z_low if moving == "upper" else -m,
-                    "disk": m if moving == "upper" else z_up,
+        out.append({"pin": -m if moving == "lower" else z_low,
+                    "disk": z_up if moving == "lower" else m,
                     "gap": r.gap, "asperity_pressure": r.pressure,
                     "squeeze": np.zeros_like(r.gap) if tau is None else tau,
                     "chi_1": cell.chi[0], "chi_2": cell.chi[1], "chi_3": cell.chi[2]})
