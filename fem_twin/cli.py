@@ -139,6 +139,14 @@ def _add_case_commands(sub):
     rn.add_argument("--from-fit", type=Path, metavar="FIT",
                     help="run with the parameters of a fit.json (fem-twin fit) and write "
                          "OUT/prediction.csv, each curve with its 95 %% band")
+    tr = _case_command(sub, "traction", "traction curve of a ball-on-disk case (an MTM): C_f "
+                                        "versus the slide-to-roll ratio at one entrainment "
+                                        "speed, per viscosity", "out", runs.traction)
+    tr.add_argument("--speed", type=float, required=True, metavar="U_M",
+                    help="entrainment speed u_m [m/s]")
+    tr.add_argument("--srr", type=float, nargs="+", metavar="SRR",
+                    help="slide-to-roll ratios u_r / u_m in [0, 2] (default: 0 0.01 0.02 "
+                         "0.05 0.1 0.2 0.3 0.5 0.7 1)")
     _case_command(sub, "compare", "cross-check FE against the FVM reference on a case: "
                                   "flow factors, fields, C_f,dev (eq 35)", "compare", runs.compare)
     cb = _case_command(sub, "calibrate", "calibration study of a case (paper 3.2): C_f,dev "

@@ -64,6 +64,28 @@ def run(args):
     return 0
 
 
+def traction(args):
+    from .case import load_case
+    from .checks import plausible
+    from .pipeline import traction
+    from .stribeck.traction import DEFAULT_RATIOS
+    if not args.case.is_file():
+        raise MissingFile(f"case file not found: {args.case}")
+    case = load_case(args.case)
+    plausible("--speed [m/s]", args.speed, "speed")
+    ratios = DEFAULT_RATIOS if args.srr is None else args.srr
+    if any(not 0 <= r <= 2 for r in ratios):
+        raise InputError(f"--srr: slide-to-roll ratios lie in [0, 2] (50 % is 0.5), got "
+                         f"{ratios}")
+    summary = traction(case, args.output, args.speed, ratios, progress=not args.no_progress)
+    out = RunLayout(args.output)
+    t = summary["stages"]["traction"]
+    print(f"{out.traction_csv}, {out.traction_png}: C_f at {len(t['slide_to_roll'])} "
+          f"slide-to-roll ratios, u_m = {args.speed:g} m/s; largest estimated C_f error "
+          f"{t['max_cf_err']:.2g}")
+    return 0
+
+
 def _short_summary(summary: dict, out: Path) -> str:
     """A few lines for the terminal; everything is in ``OUT/summary.json``."""
     stages = summary["stages"]

@@ -49,25 +49,52 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
     with (_lock(out), _logfile(out.log),
           executor_for(case.run.workers, case.run.scheduler) as executor):
         log.info("case %s -> %s", case.source, outdir)
-        invalidate_changed_stages(case, out)
-        stages = (("geometry", lambda: reconstruct_geometry(case, out, progress)),
-                  ("levelling", lambda: level_pins(case, out, progress)),
-                  ("micro", lambda: homogenise_patches(case, out, executor, progress)),
-                  ("stribeck", lambda: stribeck_curves(case, out, executor, progress)))
-        for name, stage in stages:
-            t = time.perf_counter()
-            log.info("stage %s", name)
-            try:
-                summary["stages"][name] = stage()
-            except BaseException:
-                log.exception("stage %s failed", name)    # run.log only (see cli)
-                raise
-            summary["seconds"][name] = round(time.perf_counter() - t, 2)
-            log.info("stage %s done in %.1f s", name, summary["seconds"][name])
+        _run_stages(case, out, executor, progress, summary,
+                    ("stribeck", lambda: stribeck_curves(case, out, executor, progress)))
     summary["wall_time_s"] = time.perf_counter() - t0
     summary["task_graph"] = _task_graph(case, out)
     with atomic_path(out.summary) as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
+    return summary
+
+
+def _run_stages(case: Case, out: RunLayout, executor, progress, summary, last) -> None:
+    """The stages up to the flow factors, then ``last`` (name, callable), each timed and
+    logged into ``summary``."""
+    invalidate_changed_stages(case, out)
+    stages = (("geometry", lambda: reconstruct_geometry(case, out, progress)),
+              ("levelling", lambda: level_pins(case, out, progress)),
+              ("micro", lambda: homogenise_patches(case, out, executor, progress)), last)
+    for name, stage in stages:
+        t = time.perf_counter()
+        log.info("stage %s", name)
+        try:
+            summary["stages"][name] = stage()
+        except BaseException:
+            log.exception("stage %s failed", name)    # run.log only (see cli)
+            raise
+        summary["seconds"][name] = round(time.perf_counter() - t, 2)
+        log.info("stage %s done in %.1f s", name, summary["seconds"][name])
+
+
+@one_thread
+def traction(case: Case, outdir, entrainment: float, ratios, *, progress: bool = True) -> dict:
+    """Traction curves of the ball-on-disk ``case`` (C_f versus SRR at ``entrainment``
+    [m/s], :mod:`fem_twin.stages.traction`) into ``outdir``, with the stages before them
+    cached and resumed as in :func:`run`; returns the summary (not written: the folder's
+    ``summary.json`` belongs to ``fem-twin run``)."""
+    from .stages.traction import traction_curves
+    if not case.tribometer.ball:
+        raise InputError("a traction curve needs a rolling-sliding contact: [tribometer] "
+                         "kind = \"ball-on-disk\" (a pin on a disk only slides)")
+    out = RunLayout(outdir)
+    out.root.mkdir(parents=True, exist_ok=True)
+    summary = {"case": case.name, "stages": {}, "seconds": {}}
+    with (_lock(out), _logfile(out.log),
+          executor_for(case.run.workers, case.run.scheduler) as executor):
+        _run_stages(case, out, executor, progress, summary,
+                    ("traction", lambda: traction_curves(case, out, entrainment, ratios,
+                                                         executor, progress)))
     return summary
 
 

@@ -72,3 +72,32 @@ def test_ball_case_keys_are_validated_with_units(tmp_path, old, new, key):
     (tmp_path / "bad.toml").write_text(text.replace(old, new))
     with pytest.raises(CaseError, match=key):
         load_case(tmp_path / "bad.toml")
+
+
+def test_traction_curve_of_the_ball(tmp_path, capsys):
+    """``fem-twin traction``: C_f versus SRR at one entrainment speed per viscosity, from the
+    micro stage of the same folder.  In the mixed regime (70-93 % of the load on the
+    asperities) pure rolling has no boundary friction (no sliding) and no Couette shear, so
+    its C_f is the Poiseuille shear's alone, far below the sliding points'; every point has
+    its error estimate.  A pin-on-disk case and a ratio outside [0, 2] are refused in one line
+    with exit code 2."""
+    case_file = small_ball_case(tmp_path)
+    out = tmp_path / "out"
+    argv = ["traction", str(case_file), "-o", str(out), "--speed", "0.1", "--no-progress"]
+    assert main(argv + ["--srr", "0", "0.5", "2"]) == 0
+    rows = list(csv.DictReader(open(out / "traction.csv")))
+    assert len(rows) == 6 and (out / "traction.png").is_file()
+    for mu in load_case(case_file).lubricant.viscosities:
+        r = [x for x in rows if float(x["viscosity_Pa_s"]) == mu]
+        srr = [float(x["slide_to_roll"]) for x in r]
+        cf = [float(x["friction_coefficient"]) for x in r]
+        assert srr == [0.0, 0.5, 2.0] and abs(cf[0]) < 0.01 * min(cf[1:])
+        assert float(r[0]["boundary_friction_N"]) == 0.0 < float(r[1]["boundary_friction_N"])
+        assert float(r[1]["sliding_speed_m_s"]) == pytest.approx(0.05)
+        assert all(0 < float(x["cf_err"]) < 0.1 * cf[2] for x in r)
+    capsys.readouterr()
+    assert main(argv + ["--srr", "2.5"]) == 2
+    assert "[0, 2]" in capsys.readouterr().err
+    pin = ROOT / "examples" / "pin_on_disk.toml"
+    assert main(["traction", str(pin), "-o", str(tmp_path / "pin"), "--speed", "0.1"]) == 2
+    assert "ball-on-disk" in capsys.readouterr().err

@@ -162,6 +162,21 @@ class RunLayout:
     def results(self) -> Path:
         return self.root / "results.nc"
 
+    # -- traction curves (fem-twin traction) -------------------------------------------------
+    @property
+    def traction_csv(self) -> Path:
+        """C_f versus the slide-to-roll ratio per viscosity."""
+        return self.root / "traction.csv"
+
+    @property
+    def traction_png(self) -> Path:
+        return self.root / "traction.png"
+
+    @property
+    def traction_points(self) -> Path:
+        """Checkpoints of the traction points."""
+        return self.root / "traction" / "checkpoints"
+
     @property
     def fields_nc(self) -> Path:
         return self.root / "fields.nc"

@@ -32,5 +32,8 @@ def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, C, d, spa
 
 
 def boundary_shear(contact_pressure, coefficient: float = BOUNDARY_FRICTION) -> np.ndarray:
-    """tau_con = C_f,b p_con of eq 32 [Pa]."""
+    """tau_con = C_f,b p_con of eq 32 [Pa], where the surfaces slide (u_r > 0): a pure
+    rolling contact has none (the operating point applies it only then; the creep of
+    partial slip at small slide-to-roll ratios is not modelled, so any sliding gives the
+    whole of it)."""
     return coefficient * np.asarray(contact_pressure, float)

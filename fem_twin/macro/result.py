@@ -106,7 +106,7 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
     tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev.theta, ev.mu, loc.C, loc.d, dx, speed,
                                 entrainment=P.entrainment,
                                 eyring_stress=lubricant.eyring_stress)
-    tau_con = boundary_shear(ev.p_con, s.boundary_friction)
+    tau_con = boundary_shear(ev.p_con, s.boundary_friction) * (speed > 0)   # 0: no sliding
     cell = dx[0] * dx[1]
     F_hd = float(tau_hd[face].sum() * cell)
     F_con = float(tau_con[face].sum() * cell)

@@ -1,0 +1,127 @@
+"""Traction curves: C_f versus the slide-to-roll ratio at one entrainment speed, the curve a
+mini-traction machine (MTM) measures.
+
+Each point is a mixed-lubrication operating point (:func:`fem_twin.macro.solve_mixed`) of a
+ball on a disk at entrainment speed ``u_m`` and sliding speed ``u_r = SRR u_m``, with the
+flow factors carried to that SRR (:mod:`fem_twin.micro.rolling`); the points warm-start from
+one another (from the largest SRR down), are checkpointed like the Stribeck points, and
+carry the estimate of their discretisation error (:mod:`fem_twin.macro.estimate`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ..errors import InputError
+from ..io.checkpoint import load_or_none
+from ..io.figure import save_figure
+from ..io.table import write_csv
+from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
+from ..macro.estimate import friction_error
+from ..threads import one_thread
+from .sweep import point_file, sweep_key
+
+#: the CSV header of each column of ``traction.csv``: its name with the SI unit
+HEADERS = {"slide_to_roll": "slide_to_roll", "sliding_speed": "sliding_speed_m_s",
+           "entrainment": "entrainment_m_s", "viscosity": "viscosity_Pa_s",
+           "friction_coefficient": "friction_coefficient", "friction_error": "cf_err",
+           "hydrodynamic_friction": "hydrodynamic_friction_N",
+           "boundary_friction": "boundary_friction_N",
+           "contact_load_fraction": "contact_load_fraction", "h_d": "h_d_m"}
+#: the MTM's usual sweep: pure rolling to 100 % sliding (SRR = u_r / u_m)
+DEFAULT_RATIOS = (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0)
+
+
+@dataclass(frozen=True, eq=False)
+class TractionCurve:
+    """C_f versus SRR at one entrainment speed ``entrainment`` [m/s] and viscosity mu_0
+    [Pa s]; arrays over ``slide_to_roll`` (increasing): friction_coefficient [-] with its
+    estimated discretisation error friction_error [-], the F_T parts hydrodynamic_friction
+    and boundary_friction [N], contact_load_fraction [-] and the separation h_d [m]."""
+
+    slide_to_roll: np.ndarray
+    entrainment: float
+    viscosity: float
+    friction_coefficient: np.ndarray
+    friction_error: np.ndarray
+    hydrodynamic_friction: np.ndarray
+    boundary_friction: np.ndarray
+    contact_load_fraction: np.ndarray
+    h_d: np.ndarray
+
+    @property
+    def sliding_speed(self) -> np.ndarray:
+        """u_r = SRR u_m [m/s]."""
+        return self.slide_to_roll * self.entrainment
+
+
+@one_thread
+def traction_sweep(gap, spacing, factors, slide_to_roll=DEFAULT_RATIOS, *, entrainment: float,
+                   load: float, lubricant: Lubricant, face=None,
+                   settings: MacroSettings = MacroSettings(), checkpoint=None,
+                   factors_key: str | None = None, progress: bool = False) -> TractionCurve:
+    """C_f at each slide-to-roll ratio (SRR in [0, 2]) at the entrainment speed [m/s], on
+    the macro gap [m] of ``spacing`` [m]; ``checkpoint``: folder keeping every finished
+    point (keyed by all inputs, as :func:`~fem_twin.stribeck.stribeck_sweep`)."""
+    ratios = np.unique(np.asarray(slide_to_roll, float))
+    if ratios.size == 0 or np.any(~np.isfinite(ratios)) or ratios[0] < 0 or ratios[-1] > 2:
+        raise InputError(f"slide-to-roll ratios must lie in [0, 2], got {slide_to_roll}")
+    if not (np.isfinite(entrainment) and entrainment > 0):
+        raise InputError(f"the entrainment speed must be positive [m/s], got {entrainment}")
+    key = sweep_key(gap, spacing, factors if factors_key is None else factors_key, load,
+                    lubricant, settings, face, ("traction", float(entrainment)))
+    folder = None if checkpoint is None else Path(checkpoint)
+    if folder is not None:
+        folder.mkdir(parents=True, exist_ok=True)
+    results, previous = {}, None
+    for srr in tqdm(ratios[::-1], desc=f"traction mu0={lubricant.viscosity:g}",
+                    disable=not progress, unit="point"):
+        path = None if folder is None else point_file(folder, key, srr)
+        res = None if path is None else load_or_none(path, MixedResult.load)
+        if res is None:
+            common = dict(load=load, entrainment=float(entrainment), lubricant=lubricant,
+                          face=face, settings=settings)
+            res = solve_mixed(gap, spacing, factors, speed=float(srr * entrainment),
+                              initial=previous, **common)
+            estimate = friction_error(res, gap, spacing, factors, **common)
+            res = replace(res, meta={**res.meta, "error_estimate": estimate})
+            if path is not None:
+                res.save(path)
+        results[srr] = previous = res
+    get = lambda name: np.array([getattr(results[s], name) for s in ratios])  # noqa: E731
+    return TractionCurve(
+        slide_to_roll=ratios, entrainment=float(entrainment), viscosity=lubricant.viscosity,
+        friction_coefficient=get("friction_coefficient"),
+        friction_error=np.array([results[s].meta["error_estimate"]["total"] for s in ratios]),
+        hydrodynamic_friction=get("hydrodynamic_friction"),
+        boundary_friction=get("boundary_friction"),
+        contact_load_fraction=get("contact_load") / load, h_d=get("h_d"))
+
+
+def write_traction_csv(path, curves) -> Path:
+    """The traction curves, one row per (viscosity, SRR), SI units in the header."""
+    cols = {HEADERS[name]: np.concatenate([np.broadcast_to(getattr(c, name),
+                                                           c.slide_to_roll.shape)
+                                           for c in curves])
+            for name in HEADERS}
+    return write_csv(path, cols)
+
+
+def plot_traction(curves, path, labels=None):
+    """C_f versus SRR [%] per curve, each point with its estimated discretisation error."""
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for i, c in enumerate(curves):
+        label = labels[i] if labels else f"$\\mu_0$ = {c.viscosity:g} Pa s"
+        ax.errorbar(100 * c.slide_to_roll, c.friction_coefficient, yerr=c.friction_error,
+                    marker="o", ms=4, capsize=2, label=label)
+    ax.set_xlabel("slide-to-roll ratio SRR = $u_r / u_m$ [%]")
+    ax.set_ylabel("traction coefficient $C_f$ [-]")
+    ax.set_title(f"traction at $u_m$ = {curves[0].entrainment:g} m/s")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small")
+    return save_figure(fig, path)
