@@ -101,6 +101,9 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
         raise CaseError(f"{where}: missing [geometry] section")
     tribometer = _tribometer(data, where)
     geometry = _geometry(data["geometry"], base, where, tribometer.ball)
+    if geometry.ball is not None and "ball_radius" in data.get("tribometer", {}):
+        raise CaseError(f"{where} [tribometer] ball_radius: the measured cap's fitted sphere "
+                        "gives the radius ([geometry] ball); remove one of the two")
     macro_geometry = _preprocessing(data, where)
     lubricant = _lubricant(data, where)
     materials = _section(data, "materials", Materials, where, positive=True)
@@ -137,7 +140,8 @@ def _tribometer(data, where) -> Tribometer:
 
 def _geometry(g, base, where, ball) -> Geometry:
     """[geometry]: the instrument files (resolved, existing) and the patch window."""
-    _only(g, {"pins", "disks", "patches", "patch_shape", "patch_start"}, f"{where} [geometry]")
+    _only(g, {"pins", "disks", "patches", "patch_shape", "patch_start", "ball"},
+          f"{where} [geometry]")
 
     def files(key, value):
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
@@ -148,6 +152,9 @@ def _geometry(g, base, where, ball) -> Geometry:
                 raise CaseError(f"{where} [geometry] {key}: file not found: {p}")
         return out
 
+    if "ball" in g and not ball:
+        raise CaseError(f"{where} [geometry] ball: a measured ball cap needs [tribometer] "
+                        "kind = \"ball-on-disk\"")
     if not ball and ("pins" not in g or not g["pins"]):
         raise CaseError(f"{where} [geometry]: at least one pin file is required in 'pins'")
     patches = g.get("patches", [])
@@ -160,7 +167,8 @@ def _geometry(g, base, where, ball) -> Geometry:
         patch_shape=_int_pair(g.get("patch_shape", [256, 256]),
                               f"{where} [geometry] patch_shape"),
         patch_start=_int_pair(g.get("patch_start", [0, 0]), f"{where} [geometry] patch_start",
-                              0))
+                              0),
+        ball=files("ball", [g["ball"]])[0] if "ball" in g else None)
     if geometry.disks and len(geometry.disks) != len(geometry.pins):
         raise CaseError(f"{where} [geometry]: {len(geometry.pins)} pins but "
                         f"{len(geometry.disks)} disks (give one disk per pin, or none for flat)")

@@ -33,6 +33,10 @@ class Geometry:
         (256, 256), "rows and columns of each patch, cut without interpolation", unit="px")
     patch_start: tuple[int, int] = setting((0, 0), "first row and column of the cut",
                                            unit="px")
+    ball: Path | None = setting(
+        None, "a measured ball cap, the ball-on-disk's macro gap (its sphere fitted for the "
+        "radius, the cap read around its apex); none: the smooth sphere of ball_radius",
+        unit="file path")
 
 
 @dataclass(frozen=True)

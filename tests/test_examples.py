@@ -23,7 +23,7 @@ def test_example_runs_and_ends_in_a_figure(script, tmp_path):
     """Each example at --quick size writes its figure last.  CI runs every example once, at
     this size, in the documentation build (.ci/run: sphinx-gallery, which stops on an
     example's error); ``pytest -m slow`` runs them here (about 4 minutes)."""
-    if "real_roughness" in script.name:
+    if "real_roughness" in script.name or "measured_ball" in script.name:
         if not SHARED.is_dir():
             pytest.skip(f"{SHARED} absent (a fresh clone): the real instrument files live "
                         "beside the repository")

@@ -235,3 +235,38 @@ def test_mount_pin_sets_holder():
     assert np.array_equal(out.heights[face], z[face])
     assert np.all(out.heights[~face] == -1e-3)
     assert np.array_equal(tp.pin_face(out), face)
+
+
+def synthetic_cap(n=301, size=1.2e-3, radius=9.525e-3, apex=(30e-6, -20e-6), astig=100e-9):
+    """A 3/4" ball's top over 1.2 mm, its apex off the map's centre: its sphere and an
+    astigmatic form error ``astig (x^2 - y^2) / (0.6 mm)^2`` about the map's centre (on the
+    square map orthogonal to a sphere's and a plane's terms, so no fit absorbs it)."""
+    x = np.linspace(-size / 2, size / 2, n)
+    X, Y = np.meshgrid(x, x)
+    r2 = (X - apex[0]) ** 2 + (Y - apex[1]) ** 2
+    form = astig * (X ** 2 - Y ** 2) / (size / 2) ** 2
+    sphere = np.sqrt(radius ** 2 - r2) - radius
+    return Topography(sphere + form, (x[1] - x[0],) * 2, origin=(x[0], x[0])), form
+
+
+def test_sphere_fit_of_a_ball_cap_recovers_radius_apex_and_form_error():
+    """R within 1e-4 (a 3/4" ball: 1 um), the apex within 0.1 um, the form error within 2 %
+    of its 100 nm amplitude; a flat or concave map is refused."""
+    from fem_twin.errors import InputError
+    from fem_twin.topography.sphere import cap_gap, fit_sphere
+    cap, form = synthetic_cap()
+    fit = fit_sphere(cap)
+    assert fit.radius == pytest.approx(9.525e-3, rel=1e-4)
+    assert np.allclose(fit.apex, (30e-6, -20e-6), atol=1e-7)
+    err = fit.form_error.heights - fit.form_error.heights.mean() - (form - form.mean())
+    assert np.sqrt(np.mean(err ** 2)) < 2e-9
+    sphere, _ = synthetic_cap(astig=0.0)
+    x = np.linspace(-200e-6, 200e-6, 41)
+    gap = cap_gap(sphere, fit_sphere(sphere), x, x)
+    X, Y = np.meshgrid(x, x)
+    exact = 9.525e-3 - np.sqrt(9.525e-3 ** 2 - X ** 2 - Y ** 2)
+    assert np.abs(gap - exact).max() < 1e-9            # bilinear: R'' dx^2 / 8 = 2.5e-11
+    with pytest.raises(InputError, match="beyond the measured cap"):
+        cap_gap(sphere, fit_sphere(sphere), 2 * x / x.max() * 1e-3, x)
+    with pytest.raises(InputError, match="not convex"):
+        fit_sphere(cap.with_heights(-cap.heights))

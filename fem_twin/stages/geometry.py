@@ -5,6 +5,7 @@ Reynolds scale solves on (the levelled set average, or a ball's sphere)."""
 from __future__ import annotations
 
 import logging
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,9 @@ from ..io.files import read_topography, write_topography
 from ..io.layout import RunLayout
 from ..io.mesh import grid_mesh, write_vtu
 from ..macro.point_contact import PointContact
+from ..topography.filling import fill_defects
 from ..topography.plausibility import check_patch, check_pin
+from ..topography.sphere import cap_gap, fit_sphere
 from ..topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
 
 log = logging.getLogger("fem_twin")
@@ -85,7 +88,14 @@ def level_pins(case: Case, out: RunLayout, progress: bool = True) -> dict:
     """Level every pin against its disk (torque balance, Table 4 at 50 N); average the
     levelled set and level the average (paper 2.2.1).  Writes ``levelling/``."""
     if case.tribometer.ball:
-        return {"skipped": "ball-on-disk: the macro gap is the ball's sphere"}
+        if case.geometry.ball is None:
+            return {"skipped": "ball-on-disk: the macro gap is the ball's sphere"}
+        cap, fit = measured_ball(case.geometry.ball)
+        log.info("ball cap %s: R = %.6g m, apex at %s m, form error rms %.3g m",
+                 case.geometry.ball.name, fit.radius, fit.apex, fit.form_error_rms)
+        return {"ball": {"file": str(case.geometry.ball), "radius_m": fit.radius,
+                         "apex_m": list(fit.apex), "form_error_rms_m": fit.form_error_rms,
+                         "grid": list(cap.shape), "spacing_m": list(cap.spacing)}}
     out.levelling.mkdir(parents=True, exist_ok=True)
     m = case.materials
     e_red = m.e_reduced
@@ -134,6 +144,8 @@ def macro_geometry(case: Case, out: RunLayout):
     of the ball's sphere over [-4a, 2a] x [-3a, 3a] (a the Hertz radius; face: all)."""
     if case.tribometer.ball:
         gap, spacing, x1, x2 = ball_contact(case).grid(case.macro.grid)
+        if case.geometry.ball is not None:
+            gap = cap_gap(*measured_ball(case.geometry.ball), x1, x2)
         return gap, spacing, np.ones(gap.shape, bool), (float(x1[0]), float(x2[0]))
     pin = read_topography(macro_pin_file(case, out))
     k = macro_pin_number(case)
@@ -150,10 +162,23 @@ def face_load(case: Case) -> float:
 
 def ball_contact(case: Case) -> PointContact:
     """The smooth ball of a ball-on-disk case (Hertz radius, Hamrock-Dowson films) at the
-    first viscosity and the sweep's fastest entrainment speed."""
+    first viscosity and the sweep's fastest entrainment speed; of a measured cap's fitted
+    radius when the case has one."""
     tr, lb = case.tribometer, case.lubricant
-    return PointContact(tr.ball_radius, tr.load, case.materials.e_reduced, lb.viscosities[0],
+    radius = (tr.ball_radius if case.geometry.ball is None
+              else measured_ball(case.geometry.ball)[1].radius)
+    return PointContact(radius, tr.load, case.materials.e_reduced, lb.viscosities[0],
                         lb.roelands_alpha, case.sweep.speed_max)
+
+
+@lru_cache(maxsize=4)
+def measured_ball(path: Path):
+    """``(cap, fit)``: a measured ball cap (defects filled) and its sphere
+    (:func:`fem_twin.topography.sphere.fit_sphere`)."""
+    cap = read_topography(path)
+    if not np.all(np.isfinite(cap.heights)):
+        cap = fill_defects(cap)
+    return cap, fit_sphere(cap)
 
 
 def hersey_length(case: Case) -> float:
