@@ -54,8 +54,10 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
         by keyword, replace its values: ``steps`` (N_t, paper 32; ``n_steps`` is its
         historical keyword), ``e_reduced`` and
         ``hardness`` [Pa] (Table 4), ``method`` (``"fe"`` or the paper's ``"fvm"``),
-        ``moving`` (``"upper"``: the disk slides at ``+U`` over the pin at rest; ``"lower"``:
-        the same seen from the disk), ``slide_to_roll`` (both surfaces moving, the pin at
+        ``moving`` (``"both"``, the default: the disk at ``+U/2`` and the pin at ``-U/2``,
+        the mean-speed frame without eq 8's Couette term; ``"upper"``: the disk slides at
+        ``+U`` over the pin at rest, the paper's frame; ``"lower"``: the same seen from the
+        disk; :mod:`fem_twin.micro.sliding`), ``slide_to_roll`` (both surfaces moving, the pin at
         ``u_m (1 - SRR/2)``: :mod:`fem_twin.micro.rolling`), ``time_derivative`` (``"exact"``: the squeeze term of
         eq 8 at every instant, no time-step error, :func:`.sliding.sliding_squeeze`;
         ``"backward"``: the paper's implicit Euler), ``first_step`` (``"backward"`` only),
