@@ -101,3 +101,37 @@ def test_traction_curve_of_the_ball(tmp_path, capsys):
     pin = ROOT / "examples" / "pin_on_disk.toml"
     assert main(["traction", str(pin), "-o", str(tmp_path / "pin"), "--speed", "0.1"]) == 2
     assert "ball-on-disk" in capsys.readouterr().err
+
+
+def test_a_measured_ball_cap_is_the_macro_gap(tmp_path):
+    """``[geometry] ball``: the cap's fitted sphere gives the radius (Hertz radius, grid),
+    the gap is the measured cap around its apex (the smooth ball's paraboloid plus the form
+    error, to the sphere's r^4 / (8 R^3) term); a radius given as well, or a cap on a pin
+    case, is refused."""
+    from fem_twin.io.files import write_topography
+    from fem_twin.stages.geometry import macro_geometry
+    from fem_twin.io.layout import RunLayout
+    from test_topography import synthetic_cap
+    cap, _ = synthetic_cap(astig=50e-9)
+    cap_file = write_topography(tmp_path / "cap.npz", cap)
+    text = small_ball_case(tmp_path).read_text().replace(
+        "[geometry]", f'[geometry]\nball = "{cap_file}"')
+    (tmp_path / "cap_case.toml").write_text(text)
+    with pytest.raises(CaseError, match="ball_radius"):
+        load_case(tmp_path / "cap_case.toml")
+    text = "\n".join(ln for ln in text.splitlines() if not ln.startswith("ball_radius"))
+    (tmp_path / "cap_case.toml").write_text(text)
+    case = load_case(tmp_path / "cap_case.toml")
+    contact = ball_contact(case)
+    assert contact.radius == pytest.approx(9.525e-3, rel=1e-4)
+    gap, spacing, face, origin = macro_geometry(case, RunLayout(tmp_path / "out"))
+    smooth, _, x1, x2 = contact.grid(case.macro.grid)
+    X1, X2 = np.meshgrid(x1, x2)
+    form = 50e-9 * ((X1 + 30e-6) ** 2 - (X2 - 20e-6) ** 2) / 0.6e-3 ** 2   # about the map
+    quartic = np.hypot(X1, X2).max() ** 4 / (8 * 9.525e-3 ** 3)      # sphere - paraboloid
+    assert np.ptp(gap - (smooth - form)) < quartic + 1e-9
+    pin = (ROOT / "examples" / "pin_on_disk.toml").read_text().replace(
+        "[geometry]", f'[geometry]\nball = "{cap_file}"').replace("../meshes/", str(ROOT / "meshes") + "/")
+    (tmp_path / "pin.toml").write_text(pin)
+    with pytest.raises(CaseError, match="ball-on-disk"):
+        load_case(tmp_path / "pin.toml")
