@@ -102,7 +102,8 @@ def test_the_task_graph_of_a_finished_run(tmp_path):
     from fem_twin.taskgraph import critical_path, makespan, run_task_graph
     from test_cli import small_case
     path = small_case(tmp_path, workers=2, band=True)
-    path.write_text(path.read_text().replace("h0_count = 6", "h0_count = 24"))  # 2+ rounds
+    path.write_text(path.read_text().replace("h0_count = 6", "h0_count = 24").replace(
+        "steps = 4", "steps = 8"))                                # 2+ rounds of the sampler
     out = tmp_path / "out"
     assert main(["run", str(path), "-o", str(out), "--no-progress"]) == 0
     tasks = run_task_graph(load_case(path), out)
