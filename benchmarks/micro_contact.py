@@ -5,7 +5,7 @@ the mean-speed frame (issue 27 item 6).
 
 Sample patches 1 and 2 of the bundled case, prepared as the pipeline prepares them (256 px,
 the disk flipped over the pin) and resampled periodically to the cell grid.  At each patch
-three separations where 10, 20 and 40 % of the pixels touch (found by periodic contact at
+three separations where 40, 20 and 10 % of the pixels touch (found by periodic contact at
 128^2), b1 and d1 of eqs 14 and 16:
 
 - over the time steps N_t = 16, 32, 64, 128 on the 128^2 cell (128: every pixel
@@ -67,7 +67,7 @@ def factors(low, up, n, steps, h0, moving):
 
 def study(k: int, quick: bool) -> None:
     low, up = patch_pair(k)
-    h0 = separations(low, up)
+    h0 = sorted(separations(low, up))                 # homogenise sorts them too
     steps = (16, 32) if quick else (16, 32, 64, 128)
     grids = (32, 64) if quick else (64, 128, 256)
     n_time = 64 if quick else 128
