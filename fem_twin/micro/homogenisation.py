@@ -62,7 +62,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
         eq 8 at every instant, no time-step error, :func:`.sliding.sliding_squeeze`;
         ``"backward"``: the paper's implicit Euler), ``first_step`` (``"backward"`` only),
         ``gap_floor`` [m], ``contact_tol``, ``rate_tol``, ``time_tol`` (adaptive instants,
-        exact scheme: at each h0 the midpoints are added while A11 or b1 change by more than
+        exact scheme: at each h0 the midpoints are added while A11, b1 or d1 change by more than
         this relative tolerance from every other instant to all, up to one pixel per step;
         ``meta["steps_used"]`` per h0; 0 or None: off, as in the case file).
     workers : processes for the h0 values (1: in this process); ``executor``: any

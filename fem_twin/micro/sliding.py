@@ -93,7 +93,7 @@ class CellSettings:
     rate_tol: float = setting(1e-6, "tolerance of the contact rate (the squeeze term), far "
                               "below the time and grid errors", unit="-")
     time_tol: float | None = setting(0.0, "adaptive instants per h0 (exact scheme): "
-                                     "midpoints while A11 or b1 change by more (0 or None: "
+                                     "midpoints while A11, b1 or d1 change by more (0 or None: "
                                      "off)", unit="fraction")
 
     def __post_init__(self):
@@ -271,17 +271,26 @@ def instants(sliding, h0, warm, solver, spacing, settings):
     return contacts, steps, [t1 - t0, time.perf_counter() - t1]
 
 
+#: d1 changes are measured against at least 1/3, its weight beside the sliding term of eq 31
+#: (as the adaptive h0 sampling does, :mod:`fem_twin.micro.sampling`)
+D1_SCALE = 1.0 / 3.0
+
+
 def _time_error(steps) -> float:
-    """Relative change of A11 and b1 (eqs 13, 14) from every other instant to all."""
-    def a11_b1(ms):
+    """Relative change of A11, b1 and d1 (eqs 13, 14, 16) from every other instant to all
+    (d1's relative to at least :data:`D1_SCALE`)."""
+    def a11_b1_d1(ms):
         m = time_average(ms)
-        return np.array([m["h3_grad"][0, 0] / m["h"] ** 3, 1 - m["h3_g1"][0] / m["h"]])
-    full, half = a11_b1(steps), a11_b1(steps[::2])
-    return float(np.max(np.abs(full - half) / np.abs(full)))
+        return np.array([m["h3_grad"][0, 0] / m["h"] ** 3, 1 - m["h3_g1"][0] / m["h"],
+                         m["h_g1"][0] * m["h"]])
+    full, half = a11_b1_d1(steps), a11_b1_d1(steps[::2])
+    scale = np.abs(full)
+    scale[2] = max(scale[2], D1_SCALE)
+    return float(np.max(np.abs(full - half) / scale))
 
 
 def refine_instants(contacts, steps, h0, z_low, z_up, solver, spacing, settings, midpoints):
-    """Adaptive instants (``settings.time_tol``, exact scheme): while A11 or b1 change by
+    """Adaptive instants (``settings.time_tol``, exact scheme): while A11, b1 or d1 change by
     more than the tolerance from every other instant to all, add the midpoints (the time
     average is then over twice the instants), up to one pixel per step.  In heavy contact
     the integrand jumps whenever a pixel enters contact, and a fixed N_t samples it
