@@ -101,8 +101,12 @@ def stribeck_section(out: RunLayout) -> str:
             "single-patch curves (Figure 13), squares are measured curves.")
     body = figure_section("Stribeck curves (Figure 14)", pngs, text)
     fields, val = out.fields_pngs(), out.validation_pngs()
-    return (body + figure_section("Macro fields", fields, "Fastest, middle and slowest "
-                                  "point of each sweep.")
+    return (body + figure_section("Traction curves (fem-twin traction)", [out.traction_png],
+                                  "C_f versus the slide-to-roll ratio at one entrainment "
+                                  "speed, each point with its estimated discretisation "
+                                  "error.")
+            + figure_section("Macro fields", fields, "Fastest, middle and slowest "
+                             "point of each sweep.")
             + figure_section("Validation against measured curves (eq 35)", val, ""))
 
 
@@ -175,6 +179,7 @@ def caption(png: Path) -> str:
     fixed = {"stribeck_speed": "C_f versus sliding speed U [m/s]",
              "stribeck_hersey": "C_f versus Hersey number (eq 46)",
              "flow_factors": "flow factors versus h0", "pin_centre_lines": "pin centre lines",
+             "traction": "C_f versus the slide-to-roll ratio",
              "cf_dev": f"C_f,dev of the {png.parent.name} study"}
     if stem in fixed:
         return fixed[stem]
