@@ -79,8 +79,8 @@ def test_traction_curve_of_the_ball(tmp_path, capsys):
     micro stage of the same folder.  In the mixed regime (70-93 % of the load on the
     asperities) pure rolling has no boundary friction (no sliding) and no Couette shear, so
     its C_f is the Poiseuille shear's alone, far below the sliding points'; every point has
-    its error estimate.  A pin-on-disk case and a ratio outside [0, 2] are refused in one line
-    with exit code 2."""
+    its error estimate; run again, it reads every point from its checkpoint.  A pin-on-disk
+    case and a ratio outside [0, 2] are refused in one line with exit code 2."""
     case_file = small_ball_case(tmp_path)
     out = tmp_path / "out"
     argv = ["traction", str(case_file), "-o", str(out), "--speed", "0.1", "--no-progress"]
@@ -95,6 +95,12 @@ def test_traction_curve_of_the_ball(tmp_path, capsys):
         assert float(r[0]["boundary_friction_N"]) == 0.0 < float(r[1]["boundary_friction_N"])
         assert float(r[1]["sliding_speed_m_s"]) == pytest.approx(0.05)
         assert all(0 < float(x["cf_err"]) < 0.1 * cf[2] for x in r)
+    points = sorted((out / "traction" / "checkpoints").glob("point_*.npz"))
+    stamps = [p.stat().st_mtime_ns for p in points]
+    before = (out / "traction.csv").read_text()
+    assert len(points) == 6 and main(argv + ["--srr", "0", "0.5", "2"]) == 0    # resumed
+    assert [p.stat().st_mtime_ns for p in points] == stamps
+    assert (out / "traction.csv").read_text() == before
     capsys.readouterr()
     assert main(argv + ["--srr", "2.5"]) == 2
     assert "[0, 2]" in capsys.readouterr().err
