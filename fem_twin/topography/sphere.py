@@ -43,8 +43,13 @@ class SphereFit:
 
     def sphere(self, x1, x2) -> np.ndarray:
         """Heights of the fitted sphere's cap at ``(x1, x2)`` [m]."""
-        r2 = (np.asarray(x1) - self.apex[0]) ** 2 + (np.asarray(x2) - self.apex[1]) ** 2
-        return self.apex_height - self.radius + np.sqrt(np.maximum(self.radius ** 2 - r2, 0))
+        return _cap(self.radius, self.apex, self.apex_height, x1, x2)
+
+
+def _cap(radius, apex, apex_height, x1, x2):
+    """Heights [m] of a sphere's cap of ``radius`` with its top ``apex_height`` at ``apex``."""
+    r2 = (np.asarray(x1) - apex[0]) ** 2 + (np.asarray(x2) - apex[1]) ** 2
+    return apex_height - radius + np.sqrt(np.maximum(radius ** 2 - r2, 0))
 
 
 def fit_sphere(cap: Topography) -> SphereFit:
@@ -65,20 +70,17 @@ def fit_sphere(cap: Topography) -> SphereFit:
     apex = (-c[1] * s / (2 * c[3]), -c[2] * s / (2 * c[3]))
     top = c[0] - (c[1] ** 2 + c[2] ** 2) / (4 * c[3])
 
-    def residual(p):
-        r2 = (x - p[1] * s) ** 2 + (y - p[2] * s) ** 2
-        return p[3] * s - p[0] * s + np.sqrt(np.maximum((p[0] * s) ** 2 - r2, 0)) - z
+    def residual(p):                                     # parameters in units of s
+        return _cap(p[0] * s, (p[1] * s, p[2] * s), p[3] * s, x, y) - z
 
     p = least_squares(residual, [radius / s, apex[0] / s, apex[1] / s, top / s],
-                      x_scale="jac").x
-    fit = SphereFit(float(p[0] * s), (float(p[1] * s), float(p[2] * s)), float(p[3] * s),
-                    cap.with_heights(np.zeros(cap.shape)))
-    inside = (x1.min() <= fit.apex[0] <= x1.max()) and (x2.min() <= fit.apex[1] <= x2.max())
-    if not inside:
-        raise InputError(f"the fitted apex {fit.apex} [m] lies outside the map: measure the "
+                      x_scale="jac").x * s
+    radius, apex, top = float(p[0]), (float(p[1]), float(p[2])), float(p[3])
+    if not (x1.min() <= apex[0] <= x1.max() and x2.min() <= apex[1] <= x2.max()):
+        raise InputError(f"the fitted apex {apex} [m] lies outside the map: measure the "
                          "ball's top")
-    return SphereFit(fit.radius, fit.apex, fit.apex_height,
-                     cap.with_heights(cap.heights - fit.sphere(x1, x2)))
+    return SphereFit(radius, apex, top,
+                     cap.with_heights(cap.heights - _cap(radius, apex, top, x1, x2)))
 
 
 def cap_gap(cap: Topography, fit: SphereFit, x1, x2) -> np.ndarray:
