@@ -399,6 +399,7 @@ def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors)
     measured 24 against 42); its coarse point is the one the error estimate solves."""
     from fem_twin.macro.estimate import friction_error
     from fem_twin.macro.nested import coarsened, solve_nested
+    from fem_twin.stribeck import stribeck_sweep
     gap, dx, face = macro_case(112)
     kw = dict(load=150.0, lubricant=Lubricant(0.066), face=face)
     first, first_coarse = solve_nested(gap, dx, factors, speed=0.05, **kw)
@@ -412,6 +413,10 @@ def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors)
     again = solve_mixed(gap2, dx2, factors, speed=0.03, initial=nested,
                         **{**kw, "face": face2})
     assert abs(again.friction_coefficient - coarse.friction_coefficient) < 1e-6 * 0.19245
+    # a sweep keeps each point's coarse C_f: the patch band's coarse average curve
+    curve = stribeck_sweep(gap, dx, factors, [0.05, 0.03], **kw)
+    assert abs(curve.coarse_friction_coefficient[1] - again.friction_coefficient) < 1e-6 * 0.19245
+    assert curve.coarse_friction_coefficient[0] == first_coarse.friction_coefficient
     settings = MacroSettings()
     est = friction_error(nested, gap, dx, factors, coarse=coarse, settings=settings, **kw)
     ref = friction_error(nested, gap, dx, factors, settings=settings, **kw)

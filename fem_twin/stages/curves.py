@@ -107,22 +107,29 @@ def band_curves(case: Case, out: RunLayout, common: dict, curves, executor=None,
                 progress: bool = True):
     """The single-patch curves of the scatter band (``[run] patch_band``), one list per
     patch over the viscosities, and their sweep tasks.  With ``[run] band_grid = "coarse"``
-    they are swept on the macro grid coarsened by two beside the average factors' curves,
-    and corrected by the main ``curves``' change to the full grid
-    (:func:`~fem_twin.stribeck.analysis.defect_corrected`)."""
+    they are swept on the macro grid coarsened by two and corrected by the main ``curves``'
+    change to the full grid (:func:`~fem_twin.stribeck.analysis.defect_corrected`): the
+    main sweeps' own coarse points give that change, or, where a point has none (a coarse
+    solve that failed, checkpoints of an earlier version), the average factors are swept
+    on the coarse grid too."""
     lubricants = case.lubricant.lubricants()
     sweeps = band_sweeps(case, out, common) if case.run.patch_band else []
     coarse = bool(sweeps) and case.run.band_grid == "coarse"
+    kept = coarse and all(c.coarse_friction_coefficient is not None and np.all(
+        np.isfinite(c.coarse_friction_coefficient)) for c in curves)
     if coarse:
         gap, spacing, face = coarsened(common["gap"], common["spacing"], common["face"])
         sweeps = [dict(kw, gap=gap, spacing=spacing, face=face)
-                  for kw in [*sweeps, dict(common, fields=None)]]
+                  for kw in [*sweeps, *([] if kept else [dict(common, fields=None)])]]
     tasks = [(kw, lub) for kw in sweeps for lub in lubricants]
     swept = [c.with_load_share(case.tribometer.load_share) for c in run_sweeps(
         tasks, executor, progress, desc="patch band points")]
     n = len(lubricants)
     per_patch = [swept[i:i + n] for i in range(0, len(swept), n)]
-    if coarse:
+    if kept:
+        per_patch = defect_corrected(per_patch, curves, [
+            replace(c, friction_coefficient=c.coarse_friction_coefficient) for c in curves])
+    elif coarse:
         per_patch = defect_corrected(per_patch[:-1], curves, per_patch[-1])
     return per_patch, tasks
 

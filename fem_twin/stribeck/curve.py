@@ -53,7 +53,9 @@ class StribeckCurve:
     iterations of the macro solver;
     friction_error: the estimated discretisation error of C_f [-] (absolute, both scales,
     :mod:`fem_twin.macro.estimate`) and friction_error_parts its parts by name, when the
-    sweep estimated them (None otherwise).
+    sweep estimated them (None otherwise); coarse_friction_coefficient: C_f of the same
+    points on the macro grid coarsened by two (the nested solves' coarse points, NaN where
+    none was solved), when the sweep kept them.
     """
 
     speed: np.ndarray
@@ -67,6 +69,7 @@ class StribeckCurve:
     iterations: np.ndarray
     friction_error: np.ndarray | None = None
     friction_error_parts: dict | None = None
+    coarse_friction_coefficient: np.ndarray | None = None
 
     def with_load_share(self, share: float) -> "StribeckCurve":
         """This curve, swept at ``share`` F_N,imp on the pin face, referred to the imposed
@@ -76,8 +79,10 @@ class StribeckCurve:
             return self
         parts = (None if self.friction_error_parts is None else
                  {k: share * v for k, v in self.friction_error_parts.items()})
+        coarse = self.coarse_friction_coefficient
         return replace(self, hersey=share * self.hersey,
                        friction_coefficient=share * self.friction_coefficient,
+                       coarse_friction_coefficient=None if coarse is None else share * coarse,
                        friction_error=(None if self.friction_error is None
                                        else share * self.friction_error),
                        friction_error_parts=parts)

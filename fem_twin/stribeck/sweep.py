@@ -19,6 +19,9 @@ from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from .curve import StribeckCurve, hersey_number
 
+#: a point's ``meta`` entry for C_f on the grid coarsened by two (its nested coarse solve)
+COARSE_CF = "coarse_friction_coefficient"
+
 
 @one_thread
 def point_file(folder, key: str, speed: float) -> Path:
@@ -80,6 +83,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
             res, coarse = solve_nested(gap, spacing, factors, load=load, **sliding,
                                        lubricant=lubricant, face=face, settings=settings,
                                        previous=previous, previous_coarse=previous_coarse)
+            if coarse is not None:
+                res = replace(res, meta={**res.meta, COARSE_CF: coarse.friction_coefficient})
             if path is not None:
                 res.save(path)
         if error_estimate and "error_estimate" not in res.meta:
@@ -114,7 +119,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         contact_load_fraction=get("contact_load") / load, h_d=get("h_d"),
         iterations=get("iterations"),
         friction_error=None if errors is None else errors.pop("total"),
-        friction_error_parts=errors)
+        friction_error_parts=errors,
+        coarse_friction_coefficient=np.array([r.meta.get(COARSE_CF, np.nan) for r in results]))
 
 
 def sweep_key(gap, spacing, factors, load, lubricant, settings, face,
