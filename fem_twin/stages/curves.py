@@ -30,6 +30,11 @@ from ..threads import worker_heap
 from .geometry import ball_contact, face_load, hersey_length, macro_geometry
 from .provenance import provenance, stage_keys
 
+#: coupling tolerance of the band's single-patch sweeps (the average curves keep the case's,
+#: 1e-6).  Measured on the bundled case: the band moves by at most 1.6e-5 C_f,b, against
+#: the defect correction's error of up to 0.9 % C_f,b, and its sweeps take 15 % less time.
+BAND_TOL = 1e-4
+
 log = logging.getLogger("fem_twin")
 
 
@@ -171,8 +176,10 @@ def band_sweeps(case: Case, out: RunLayout, common: dict) -> list[dict]:
     n = len(case.geometry.patches)
     if n < 2:
         return []
+    settings = replace(common["settings"], tol=max(common["settings"].tol, BAND_TOL))
     return [dict(common, factors=FlowFactors.load(out.patch_factors(i + 1)),
-                 factors_key=f"{common['factors_key']}-patch{i + 1}", fields=None)
+                 factors_key=f"{common['factors_key']}-patch{i + 1}", fields=None,
+                 settings=settings)
             for i in range(n)]
 
 
