@@ -285,7 +285,7 @@ def test_newton_jacobian_is_exact(case32, factors):
     assert res.contact_load > 10
     P = macro_problem(gap, spacing, factors, Lubricant(0.066), s, 0.03, 0.015)
     interior = P.interior
-    x = newton.state_from(res, s)
+    x = newton.state_from(res, P)
     ev = newton.evaluate(P, x, 150.0)
     jac = jacobian.jacobian(P, ev)
     rng = np.random.default_rng(0)

@@ -134,7 +134,7 @@ def _solve_newton(P, load, face, initial, progress, t0):
         x, ev, it, history = newton.continuation(P, load, tol=s.tol, max_iter=max_iter,
                                                  progress=progress)
     else:
-        x, ev, it, history = newton.solve(P, newton.state_from(initial, s), load, tol=s.tol,
+        x, ev, it, history = newton.solve(P, newton.state_from(initial, P), load, tol=s.tol,
                                           max_iter=max_iter, progress=progress)
     return mixed_result(ev, x.w, x.h_d, P, load, face, it, history,
                         time.perf_counter() - t0, coupling="newton")

@@ -177,11 +177,14 @@ def line_search(P: Problem, x: State, ev: NewtonEvaluation, step, load: float, s
     return fallback
 
 
-def state_from(result, settings) -> State:
-    """The Newton state of a converged :class:`MixedResult` (a warm start)."""
-    phi = cavitation_model(settings.complementarity).unknown(
-        (result.pressure - settings.cavitation_pressure).ravel(),
-        result.cavity_fraction.ravel(), settings.p_ref)
+def state_from(result, P: Problem) -> State:
+    """The Newton state of a converged :class:`MixedResult` (a warm start), its Dirichlet
+    nodes at ambient pressure."""
+    s = P.settings
+    phi = cavitation_model(s.complementarity).unknown(
+        (result.pressure - s.cavitation_pressure).ravel(), result.cavity_fraction.ravel(),
+        s.p_ref)
+    phi[P.boundary.ravel()] = s.ambient_pressure - s.cavitation_pressure
     return State(phi, np.asarray(result.elastic_deformation, float).copy(), float(result.h_d))
 
 

@@ -15,7 +15,7 @@ import numpy as np
 import scipy.fft as fft
 
 from ..contact.elastic import elastic_operator
-from .reynolds import fe_poiseuille, trapezoid_weights
+from .reynolds import OPEN_GAP, fe_poiseuille, trapezoid_weights
 from .reynolds_fv import fvm_poiseuille
 
 #: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
@@ -85,11 +85,13 @@ class Problem:
 def macro_problem(gap, spacing, factors, lubricant, settings, speed: float,
                   entrainment: float) -> Problem:
     """The :class:`Problem` of a validated gap (ny, nx) [m] and spacing (dx1, dx2) [m]:
-    Dirichlet nodes on the grid's edge, the non-periodic FFT half-space of eqs 20-22 and the
-    Poiseuille operator of ``settings.method``."""
+    Dirichlet nodes (ambient pressure) on the grid's edge and wherever the rigid gap opens
+    beyond ``OPEN_GAP`` (around the pin face: the oil bath over the holder), the
+    non-periodic FFT half-space of eqs 20-22 and the Poiseuille operator of
+    ``settings.method``."""
     gap = np.asarray(gap, float)
     dx = tuple(float(v) for v in spacing)
-    boundary = np.zeros(gap.shape, bool)
+    boundary = gap > OPEN_GAP
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
     return Problem(gap, dx, factors, lubricant, settings,
                    partial(_poiseuille, POISEUILLE[settings.method], dx),
