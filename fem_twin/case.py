@@ -20,16 +20,21 @@ class CaseError(InputError):
 
 #: a warm Stribeck point of a pin at 128^2 [s], its growth with the pixels, and the cost of
 #: a main-curve point with its C_f error estimate in plain points: fitted to the bundled
-#: case (276 s without the estimates, 288 s with them) and the paper case (sweeps and band
-#: 1069 s at 256^2), 2026-11-24
-POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 1.85, 0.55, 1.37
+#: case (main sweeps 23 s, band 17 s, 2026-11-25 afternoon) and the paper case (sweeps,
+#: band and results 249 s at 256^2, the same hour)
+POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 1.1, 0.7, 1.28
 #: a band point on the coarsened grid ([run] band_grid = "coarse") in full-grid points:
-#: 0.32 s against 1.28 s on the bundled case (64^2 against 128^2, 2026-11-25)
-COARSE_BAND_COST = 0.25
+#: 0.157 s against 1.28 s a main point on the bundled case (64^2 at the band's tolerance
+#: against 128^2 with the error estimate, 2026-11-25)
+COARSE_BAND_COST = 0.14
+#: micro stage cost per cell pixel, time step and separation on one core [s] (the cell
+#: problems, the periodic contact and the coarsened cell of the error estimate: 2.3e-6 on
+#: the paper case, 2.7e-6 on the bundled one, 2026-11-25)
+MICRO_SECONDS = 2.5e-6
 #: separations an adaptive h0 sample solves, for the time estimate (measured at h0_tol =
-#: 0.01: 20-26 of the paper's 100 on sample patches 1 and 3 at 128^2 x 16, 24-39 over the
-#: six at 256^2 x 32)
-ADAPTIVE_H0 = 28
+#: 0.01: 16 of 16 on the bundled case, 24-37 of the paper's 100 over the six sample
+#: patches at 256^2 x 32, 191 in all)
+ADAPTIVE_H0 = 32
 
 
 @dataclass(frozen=True)
@@ -52,19 +57,19 @@ class Case:
 
     def estimated_seconds(self, cores: int = 2) -> float:
         """Rough wall time of ``fem-twin run`` on ``cores`` cores [s], from the costs measured
-        on this project's 2-core machine: ~3 us per cell pixel and time step of the micro
-        stage on one core (adaptive h0 solves about ``ADAPTIVE_H0`` of the candidates); a
-        warm Stribeck point of a pin ``POINT_SECONDS`` at 128^2 growing as
-        N^``POINT_GROWTH`` (pixels), ``ESTIMATE_COST`` times that on the main curves (their
-        C_f error estimates), one sweep per viscosity and, with ``[run] patch_band``, one
-        more per patch (and the average's, at ``COARSE_BAND_COST`` on the coarse grid of
-        ``[run] band_grid``); a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured against
-        it: the bundled case 141 s (estimated 142 s), the paper case 20.0 min with the band
-        and 13.4 without (estimated 16.5 and 12.2)."""
+        on this project's 2-core machine: ``MICRO_SECONDS`` per cell pixel, time step and
+        separation of the micro stage on one core (adaptive h0 solves about ``ADAPTIVE_H0``
+        of the candidates); a warm Stribeck point of a pin ``POINT_SECONDS`` at 128^2
+        growing as N^``POINT_GROWTH`` (pixels), ``ESTIMATE_COST`` times that on the main
+        curves (their C_f error estimates), one sweep per viscosity and, with ``[run]
+        patch_band``, one more per patch (at ``COARSE_BAND_COST`` on the coarse grid of
+        ``[run] band_grid``); a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured
+        against it (2026-11-25): the bundled case 81 s (estimated 75 s), the paper case
+        712 s (estimated 746 s)."""
         patches = len(self.geometry.patches)
         h0 = min(self.micro.h0_count, ADAPTIVE_H0) if self.micro.h0_tol else self.micro.h0_count
-        micro = (3e-6 * self.micro.resolution[0] * self.micro.resolution[1] * self.micro.steps
-                 * h0 * patches / max(cores, 1))
+        pixels = self.micro.resolution[0] * self.micro.resolution[1]
+        micro = MICRO_SECONDS * pixels * self.micro.steps * h0 * patches / max(cores, 1)
         if self.tribometer.ball:         # Newton coupling: ~2.5 s a point at 73^2 measured
             point, estimate = 2.5 * (self.macro.grid / 73) ** 2.4, 1.0
         else:
@@ -74,8 +79,8 @@ class Case:
         n_mu = len(self.lubricant.viscosities)
         points = self.sweep.count * (1 + 0.5 * self.sweep.refine)   # refinement: ~+50 %
         band = patches if self.run.patch_band and patches > 1 else 0
-        if band and self.run.band_grid == "coarse":        # and the average on that grid
-            band = (band + 1) * COARSE_BAND_COST
+        if band and self.run.band_grid == "coarse":
+            band *= COARSE_BAND_COST
         sweeps = n_mu * (1 + (patches if band else 0))
         macro = point * points * n_mu * (estimate + band) / max(1, min(cores, sweeps))
         return micro + macro

@@ -57,6 +57,8 @@ class _Grid:
         self.position[interior] = np.arange(interior.size)
         self.n = interior.size
         self.indptr, self.indices, self.keys = _stencil_pattern(shape, self.position, self.n)
+        self.rows = np.repeat(np.arange(self.n), np.diff(self.indptr))
+        self.diagonal = np.flatnonzero(self.rows == self.indices)
         self.solver = SPDSolver(self.indptr, self.indices, "pardiso", symmetric=False)
         self._maps = []                       # [(indptr, indices, at, keep, col)]
 
@@ -80,9 +82,13 @@ class _Grid:
 
     def factor_and_solve(self, J, values, rhs):
         """Factorise ``J`` and solve; None if pivots were perturbed or the step falls short
-        of ``STEP_RTOL``."""
-        size = float(np.abs(values).max())            # PARDISO's pivot threshold is absolute
-        x = self.solver.factor(values / size).solve(rhs / size)
+        of ``STEP_RTOL``.  The matrix is equilibrated first, ``S J S`` with ``S`` the
+        inverse square root of its diagonal: PARDISO's pivot threshold is absolute, and the
+        film's ``h^3`` spans 1e9 over a pin face (a 20 nm film beside the 40 um edge)."""
+        d = np.abs(values[self.diagonal])
+        scale = 1 / np.sqrt(np.where(d > 0, d, max(float(d.max()), 1e-300)))
+        x = scale * self.solver.factor(
+            values * scale[self.rows] * scale[self.indices]).solve(scale * rhs)
         if self.solver.perturbed or not _solves(J, x, rhs):
             return None
         return x
