@@ -23,10 +23,11 @@ class CaseError(InputError):
 #: case (main sweeps 23 s, band 17 s, 2026-11-25 afternoon) and the paper case (sweeps,
 #: band and results 249 s at 256^2, the same hour)
 POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 1.1, 0.7, 1.28
-#: a band point on the coarsened grid ([run] band_grid = "coarse") in full-grid points:
-#: 0.157 s against 1.28 s a main point on the bundled case (64^2 at the band's tolerance
-#: against 128^2 with the error estimate, 2026-11-25)
-COARSE_BAND_COST = 0.14
+#: a band point in main-curve points, by ``[run] band_grid``: the band's sweeps converge to
+#: 1e-4 and carry no error estimate, and "coarse" runs them on the coarsened grid (bundled
+#: case, 2026-11-25: 0.157 s on the coarse grid, 0.59 s on the full one, against 1.28 s a
+#: main point with its error estimate)
+BAND_POINT_COST = {"coarse": 0.14, "full": 0.54}
 #: micro stage cost per cell pixel, time step and separation on one core [s] (the cell
 #: problems, the periodic contact and the coarsened cell of the error estimate: 2.3e-6 on
 #: the paper case, 2.7e-6 on the bundled one, 2026-11-25)
@@ -62,10 +63,10 @@ class Case:
         of the candidates); a warm Stribeck point of a pin ``POINT_SECONDS`` at 128^2
         growing as N^``POINT_GROWTH`` (pixels), ``ESTIMATE_COST`` times that on the main
         curves (their C_f error estimates), one sweep per viscosity and, with ``[run]
-        patch_band``, one more per patch (at ``COARSE_BAND_COST`` on the coarse grid of
-        ``[run] band_grid``); a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured
-        against it (2026-11-25): the bundled case 81 s (estimated 75 s), the paper case
-        712 s (estimated 746 s)."""
+        patch_band``, one more per patch (a point at ``BAND_POINT_COST`` by ``[run]
+        band_grid``); a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured
+        against it (2026-11-25): the bundled case 81 s (estimated 73 s), 127 s with its band
+        on the full grid (121 s), the paper case 712 s (734 s), the ball case 63 s (61 s)."""
         patches = len(self.geometry.patches)
         h0 = min(self.micro.h0_count, ADAPTIVE_H0) if self.micro.h0_tol else self.micro.h0_count
         pixels = self.micro.resolution[0] * self.micro.resolution[1]
@@ -79,8 +80,7 @@ class Case:
         n_mu = len(self.lubricant.viscosities)
         points = self.sweep.count * (1 + 0.5 * self.sweep.refine)   # refinement: ~+50 %
         band = patches if self.run.patch_band and patches > 1 else 0
-        if band and self.run.band_grid == "coarse":
-            band *= COARSE_BAND_COST
+        band *= BAND_POINT_COST[self.run.band_grid]
         sweeps = n_mu * (1 + (patches if band else 0))
         macro = point * points * n_mu * (estimate + band) / max(1, min(cores, sweeps))
         return micro + macro
