@@ -23,7 +23,6 @@ from .curve import StribeckCurve, hersey_number
 COARSE_CF = "coarse_friction_coefficient"
 
 
-@one_thread
 def point_file(folder, key: str, speed: float) -> Path:
     """The checkpoint of one Stribeck point: ``point_KEY_SPEED.npz`` in ``folder``."""
     return Path(folder) / f"point_{key}_{speed:.9e}.npz"
@@ -39,6 +38,7 @@ def point_key(path) -> str:
     return Path(path).name.split("_")[1]
 
 
+@one_thread
 def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    lubricant: Lubricant, diameter: float = 8e-3, face=None,
                    settings: MacroSettings = MacroSettings(), checkpoint=None, fields=None,
