@@ -510,38 +510,63 @@ def bench_paper():
     ]
 
 
-def bench_estimate(viscosity=0.066):
-    """Honesty of the C_f error estimate at full size: the bundled case with its first patch
-    pair and first viscosity (128^2 macro and cell, 16 h0 candidates, 16 steps, no speed
-    refinement) against a reference at twice the resolution on both scales (256^2), 31 h0
-    candidates and four times the steps (64).  Rows: per speed, the estimate over the change
-    to the reference (goal: 1 to 3, or both below 0.05 % C_f,b).  Baseline: the base run."""
-    import tempfile
+def _refined(case, scale, steps, h0):
+    """``case`` with both grids ``scale`` times finer, ``steps`` x the instants and the h0
+    candidates refined ``h0`` times (old candidates kept)."""
     from dataclasses import replace
 
+    res = tuple(scale * n for n in case.macro_geometry.resolution)
+    cell = tuple(scale * n for n in case.micro.resolution)
+    return replace(case, macro_geometry=replace(case.macro_geometry, resolution=res),
+                   micro=replace(case.micro, resolution=cell, steps=steps * case.micro.steps,
+                                 h0_count=h0 * (case.micro.h0_count - 1) + 1))
+
+
+def _run_kept(case, name):
+    """Run ``case`` into ``$FEM_TWIN_BENCH_DIR/name`` (kept, so an interrupted reference
+    resumes from its checkpoints) or a temporary directory; wall time [s] and the curve."""
+    import tempfile
+
     from fem_twin import pipeline
-    from fem_twin.case import load_case
     from fem_twin.stribeck.curve import read_stribeck_csv
 
-    case = load_case(os.path.join(HERE, "..", "examples", "pin_on_disk.toml"))
+    keep = os.environ.get("FEM_TWIN_BENCH_DIR")
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(keep, name) if keep else tmp
+        t0 = time.perf_counter()
+        pipeline.run(case, out, progress=False)
+        seconds = time.perf_counter() - t0
+        return seconds, read_stribeck_csv(os.path.join(out, "stribeck.csv"))[0]
+
+
+def bench_estimate(case_file="pin_on_disk.toml", viscosity=0.066):
+    """Honesty of the C_f error estimate at full size: a case with its first patch pair and
+    first viscosity (no speed refinement, no band) against a reference at twice the
+    resolution on both scales, four times the steps and twice the h0 candidates.  The
+    bundled case (128^2, 16 h0, 16 steps; reference 256^2, 31 h0, 64 steps) or, as
+    ``estimate-paper``, the paper case (256^2, 100 h0, 32 steps; reference 512^2, 199 h0,
+    128 steps, a few hours on 2 cores).  Rows: per speed, the estimate over the change to
+    the reference (goal: 1 to 3, or both below 0.05 % C_f,b).  Baseline: the base run.
+    ``$FEM_TWIN_BENCH_DIR`` keeps both runs (and resumes them)."""
+    from dataclasses import replace
+
+    from fem_twin.case import load_case
+
+    case = load_case(os.path.join(HERE, "..", "examples", case_file))
     case = replace(case, geometry=replace(case.geometry, patches=case.geometry.patches[:1]),
                    lubricant=replace(case.lubricant, viscosities=(viscosity,),
                                      temperatures=case.lubricant.temperatures[:1]),
                    sweep=replace(case.sweep, refine=0), measured=(),
                    run=replace(case.run, patch_band=False))
-    fine = replace(case, macro_geometry=replace(case.macro_geometry, resolution=(256, 256)),
-                   micro=replace(case.micro, resolution=(256, 256), steps=64, h0_count=31))
-    curves, times = [], []
-    for c in (case, fine):
-        with tempfile.TemporaryDirectory() as tmp:
-            t0 = time.perf_counter()
-            pipeline.run(c, tmp, progress=False)
-            times.append(time.perf_counter() - t0)
-            curves.append(read_stribeck_csv(os.path.join(tmp, "stribeck.csv"))[0])
-    base, ref = curves
+    fine = _refined(case, 2, 4, 2)
+    stem = os.path.splitext(case_file)[0]
+    t_base, base = _run_kept(case, f"{stem}_base")
+    t_ref, ref = _run_kept(fine, f"{stem}_reference")
     cb = case.tribometer.boundary_friction
-    rows = [("baseline: bundled case, 1 patch, 1 viscosity", times[0], ""),
-            ("reference: 256^2 both scales, 31 h0, 64 steps", times[1], "")]
+    res, cell = fine.macro_geometry.resolution[0], fine.micro.resolution[0]
+    rows = [(f"baseline: {stem}, 1 patch, 1 viscosity", t_base, ""),
+            (f"reference: {res}^2 / {cell}^2, {fine.micro.h0_count} h0, "
+             f"{fine.micro.steps} steps", t_ref, "")]
     for u, cf, err, cf_ref in zip(base.speed, base.friction_coefficient, base.friction_error,
                                   ref.friction_coefficient):
         actual = abs(cf - cf_ref)
@@ -549,7 +574,7 @@ def bench_estimate(viscosity=0.066):
         rows.append((f"  {u:.4g} m/s: C_f {cf:.5f}, reference {cf_ref:.5f}", 0.0,
                      f"estimate {err / cb:.3%}, actual {actual / cb:.3%} C_f,b, "
                      f"effectivity {err / actual:.2f} {'ok' if ok else 'OUTSIDE'}"))
-    return times[0], rows
+    return t_base, rows
 
 
 from scale import bench_scale  # noqa: E402
@@ -557,11 +582,13 @@ from scale import bench_scale  # noqa: E402
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
           "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "paper": bench_paper, "stribeck": bench_stribeck,
           "estimate": bench_estimate, "scale": bench_scale,
+          "estimate-paper": lambda: bench_estimate("paper.toml"),
           "micro-full": lambda: bench_micro(full=True)}
 
 
 def main(argv):
-    groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "scale")]
+    groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "estimate-paper",
+                                                        "scale")]
     for name in groups:
         base, rows = GROUPS[name]()
         print(f"\n## {name}")

@@ -106,7 +106,8 @@ def _seconds(moments) -> float:
 
 
 def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task]:
-    """The sweeps of the macro scale: first passes, refinements, then the band's."""
+    """The sweeps of the macro scale: first passes, then the refinements with the band's
+    beside them (beside the first passes without refinement)."""
     first = np.asarray(case.sweep.speeds, float)
     sweeps = defaultdict(list)
     for path in point_files(out.points):
@@ -124,8 +125,8 @@ def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task
     passes = [Task(f"sweep {key}", s[0], micro) for key, s in split.items()]
     refined = [Task(f"refinement {key}", s[1], tuple(t.name for t in passes))
                for key, s in split.items()]
-    return passes + refined + [Task(f"band sweep {key}", sum(s for _, s, _ in v),
-                                    tuple(t.name for t in refined))
+    band_after = tuple(t.name for t in passes) if case.sweep.refine else micro
+    return passes + refined + [Task(f"band sweep {key}", sum(s for _, s, _ in v), band_after)
                                for key, v in sweeps.items() if key not in main]
 
 

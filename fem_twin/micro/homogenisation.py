@@ -70,7 +70,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
         ``workers`` the processes serving it.  The h0 values go out as ``4 workers`` tasks
         (each warm-starts along its own h0 values), so a 64-worker cluster gets 100 tasks
         of one h0 from the paper's 100 values; with ``h0_tol``, the new points of each round
-        of the adaptive sample go out so (9 to start with, then the bisected gaps).
+        of the adaptive sample go out so (5 to start with, then the bisected gaps).
     checkpoint : folder that keeps one file per finished h0; a rerun resumes from it.
     progress : show a progress bar (or a tqdm-like bar to advance, shared by several runs).
     patch_id : recorded in the metadata.

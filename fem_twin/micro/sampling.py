@@ -32,8 +32,12 @@ from ..errors import InputError
 from .estimate import QUANTITIES
 from .flow_factors import ARRAYS
 
-#: separations of the coarse start (8 intervals: 17 points after the first bisection)
-START = 9
+#: separations of the coarse start (4 intervals: 9 points after the first bisection).
+#: Measured on the paper case's six patch pairs (100 candidates, tol 0.01): 183 solved
+#: against 191 with a start of 9, the same h0 bounds; the bisection adds the points where
+#: the factors turn, so the start need only be dense enough not to step over a turn
+#: (9 points over a decade: ratio 1.33)
+START = 5
 #: misses are relative to ``max(|f|, FLOOR max |f|)`` per quantity ...
 FLOOR = 0.01
 #: ... and for d1 to at least 1/3, its weight beside the sliding term of eq 31

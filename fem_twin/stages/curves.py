@@ -64,13 +64,14 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
                   speeds=case.sweep.speeds, load=face_load(case), diameter=hersey_length(case),
                   face=face, **ball, settings=macro_settings(case), checkpoint=out.points,
                   fields=out.fields, origin=origin, factors_key=stage_keys(case)["micro"])
-    curves, speeds = refined_curves(case, common, executor, progress)
+    band = lambda speeds: band_tasks(case, out, dict(common, speeds=speeds))  # noqa: E731
+    curves, speeds, swept = refined_curves(case, common, executor, progress, beside=band)
     tasks = [(dict(common, speeds=speeds, error_estimate=True), lub)
              for lub in case.lubricant.lubricants()]
-    patch_curves, band_tasks = band_curves(case, out, dict(common, speeds=speeds), curves,
-                                           executor, progress)
+    patch_curves, patch_tasks = band_curves(case, dict(common, speeds=speeds), curves,
+                                            band(speeds), swept, executor, progress)
     band = patch_band(patch_curves) if patch_curves else None
-    _prune_points(common["checkpoint"], tasks + band_tasks)
+    _prune_points(common["checkpoint"], tasks + patch_tasks)
     write_stribeck_csv(out.stribeck_csv, curves, band)
     summary = _summary(case, out, curves, band)
     plot_curves(case, curves, band, out)
@@ -89,54 +90,74 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     return summary
 
 
-def refined_curves(case: Case, common: dict, executor=None, progress: bool = True):
+def refined_curves(case: Case, common: dict, executor=None, progress: bool = True,
+                   beside=lambda speeds: []):
     """The main curves (with their C_f error estimates) over the case's speeds, then
-    ``[sweep] refine`` passes adding the midpoints where C_f jumps; ``(curves, speeds)``."""
+    ``[sweep] refine`` passes adding the midpoints where C_f jumps; ``(curves, speeds,
+    others)``.  ``beside(speeds)``: more sweep tasks (the patch band) that run on the
+    executor beside the final pass, so that no worker waits for the last main sweep;
+    ``others`` are their curves."""
     tr, step = case.tribometer, case.sweep.refine_step * case.tribometer.boundary_friction
     lubricants = case.lubricant.lubricants()
     speeds = case.sweep.speeds
+
+    def sweeps(final):            # the fields (VTU) and the other tasks with the final pass
+        tasks = [(dict(common, speeds=speeds, error_estimate=True,
+                       fields=common["fields"] if final else None), lub) for lub in lubricants]
+        swept = run_sweeps(tasks + (beside(speeds) if final else []), executor, progress)
+        return ([c.with_load_share(tr.load_share) for c in swept[:len(tasks)]],
+                swept[len(tasks):])
+
     for level in range(case.sweep.refine + 1):
-        curves = [c.with_load_share(tr.load_share) for c in run_sweeps(
-            [(dict(common, speeds=speeds, error_estimate=True), lub) for lub in lubricants],
-            executor, progress)]
+        final = level == case.sweep.refine
+        curves, others = sweeps(final)
         extra = transition_speeds(curves, step)
-        if level == case.sweep.refine or extra.size == 0:
+        if final or extra.size == 0:
             break
         log.info("sweep refinement %d: %d speeds added where C_f changes by more than "
                  "%.3g", level + 1, extra.size, step)
         speeds = np.unique(np.r_[speeds, extra])[::-1]
-    return curves, speeds
+    if not final:                 # every main point checkpointed: the fields, the others
+        curves, others = sweeps(True)
+    return curves, speeds, others
 
 
-def band_curves(case: Case, out: RunLayout, common: dict, curves, executor=None,
-                progress: bool = True):
-    """The single-patch curves of the scatter band (``[run] patch_band``), one list per
-    patch over the viscosities, and their sweep tasks.  With ``[run] band_grid = "coarse"``
-    they are swept on the macro grid coarsened by two and corrected by the main ``curves``'
-    change to the full grid (:func:`~fem_twin.stribeck.analysis.defect_corrected`): the
-    main sweeps' own coarse points give that change, or, where a point has none (a coarse
-    solve that failed, checkpoints of an earlier version), the average factors are swept
-    on the coarse grid too."""
-    lubricants = case.lubricant.lubricants()
+def band_tasks(case: Case, out: RunLayout, common: dict) -> list:
+    """The sweep tasks of the scatter band (``[run] patch_band``): one per patch and
+    viscosity, on the macro grid coarsened by two with ``[run] band_grid = "coarse"``."""
     sweeps = band_sweeps(case, out, common) if case.run.patch_band else []
-    coarse = bool(sweeps) and case.run.band_grid == "coarse"
-    kept = coarse and all(c.coarse_friction_coefficient is not None and np.all(
-        np.isfinite(c.coarse_friction_coefficient)) for c in curves)
-    if coarse:
+    if sweeps and case.run.band_grid == "coarse":
         gap, spacing, face = coarsened(common["gap"], common["spacing"], common["face"])
-        sweeps = [dict(kw, gap=gap, spacing=spacing, face=face)
-                  for kw in [*sweeps, *([] if kept else [dict(common, fields=None)])]]
-    tasks = [(kw, lub) for kw in sweeps for lub in lubricants]
-    swept = [c.with_load_share(case.tribometer.load_share) for c in run_sweeps(
-        tasks, executor, progress, desc="patch band points")]
-    n = len(lubricants)
+        sweeps = [dict(kw, gap=gap, spacing=spacing, face=face) for kw in sweeps]
+    return [(kw, lub) for kw in sweeps for lub in case.lubricant.lubricants()]
+
+
+def band_curves(case: Case, common: dict, curves, tasks, swept, executor=None,
+                progress: bool = True):
+    """The single-patch curves of the scatter band, one list per patch over the
+    viscosities, from the curves ``swept`` of :func:`band_tasks`' ``tasks``, and the tasks
+    (with any sweep added here).  Swept on the coarse grid, they are corrected by the
+    main ``curves``' change to the full grid
+    (:func:`~fem_twin.stribeck.analysis.defect_corrected`): the main sweeps' own coarse
+    points give that change, or, where a point has none (a coarse solve that failed,
+    checkpoints of an earlier version), the average factors are swept on the coarse grid
+    too."""
+    n = len(case.lubricant.lubricants())
+    swept = [c.with_load_share(case.tribometer.load_share) for c in swept]
     per_patch = [swept[i:i + n] for i in range(0, len(swept), n)]
-    if kept:
-        per_patch = defect_corrected(per_patch, curves, [
-            replace(c, friction_coefficient=c.coarse_friction_coefficient) for c in curves])
-    elif coarse:
-        per_patch = defect_corrected(per_patch[:-1], curves, per_patch[-1])
-    return per_patch, tasks
+    if not per_patch or case.run.band_grid != "coarse":
+        return per_patch, tasks
+    if all(c.coarse_friction_coefficient is not None and np.all(
+            np.isfinite(c.coarse_friction_coefficient)) for c in curves):
+        return defect_corrected(per_patch, curves, [
+            replace(c, friction_coefficient=c.coarse_friction_coefficient)
+            for c in curves]), tasks
+    kw = tasks[0][0]
+    average = [(dict(common, gap=kw["gap"], spacing=kw["spacing"], face=kw["face"],
+                     fields=None), lub) for lub in case.lubricant.lubricants()]
+    coarse = [c.with_load_share(case.tribometer.load_share)
+              for c in run_sweeps(average, executor, progress, desc="patch band points")]
+    return defect_corrected(per_patch, curves, coarse), tasks + average
 
 
 def _summary(case: Case, out: RunLayout, curves, band) -> dict:
