@@ -437,7 +437,7 @@ def bench_paper():
     """A reduced paper case and the whole-twin extrapolation (examples/paper.toml: 6 patch
     pairs at 256^2 x 32 steps over the paper's 100 h0 candidates, adaptive h0; 2
     viscosities x 25 speeds (+ refinement, ~37 points) at 256^2; patch band: 12 more
-    sweeps, 14 on the coarse grid; 2 cores).  Measured here: sample patch pair 3 at 256^2,
+    sweeps on the coarse grid; 2 cores).  Measured here: sample patch pair 3 at 256^2,
     adaptive h0 on 2 processes, and the previous method's cost of one h0 (10 of the 100,
     serial); 8 consecutive speeds of the paper's 25 (0.53 -> 0.07 m/s) at 256^2 with the
     macro groups' flow factors (patch 1 at 64^2, 30 h0), the first point cold, and the same
@@ -480,7 +480,7 @@ def bench_paper():
     sweep = cold + (points - 1) * warm
     macro_avg = sweep * n_mu / min(cores, n_mu)
     macro_band = sweep * patches * n_mu / cores
-    coarse_band = points * coarse * (patches + 1) * n_mu / cores
+    coarse_band = points * coarse * patches * n_mu / cores
     return per_h0, [
         ("micro: one h0 (32 steps, 256^2), measured", per_h0, "serial, 10 of the 100 h0"),
         ("micro: one patch pair, adaptive h0, measured", t_pair,
@@ -501,7 +501,7 @@ def bench_paper():
         ("paper twin, patch band on the full grid (extrapolated)", macro_band,
          f"{patches * n_mu} single-patch sweeps / {cores} cores (band_grid = \"full\")"),
         ("paper twin, patch band on the coarse grid (extrapolated)", coarse_band,
-         f"{(patches + 1) * n_mu} sweeps at 128^2 / {cores} cores (the default); "
+         f"{patches * n_mu} sweeps at 128^2 / {cores} cores (the default); "
          f"{macro_band / coarse_band:.1f}x faster"),
         ("paper twin, whole (extrapolated)", micro + macro_avg + coarse_band,
          f"{(micro + macro_avg + coarse_band) / 60:.0f} min; "

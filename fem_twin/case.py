@@ -32,10 +32,11 @@ BAND_POINT_COST = {"coarse": 0.14, "full": 0.54}
 #: problems, the periodic contact and the coarsened cell of the error estimate: 2.3e-6 on
 #: the paper case, 2.7e-6 on the bundled one, 2026-11-25)
 MICRO_SECONDS = 2.5e-6
-#: separations an adaptive h0 sample solves, for the time estimate (measured at h0_tol =
-#: 0.01: 16 of 16 on the bundled case, 24-37 of the paper's 100 over the six sample
-#: patches at 256^2 x 32, 191 in all)
-ADAPTIVE_H0 = 32
+#: separations an adaptive h0 sample solves per patch pair, for the time estimate:
+#: ``a + k / sqrt(h0_tol)`` (at most the candidates), fitted to the paper case's six patch
+#: pairs at 256^2 x 32 (2026-11-25: 30.5, 27, 22.3 and 18.8 a pair at h0_tol = 0.01, 0.02,
+#: 0.03 and 0.05; the bundled case solves all its 16)
+ADAPTIVE_H0 = (9.3, 2.1)
 
 
 @dataclass(frozen=True)
@@ -59,16 +60,20 @@ class Case:
     def estimated_seconds(self, cores: int = 2) -> float:
         """Rough wall time of ``fem-twin run`` on ``cores`` cores [s], from the costs measured
         on this project's 2-core machine: ``MICRO_SECONDS`` per cell pixel, time step and
-        separation of the micro stage on one core (adaptive h0 solves about ``ADAPTIVE_H0``
+        separation of the micro stage on one core (adaptive h0 solves ``ADAPTIVE_H0``
         of the candidates); a warm Stribeck point of a pin ``POINT_SECONDS`` at 128^2
         growing as N^``POINT_GROWTH`` (pixels), ``ESTIMATE_COST`` times that on the main
         curves (their C_f error estimates), one sweep per viscosity and, with ``[run]
         patch_band``, one more per patch (a point at ``BAND_POINT_COST`` by ``[run]
         band_grid``); a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured
-        against it (2026-11-25): the bundled case 81 s (estimated 73 s), 127 s with its band
-        on the full grid (121 s), the paper case 712 s (734 s), the ball case 63 s (61 s)."""
+        against it (2026-11-25, late afternoon): the bundled case 86 s (estimated 73 s), 137 s
+        with its band on the full grid (121 s), the paper case 538 s (525 s), the ball case
+        64 s (61 s)."""
         patches = len(self.geometry.patches)
-        h0 = min(self.micro.h0_count, ADAPTIVE_H0) if self.micro.h0_tol else self.micro.h0_count
+        h0 = self.micro.h0_count
+        if self.micro.h0_tol:
+            a, k = ADAPTIVE_H0
+            h0 = min(h0, a + k / math.sqrt(self.micro.h0_tol))
         pixels = self.micro.resolution[0] * self.micro.resolution[1]
         micro = MICRO_SECONDS * pixels * self.micro.steps * h0 * patches / max(cores, 1)
         if self.tribometer.ball:         # Newton coupling: ~2.5 s a point at 73^2 measured

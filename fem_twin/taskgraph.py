@@ -7,9 +7,9 @@ A run's independent work is a graph of tasks, each timed as it ran:
   task, its time the contact and cell seconds in its checkpoint), then the coarsened cell's
   pass for the grid-error estimate at the chosen h0;
 * the macro scale, after every patch: one sweep per viscosity over the case's speeds (a
-  chain of warm-started points: one task, the sum of its points' solve and error-estimate
-  seconds), the refinement's added speeds of each (after all first passes), and the
-  patch band's sweeps (after the refinement).
+  chain of warm-started points: one task, the sum of its points' solve, nested coarse solve
+  and error-estimate seconds), the refinement's added speeds of each (after all first
+  passes), and the patch band's sweeps (beside the refinement).
 
 The rounds are replayed from the checkpoints (the sampler is deterministic), so the graph
 of any finished run can be read back.  :func:`makespan` schedules the graph greedily on
@@ -114,7 +114,8 @@ def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task
         with np.load(path) as data:
             meta, scalars = json.loads(str(data["meta"])), json.loads(str(data["scalars"]))
         speed = meta.get("entrainment") if case.tribometer.ball else scalars["speed"]
-        seconds = meta.get("seconds", 0.0) + meta.get("seconds_estimate", 0.0)
+        seconds = sum(meta.get(k, 0.0) for k in ("seconds", "seconds_coarse",
+                                                   "seconds_estimate"))
         sweeps[point_key(path)].append((speed, seconds, "error_estimate" in meta))
     main = {k: v for k, v in sweeps.items() if any(e for _, _, e in v)}
     split = {}

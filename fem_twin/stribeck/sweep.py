@@ -84,7 +84,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                                        lubricant=lubricant, face=face, settings=settings,
                                        previous=previous, previous_coarse=previous_coarse)
             if coarse is not None:
-                res = replace(res, meta={**res.meta, COARSE_CF: coarse.friction_coefficient})
+                res = replace(res, meta={**res.meta, COARSE_CF: coarse.friction_coefficient,
+                                         "seconds_coarse": coarse.meta["seconds"]})
             if path is not None:
                 res.save(path)
         if error_estimate and "error_estimate" not in res.meta:
