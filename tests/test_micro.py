@@ -595,22 +595,30 @@ def test_adaptive_separations_do_not_chase_time_sampling_jitter():
 def test_homogenise_with_adaptive_h0_matches_the_dense_run(tmp_path):
     """homogenise(h0_tol=...): a subset of the candidates is solved, each point as in the
     dense run; the interpolant of the subset reads the dense factors within the larger of
-    the h0 bound and the time-error estimate it reports (the jitter of 8 instants); a rerun
-    resumes everything from the checkpoints."""
+    the h0 bound and the time-error estimate it reports (the jitter of 8 instants; d1
+    within the sampler's JITTER times it); a rerun resumes everything from the
+    checkpoints."""
+    from fem_twin.micro.sampling import JITTER, START
     pin, disk = rough_pair(32)
     h0 = np.geomspace(0.05e-6, 0.5e-6, 40)
     dense = homogenise(pin, disk, h0, n_steps=8)
     ad = homogenise(pin, disk, h0, n_steps=8, h0_tol=0.005, checkpoint=tmp_path)
     idx = np.searchsorted(h0, ad.h0)
-    assert np.allclose(h0[idx], ad.h0, rtol=1e-14) and 17 <= len(ad) < 30
+    start = 2 * START - 1                                    # the start, bisected once
+    assert np.allclose(h0[idx], ad.h0, rtol=1e-14) and start < len(ad) < 30
     assert np.allclose(ad.A, dense.A[idx], rtol=1e-6) and np.allclose(ad.b, dense.b[idx],
                                                                        rtol=1e-6)
     est = ad.meta["error_estimate"]
     loc = ad.at(h0)
-    for name, get in (("A11", lambda f: f.A[:, 0, 0]), ("b1", lambda f: f.b[:, 0]),
-                      ("p_con", lambda f: f.p_con), ("d1", lambda f: f.d[:, 0])):
+    # d1 on this 32^2 cell at 8 instants is mostly time jitter (its time estimate 0.81 of
+    # its largest value): the sampler leaves misses within JITTER times it unrefined, so
+    # its interpolant reads the dense d1 within that band (0.85 measured)
+    for name, get, jitter in (("A11", lambda f: f.A[:, 0, 0], 1.0),
+                              ("b1", lambda f: f.b[:, 0], 1.0),
+                              ("p_con", lambda f: f.p_con, 1.0),
+                              ("d1", lambda f: f.d[:, 0], JITTER)):
         miss = np.abs(get(loc) - get(dense)).max() / np.abs(get(dense)).max()
-        assert miss <= max(est["h0"][name], est["time"][name]), name
+        assert miss <= max(est["h0"][name], jitter * est["time"][name]), name
     again = homogenise(pin, disk, h0, n_steps=8, h0_tol=0.005, checkpoint=tmp_path)
     assert again.meta["seconds"]["computed_h0"] == 0 and np.array_equal(again.A, ad.A)
     mean = average([ad, dense])
