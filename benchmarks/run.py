@@ -1,8 +1,9 @@
 """Run the benchmarks and print wall times with ratios to a same-run baseline.
 
     python benchmarks/run.py [GROUP ...]      # topography contact micro macro stribeck ...
-                                              # (micro-full: ~15 min, estimate: ~10 min,
-                                              #  scale: ~10 min; only when named)
+                                              # (micro-full: ~15 min, estimate: ~40 min,
+                                              #  estimate-paper: ~100 min, scale: ~10 min;
+                                              #  only when named)
 """
 
 from __future__ import annotations
