@@ -64,12 +64,12 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
                   speeds=case.sweep.speeds, load=face_load(case), diameter=hersey_length(case),
                   face=face, **ball, settings=macro_settings(case), checkpoint=out.points,
                   fields=out.fields, origin=origin, factors_key=stage_keys(case)["micro"])
-    band = lambda speeds: band_tasks(case, out, dict(common, speeds=speeds))  # noqa: E731
-    curves, speeds, swept = refined_curves(case, common, executor, progress, beside=band)
+    band_at = lambda speeds: band_tasks(case, out, dict(common, speeds=speeds))  # noqa: E731
+    curves, speeds, swept = refined_curves(case, common, executor, progress, beside=band_at)
     tasks = [(dict(common, speeds=speeds, error_estimate=True), lub)
              for lub in case.lubricant.lubricants()]
     patch_curves, patch_tasks = band_curves(case, dict(common, speeds=speeds), curves,
-                                            band(speeds), swept, executor, progress)
+                                            band_at(speeds), swept, executor, progress)
     band = patch_band(patch_curves) if patch_curves else None
     _prune_points(common["checkpoint"], tasks + patch_tasks)
     write_stribeck_csv(out.stribeck_csv, curves, band)
