@@ -12,8 +12,7 @@ Both scales contribute, and each part is a change of C_f [-]:
     the flow factors' own error estimates carried into C_f: the point solved with each
     variant of the factors (:meth:`FlowFactors.variants`: every other instant, the
     coarsened cell's difference added, every other separation), on the coarse grid and
-    warm from the coarse point, minus the coarse point (to the coupling tolerance
-    ``VARIANT_TOL``).  The sensitivity of C_f to the
+    warm from the coarse point, minus the coarse point.  The sensitivity of C_f to the
     factors needs no finer grid than that: the coarse grid changes C_f itself by a few
     tenths of a per cent of C_f,b.  The ``"h0"`` variant's interpolation error is that of
     twice the spacing, ``H0_SPACING_RATIO`` times the error of the computed sample.
@@ -25,8 +24,6 @@ estimate).  A part that could not be estimated is NaN, left out of the total and
 """
 
 from __future__ import annotations
-
-from dataclasses import replace
 
 import numpy as np
 
@@ -47,10 +44,6 @@ MACRO_ORDER = 1.5
 #: h0 part is 1.1-2.0 times the h0 error wherever that exceeds 0.2 % C_f,b (4.9 times at
 #: one point where it is 0.11 %)
 H0_SPACING_RATIO = 4.0
-#: coupling tolerance of the variant solves (the point itself keeps its own, 1e-6).  Measured
-#: on the paper case at 256^2: the parts move by at most 2e-5 C_f,b (against parts of up to
-#: 1.4e-3 C_f,b), and the estimate takes 25-40 % less time.
-VARIANT_TOL = 1e-4
 #: the parts of an estimate, in the order of the CSV and NetCDF outputs
 PARTS = ("macro", "time", "grid", "h0")
 
@@ -74,7 +67,6 @@ def friction_error(result, gap, spacing, factors, *, load: float, lubricant, fac
                 "failed": [f"coarse grid: {err.args[0]}"]}
     cf = base.friction_coefficient
     out["macro"] = abs(result.friction_coefficient - cf) / (2 ** MACRO_ORDER - 1)
-    common["settings"] = replace(settings, tol=max(settings.tol, VARIANT_TOL))
     for kind, variant in factors.variants().items():
         try:
             moved = solve_mixed(gap2, spacing2, variant, initial=base, **common)

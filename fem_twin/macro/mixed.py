@@ -17,7 +17,7 @@ points (:mod:`.fixed_point`) and the monolithic ``"newton"`` coupling (:mod:`.ne
 ``"auto"`` (default) takes Anderson and switches to Newton for elastically dominated
 contacts or when Anderson fails.  The problem is a value (:mod:`.problem`), the converged
 point a :class:`MixedResult` (:mod:`.result`); the cold start is in :mod:`.start`.
-Converged when, between two iterations, all of the following are below ``tol`` (1e-6):
+Converged when, between two iterations, all of the following are below ``tol`` (1e-4):
 the change of ``h_el`` / h_ref, the update of ``p_con`` / p_ref (eq 27), the change of
 ``p`` / p_ref (lagged viscosity and density) and the load residual (eq 30).  Otherwise
 :class:`MixedNotConverged` carries the history.

@@ -30,11 +30,6 @@ from ..threads import worker_heap
 from .geometry import ball_contact, face_load, hersey_length, macro_geometry
 from .provenance import provenance, stage_keys
 
-#: coupling tolerance of the band's single-patch sweeps (the average curves keep the case's,
-#: 1e-6).  Measured on the bundled case: the band moves by at most 1.6e-5 C_f,b, against
-#: the defect correction's error of up to 0.9 % C_f,b, and its sweeps take 15 % less time.
-BAND_TOL = 1e-4
-
 log = logging.getLogger("fem_twin")
 
 
@@ -64,7 +59,13 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
                   speeds=case.sweep.speeds, load=face_load(case), diameter=hersey_length(case),
                   face=face, **ball, settings=macro_settings(case), checkpoint=out.points,
                   fields=out.fields, origin=origin, factors_key=stage_keys(case)["micro"])
-    band_at = lambda speeds: band_tasks(case, out, dict(common, speeds=speeds))  # noqa: E731
+    made = {}                                    # the band's tasks, made once per speeds
+
+    def band_at(speeds):
+        key = tuple(speeds)
+        if key not in made:
+            made[key] = band_tasks(case, out, dict(common, speeds=speeds))
+        return made[key]
     curves, speeds, swept = refined_curves(case, common, executor, progress, beside=band_at)
     tasks = [(dict(common, speeds=speeds, error_estimate=True), lub)
              for lub in case.lubricant.lubricants()]
@@ -197,10 +198,8 @@ def band_sweeps(case: Case, out: RunLayout, common: dict) -> list[dict]:
     n = len(case.geometry.patches)
     if n < 2:
         return []
-    settings = replace(common["settings"], tol=max(common["settings"].tol, BAND_TOL))
     return [dict(common, factors=FlowFactors.load(out.patch_factors(i + 1)),
-                 factors_key=f"{common['factors_key']}-patch{i + 1}", fields=None,
-                 settings=settings)
+                 factors_key=f"{common['factors_key']}-patch{i + 1}", fields=None)
             for i in range(n)]
 
 
