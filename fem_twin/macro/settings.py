@@ -47,9 +47,9 @@ class MacroSettings:
                                "point (0: every solve to convergence)", unit="-")
     p_ref: float = setting(100e6, "pressure scale of the residuals and of theta", unit="Pa")
     h_ref: float = setting(1e-6, "length scale of the residuals", unit="m")
-    # 1e-4 from measured convergence (2026-11-25): C_f within 1.5e-5 C_f,b of 1e-6 on the
-    # sample pin at 256^2 (6 speeds, 0.2-0.02 m/s) and 6.4e-6 C_f,b on the bundled case's
-    # 36 points, against C_f error estimates of 1e-4 to 1e-2 C_f,b; 17 % less time at 256^2
+    # 1e-4 from measured convergence (2026-11-25, docs/accuracy.md): C_f within 2.1e-5
+    # C_f,b of 1e-6 on the paper case's 64 points, against C_f error estimates of 1e-4 to
+    # 1e-2 C_f,b; 34 % fewer coupling iterations
     tol: float = setting(1e-4, "convergence tolerance of the coupling (scaled residuals)",
                          unit="-")
     max_iter: int = setting(300, "iterations of the coupling before it gives up", unit="-")
