@@ -59,18 +59,13 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
                   speeds=case.sweep.speeds, load=face_load(case), diameter=hersey_length(case),
                   face=face, **ball, settings=macro_settings(case), checkpoint=out.points,
                   fields=out.fields, origin=origin, factors_key=stage_keys(case)["micro"])
-    made = {}                                    # the band's tasks, made once per speeds
-
-    def band_at(speeds):
-        key = tuple(speeds)
-        if key not in made:
-            made[key] = band_tasks(case, out, dict(common, speeds=speeds))
-        return made[key]
-    curves, speeds, swept = refined_curves(case, common, executor, progress, beside=band_at)
+    band_at = lambda speeds: band_tasks(case, out, dict(common, speeds=speeds))  # noqa: E731
+    curves, speeds, (band_sweeps_run, swept) = refined_curves(
+        case, common, executor, progress, beside=band_at)
     tasks = [(dict(common, speeds=speeds, error_estimate=True), lub)
              for lub in case.lubricant.lubricants()]
     patch_curves, patch_tasks = band_curves(case, dict(common, speeds=speeds), curves,
-                                            band_at(speeds), swept, executor, progress)
+                                            band_sweeps_run, swept, executor, progress)
     band = patch_band(patch_curves) if patch_curves else None
     _prune_points(common["checkpoint"], tasks + patch_tasks)
     write_stribeck_csv(out.stribeck_csv, curves, band)
@@ -95,9 +90,9 @@ def refined_curves(case: Case, common: dict, executor=None, progress: bool = Tru
                    beside=lambda speeds: []):
     """The main curves (with their C_f error estimates) over the case's speeds, then
     ``[sweep] refine`` passes adding the midpoints where C_f jumps; ``(curves, speeds,
-    others)``.  ``beside(speeds)``: more sweep tasks (the patch band) that run on the
-    executor beside the final pass, so that no worker waits for the last main sweep;
-    ``others`` are their curves."""
+    (others, their_curves))``.  ``beside(speeds)``: more sweep tasks (the patch band) that
+    run on the executor beside the final pass, so that no worker waits for the last main
+    sweep; ``others`` are those tasks, made once."""
     tr, step = case.tribometer, case.sweep.refine_step * case.tribometer.boundary_friction
     lubricants = case.lubricant.lubricants()
     speeds = case.sweep.speeds
@@ -105,9 +100,10 @@ def refined_curves(case: Case, common: dict, executor=None, progress: bool = Tru
     def sweeps(final):            # the fields (VTU) and the other tasks with the final pass
         tasks = [(dict(common, speeds=speeds, error_estimate=True,
                        fields=common["fields"] if final else None), lub) for lub in lubricants]
-        swept = run_sweeps(tasks + (beside(speeds) if final else []), executor, progress)
+        more = beside(speeds) if final else []
+        swept = run_sweeps(tasks + more, executor, progress)
         return ([c.with_load_share(tr.load_share) for c in swept[:len(tasks)]],
-                swept[len(tasks):])
+                (more, swept[len(tasks):]))
 
     for level in range(case.sweep.refine + 1):
         final = level == case.sweep.refine
