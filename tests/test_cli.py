@@ -148,6 +148,18 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     assert prov["case_sha256"] == hashlib.sha256(case.read_bytes()).hexdigest()[:16]
     assert prov["fem_twin_version"] and "git_commit" in prov
     assert "point mu_0 = 0.066 Pa s, U = 2 m/s" in (ref / "run.log").read_text()
+    # no contact is read below the computed separations (p_con extrapolated there); with
+    # every node below (h0_min 1 m) the share is the point's whole contact load
+    assert summary["stages"]["stribeck"]["h0_range"]["max_load_share_below"] < 0.01
+    from fem_twin.macro import MixedResult
+    from fem_twin.stribeck.accuracy import range_summary
+    point = max((MixedResult.load(p) for p in (ref / "stribeck" / "checkpoints").iterdir()),
+                key=lambda r: r.contact_load)
+    assert point.contact_load > 0.3 * point.normal_load
+    below = range_summary({(0.066, point.speed): point}, 1.0)
+    assert below["points_above"] == 1
+    assert below["max_load_share_below"] == pytest.approx(
+        point.contact_load / point.normal_load, rel=1e-9)
     # ParaView (issue 18 item 7): PVD time = speed [m/s]; gauge pressure beside the absolute
     import re
 

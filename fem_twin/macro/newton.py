@@ -76,9 +76,11 @@ def evaluate(P: Problem, x: State, load: float) -> NewtonEvaluation:
 
 def merit(ev: NewtonEvaluation, sizes: tuple) -> float:
     """Scaled residual norm: root of the summed mean squares of ``R``, ``G`` and ``L``, each
-    divided by its size from :func:`scales` (held fixed over a line search)."""
-    return float(np.sqrt(np.mean((ev.R / sizes[0]) ** 2)
-                         + np.mean((ev.G / sizes[1]) ** 2) + (ev.L / sizes[2]) ** 2))
+    divided by its size from :func:`scales` (held fixed over a line search); inf for a
+    trial step that overflows, which the line search then rejects."""
+    with np.errstate(over="ignore"):
+        return float(np.sqrt(np.mean((ev.R / sizes[0]) ** 2)
+                             + np.mean((ev.G / sizes[1]) ** 2) + (ev.L / sizes[2]) ** 2))
 
 
 def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progress=None):

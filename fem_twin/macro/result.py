@@ -84,6 +84,15 @@ class MixedResult:
             return cls(**scalars, **arrays, history=data["history"],
                        meta=json.loads(str(data["meta"])))
 
+    def contact_load_below(self, h0_min: float) -> float:
+        """The share of the normal load F_N carried by asperity contact where the
+        separation lies below ``h0_min`` [m], the smallest computed by the micro scale:
+        there :meth:`~fem_twin.micro.FlowFactors.at` extrapolates p_con instead of reading
+        it from a cell problem (lumped nodal areas, the face alone) [-]."""
+        below = self.face & (self.h0 < h0_min)
+        cell = self.spacing[0] * self.spacing[1]
+        return float(self.contact_pressure[below].sum() * cell / self.normal_load)
+
     def write_vtu(self, path, origin=(0.0, 0.0)) -> Path:
         """Fields on the structured grid for ParaView (:func:`fem_twin.io.mesh.write_vtu`),
         SI units; ``pressure`` is absolute (its minimum is p_cav), ``pressure_gauge`` is

@@ -21,7 +21,7 @@ from ..macro.figures import plot_point_fields
 from ..macro.point_contact import film_against_hamrock_dowson
 from ..micro import FlowFactors
 from ..stribeck import plot_stribeck, read_measured_csv, stribeck_sweep, write_stribeck_csv
-from ..stribeck.accuracy import error_summary
+from ..stribeck.accuracy import error_summary, range_summary
 from ..stribeck.analysis import (defect_corrected, hersey_collapse, patch_band,
                                  transition_speeds)
 from ..stribeck.sweep import point_files, point_key, sweep_key
@@ -72,6 +72,7 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     summary = _summary(case, out, curves, band)
     plot_curves(case, curves, band, out)
     points = sweep_points(common["checkpoint"], tasks)
+    summary["h0_range"] = range_summary(points, common["factors"].h0[0])
     _plot_fields(out, points, case.lubricant.viscosities)
     _log_points(curves)
     if len(curves) > 1:

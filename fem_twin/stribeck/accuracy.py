@@ -4,7 +4,8 @@ Each point of a sweep run with ``error_estimate=True`` carries the estimated dis
 error of its friction coefficient, in total and per part (macro grid; the flow factors'
 time, grid and h0 sampling: :mod:`fem_twin.macro.estimate`).  Here they are put relative to
 the boundary friction coefficient C_f,b, the scale of eq 35's deviations, and the points
-above a tolerance are named.
+above a tolerance are named.  :func:`range_summary` checks what the estimate cannot see:
+contact carried at separations below the micro scale's range, where p_con is extrapolated.
 """
 
 from __future__ import annotations
@@ -39,3 +40,25 @@ def error_summary(curves, boundary: float, tolerance: float) -> dict:
             "parts_max_relative": {part: largest([c.friction_error_parts[part]
                                                   for c in curves]) for part in PARTS},
             "tolerance": tolerance, "points_above": len(above)}
+
+
+#: the share of a point's load that may be carried by extrapolated contact pressure (h0
+#: below the micro scale's smallest separation) before the run warns
+EXTRAPOLATED_LOAD = 0.01
+
+
+def range_summary(points, h0_min: float) -> dict:
+    """The largest share of the load carried where h0 < ``h0_min`` [m] over ``points``
+    ({(viscosity, speed): MixedResult}), with a logged warning naming the worst point when
+    it exceeds :data:`EXTRAPOLATED_LOAD`: below its range :meth:`FlowFactors.at` continues
+    p_con linearly, which no error estimate covers."""
+    shares = {key: res.contact_load_below(h0_min) for key, res in points.items()}
+    (mu, speed), worst = max(shares.items(), key=lambda kv: kv[1], default=((0, 0), 0.0))
+    above = sum(v > EXTRAPOLATED_LOAD for v in shares.values())
+    if above:
+        log.warning("C_f: %d of %d points carry more than %.2g %% of their load at separations "
+                    "below [micro] h0_min = %.3g m (largest %.1f %% at mu_0 = %g Pa s, U = %.3g "
+                    "m/s), where p_con is extrapolated: lower h0_min", above, len(shares),
+                    100 * EXTRAPOLATED_LOAD, h0_min, 100 * worst, mu, speed)
+    return {"h0_min_m": float(h0_min), "max_load_share_below": float(worst),
+            "tolerance": EXTRAPOLATED_LOAD, "points_above": int(above)}
