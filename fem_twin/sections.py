@@ -174,7 +174,8 @@ class RunSpec:
 
     workers: int = setting(0, "local processes (0: all cores)", unit="-")
     scheduler: str | None = setting(None, "a Dask scheduler's address instead, e.g. "
-                                    '"tcp://10.0.0.1:8786" (the cluster extra)',
+                                    '"tcp://10.0.0.1:8786", or "local": a Dask LocalCluster '
+                                    "of `workers` processes (the cluster extra)",
                                     unit="address")
     patch_band: bool = setting(True, "one more sweep per patch: the roughness scatter band "
                                "(Figure 13)", unit="true or false")

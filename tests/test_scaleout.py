@@ -45,6 +45,28 @@ def test_dask_local_cluster_gives_the_serial_numbers(tmp_path):
         assert np.array_equal(a.h_d, b.h_d)
 
 
+def test_a_local_cluster_computes_without_the_dask_profiler():
+    """Issue 28 item 4: [run] scheduler = "local" serves tasks from a LocalCluster of
+    [run] workers processes whose Dask settings keep background work out of the tasks'
+    way (threads.DASK_CONFIG: a default worker's profiler and ticks made a task's wall time
+    7-10 % longer than its CPU time on 2 cores)."""
+    pytest.importorskip("distributed")
+    from fem_twin.threads import DASK_CONFIG, DASK_ENVIRONMENT, executor_for
+
+    def settings():
+        import os
+
+        import dask
+        return {k: dask.config.get(k) for k in DASK_CONFIG}, os.getpid()
+
+    with executor_for(2, "local") as executor:
+        assert executor.n_workers == 2
+        seen = [executor.submit(settings).result() for _ in range(4)]
+    for config, pid in seen:
+        assert config == DASK_CONFIG and pid != __import__("os").getpid()
+    assert DASK_ENVIRONMENT["DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED"] == "False"
+
+
 def test_micro_tasks_follow_the_cluster_size():
     """Issue 17 item 5: with an executor served by W processes the h0 values go out as 4 W
     tasks (at most one per h0), so a large Dask cluster is not left idle."""

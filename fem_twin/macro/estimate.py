@@ -17,8 +17,11 @@ Both scales contribute, and each part is a change of C_f [-]:
     tenths of a per cent of C_f,b.  The ``"h0"`` variant's interpolation error is that of
     twice the spacing, ``H0_SPACING_RATIO`` times the error of the computed sample.
 
-``"total"`` is the sum of the parts' magnitudes (the parts' signs are unknown to the
-estimate).  A part that could not be estimated is NaN, left out of the total and named in
+``"total"`` is the sum of the parts' magnitudes.  ``"signed"`` keeps each part with its
+sign as an estimate of ``C_f - C_f,converged`` (macro: ``(C_f(2h) - C_f(h)) / (2^p - 1)``;
+the others: the variant's change, which is the error of the run's own factors where they
+converge at first order), kept for studies of how the parts combine; the total does not
+use it, as the signs are reliable only in the asymptotic range.  A part that could not be estimated is NaN, left out of the total and named in
 ``"missing"`` (factors computed without their error estimate), with the reason in
 ``"failed"`` when its solve did not converge.  Smooth factors have no micro parts (0).
 """
@@ -66,7 +69,7 @@ def friction_error(result, gap, spacing, factors, *, load: float, lubricant, fac
         return {**{part: np.nan for part in PARTS}, "total": np.nan,
                 "failed": [f"coarse grid: {err.args[0]}"]}
     cf = base.friction_coefficient
-    out["macro"] = abs(result.friction_coefficient - cf) / (2 ** MACRO_ORDER - 1)
+    signed = {"macro": (cf - result.friction_coefficient) / (2 ** MACRO_ORDER - 1)}
     for kind, variant in factors.variants().items():
         try:
             moved = solve_mixed(gap2, spacing2, variant, initial=base, **common)
@@ -74,11 +77,14 @@ def friction_error(result, gap, spacing, factors, *, load: float, lubricant, fac
             out[kind] = np.nan
             failed.append(f"{kind}: {err.args[0]}")
             continue
-        out[kind] = abs(moved.friction_coefficient - cf) / (
+        signed[kind] = (moved.friction_coefficient - cf) / (
             H0_SPACING_RATIO if kind == "h0" else 1.0)
     smooth = factors.meta.get("smooth", False)              # no roughness: no micro error
-    out = {part: float(out.get(part, 0.0 if smooth else np.nan)) for part in PARTS}
+    for kind in set(PARTS) - set(signed):
+        signed[kind] = out.get(kind, 0.0 if smooth else np.nan)
+    out = {part: abs(float(signed[part])) for part in PARTS}
     out["total"] = float(np.nansum(list(out.values())))
+    out["signed"] = {part: float(signed[part]) for part in PARTS}
     missing = [part for part in PARTS if np.isnan(out[part])]
     if missing:
         out["missing"] = missing
