@@ -17,6 +17,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .cavitation import cavitation_model
+from .contact_load import contact_load
 from .evaluation import NewtonEvaluation
 from .problem import MAX_COEFFICIENT_PRESSURE, Problem
 
@@ -57,7 +58,8 @@ def _probe(P: Problem, coefficients, p) -> sp.csr_matrix:
 def jacobian(P: Problem, ev: NewtonEvaluation) -> dict:
     """The sparse blocks of the Jacobian: ``J_pp = dR/dphi`` (interior x interior),
     ``J_ph = dR/dh0`` (interior x all, through h_m, A and b), ``pos`` (dp/dphi) and
-    ``dpc = dp_con/dh0``."""
+    ``dpc = dp_con/dh0`` (per node; with the ``"gauss"`` contact quadrature the row sums of
+    ``Dpc``, the sparse ``dp_con,i/dh0_j`` that the exact action uses)."""
     lub, I = P.lubricant, P.interior
     pos, dtheta = cavitation_model(P.settings.complementarity).derivatives(
         ev.phi.ravel(), P.settings.p_ref)
@@ -82,8 +84,12 @@ def jacobian(P: Problem, ev: NewtonEvaluation) -> dict:
            + (Kg @ sp.diags(dg_dp) + Bq @ sp.diags(dq_dp)) @ sp.diags(pos))
     J_h = Kg @ sp.diags(dg_dh) + Bq @ sp.diags(dq_dh) + KA + Bb @ sp.diags(free.ravel() * 1.0)
     J_p, J_h = J_p.tocsr()[I], J_h.tocsr()[I]
-    return dict(J_pp=J_p[:, I].tocsc(), J_ph=J_h.tocsr(), pos=pos,
-                dpc=(d["p_con"] * free).ravel())
+    out = dict(J_pp=J_p[:, I].tocsc(), J_ph=J_h.tocsr(), pos=pos,
+               dpc=(d["p_con"] * free).ravel(), Dpc=None)
+    if P.settings.contact_quadrature != "nodal":        # p_con_i depends on its neighbours
+        out["Dpc"] = contact_load(P.shape).derivative(P.factors, ev.h0, free)
+        out["dpc"] = np.asarray(out["Dpc"].sum(axis=1)).ravel()    # lumped: preconditioner
+    return out
 
 
 class Preconditioner:
@@ -199,7 +205,7 @@ def apply_jacobian(P: Problem, jac: dict, dphi, dw, dhd):
     dp = np.zeros(P.gap.size)
     dp[P.interior] = jac["pos"][P.interior] * dphi
     dh = dw + dhd
-    dpt = dp + jac["dpc"] * dh
+    dpt = dp + (jac["dpc"] * dh if jac["Dpc"] is None else jac["Dpc"] @ dh)
     return (jac["J_pp"] @ dphi + jac["J_ph"] @ dh,
             dw - P.elastic(dpt.reshape(P.shape)).ravel(), float(P.area.ravel() @ dpt))
 

@@ -8,13 +8,14 @@ pressure and a separation field.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 
 import numpy as np
 import scipy.fft as fft
 
 from ..contact.elastic import elastic_operator
+from .contact_load import nodal_contact_pressure
 from .reynolds import OPEN_GAP, fe_poiseuille, trapezoid_weights
 from .reynolds_fv import fvm_poiseuille
 
@@ -57,8 +58,11 @@ class Problem:
     def coefficients(self, p, h0):
         """Eq 17's coefficients at the film pressure ``p`` (relative to p_cav) [Pa] and the
         separation ``h0`` [m]: ``(loc, mu, rho, g, q)`` with ``loc`` the flow factors at
-        ``h0``, ``g = rho h_m^3 / (12 mu)`` [m^3/(Pa s)] and ``q = rho h_m u_m`` [m^2/s]."""
+        ``h0`` (its ``p_con`` by ``settings.contact_quadrature``, :mod:`.contact_load`), ``g = rho h_m^3 / (12 mu)`` [m^3/(Pa s)] and ``q = rho h_m u_m`` [m^2/s]."""
         loc = self.factors.at(h0)
+        if self.settings.contact_quadrature != "nodal":
+            loc = replace(loc, p_con=nodal_contact_pressure(
+                self.factors, h0, self.settings.contact_quadrature))
         p_coef = np.minimum(p, MAX_COEFFICIENT_PRESSURE)
         mu = self.lubricant.viscosity_at(p_coef)
         rho = self.lubricant.density_ratio(p_coef)

@@ -11,6 +11,7 @@ from .. import tables as T
 from ..checks import check_choices, setting
 from ..errors import InputError
 from .cavitation import MODELS, cavitation_model
+from .contact_load import RULES
 from .couette import SCHEMES
 from .friction import BOUNDARY_FRICTION
 
@@ -36,6 +37,10 @@ class MacroSettings:
                                    "FBNS, slower)", unit="a registered model")
     couette: str = setting("central", "Couette flux of eq 17: second order, or the paper's "
                            "first-order upwind", choices=SCHEMES)
+    contact_quadrature: str = setting("gauss", "nodal contact pressure: the Galerkin load "
+                                      "of p_con over the bilinear film (3 x 3 Gauss points "
+                                      "a pixel), or the paper's p_con at the nodes",
+                                      choices=RULES)
     relaxation_pcon: float = setting(T.RELAXATION_PCON, "under-relaxation alpha_pcon of "
                                      "p_con, eq 26 (pid coupling)", unit="-")
     relaxation_elastic: float = setting(0.1, "under-relaxation of h_el (pid coupling)",
