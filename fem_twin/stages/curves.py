@@ -72,7 +72,7 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     summary = _summary(case, out, curves, band)
     plot_curves(case, curves, band, out)
     points = sweep_points(common["checkpoint"], tasks)
-    summary["h0_range"] = range_summary(points, common["factors"].h0[0])
+    summary["h0_range"] = _range_check(common, points, patch_tasks)
     _plot_fields(out, points, case.lubricant.viscosities)
     _log_points(curves)
     if len(curves) > 1:
@@ -170,6 +170,23 @@ def _summary(case: Case, out: RunLayout, curves, band) -> dict:
     summary["cf_error"] = error_summary(curves, case.tribometer.boundary_friction,
                                         case.sweep.error_tolerance)
     return summary
+
+
+def _range_check(common: dict, points: dict, band_tasks) -> dict:
+    """:func:`~fem_twin.stribeck.accuracy.range_summary` over the main curves' ``points``
+    and the band sweeps' (whose single patches reach lower separations)."""
+    labelled = _labelled(points, "average")
+    for kw, lub in band_tasks:
+        name = kw["factors_key"].rsplit("-", 1)[-1]
+        labelled += _labelled(sweep_points(common["checkpoint"], [(kw, lub)]),
+                              name if name.startswith("patch") else "average")
+    return range_summary(labelled, common["factors"].h0[0])
+
+
+def _labelled(points: dict, factors: str) -> list:
+    """``[(label, MixedResult)]`` of ``{(viscosity, speed): MixedResult}``."""
+    return [(f"{factors} factors, mu_0 = {mu:g} Pa s, U = {u:.3g} m/s", res)
+            for (mu, u), res in points.items()]
 
 
 def _plot_fields(out: RunLayout, points, viscosities) -> None:

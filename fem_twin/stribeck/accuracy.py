@@ -49,16 +49,17 @@ EXTRAPOLATED_LOAD = 0.01
 
 def range_summary(points, h0_min: float) -> dict:
     """The largest share of the load carried where h0 < ``h0_min`` [m] over ``points``
-    ({(viscosity, speed): MixedResult}), with a logged warning naming the worst point when
-    it exceeds :data:`EXTRAPOLATED_LOAD`: below its range :meth:`FlowFactors.at` continues
-    p_con linearly, which no error estimate covers."""
-    shares = {key: res.contact_load_below(h0_min) for key, res in points.items()}
-    (mu, speed), worst = max(shares.items(), key=lambda kv: kv[1], default=((0, 0), 0.0))
-    above = sum(v > EXTRAPOLATED_LOAD for v in shares.values())
+    (``[(label, MixedResult), ...]``: the main curves' and the band's), with a logged
+    warning naming the worst point when it exceeds :data:`EXTRAPOLATED_LOAD`: below its
+    range :meth:`FlowFactors.at` continues p_con linearly, which no error estimate covers."""
+    shares = [(res.contact_load_below(h0_min), label) for label, res in points]
+    worst, where = max(shares, default=(0.0, ""))
+    above = sum(share > EXTRAPOLATED_LOAD for share, _ in shares)
     if above:
         log.warning("C_f: %d of %d points carry more than %.2g %% of their load at separations "
-                    "below [micro] h0_min = %.3g m (largest %.1f %% at mu_0 = %g Pa s, U = %.3g "
-                    "m/s), where p_con is extrapolated: lower h0_min", above, len(shares),
-                    100 * EXTRAPOLATED_LOAD, h0_min, 100 * worst, mu, speed)
+                    "below [micro] h0_min = %.3g m (largest %.1f %% at %s), where p_con is "
+                    "extrapolated: lower h0_min", above, len(shares), 100 * EXTRAPOLATED_LOAD,
+                    h0_min, 100 * worst, where)
     return {"h0_min_m": float(h0_min), "max_load_share_below": float(worst),
-            "tolerance": EXTRAPOLATED_LOAD, "points_above": int(above)}
+            "worst_point": where, "tolerance": EXTRAPOLATED_LOAD, "points": len(shares),
+            "points_above": int(above)}
