@@ -47,6 +47,8 @@ class FixedPattern:
         uniq, slot = np.unique(key, return_inverse=True)
         pattern = sp.csr_matrix((np.ones(uniq.size), (uniq // n, uniq % n)), shape=(n, n))
         pattern.sort_indices()          # CSR data order = the sorted keys np.unique returns
+        if uniq.size < 2 ** 31:         # 4 B an entry instead of 8: 64 B a node of a Q1 grid
+            slot = slot.astype(np.int32)
         return cls(slot, pattern.indptr, pattern.indices, int(n))
 
     def values(self, data) -> np.ndarray:

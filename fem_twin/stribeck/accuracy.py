@@ -49,7 +49,7 @@ EXTRAPOLATED_LOAD = 0.01
 
 def range_summary(points, h0_min: float) -> dict:
     """The largest share of the load carried where h0 < ``h0_min`` [m] over ``points``
-    (``[(label, MixedResult), ...]``: the main curves' and the band's), with a logged
+    (an iterable of ``(label, MixedResult)``: the main curves' and the band's), with a logged
     warning naming the worst point when it exceeds :data:`EXTRAPOLATED_LOAD`: below its
     range :meth:`FlowFactors.at` continues p_con linearly, which no error estimate covers."""
     shares = [(res.contact_load_below(h0_min), label) for label, res in points]
