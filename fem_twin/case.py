@@ -68,7 +68,8 @@ class Case:
         band_grid``); a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured
         against it (2026-11-25, late afternoon): the bundled case 86 s (estimated 73 s), 137 s
         with its band on the full grid (121 s), the paper case 538 s (525 s), the ball case
-        64 s (61 s); the bundled case at 20 steps and the Galerkin contact load since: 0.96x (about 82 s)."""
+        64 s (61 s); the bundled case at 20 steps and the Galerkin contact load since: 0.96x
+        (about 82 s)."""
         patches = len(self.geometry.patches)
         h0 = self.micro.h0_count
         if self.micro.h0_tol:

@@ -32,14 +32,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..assembly import FixedPattern, element_entries
+from ..micro.flow_factors import REL_STEP
 
 #: the rules of ``MacroSettings.contact_quadrature``
 RULES = ("gauss", "nodal")
 #: Gauss points per pixel side: p_con varies by a factor of about 5 over a pixel at 128^2
 #: in the mixed regime; 3 points integrate its exponential-like profile there to 1e-4
 POINTS = 3
-#: relative step of the central differences of p_con in h0 (as FlowFactors.slopes)
-REL_STEP = 1e-6
 
 
 class ContactLoad:

@@ -28,6 +28,8 @@ ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "contact_fraction")
 #: bundled case's C_f was up to 0.13 % C_f,b off a 46-separation run, in log 0.019 %
 #: (2026-11-25); the floor keeps the log finite where the surfaces separate (p_con = 0)
 P_CON_FLOOR = 1e-6
+#: relative step of the central differences in h0 (:meth:`FlowFactors.slopes`)
+REL_STEP = 1e-6
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,7 +86,7 @@ class FlowFactors:
                    b=np.tile([1.0, 0.0], (n, 1)), C=np.tile(np.eye(2), (n, 1, 1)),
                    d=np.zeros((n, 2)), contact_fraction=np.zeros(n), meta={"smooth": True})
 
-    def slopes(self, h0, rel_step: float = 1e-6) -> dict:
+    def slopes(self, h0, rel_step: float = REL_STEP) -> dict:
         """Derivatives with respect to ``h0`` of ``h_m`` [-], ``p_con`` [Pa/m], ``A`` and
         ``b`` [1/m] at ``h0``: central differences of :meth:`at`'s rules with a relative
         step (the Jacobian of the macro Newton coupling)."""
