@@ -49,8 +49,7 @@ def newton_solver(shape, dirichlet, interior, K, B):
         return None
 
     def step(pos, dtheta, rhs):
-        values = sum(np.bincount(at, data * w[col], minlength=grid.indices.size)
-                     for (at, data, col), w in zip(parts, (pos.astype(float), dtheta)))
+        values = parts[0] * pos[grid.indices] + parts[1] * dtheta[grid.indices]
         J = sp.csr_matrix((values, grid.indices, grid.indptr), shape=(grid.n, grid.n))
         return grid.factor_and_solve(J, values, rhs)
     return step
@@ -68,17 +67,18 @@ class _Grid:
         self.diagonal = np.flatnonzero(self.rows == self.indices)
         self.solver = SPDSolver(self.indptr, self.indices, "pardiso", symmetric=False,
                                 single=True)
-        self._maps = []                       # [(digest, at, keep, col)]
+        self._maps = []                       # [(digest, at, keep)]
 
     def entries(self, M):
-        """``(at, data, col)``: where each interior entry of ``M`` goes in the pattern, its
-        value and its column; the map is kept per sparsity pattern of ``M`` (known by a
-        digest of it: at 2048^2 a copy of the pattern would hold 40 B a node)."""
+        """The interior entries of ``M`` in the pattern's order (zeros where ``M`` has none),
+        or None if ``M`` leaves the stencil; where each entry lands is kept per sparsity
+        pattern of ``M`` (known by a digest of it: at 2048^2 a copy of the pattern would
+        hold 40 B a node)."""
         M = M.tocsr()
         digest = _digest(M)
-        for known, at, keep, col in self._maps:
+        for known, at, keep in self._maps:
             if known == digest:
-                return at, M.data[keep], col
+                return np.bincount(at, M.data[keep], minlength=self.indices.size)
         rows = self.position[np.repeat(np.arange(M.shape[0]), np.diff(M.indptr))]
         cols = self.position[M.indices]
         keep = (rows >= 0) & (cols >= 0)
@@ -87,10 +87,9 @@ class _Grid:
         at = np.searchsorted(keys, entries)
         if not np.array_equal(keys[np.minimum(at, keys.size - 1)], entries):
             return None                           # not a stencil matrix: the general path
-        # ``at`` only feeds bincount, as fast from int32; ``col`` indexes, 1.5x slower so
-        at, col = at.astype(np.int32), cols[keep]
-        self._maps = [*self._maps[-1:], (digest, at, keep, col)]
-        return at, M.data[keep], col
+        at = at.astype(np.int32)                  # only feeds bincount, as fast from int32
+        self._maps = [*self._maps[-1:], (digest, at, keep)]
+        return np.bincount(at, M.data[keep], minlength=self.indices.size)
 
     def factor_and_solve(self, J, values, rhs):
         """Factorise ``J`` and solve; None if pivots were perturbed or the step falls short

@@ -40,12 +40,11 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
     if phi0 is not None:
         phi[interior] = np.asarray(phi0, float).ravel()[interior]
     ones = np.ones(n)
-    absK, absB = abs(K[interior]), abs(B[interior])
-    couette_size = absB @ ones
+    KI, BI = K[interior], B[interior]
+    absK, couette_size = abs(KI), abs(BI) @ ones
     floor = 1e-300 + 1e-12 * float(couette_size.max())
     order = _interior_order(tuple(dirichlet.shape) if dirichlet.ndim == 2 else None,
                             dirichlet.ravel(), interior)
-    KI, BI = K[interior], B[interior]
 
     def residual(phi):
         pos = phi >= 0
