@@ -90,8 +90,8 @@ class SPDSolver:
         self.perturbed = 0
         if self.backend == "pardiso" and not symmetric:
             self._upper = slice(None)
-            self._ia = self._indptr.astype(np.int32)
-            self._ja = self._indices.astype(np.int32)
+            self._ia = np.asarray(self._indptr, dtype=np.int32)    # no copy if int32
+            self._ja = np.asarray(self._indices, dtype=np.int32)
         elif self.backend == "pardiso":
             if _mkl_rt() is None:
                 raise MissingDependency("the 'pardiso' backend needs MKL: pip install "
