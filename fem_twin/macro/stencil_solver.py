@@ -31,6 +31,9 @@ STEP_RTOL = 1e-8
 #: iterative refinement steps (residual in double precision) with the single-precision
 #: factors; each gains about five digits
 REFINEMENTS = 4
+#: the largest entry of the equilibrated matrix a single-precision factorisation takes
+#: (float32 overflows at 3.4e38; beyond this the step goes to SuperLU in double precision)
+SINGLE_MAX = 1e30
 #: grids whose patterns and PARDISO analyses are kept (a sweep with error estimates
 #: alternates between the grid and its coarsening)
 GRIDS = 3
@@ -102,13 +105,19 @@ class _Grid:
         scaled = np.repeat(scale, self.counts)
         scaled *= values
         scaled *= scale[self.indices]
+        if not np.abs(scaled).max() < SINGLE_MAX:
+            return None                       # beyond single precision: the general path
         self.solver.factor(scaled)
         del scaled
         if self.solver.perturbed:
             return None
         x, residual = np.zeros_like(rhs), rhs
         for _ in range(1 + REFINEMENTS):
-            x = x + scale * self.solver.solve(scale * residual)
+            b = scale * residual
+            size = np.abs(b).max()            # the solve sees b / size: no overflow
+            if not 0 < size < np.inf:
+                return x if size == 0 else None
+            x = x + scale * self.solver.solve(b / size) * size
             residual = rhs - J @ x
             if not np.all(np.isfinite(x)):
                 return None
