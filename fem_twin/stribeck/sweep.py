@@ -13,7 +13,7 @@ from ..errors import InputError
 from ..io.checkpoint import input_key, load_or_none
 from ..io.mesh import write_pvd
 from ..macro import Lubricant, MacroSettings, MixedResult
-from ..macro.estimate import PARTS, combined, friction_error
+from ..macro.estimate import PARTS, friction_error
 from ..macro.nested import solve_nested
 from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
@@ -110,7 +110,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         write_pvd(fields / f"stribeck_mu{lubricant.viscosity:g}.pvd", entries)
     get = lambda name: np.array([getattr(r, name) for r in results])  # noqa: E731
     errors = ({part: np.array([r.meta["error_estimate"][part] for r in results])
-               for part in PARTS} if error_estimate else None)
+               for part in (*PARTS, "total")} if error_estimate else None)
     return StribeckCurve(
         speed=speeds.copy(),
         hersey=hersey_number(lubricant.viscosity, speeds, diameter, load),
@@ -119,7 +119,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         boundary_friction=get("boundary_friction"),
         contact_load_fraction=get("contact_load") / load, h_d=get("h_d"),
         iterations=get("iterations"),
-        friction_error=None if errors is None else combined(errors),
+        friction_error=None if errors is None else errors.pop("total"),
         friction_error_parts=errors,
         coarse_friction_coefficient=np.array([r.meta.get(COARSE_CF, np.nan) for r in results]))
 

@@ -21,7 +21,7 @@ from ..io.checkpoint import load_or_none
 from ..io.figure import save_figure
 from ..io.table import write_csv
 from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
-from ..macro.estimate import combined, friction_error
+from ..macro.estimate import friction_error
 from ..threads import one_thread
 from .sweep import point_file, sweep_key
 
@@ -96,7 +96,7 @@ def traction_sweep(gap, spacing, factors, slide_to_roll=DEFAULT_RATIOS, *, entra
     return TractionCurve(
         slide_to_roll=ratios, entrainment=float(entrainment), viscosity=lubricant.viscosity,
         friction_coefficient=get("friction_coefficient"),
-        friction_error=np.array([combined(results[s].meta["error_estimate"]) for s in ratios]),
+        friction_error=np.array([results[s].meta["error_estimate"]["total"] for s in ratios]),
         hydrodynamic_friction=get("hydrodynamic_friction"),
         boundary_friction=get("boundary_friction"),
         contact_load_fraction=get("contact_load") / load, h_d=get("h_d"))
