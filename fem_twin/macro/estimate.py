@@ -18,8 +18,8 @@ Both scales contribute, and each part is a change of C_f [-]:
     twice the spacing, ``H0_SPACING_RATIO`` times the error of the computed sample.
 
 ``"total"`` is the sum of the parts' magnitudes: their root sum of squares (independent
-errors of unknown sign), tried on 2026-11-26, fell to 0.62-0.87 of the truth on the paper-
-grade patch pair in heavy contact, where the parts' errors add with one sign
+errors of unknown sign), tried on 2026-11-26, fell to 0.62-0.87 of the truth on the
+paper-grade patch pair in heavy contact, where the parts' errors add with one sign
 (``benchmarks/README.md``). ``"signed"`` keeps each part with its sign as an estimate of
 ``C_f - C_f,converged`` (macro: ``(C_f(2h) - C_f(h)) / (2^p - 1)``; the others: the
 variant's change, which is the error of the run's own factors where they converge at first
