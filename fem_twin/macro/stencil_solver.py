@@ -80,9 +80,15 @@ class _Grid:
         hold 40 B a node)."""
         M = M.tocsr()
         digest = _digest(M)
-        for known, at, keep in self._maps:
-            if known == digest:
-                return np.bincount(at, M.data[keep], minlength=self.indices.size)
+        found = next((m for m in self._maps if m[0] == digest), None) or self._map(M, digest)
+        if found is None:
+            return None                           # not a stencil matrix: the general path
+        _, at, keep = found
+        return np.bincount(at, M.data[keep], minlength=self.indices.size)
+
+    def _map(self, M, digest):
+        """``(digest, at, keep)`` for a new sparsity pattern of ``M``: the position in the
+        pattern of each of its interior entries ``keep``; None if one lies outside."""
         rows = self.position[np.repeat(np.arange(M.shape[0]), np.diff(M.indptr))]
         cols = self.position[M.indices]
         keep = (rows >= 0) & (cols >= 0)
@@ -90,10 +96,10 @@ class _Grid:
         keys = np.repeat(np.arange(self.n) * self.n, self.counts) + self.indices  # sorted
         at = np.searchsorted(keys, entries)
         if not np.array_equal(keys[np.minimum(at, keys.size - 1)], entries):
-            return None                           # not a stencil matrix: the general path
-        at = at.astype(np.int32)                  # only feeds bincount, as fast from int32
-        self._maps = [*self._maps[-1:], (digest, at, keep)]
-        return np.bincount(at, M.data[keep], minlength=self.indices.size)
+            return None
+        # ``at`` only feeds bincount, as fast from int32
+        self._maps = [*self._maps[-1:], (digest, at.astype(np.int32), keep)]
+        return self._maps[-1]
 
     def factor_and_solve(self, J, values, rhs):
         """Factorise ``J`` and solve; None if pivots were perturbed or the step falls short
@@ -112,18 +118,19 @@ class _Grid:
         if self.solver.perturbed:
             return None
         x, residual = np.zeros_like(rhs), rhs
+        target = STEP_RTOL * np.linalg.norm(rhs)
         for _ in range(1 + REFINEMENTS):
+            if np.linalg.norm(residual) <= target:
+                return x
             b = scale * residual
             size = np.abs(b).max()            # the solve sees b / size: no overflow
             if not 0 < size < np.inf:
-                return x if size == 0 else None
+                return None
             x = x + scale * self.solver.solve(b / size) * size
-            residual = rhs - J @ x
             if not np.all(np.isfinite(x)):
                 return None
-            if np.linalg.norm(residual) <= STEP_RTOL * np.linalg.norm(rhs):
-                return x
-        return None
+            residual = rhs - J @ x
+        return x if np.linalg.norm(residual) <= target else None
 
 
 def _grid(shape, dirichlet, interior) -> _Grid:
