@@ -60,6 +60,50 @@ class FixedPattern:
                              shape=(self.n, self.n))
 
 
+#: the local nodes of a Q1 pixel element as (row, column) offsets from its first node, in
+#: the order of :func:`fem_twin.io.mesh.grid_mesh` and :func:`unit_element`
+CORNERS = ((0, 0), (0, 1), (1, 1), (1, 0))
+
+
+@dataclass(frozen=True, eq=False)
+class GridStencil:
+    """CSR pattern of the 3 x 3 stencil on a non-periodic ``(ny, nx)`` node grid.
+
+    A matrix on it is a stencil array ``S`` (ny, nx, 3, 3): ``S[r, c, a, b]`` couples node
+    ``(r, c)`` with ``(r + a - 1, c + b - 1)``; ``valid`` masks the offsets inside the grid,
+    and ``S[valid]`` is the CSR data in this pattern's (sorted) order.  Element matrices are
+    added block by block (:meth:`add_elements`), so no list of element entries is kept
+    (a :class:`FixedPattern` holds 64 B a node for it)."""
+
+    shape: tuple
+    valid: np.ndarray
+    indptr: np.ndarray
+    indices: np.ndarray
+
+    @classmethod
+    def of(cls, shape) -> "GridStencil":
+        ny, nx = shape
+        r = np.arange(ny)[:, None, None, None] + np.arange(-1, 2)[None, None, :, None]
+        c = np.arange(nx)[None, :, None, None] + np.arange(-1, 2)[None, None, None, :]
+        valid = (r >= 0) & (r < ny) & (c >= 0) & (c < nx)
+        indices = (r * nx + c)[valid].astype(np.int32)
+        indptr = np.r_[0, np.cumsum(valid.sum(axis=(2, 3)).ravel())].astype(np.int32)
+        return cls((ny, nx), valid, indptr, indices)
+
+    def add_elements(self, S, local, r0: int) -> None:
+        """Add the 4 x 4 matrices ``local`` (4, 4, rows, nx - 1) of the elements whose first
+        node is in rows ``r0, r0 + 1, ...`` (local nodes :data:`CORNERS`) into ``S``."""
+        rows, nx = local.shape[2], self.shape[1]
+        for i, (ai, bi) in enumerate(CORNERS):
+            for j, (aj, bj) in enumerate(CORNERS):
+                S[r0 + ai:r0 + ai + rows, bi:nx - 1 + bi, aj - ai + 1, bj - bi + 1] += \
+                    local[i, j]
+
+    def csr(self, S) -> sp.csr_matrix:
+        n = self.shape[0] * self.shape[1]
+        return sp.csr_matrix((S[self.valid], self.indices, self.indptr), shape=(n, n))
+
+
 def periodic_unknowns(shape, pinned: int):
     """Unknowns of a periodic cell with one pixel pinned, numbered in the nested-dissection
     order of the torus (fill-reducing, 1.6x faster to factorise than SuperLU's own MMD

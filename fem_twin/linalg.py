@@ -120,10 +120,13 @@ class SPDSolver:
                 pass
 
     def factor(self, values) -> "SPDSolver":
-        values = np.asarray(values, dtype=float)
+        """Factorise the matrix with CSR data ``values`` (PARDISO keeps them: values already
+        in the factors' precision and a full pattern are not copied)."""
+        values = np.asarray(values)
         if self.backend == "superlu":
             # the CSR pattern read as CSC is the transpose: the same matrix when symmetric
-            K = sp.csc_matrix((values, self._indices, self._indptr), shape=(self.n, self.n))
+            K = sp.csc_matrix((values.astype(float, copy=False), self._indices, self._indptr),
+                              shape=(self.n, self.n))
             self._lu = spla.splu(K if self.symmetric else K.T.tocsc(), permc_spec="NATURAL",
                                  diag_pivot_thresh=0.0 if self.symmetric else 0.1,
                                  options={"SymmetricMode": True})

@@ -114,3 +114,15 @@ def test_couette_derivatives_match_finite_differences():
         assert np.allclose(C.size(), abs(C.matrix()) @ np.ones(s.size))
     with pytest.raises(ValueError, match="scheme"):
         couette(q1, q2, dx, "quick")
+
+
+def test_face_by_face_matrix_is_the_face_matrices_product():
+    """``couette_matrix`` (assembled face by face, no face matrices kept) is
+    ``Couette.matrix`` to round-off, with flows of both signs (upwinding on both sides)."""
+    rng = np.random.default_rng(2)
+    shape, dx = (8, 11), (2e-5, 3e-5)
+    q1, q2 = rng.normal(size=shape), rng.normal(size=shape)
+    for scheme in ("central", "upwind"):
+        direct = couette_matrix(q1, q2, dx, scheme).toarray()
+        assert np.allclose(direct, couette(q1, q2, dx, scheme).matrix().toarray(),
+                           rtol=1e-14, atol=1e-14 * np.abs(direct).max())

@@ -443,14 +443,19 @@ def exponential_factors(scale=40e-9, p0=1e10):
                        contact_fraction=np.zeros(n))
 
 
-def test_contact_load_integrates_the_bilinear_film():
+@pytest.mark.parametrize("block", [1 << 16, 32])
+def test_contact_load_integrates_the_bilinear_film(block, monkeypatch):
     """The "gauss" contact quadrature (macro/contact_load.py) on a film tilted by 60 nm a
     pixel (as a crowned pin face at 128^2) under p_con = p0 exp(-h0 / 40 nm): the load
     sum a_i p_i is the exact integral to 1e-5 (3 x 3 Gauss points of an exponential that
     changes 4.5x over a pixel: 1e-6 measured), where reading p_con at the nodes (the
     paper's rule) is 19 % high (the trapezoid rule's (k dx)^2 / 12); its derivative is
-    the exact one of the nodal pressures (central differences, 1e-6)."""
-    from fem_twin.macro.contact_load import contact_load, nodal_contact_pressure
+    the exact one of the nodal pressures (central differences, 1e-6); the same with the
+    pixels taken in one block and one row at a time."""
+    from fem_twin.macro import contact_load as module
+    from fem_twin.macro.contact_load import nodal_contact_pressure
+    monkeypatch.setattr(module, "BLOCK", block)
+    contact_load = module.ContactLoad
     from fem_twin.macro.reynolds import trapezoid_weights
     ff, scale, dx = exponential_factors(), 40e-9, 62.5e-6
     ny, nx, slope = 17, 33, 60e-9 / dx

@@ -203,10 +203,15 @@ def test_fbns_solves_the_same_problems_as_the_switch():
         solve_reynolds(h, dx, U, MU, complementarity="lcp")
 
 
-def test_poiseuille_reassembly_equals_the_scikit_fem_form():
+@pytest.mark.parametrize("block", [1 << 16, 22, 1])
+def test_poiseuille_reassembly_equals_the_scikit_fem_form(block, monkeypatch):
     """Element-tensor re-assembly is the skfem assembly of the same form (round-off), with
-    a full non-symmetric A and without A."""
+    a full non-symmetric A and without A, whether the elements come in one block or in
+    blocks of two rows or one."""
     import skfem
+
+    from fem_twin.macro import reynolds
+    monkeypatch.setattr(reynolds, "BLOCK", block)
 
     from fem_twin.io.mesh import grid_mesh
     from fem_twin.macro.reynolds import (fe_poiseuille, homogenised_poiseuille_form,

@@ -31,7 +31,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import FixedPattern, element_entries
+from ..assembly import CORNERS, GridStencil
 from ..micro.flow_factors import REL_STEP
 
 #: the rules of ``MacroSettings.contact_quadrature``
@@ -41,46 +41,72 @@ RULES = ("gauss", "nodal")
 POINTS = 3
 
 
+#: pixels evaluated at a time: bounds the transients (the film and p_con at the Gauss
+#: points, 72 B a pixel each) to a block of the grid
+BLOCK = 1 << 16
+
+
 class ContactLoad:
     """The ``"gauss"`` rule on one node grid ``shape`` (ny, nx): :meth:`pressure` and its
-    derivative :meth:`derivative` (the Newton coupling's Jacobian)."""
+    derivative :meth:`derivative` (the Newton coupling's Jacobian).  Pixels are taken a
+    block of rows at a time, their corners by slicing (:data:`fem_twin.assembly.CORNERS`),
+    so nothing is kept per pixel."""
 
     def __init__(self, shape, points: int = POINTS):
         ny, nx = shape
         self.shape, self.n = (ny, nx), ny * nx
-        node = np.arange(self.n).reshape(ny, nx)
-        self.pix = np.stack([node[:-1, :-1].ravel(), node[:-1, 1:].ravel(),
-                             node[1:, :-1].ravel(), node[1:, 1:].ravel()])   # (4, ncell)
         x, w = np.polynomial.legendre.leggauss(points)
         x, w = (x + 1) / 2, w / 2                                         # on [0, 1]
-        s, t = (v.ravel() for v in np.meshgrid(x, x))
-        self.phi = np.stack([(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t])  # (4, nq)
+        s, t = (v.ravel() for v in np.meshgrid(x, x))                     # s: x1, t: x2
+        self.phi = np.stack([(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t])  # (4, nq)
         self.wphi = self.phi * np.outer(w, w).ravel()
-        self.mass = self._to_nodes(np.repeat(self.wphi.sum(1)[:, None], self.pix.shape[1], 1))
+        corner_mass = self.wphi.sum(1)
+        self.mass = np.zeros(self.shape)
+        for r0, r1 in self._blocks():
+            self._to_nodes(self.mass, np.broadcast_to(corner_mass[:, None, None],
+                                                      (4, r1 - r0, nx - 1)), r0)
 
-    def _to_nodes(self, per_cell) -> np.ndarray:
-        """Sum ``(4, ncell)`` contributions of the cells' corners onto the nodes."""
-        return np.bincount(self.pix.ravel(), np.ravel(per_cell), minlength=self.n)
+    def _blocks(self):
+        """``(r0, r1)``: the pixel rows of each block."""
+        rows = max(1, BLOCK // (self.shape[1] - 1))
+        return [(r0, min(r0 + rows, self.shape[0] - 1))
+                for r0 in range(0, self.shape[0] - 1, rows)]
 
-    def at_points(self, h0) -> np.ndarray:
-        """The bilinear interpolant of the nodal ``h0`` at the Gauss points, ``(nq, ncell)``."""
-        return self.phi.T @ np.asarray(h0, float).ravel()[self.pix]
+    def _to_nodes(self, out, per_pixel, r0) -> None:
+        """Add ``(4, rows, nx - 1)`` contributions of the pixels' corners onto the nodes."""
+        rows, nx = per_pixel.shape[1], self.shape[1]
+        for (a, b), values in zip(CORNERS, per_pixel):
+            out[r0 + a:r0 + a + rows, b:nx - 1 + b] += values
+
+    def at_points(self, h0, r0, r1) -> np.ndarray:
+        """The bilinear interpolant of the nodal ``h0`` at the Gauss points of the pixel rows
+        ``r0 .. r1 - 1``, ``(nq, rows, nx - 1)``."""
+        h0, nx = np.asarray(h0, float), self.shape[1]
+        corners = np.stack([h0[r0 + a:r1 + a, b:nx - 1 + b] for a, b in CORNERS])
+        return (self.phi.T @ corners.reshape(4, -1)).reshape(-1, r1 - r0, nx - 1)
 
     def pressure(self, factors, h0) -> np.ndarray:
         """Nodal contact pressure [Pa] of the film ``h0`` (ny, nx) [m] (module docstring)."""
-        p = factors.contact_pressure(self.at_points(h0))
-        return (self._to_nodes(self.wphi @ p) / self.mass).reshape(self.shape)
+        out = np.zeros(self.shape)
+        for r0, r1 in self._blocks():
+            p = factors.contact_pressure(self.at_points(h0, r0, r1))
+            self._to_nodes(out, (self.wphi @ p.reshape(p.shape[0], -1)).reshape(
+                4, *p.shape[1:]), r0)
+        return out / self.mass
 
     def derivative(self, factors, h0, free=None) -> sp.csr_matrix:
         """``d p_i / d h0_j`` [Pa/m], ``(n, n)`` on the 3 x 3 stencil; columns of the nodes
         not ``free`` (floored separations, which do not move) are zero."""
-        hq = self.at_points(h0)
-        eps = REL_STEP * hq
-        slope = (factors.contact_pressure(hq + eps)
-                 - factors.contact_pressure(hq - eps)) / (2 * eps)            # (nq, ncell)
-        local = np.einsum("aq,bq,qc->cab", self.wphi, self.phi, slope)
-        D = _pattern(self.shape).csr(local)
-        D = sp.diags(1 / self.mass) @ D
+        stencil = GridStencil.of(self.shape)
+        S = np.zeros((*self.shape, 3, 3))
+        for r0, r1 in self._blocks():
+            hq = self.at_points(h0, r0, r1)
+            eps = REL_STEP * hq
+            slope = (factors.contact_pressure(hq + eps)
+                     - factors.contact_pressure(hq - eps)) / (2 * eps)        # (nq, rows, nx-1)
+            stencil.add_elements(S, np.einsum("aq,bq,qrc->abrc", self.wphi, self.phi, slope),
+                                 r0)
+        D = sp.diags(1 / self.mass.ravel()) @ stencil.csr(S)
         return D if free is None else D @ sp.diags(np.ravel(free).astype(float))
 
 
@@ -88,12 +114,6 @@ class ContactLoad:
 def contact_load(shape) -> ContactLoad:
     """The (cached) :class:`ContactLoad` of a grid."""
     return ContactLoad(tuple(shape))
-
-
-@lru_cache(maxsize=4)
-def _pattern(shape) -> FixedPattern:
-    load = contact_load(shape)
-    return FixedPattern.from_entries(*element_entries(load.pix), load.n)
 
 
 def nodal_contact_pressure(factors, h0, rule: str) -> np.ndarray:

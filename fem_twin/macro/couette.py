@@ -78,9 +78,7 @@ class Couette:
 def couette(q1, q2, spacing, scheme: str = "central") -> Couette:
     """The :class:`Couette` term of the nodal coefficient ``(q1, q2)`` (ny, nx) [m^2/s] on a
     non-periodic grid of spacing ``(dx1, dx2)`` [m]."""
-    if scheme not in SCHEMES:
-        raise InputError(f"couette scheme must be one of {SCHEMES}, got {scheme!r}")
-    q1, q2 = np.asarray(q1, float), np.asarray(q2, float)
+    q1, q2 = _checked(q1, q2, scheme)
     parts = []
     for k, q in enumerate((q1, q2)):
         D, mean, a, b = _faces(q1.shape, tuple(float(v) for v in spacing), k)
@@ -94,21 +92,46 @@ def couette(q1, q2, spacing, scheme: str = "central") -> Couette:
 
 def couette_matrix(q1, q2, spacing, scheme: str = "central") -> sp.csr_matrix:
     """``B`` with ``B @ (1 - theta)`` the net Couette outflow of each node's dual cell
-    [m^3/s] (:func:`couette`)."""
-    return couette(q1, q2, spacing, scheme).matrix()
+    [m^3/s], :meth:`Couette.matrix` assembled face by face without the face matrices
+    (which a grid would keep: 180 B a node)."""
+    q1, q2 = _checked(q1, q2, scheme)
+    rows, cols, values = [], [], []
+    for k, q in enumerate((q1.ravel(), q2.ravel())):
+        a, b, width = _face_nodes(q1.shape, spacing, k)
+        q_a, q_b = q[a], q[b]
+        forward = q_a + q_b >= 0
+        up = np.where(forward, a, b)
+        flux = width * ((q_a + q_b) / 2 if scheme == "central" else np.where(forward, q_a, q_b))
+        rows += [a, b]
+        cols += [up, up]
+        values += [flux, -flux]
+    n = q1.size
+    return sp.csr_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(n, n))
+
+
+def _checked(q1, q2, scheme):
+    if scheme not in SCHEMES:
+        raise InputError(f"couette scheme must be one of {SCHEMES}, got {scheme!r}")
+    return np.asarray(q1, float), np.asarray(q2, float)
+
+
+def _face_nodes(shape, spacing, k):
+    """The two nodes ``a -> b`` of each face along direction ``k`` (0: x1, columns; 1: x2,
+    rows) and the faces' width [m]."""
+    ny, nx = shape
+    idx = np.arange(ny * nx).reshape(ny, nx)
+    a, b = (idx[:, :-1], idx[:, 1:]) if k == 0 else (idx[:-1, :], idx[1:, :])
+    return a.ravel(), b.ravel(), float(spacing[1] if k == 0 else spacing[0])
 
 
 @lru_cache(maxsize=16)
 def _faces(shape, spacing, k):
-    """Faces along direction ``k`` (0: x1, columns; 1: x2, rows) of a grid: the signed
-    width matrix ``D`` (n x faces), the face-mean matrix (faces x n) and the two nodes
-    ``a -> b`` of each face."""
-    ny, nx = shape
-    idx = np.arange(ny * nx).reshape(ny, nx)
-    a, b = (idx[:, :-1], idx[:, 1:]) if k == 0 else (idx[:-1, :], idx[1:, :])
-    a, b = a.ravel(), b.ravel()
-    width = spacing[1] if k == 0 else spacing[0]
-    nf, n, f = a.size, ny * nx, np.arange(a.size)
+    """Faces along direction ``k`` of a grid (:func:`_face_nodes`): the signed width matrix
+    ``D`` (n x faces), the face-mean matrix (faces x n) and the two nodes ``a -> b`` of
+    each face."""
+    a, b, width = _face_nodes(shape, spacing, k)
+    nf, n, f = a.size, shape[0] * shape[1], np.arange(a.size)
     D = sp.csr_matrix((np.r_[np.full(nf, width), np.full(nf, -width)],
                        (np.r_[a, b], np.r_[f, f])), shape=(n, nf))
     mean = sp.csr_matrix((np.full(2 * nf, 0.5), (np.r_[f, f], np.r_[a, b])), shape=(nf, n))

@@ -91,6 +91,7 @@ def solve_fixed_point(P, load: float, face, initial=None, progress=None):
         if res < s.tol and it > 1 and exact:
             return ev, h_el, h_d, it, history
         h_el, h_d, p_con = outer.update(ev, h_el, h_d, p_con, row, res)
+        del ev                      # not alive beside the next one (~200 B a node)
     raise MixedNotConverged(
         f"macro iteration ({s.coupling}) did not reach residuals below {s.tol} in "
         f"{s.max_iter} iterations (last: h_el {row[0]:.2e}, p_con {row[1]:.2e}, "

@@ -58,9 +58,10 @@ class Problem:
     def coefficients(self, p, h0):
         """Eq 17's coefficients at the film pressure ``p`` (relative to p_cav) [Pa] and the
         separation ``h0`` [m]: ``(loc, mu, rho, g, q)`` with ``loc`` the flow factors at
-        ``h0`` (its ``p_con`` by ``settings.contact_quadrature``, :mod:`.contact_load`),
+        ``h0`` (its ``p_con`` by ``settings.contact_quadrature``, :mod:`.contact_load`; without
+        the shear factors, which :func:`.result.mixed_result` evaluates once),
         ``g = rho h_m^3 / (12 mu)`` [m^3/(Pa s)] and ``q = rho h_m u_m`` [m^2/s]."""
-        loc = self.factors.at(h0)
+        loc = self.factors.at(h0, friction=False)
         if self.settings.contact_quadrature != "nodal":
             loc = replace(loc, p_con=nodal_contact_pressure(
                 self.factors, h0, self.settings.contact_quadrature))

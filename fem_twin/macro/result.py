@@ -111,8 +111,9 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
     ``face``."""
     s, dx, area, speed, lubricant = P.settings, P.spacing, P.area, P.speed, P.lubricant
     loc = ev.loc
+    shear = loc if loc.C is not None else P.factors.at(ev.h0)        # C, d of eqs 31-32
     p_hd = ev.p + s.cavitation_pressure
-    tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev.theta, ev.mu, loc.C, loc.d, dx, speed,
+    tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev.theta, ev.mu, shear.C, shear.d, dx, speed,
                                 entrainment=P.entrainment,
                                 eyring_stress=lubricant.eyring_stress)
     tau_con = boundary_shear(ev.p_con, s.boundary_friction) * (speed > 0)   # 0: no sliding

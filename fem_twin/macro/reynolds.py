@@ -33,8 +33,7 @@ import skfem
 from skfem.helpers import dot, grad
 
 from ..errors import InputError, ReynoldsNotConverged
-from ..assembly import FixedPattern, element_entries, unit_element
-from ..io.mesh import grid_mesh
+from ..assembly import CORNERS, GridStencil, unit_element
 from .cavitation import cavitation_model
 from .couette import SCHEMES, couette_matrix
 from .lubricant import Lubricant
@@ -171,21 +170,25 @@ def fe_poiseuille(g, spacing, A=None) -> sp.csr_matrix:
     return _assembly(g.shape, tuple(float(v) for v in spacing)).matrix(g, A)
 
 
+#: elements assembled at a time: bounds the transients (coefficients at the Gauss points,
+#: element matrices: 260 B an element) to a block of the grid
+BLOCK = 1 << 16
+
+
 class PoiseuilleAssembly:
     """Fast re-assembly of ``homogenised_poiseuille_form`` on one grid.
 
     Every element is the same rectangle, so the element matrix is
     ``sum_q g_q A_kl,q T[q, k, l]`` with 16 x 16 reference tensors ``T`` that scikit-fem
     assembles once on a single element (unit coefficient at one quadrature point and one
-    tensor entry).  A new matrix is then one ``einsum`` and one ``bincount`` onto a CSR
-    pattern fixed in advance: about 10x faster than ``BilinearForm.assemble`` with five
-    interpolated coefficient fields (``benchmarks/run.py macro``).
+    tensor entry).  A new matrix is then one matrix product per block of element rows,
+    added into the grid's 3 x 3 stencil (:class:`fem_twin.assembly.GridStencil`): about
+    10x faster than ``BilinearForm.assemble`` with five interpolated coefficient fields
+    (``benchmarks/run.py macro``), with nothing kept per element.
     """
 
     def __init__(self, shape, spacing):
-        gm = grid_mesh(shape, spacing)
         self.shape = tuple(shape)
-        self._pix = gm.node_pixel[gm.mesh.t]                   # (4, nelems)
         b = unit_element(spacing)
         nq = b.X.shape[1]
         T = np.zeros((nq, 2, 2, 16))
@@ -201,13 +204,16 @@ class PoiseuilleAssembly:
                         b, g=np.ones((1, nq)), **coef).toarray().ravel()
         self._T = T
         self._phi = np.array([np.asarray(b.basis[i][0])[0] for i in range(4)])   # (4, nq)
-        self._pattern = FixedPattern.from_entries(*element_entries(self._pix),
-                                                  shape[0] * shape[1])
+        self._stencil = GridStencil.of(self.shape)
 
-    def at_quadrature(self, field) -> np.ndarray:
-        """Nodal field ``(ny, nx, ...)`` -> values at the Gauss points ``(nelems, nq, ...)``."""
-        f = np.asarray(field, float).reshape(self.shape[0] * self.shape[1], -1)[self._pix]
-        return np.einsum("iec,iq->eqc", f, self._phi)
+    def at_quadrature(self, field, r0: int = 0, r1: int | None = None) -> np.ndarray:
+        """Nodal field ``(..., ny, nx)`` -> values at the Gauss points of the elements whose
+        first node is in rows ``r0 .. r1 - 1``: ``(nq, ..., r1 - r0, nx - 1)``."""
+        f = np.asarray(field, float)
+        r1 = self.shape[0] - 1 if r1 is None else r1
+        nx = self.shape[1]
+        corners = np.stack([f[..., r0 + a:r1 + a, b:nx - 1 + b] for a, b in CORNERS])
+        return (self._phi.T @ corners.reshape(4, -1)).reshape(-1, *corners.shape[1:])
 
     def matrix(self, g, A=None) -> sp.csr_matrix:
         if np.shape(g) != self.shape:
@@ -215,13 +221,22 @@ class PoiseuilleAssembly:
                              f"{self.shape}")
         if A is not None and np.shape(A) != (*self.shape, 2, 2):
             raise InputError(f"flow factor field shape {np.shape(A)} is not {(*self.shape, 2, 2)}")
-        gq = self.at_quadrature(g)                               # (nelems, nq, 1)
-        if A is None:
-            data = gq[..., 0] @ (self._T[:, 0, 0] + self._T[:, 1, 1])
-        else:
-            coef = gq * self.at_quadrature(np.asarray(A, float).reshape(*self.shape, 4))
-            data = coef.reshape(coef.shape[0], -1) @ self._T.reshape(-1, 16)
-        return self._pattern.csr(data)
+        ny, nx = self.shape
+        nq = self._phi.shape[1]
+        A4 = None if A is None else np.asarray(A, float).reshape(ny, nx, 4).transpose(2, 0, 1)
+        S = np.zeros((ny, nx, 3, 3))
+        rows = max(1, BLOCK // (nx - 1))
+        for r0 in range(0, ny - 1, rows):
+            r1 = min(r0 + rows, ny - 1)
+            gq = self.at_quadrature(g, r0, r1)                       # (nq, rows, nx - 1)
+            if A4 is None:
+                coef, T = gq, self._T[:, 0, 0] + self._T[:, 1, 1]
+            else:
+                coef, T = gq[:, None] * self.at_quadrature(A4, r0, r1), self._T
+            # (16, elements): each entry of the element matrices contiguous
+            local = T.reshape(-1, 16).T @ coef.reshape(-1, (r1 - r0) * (nx - 1))
+            self._stencil.add_elements(S, local.reshape(4, 4, r1 - r0, nx - 1), r0)
+        return self._stencil.csr(S)
 
 
 @lru_cache(maxsize=8)

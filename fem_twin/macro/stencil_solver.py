@@ -47,12 +47,14 @@ def newton_solver(shape, dirichlet, interior, K, B):
     if shape is None or default_backend() != "pardiso":
         return None
     grid = _grid(shape, dirichlet, interior)
-    parts = [grid.entries(M) for M in (K, B)]
-    if any(part is None for part in parts):
+    K, B = K.tocsr(), B.tocsr()
+    maps = [grid.locate(M) for M in (K, B)]
+    if any(found is None for found in maps):
         return None
 
     def step(pos, dtheta, rhs):
-        values = parts[0] * pos[grid.indices] + parts[1] * dtheta[grid.indices]
+        values = grid.entries(K, maps[0], pos)
+        values += grid.entries(B, maps[1], dtheta)
         J = sp.csr_matrix((values, grid.indices, grid.indptr), shape=(grid.n, grid.n))
         return grid.factor_and_solve(J, values, rhs)
     return step
@@ -73,18 +75,22 @@ class _Grid:
                                 single=True)
         self._maps = []                       # [(digest, at, keep)]
 
-    def entries(self, M):
-        """The interior entries of ``M`` in the pattern's order (zeros where ``M`` has none),
-        or None if ``M`` leaves the stencil; where each entry lands is kept per sparsity
+    def locate(self, M):
+        """``(at, keep)``: the position ``at`` in the pattern of each interior entry ``keep``
+        of the CSR matrix ``M``, or None if ``M`` leaves the stencil.  Kept per sparsity
         pattern of ``M`` (known by a digest of it: at 2048^2 a copy of the pattern would
         hold 40 B a node)."""
-        M = M.tocsr()
         digest = _digest(M)
         found = next((m for m in self._maps if m[0] == digest), None) or self._map(M, digest)
-        if found is None:
-            return None                           # not a stencil matrix: the general path
-        _, at, keep = found
-        return np.bincount(at, M.data[keep], minlength=self.indices.size)
+        return None if found is None else found[1:]
+
+    def entries(self, M, found, weight):
+        """The interior entries of ``M diag(weight)`` in the pattern's order (zeros where
+        ``M`` has none), ``found`` from :meth:`locate` (computed per step, so no copy of
+        ``M`` is alive during the factorisation)."""
+        at, keep = found
+        return np.bincount(at, M.data[keep] * weight[self.indices[at]],
+                           minlength=self.indices.size)
 
     def _map(self, M, digest):
         """``(digest, at, keep)`` for a new sparsity pattern of ``M``: the position in the
@@ -108,11 +114,13 @@ class _Grid:
         film's ``h^3`` spans 1e9 over a pin face (a 20 nm film beside the 40 um edge)."""
         d = np.abs(values[self.diagonal])
         scale = 1 / np.sqrt(np.where(d > 0, d, max(float(d.max()), 1e-300)))
-        scaled = np.repeat(scale, self.counts)
-        scaled *= values
-        scaled *= scale[self.indices]
-        if not np.abs(scaled).max() < SINGLE_MAX:
+        largest = float(np.max(np.abs(values) * np.repeat(scale, self.counts)
+                               * scale[self.indices]))
+        if not largest < SINGLE_MAX:
             return None                       # beyond single precision: the general path
+        scaled = np.repeat(scale.astype(np.float32), self.counts)    # single precision: the
+        scaled *= values                                             # factors' own, no
+        scaled *= scale[self.indices]                                # double copy alive
         self.solver.factor(scaled)
         del scaled
         if self.solver.perturbed:

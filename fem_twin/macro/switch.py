@@ -30,29 +30,28 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
     Dirichlet nodes keep ``p = p_boundary``, ``theta = 0``.  ``phi0`` warm-starts the
     interior; ``inexact`` returns the iterate after ``max_iter`` steps instead of raising (a
     truncated inner solve of a fixed point that ends on an exact one).
-    Returns ``phi``, the number of iterations and the residual history (scaled by
-    the size of each node's fluxes, ``|K| p + |B| 1``).  Each Newton matrix is factorised by SuperLU in a
-    nested-dissection order of the grid (computed once per grid).
+    Returns ``phi``, the number of iterations and the residual history (scaled by the size
+    of each node's fluxes, ``|K| p + |B| 1``).  Each Newton step is solved by
+    :func:`.stencil_solver.newton_solver`, else by SuperLU in a nested-dissection order of
+    the grid (computed once per grid).
     """
     n = K.shape[0]
     interior = np.flatnonzero(~dirichlet)
     phi = np.full(n, float(p_boundary))
     if phi0 is not None:
         phi[interior] = np.asarray(phi0, float).ravel()[interior]
-    ones = np.ones(n)
-    KI, BI = K[interior], B[interior]
-    absK, couette_size = abs(KI), abs(BI) @ ones
+    K, B = K.tocsr(), B.tocsr()
+    couette_size = _absolute(B) @ np.ones(n)
     floor = 1e-300 + 1e-12 * float(couette_size.max())
-    order = _interior_order(tuple(dirichlet.shape) if dirichlet.ndim == 2 else None,
-                            dirichlet.ravel(), interior)
 
     def residual(phi):
+        # full products, then the interior rows: no copy of K's and B's rows kept alive
         pos = phi >= 0
         p = np.where(pos, phi, 0.0)
-        r = KI @ p + BI @ (ones - np.where(pos, 0.0, -phi / scale))
+        r = (K @ p + B @ np.where(pos, 1.0, 1.0 + phi / scale))[interior]
         # each node's mass residual relative to the size of its own fluxes
-        res = float(np.max(np.abs(r) / (absK @ p + couette_size + floor)))
-        return r, pos, res
+        size = (_absolute(K) @ p)[interior] + couette_size[interior] + floor
+        return r, pos, float(np.max(np.abs(r) / size))
 
     newton = newton_solver(tuple(dirichlet.shape) if dirichlet.ndim == 2 else None,
                             dirichlet.ravel(), interior, K, B)
@@ -72,7 +71,9 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
             phi[interior] += step
             r, pos, res = residual(phi)
             continue
-        J = (KI @ sp.diags(pos.astype(float)) + BI @ sp.diags(dtheta))[:, interior]
+        J = (K @ sp.diags(pos.astype(float)) + B @ sp.diags(dtheta))[interior][:, interior]
+        order = _interior_order(tuple(dirichlet.shape) if dirichlet.ndim == 2 else None,
+                                dirichlet.ravel(), interior)
         step = np.empty(interior.size)
         try:
             lu = spla.splu(J[order][:, order].tocsc(), permc_spec="NATURAL",
@@ -88,6 +89,11 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
     if inexact:
         return phi, max_iter + 1, history
     raise ReynoldsNotConverged(f"no convergence in {max_iter} Newton steps (tol {tol})", history)
+
+
+def _absolute(M):
+    """``|M|`` entrywise, sharing ``M``'s index arrays (CSR)."""
+    return sp.csr_matrix((np.abs(M.data), M.indices, M.indptr), shape=M.shape, copy=False)
 
 
 def _interior_order(shape, dirichlet, interior):

@@ -72,7 +72,11 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     folder = Path(checkpoint) if checkpoint is not None else None
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
-    results, previous, previous_coarse = [], None, None
+    if fields is not None:
+        fields = Path(fields)
+        fields.mkdir(parents=True, exist_ok=True)
+    # each point's numbers; its fields go to disk at once (a 2048^2 point holds 0.5 GB)
+    records, entries, previous, previous_coarse = [], [], None, None
     for i, speed in enumerate(tqdm(speeds, desc=f"Stribeck mu0={lubricant.viscosity:g}",
                                    disable=not progress, unit="speed")):
         path = None if folder is None else point_file(folder, key, speed)
@@ -98,18 +102,15 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                                      "seconds_estimate": time.perf_counter() - t0})
             if path is not None:
                 res.save(path)
-        results.append(res)
-        previous, previous_coarse = res, coarse
-    if fields is not None:
-        fields = Path(fields)
-        fields.mkdir(parents=True, exist_ok=True)
-        entries = []
-        for i, res in enumerate(results):
+        if fields is not None:
             vtu = res.write_vtu(fields / f"mu{lubricant.viscosity:g}_{i:03d}.vtu", origin)
             entries.append((float(res.speed), vtu))            # ParaView time = U [m/s]
+        records.append(_record(res))
+        previous, previous_coarse = res, coarse
+    if fields is not None:
         write_pvd(fields / f"stribeck_mu{lubricant.viscosity:g}.pvd", entries)
-    get = lambda name: np.array([getattr(r, name) for r in results])  # noqa: E731
-    errors = ({part: np.array([r.meta["error_estimate"][part] for r in results])
+    get = lambda name: np.array([r[name] for r in records])  # noqa: E731
+    errors = ({part: np.array([r["error_estimate"][part] for r in records])
                for part in (*PARTS, "total")} if error_estimate else None)
     return StribeckCurve(
         speed=speeds.copy(),
@@ -121,7 +122,15 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         iterations=get("iterations"),
         friction_error=None if errors is None else errors.pop("total"),
         friction_error_parts=errors,
-        coarse_friction_coefficient=np.array([r.meta.get(COARSE_CF, np.nan) for r in results]))
+        coarse_friction_coefficient=get(COARSE_CF))
+
+
+def _record(res: MixedResult) -> dict:
+    """The numbers of a point the curve keeps (no fields)."""
+    return {**{name: getattr(res, name) for name in (
+        "friction_coefficient", "hydrodynamic_friction", "boundary_friction", "contact_load",
+        "h_d", "iterations")}, COARSE_CF: res.meta.get(COARSE_CF, np.nan),
+        "error_estimate": res.meta.get("error_estimate")}
 
 
 def sweep_key(gap, spacing, factors, load, lubricant, settings, face,
