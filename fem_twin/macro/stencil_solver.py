@@ -35,8 +35,11 @@ REFINEMENTS = 4
 #: (float32 overflows at 3.4e38; beyond this the step goes to SuperLU in double precision)
 SINGLE_MAX = 1e30
 #: grids whose patterns and PARDISO analyses are kept (a sweep with error estimates
-#: alternates between the grid and its coarsening)
+#: alternates between the grid and its coarsening) ...
 GRIDS = 3
+#: ... while the unknowns of those besides the current one add up to at most this: at
+#: 2048^2 the 1024^2 grid's analysis (0.4 GiB) is not kept, and redone (4 s) at each point
+KEPT_UNKNOWNS = 1 << 19
 
 
 def newton_solver(shape, dirichlet, interior, K, B):
@@ -114,13 +117,13 @@ class _Grid:
         film's ``h^3`` spans 1e9 over a pin face (a 20 nm film beside the 40 um edge)."""
         d = np.abs(values[self.diagonal])
         scale = 1 / np.sqrt(np.where(d > 0, d, max(float(d.max()), 1e-300)))
-        largest = float(np.max(np.abs(values) * np.repeat(scale, self.counts)
-                               * scale[self.indices]))
-        if not largest < SINGLE_MAX:
+        scale32 = scale.astype(np.float32)
+        with np.errstate(over="ignore", invalid="ignore"):
+            scaled = np.repeat(scale32, self.counts)      # single precision, the factors'
+            scaled *= values                              # own: no double copy alive
+            scaled *= scale32[self.indices]
+        if not np.abs(scaled).max() < SINGLE_MAX:         # inf or nan too
             return None                       # beyond single precision: the general path
-        scaled = np.repeat(scale.astype(np.float32), self.counts)    # single precision: the
-        scaled *= values                                             # factors' own, no
-        scaled *= scale[self.indices]                                # double copy alive
         self.solver.factor(scaled)
         del scaled
         if self.solver.perturbed:
@@ -146,9 +149,10 @@ def _grid(shape, dirichlet, interior) -> _Grid:
     grid = _GRIDS.pop(key, None) or _Grid(shape, interior)
     for other in _GRIDS.values():                   # one grid's factors alive at a time
         other.solver.release()
+    while _GRIDS and (len(_GRIDS) >= GRIDS
+                      or sum(g.n for g in _GRIDS.values()) > KEPT_UNKNOWNS):
+        _GRIDS.popitem(last=False)                  # the least recently used first
     _GRIDS[key] = grid
-    while len(_GRIDS) > GRIDS:
-        _GRIDS.popitem(last=False)
     return grid
 
 
