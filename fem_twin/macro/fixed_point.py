@@ -25,6 +25,8 @@ corrects what they leave); convergence is only accepted after an exact one.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..anderson import Anderson
@@ -133,10 +135,16 @@ class _Reynolds:
         h0 = np.maximum(h_d + P.gap + h_el, s.gap_floor)
         p_prev = self.p
         loc, mu, rho, g, q = P.coefficients(p_prev, h0)
+        K = P.poiseuille(g, loc.A)
         B = couette_matrix(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing, s.couette)
+        # of the factors the result needs h_m and p_con: A, b, g and q are not kept through
+        # the solve (64 B a node)
+        loc = replace(loc, A=None, b=None)
+        del g, q
         cut = {} if steps is None else dict(max_iter=steps, inexact=True)
-        phi, its, _ = self.model.solve(P.poiseuille(g, loc.A), B, P.boundary,
-                                       self.p_amb_rel, s.p_ref, phi0=self.phi, **cut)
+        phi, its, _ = self.model.solve(K, B, P.boundary, self.p_amb_rel, s.p_ref,
+                                       phi0=self.phi, **cut)
+        del K, B
         self.phi, self.newton = phi, its
         p, theta = (v.reshape(P.shape) for v in self.model.split(phi, s.p_ref))
         self.p = p

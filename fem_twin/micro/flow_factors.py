@@ -50,8 +50,8 @@ class FlowFactors:
     h0: np.ndarray
     h_m: np.ndarray
     p_con: np.ndarray
-    A: np.ndarray
-    b: np.ndarray
+    A: np.ndarray | None
+    b: np.ndarray | None
     C: np.ndarray | None
     d: np.ndarray | None
     contact_fraction: np.ndarray | None
@@ -229,14 +229,15 @@ class LocalFactors:
 
     ``h_m``, ``p_con``, ``contact_fraction`` are shaped like ``h0``; ``A``, ``C`` add
     ``(2, 2)`` and ``b``, ``d`` add ``(2,)`` as trailing axes; ``C``, ``d`` and
-    ``contact_fraction`` are None when evaluated without them (``at(h0, friction=False)``).
+    ``contact_fraction`` are None when evaluated without them (``at(h0, friction=False)``),
+    and ``A``, ``b`` where a caller dropped them once the Reynolds matrices were built.
     """
 
     h0: np.ndarray
     h_m: np.ndarray
     p_con: np.ndarray
-    A: np.ndarray
-    b: np.ndarray
+    A: np.ndarray | None
+    b: np.ndarray | None
     C: np.ndarray | None
     d: np.ndarray | None
     contact_fraction: np.ndarray | None
