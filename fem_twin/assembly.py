@@ -82,6 +82,7 @@ class GridStencil:
 
     @classmethod
     def of(cls, shape) -> "GridStencil":
+        """The pattern of the grid ``shape`` (ny, nx) (column indices int32, sorted)."""
         ny, nx = shape
         r = np.arange(ny)[:, None, None, None] + np.arange(-1, 2)[None, None, :, None]
         c = np.arange(nx)[None, :, None, None] + np.arange(-1, 2)[None, None, None, :]
@@ -100,6 +101,7 @@ class GridStencil:
                     local[i, j]
 
     def csr(self, S) -> sp.csr_matrix:
+        """The ``(n, n)`` CSR matrix of the stencil array ``S`` (sharing the pattern)."""
         n = self.shape[0] * self.shape[1]
         return sp.csr_matrix((S[self.valid], self.indices, self.indptr), shape=(n, n))
 

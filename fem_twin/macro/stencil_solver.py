@@ -37,8 +37,9 @@ SINGLE_MAX = 1e30
 #: grids whose patterns and PARDISO analyses are kept (a sweep with error estimates
 #: alternates between the grid and its coarsening) ...
 GRIDS = 3
-#: ... while the unknowns of those besides the current one add up to at most this: at
-#: 2048^2 the 1024^2 grid's analysis (0.4 GiB) is not kept, and redone (4 s) at each point
+#: ... while the unknowns of those smaller than the current one add up to at most this: at
+#: 2048^2 the 1024^2 grid's analysis (0.4 GiB) is not kept beside the 2048^2 one, and is
+#: redone (4 s) at each point's coarse solve
 KEPT_UNKNOWNS = 1 << 19
 
 
@@ -154,9 +155,11 @@ def _grid(shape, dirichlet, interior) -> _Grid:
     grid = _GRIDS.pop(key, None) or _Grid(shape, interior)
     for other in _GRIDS.values():                   # one grid's factors alive at a time
         other.solver.release()
-    while _GRIDS and (len(_GRIDS) >= GRIDS
-                      or sum(g.n for g in _GRIDS.values()) > KEPT_UNKNOWNS):
-        _GRIDS.popitem(last=False)                  # the least recently used first
+    while _GRIDS and (len(_GRIDS) >= GRIDS or sum(
+            g.n for g in _GRIDS.values() if g.n < grid.n) > KEPT_UNKNOWNS):
+        # the least recently used of the smaller grids first: the finest grid sets the peak
+        smaller = [k for k, g in _GRIDS.items() if g.n < grid.n]
+        del _GRIDS[smaller[0] if smaller else next(iter(_GRIDS))]
     _GRIDS[key] = grid
     return grid
 
