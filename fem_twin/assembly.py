@@ -9,6 +9,7 @@ pattern fixed in advance (:class:`FixedPattern`).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import scipy.sparse as sp
@@ -104,6 +105,22 @@ class GridStencil:
         """The ``(n, n)`` CSR matrix of the stencil array ``S`` (sharing the pattern)."""
         n = self.shape[0] * self.shape[1]
         return sp.csr_matrix((S[self.valid], self.indices, self.indptr), shape=(n, n))
+
+
+def at_points(phi, field, r0: int, r1: int) -> np.ndarray:
+    """A nodal ``field`` ``(..., ny, nx)`` interpolated with the corner weights ``phi``
+    (4, npoints; corners :data:`CORNERS`) at the points of the pixels whose first node is in
+    rows ``r0 .. r1 - 1``: ``(npoints, ..., r1 - r0, nx - 1)``."""
+    f = np.asarray(field, float)
+    nx = f.shape[-1]
+    corners = np.stack([f[..., r0 + a:r1 + a, b:nx - 1 + b] for a, b in CORNERS])
+    return (phi.T @ corners.reshape(4, -1)).reshape(-1, *corners.shape[1:])
+
+
+@lru_cache(maxsize=8)
+def grid_stencil(shape) -> GridStencil:
+    """The (cached) :class:`GridStencil` of the grid ``shape`` (ny, nx)."""
+    return GridStencil.of(tuple(shape))
 
 
 def periodic_unknowns(shape, pinned: int):

@@ -31,7 +31,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import CORNERS, GridStencil
+from ..assembly import CORNERS, at_points, grid_stencil
 from ..micro.flow_factors import REL_STEP
 
 #: the rules of ``MacroSettings.contact_quadrature``
@@ -81,9 +81,7 @@ class ContactLoad:
     def at_points(self, h0, r0, r1) -> np.ndarray:
         """The bilinear interpolant of the nodal ``h0`` at the Gauss points of the pixel rows
         ``r0 .. r1 - 1``, ``(nq, rows, nx - 1)``."""
-        h0, nx = np.asarray(h0, float), self.shape[1]
-        corners = np.stack([h0[r0 + a:r1 + a, b:nx - 1 + b] for a, b in CORNERS])
-        return (self.phi.T @ corners.reshape(4, -1)).reshape(-1, r1 - r0, nx - 1)
+        return at_points(self.phi, h0, r0, r1)
 
     def pressure(self, factors, h0) -> np.ndarray:
         """Nodal contact pressure [Pa] of the film ``h0`` (ny, nx) [m] (module docstring)."""
@@ -97,7 +95,7 @@ class ContactLoad:
     def derivative(self, factors, h0, free=None) -> sp.csr_matrix:
         """``d p_i / d h0_j`` [Pa/m], ``(n, n)`` on the 3 x 3 stencil; columns of the nodes
         not ``free`` (floored separations, which do not move) are zero."""
-        stencil = GridStencil.of(self.shape)
+        stencil = grid_stencil(self.shape)
         S = np.zeros((*self.shape, 3, 3))
         for r0, r1 in self._blocks():
             hq = self.at_points(h0, r0, r1)

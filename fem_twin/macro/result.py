@@ -111,7 +111,7 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
     ``face``."""
     s, dx, area, speed, lubricant = P.settings, P.spacing, P.area, P.speed, P.lubricant
     loc = ev.loc
-    shear = loc if loc.C is not None else P.factors.at(ev.h0)        # C, d of eqs 31-32
+    shear = P.factors.at(ev.h0)         # C, d of eqs 31-32 (the iterations read no C, d)
     p_hd = ev.p + s.cavitation_pressure
     tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev.theta, ev.mu, shear.C, shear.d, dx, speed,
                                 entrainment=P.entrainment,

@@ -33,7 +33,7 @@ import skfem
 from skfem.helpers import dot, grad
 
 from ..errors import InputError, ReynoldsNotConverged
-from ..assembly import CORNERS, GridStencil, unit_element
+from ..assembly import at_points, grid_stencil, unit_element
 from .cavitation import cavitation_model
 from .couette import SCHEMES, couette_matrix
 from .lubricant import Lubricant
@@ -204,16 +204,12 @@ class PoiseuilleAssembly:
                         b, g=np.ones((1, nq)), **coef).toarray().ravel()
         self._T = T
         self._phi = np.array([np.asarray(b.basis[i][0])[0] for i in range(4)])   # (4, nq)
-        self._stencil = GridStencil.of(self.shape)
+        self._stencil = grid_stencil(self.shape)
 
     def at_quadrature(self, field, r0: int = 0, r1: int | None = None) -> np.ndarray:
         """Nodal field ``(..., ny, nx)`` -> values at the Gauss points of the elements whose
         first node is in rows ``r0 .. r1 - 1``: ``(nq, ..., r1 - r0, nx - 1)``."""
-        f = np.asarray(field, float)
-        r1 = self.shape[0] - 1 if r1 is None else r1
-        nx = self.shape[1]
-        corners = np.stack([f[..., r0 + a:r1 + a, b:nx - 1 + b] for a, b in CORNERS])
-        return (self._phi.T @ corners.reshape(4, -1)).reshape(-1, *corners.shape[1:])
+        return at_points(self._phi, field, r0, self.shape[0] - 1 if r1 is None else r1)
 
     def matrix(self, g, A=None) -> sp.csr_matrix:
         if np.shape(g) != self.shape:

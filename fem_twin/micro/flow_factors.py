@@ -50,11 +50,11 @@ class FlowFactors:
     h0: np.ndarray
     h_m: np.ndarray
     p_con: np.ndarray
-    A: np.ndarray | None
-    b: np.ndarray | None
-    C: np.ndarray | None
-    d: np.ndarray | None
-    contact_fraction: np.ndarray | None
+    A: np.ndarray
+    b: np.ndarray
+    C: np.ndarray
+    d: np.ndarray
+    contact_fraction: np.ndarray
     meta: dict = field(default_factory=dict)
 
     def __post_init__(self):
