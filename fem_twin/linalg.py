@@ -154,6 +154,7 @@ class SPDSolver:
         next ``factor`` computes them anew."""
         if self._analysed and self._a is not None:
             self._pardiso(0, np.zeros((self.n, 1), self.dtype))
+            _mkl_rt().mkl_free_buffers()            # back to the system, not MKL's pool
         self._lu = self._a = None
 
     def _pardiso(self, phase, b):
