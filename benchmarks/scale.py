@@ -61,13 +61,12 @@ def _point(n: int, factors: str) -> dict:
     gap, spacing, face = _macro_gap(n)
     common = dict(load=150.0, face=face, lubricant=Lubricant(0.066))
     t0 = time.perf_counter()
-    cold, coarse = solve_nested(gap, spacing, ff, speed=COLD, **common)
+    cold = solve_nested(gap, spacing, ff, speed=COLD, **common)
     t1 = time.perf_counter()
-    warm, _ = solve_nested(gap, spacing, ff, speed=WARM, previous=cold, previous_coarse=coarse,
-                           **common)
+    warm = solve_nested(gap, spacing, ff, speed=WARM, previous=cold, **common)
     t2 = time.perf_counter()
-    return {"n": n, "cold": t1 - t0, "warm": t2 - t1, "cf": cold.friction_coefficient,
-            "cold_iterations": cold.iterations, "warm_iterations": warm.iterations,
+    return {"n": n, "cold": t1 - t0, "warm": t2 - t1, "cf": cold[0].friction_coefficient,
+            "cold_iterations": cold[0].iterations, "warm_iterations": warm[0].iterations,
             "rss_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20}
 
 

@@ -12,9 +12,10 @@ start is then the previous fine state plus that change, interpolated:
 for the pressure, cavity fraction, elastic deformation, contact pressure and ``h_d`` (the
 full approximation scheme's correction, Brandt 1977).  The fine grid keeps its own detail
 and needs 8-10 iterations instead of 19-26 (sample pin 1 at 256^2, 8 speeds of the paper's
-sweep: 33.5 s against 46.5 s, C_f the same to 7e-9 C_f,b).  The coarse solution is also
-the base of the point's macro error estimate (:mod:`fem_twin.macro.estimate`), which no
-longer solves it.
+sweep: 33.5 s against 46.5 s, C_f the same to 7e-9 C_f,b).  The coarse point is itself
+solved so, from the next coarser grid, down to the coarse start: a sweep keeps every
+level of its last point.  The coarse solution is also the base of the point's macro error
+estimate (:mod:`fem_twin.macro.estimate`), which no longer solves it.
 """
 
 from __future__ import annotations
@@ -37,24 +38,43 @@ def coarsened(gap, spacing, face):
             None if face is None else np.asarray(face, bool)[::2, ::2])
 
 
-def solve_nested(gap, spacing, factors, *, previous: MixedResult | None = None,
-                 previous_coarse: MixedResult | None = None, face=None,
-                 **point) -> tuple[MixedResult, MixedResult | None]:
-    """One sweep point and its solution on the grid coarsened by two (None on grids under
-    ``2 COARSE_START`` nodes a side, or when the coarse solve fails).  ``previous`` and
-    ``previous_coarse`` are the last point's pair; ``point`` the other arguments of
-    :func:`~fem_twin.macro.solve_mixed` (``load``, ``speed``, ``lubricant``, ...)."""
+def solve_nested(gap, spacing, factors, *, previous: tuple[MixedResult, ...] = (),
+                 face=None, **point) -> tuple[MixedResult, ...]:
+    """One sweep point on its grid and on each coarsening by two down to the coarse start
+    (:data:`~fem_twin.macro.mixed.COARSE_START`), finest first: ``(point, coarse, ...)``.
+
+    ``previous``: the last point's levels as this returned them (empty for a cold point; a
+    point reloaded from its checkpoint without its levels: ``(point,)``); ``point`` the
+    other arguments of :func:`~fem_twin.macro.solve_mixed` (``load``, ``speed``,
+    ``lubricant``, ...).  Each level starts from the previous point's same level moved by
+    the change one level down (the full approximation scheme, recursively): only the
+    coarsest grid iterates the whole speed change (sample pin at 2048^2, warm point: the
+    1024^2 level took 30 iterations from the previous point alone).  A level whose solve
+    fails leaves the finer ones to start from ``previous`` alone, and is left out."""
+    previous = tuple(previous)
     if min(np.shape(gap)) < 2 * COARSE_START:
-        return solve_mixed(gap, spacing, factors, face=face, initial=previous, **point), None
+        return (solve_mixed(gap, spacing, factors, face=face, initial=_last(previous),
+                            **point),)
     gap2, spacing2, face2 = coarsened(gap, spacing, face)
     try:
-        coarse = solve_mixed(gap2, spacing2, factors, face=face2,
-                             initial=previous_coarse or previous, **point)
+        levels = solve_nested(gap2, spacing2, factors, face=face2,
+                              previous=previous[1:] or previous[:1], **point)
     except MixedNotConverged:
-        return solve_mixed(gap, spacing, factors, face=face, initial=previous, **point), None
-    start = (coarse if previous is None else previous if previous_coarse is None
-             else corrected(previous, previous_coarse, coarse))
-    return solve_mixed(gap, spacing, factors, face=face, initial=start, **point), coarse
+        return (solve_mixed(gap, spacing, factors, face=face, initial=_last(previous),
+                            **point),)
+    coarse = levels[0]
+    if not previous:
+        start = coarse
+    elif len(previous) > 1 and previous[1].pressure.shape == coarse.pressure.shape:
+        start = corrected(previous[0], previous[1], coarse)
+    else:
+        start = previous[0]
+    return (solve_mixed(gap, spacing, factors, face=face, initial=start, **point), *levels)
+
+
+def _last(previous):
+    """The previous point's finest level, or None."""
+    return previous[0] if previous else None
 
 
 def corrected(previous: MixedResult, previous_coarse: MixedResult,

@@ -76,17 +76,19 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         fields = Path(fields)
         fields.mkdir(parents=True, exist_ok=True)
     # each point's numbers; its fields go to disk at once (a 2048^2 point holds 0.5 GB)
-    records, entries, previous, previous_coarse = [], [], None, None
+    records, entries, previous = [], [], ()
     for i, speed in enumerate(tqdm(speeds, desc=f"Stribeck mu0={lubricant.viscosity:g}",
                                    disable=not progress, unit="speed")):
         path = None if folder is None else point_file(folder, key, speed)
-        res, coarse = None if path is None else load_or_none(path, MixedResult.load), None
+        res = None if path is None else load_or_none(path, MixedResult.load)
+        levels = (res,)
         if res is None:
             sliding = dict(speed=float(speed)) if slide_to_roll is None else dict(
                 speed=float(slide_to_roll * speed), entrainment=float(speed))
-            res, coarse = solve_nested(gap, spacing, factors, load=load, **sliding,
-                                       lubricant=lubricant, face=face, settings=settings,
-                                       previous=previous, previous_coarse=previous_coarse)
+            levels = solve_nested(gap, spacing, factors, load=load, **sliding,
+                                  lubricant=lubricant, face=face, settings=settings,
+                                  previous=previous)
+            res, coarse = levels[0], _coarse(levels)
             if coarse is not None:
                 res = replace(res, meta={**res.meta, COARSE_CF: coarse.friction_coefficient,
                                          "seconds_coarse": coarse.meta["seconds"]})
@@ -97,7 +99,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
             estimate = friction_error(res, gap, spacing, factors, load=load,
                                       lubricant=lubricant, face=face, settings=settings,
                                       entrainment=res.meta.get("entrainment"),
-                                      coarse=coarse)
+                                      coarse=_coarse(levels))
             res = replace(res, meta={**res.meta, "error_estimate": estimate,
                                      "seconds_estimate": time.perf_counter() - t0})
             if path is not None:
@@ -106,7 +108,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
             vtu = res.write_vtu(fields / f"mu{lubricant.viscosity:g}_{i:03d}.vtu", origin)
             entries.append((float(res.speed), vtu))            # ParaView time = U [m/s]
         records.append(_record(res))
-        previous, previous_coarse = res, coarse
+        previous = (res, *levels[1:])
     if fields is not None:
         write_pvd(fields / f"stribeck_mu{lubricant.viscosity:g}.pvd", entries)
     get = lambda name: np.array([r[name] for r in records])  # noqa: E731
@@ -123,6 +125,11 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         friction_error=None if errors is None else errors.pop("total"),
         friction_error_parts=errors,
         coarse_friction_coefficient=get(COARSE_CF))
+
+
+def _coarse(levels):
+    """A point's solution on the grid coarsened by two, or None."""
+    return levels[1] if len(levels) > 1 else None
 
 
 def _record(res: MixedResult) -> dict:
