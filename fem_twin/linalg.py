@@ -116,6 +116,7 @@ class SPDSolver:
         if getattr(self, "_analysed", False):
             try:
                 self._pardiso(-1, np.zeros((self.n, 1), self.dtype))
+                _mkl_rt().mkl_free_buffers()        # back to the system, not MKL's pool
             except Exception:                       # interpreter shutdown: nothing to free
                 pass
 

@@ -137,7 +137,8 @@ def test_one_thread_while_computing_and_restored_after(monkeypatch):
 def test_anderson_mixing_is_gmres_on_a_linear_map():
     """x = G x + c with a slow contraction (spectral radius 0.95): Anderson with memory >=
     the dimension n reaches the fixed point in at most n + 1 steps (GMRES equivalence),
-    where the plain iteration needs hundreds; depth 0 is the plain iteration."""
+    where the plain iteration needs hundreds, damped or not (the damped steps span the same
+    Krylov space); depth 0 is the plain iteration."""
     from fem_twin.anderson import Anderson
     rng = np.random.default_rng(5)
     n = 6
@@ -146,13 +147,14 @@ def test_anderson_mixing_is_gmres_on_a_linear_map():
     c = rng.normal(size=n)
     exact = np.linalg.solve(np.eye(n) - G, c)
 
-    def solve(depth, steps):
-        mixer, x = Anderson(depth), np.zeros(n)
+    def solve(depth, steps, beta=1.0):
+        mixer, x = Anderson(depth, beta), np.zeros(n)
         for _ in range(steps):
             x = mixer.step(x, G @ x + c - x)
         return np.linalg.norm(x - exact) / np.linalg.norm(exact)
 
     assert solve(depth=8, steps=n + 1) < 1e-9
+    assert solve(depth=8, steps=n + 1, beta=0.5) < 1e-9
     plain = solve(depth=0, steps=n + 1)
     x = np.zeros(n)
     for _ in range(n + 1):

@@ -9,7 +9,9 @@ rigid-body separation ``h_d`` (eqs 28-30):
     the fixed point ``(h_el, h_d) -> (op(p_tot - p_amb), h_d + dF/k)`` with ``p_con``
     taken at the current ``h0`` (no under-relaxation), accelerated by Anderson mixing
     (Walker and Ni 2011).  ``k`` is a load-stiffness estimate (contact stiffness from the
-    slope of ``p_con(h0)`` plus ``2 F_hd / h``); Anderson mixing corrects it.
+    slope of ``p_con(h0)`` plus ``2 F_hd / h``); Anderson mixing corrects it.  Its steps
+    are damped (``MacroSettings.anderson_damping``): the undamped first step from a
+    coarse-grid start thins the film near contact enough to move the pressure by 70 MPa.
 ``"pid"``
     the paper's scheme: ``p_con`` under-relaxed with ``alpha_pcon`` (eq 26), the
     incremental PID controller of eq 29 on ``h_d``, and ``h_el`` under-relaxed (the
@@ -208,7 +210,8 @@ class _Mixing:
         self.restart()
 
     def restart(self):
-        self.mixer = Anderson(self.P.settings.anderson_depth)
+        s = self.P.settings
+        self.mixer = Anderson(s.anderson_depth, s.anderson_damping)
 
     def update(self, ev, h_el, h_d, p_con, row, res):
         P, s = self.P, self.P.settings

@@ -163,9 +163,12 @@ def _grid(shape, dirichlet, interior) -> _Grid:
     grid = _GRIDS.pop(key, None) or _Grid(shape, interior)
     while _GRIDS and (len(_GRIDS) >= GRIDS or sum(
             g.n for g in _GRIDS.values() if g.n < grid.n) > KEPT_UNKNOWNS):
-        # the least recently used of the smaller grids first: the finest grid sets the peak
-        smaller = [k for k, g in _GRIDS.items() if g.n < grid.n]
-        del _GRIDS[smaller[0] if smaller else next(iter(_GRIDS))]
+        # the least recently used of the smaller grids first (the finest grid sets the
+        # peak), the finest one last (a nested point's levels run coarse to fine)
+        finest = max(_GRIDS, key=lambda k: _GRIDS[k].n)
+        victims = ([k for k, g in _GRIDS.items() if g.n < grid.n]
+                   or [k for k in _GRIDS if k != finest] or [finest])
+        del _GRIDS[victims[0]]
     _GRIDS[key] = grid
     return grid
 
