@@ -4,10 +4,11 @@ Sample pin 1 on disk 1 prepared at n^2 (``run._macro_gap``) with the macro group
 factors (sample patch 1 at 64^2, 30 h0 x 8 steps), 150 N, 0.066 Pa s: a cold point at
 0.03 m/s (mixed lubrication, the coarse-to-fine start included) and a warm one at
 0.025 m/s from it, both as a sweep solves them (:func:`fem_twin.macro.nested.solve_nested`:
-the point on the coarsened grid first).  Each grid runs in a process of its own, so its peak memory (maximum
-resident set) is its own.  ``FEM_TWIN_SCALE_MAX`` (default 1024) is the largest grid:
-2048 takes about 14 min for its cold point and 8.1 GiB (2026-11-26).  Baseline: the cold point at 128^2.  The
-growth exponent is ``log(t_n / t_(n/2)) / log 4``, in the number of nodes N.
+the point on every coarsening first).  Each grid runs in a process of its own, so its peak
+memory (maximum resident set) is its own.  ``FEM_TWIN_SCALE_MAX`` (default 1024) is the
+largest grid: 2048 takes 13 min for its cold point and 7.9 GiB (2026-11-26).
+Baseline: the cold point at 128^2.  The growth exponent is ``log(t_n / t_(n/2)) / log 4``,
+in the number of nodes N.
 """
 
 from __future__ import annotations
