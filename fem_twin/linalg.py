@@ -115,8 +115,7 @@ class SPDSolver:
     def __del__(self):                              # release PARDISO's memory
         if getattr(self, "_analysed", False):
             try:
-                self._pardiso(-1, np.zeros((self.n, 1), self.dtype))
-                _mkl_rt().mkl_free_buffers()        # back to the system, not MKL's pool
+                self._free(-1)
             except Exception:                       # interpreter shutdown: nothing to free
                 pass
 
@@ -154,9 +153,14 @@ class SPDSolver:
         """Free the factors (PARDISO phase 0), keep the ordering and symbolic analysis; the
         next ``factor`` computes them anew."""
         if self._analysed and self._a is not None:
-            self._pardiso(0, np.zeros((self.n, 1), self.dtype))
-            _mkl_rt().mkl_free_buffers()            # back to the system, not MKL's pool
+            self._free(0)
         self._lu = self._a = None
+
+    def _free(self, phase):
+        """PARDISO ``phase`` 0 (the factors) or -1 (everything), the memory given back to
+        the system rather than kept in MKL's pool."""
+        self._pardiso(phase, np.zeros((self.n, 1), self.dtype))
+        _mkl_rt().mkl_free_buffers()
 
     def _pardiso(self, phase, b):
         """One call of MKL's ``pardiso`` (``b`` of ``self.dtype``; zero-based indices, METIS

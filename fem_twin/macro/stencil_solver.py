@@ -7,9 +7,9 @@ of theirs, so a step costs one numeric factorisation and two solves (the kept ma
 bundled-case sweep 12 % faster).  The factors are single precision, refined with the
 residual in double precision (one refinement step reaches ``STEP_RTOL`` on the
 equilibrated matrix; 512^2 scale point: 0.85x the time and 0.87x the peak memory of double
-precision, C_f the same to 2e-14).  The factors are freed after each step (never reused;
-at 2048^2 they are 2.06 GiB, and the evaluation between steps no longer stacks on them).  A step is
-returned only when it solves ``J x = rhs`` to ``STEP_RTOL``.
+precision, C_f the same to 2e-14).  The factors are freed after each step: they are never
+reused, and at 2048^2 (2.06 GiB) the evaluation between steps no longer stacks on them.  A
+step is returned only when it solves ``J x = rhs`` to ``STEP_RTOL``.
 
 Tried and dropped (2026-11-25, bundled case, 12 speeds at 128^2): the last factorisation
 as a GMRES preconditioner for the next step.  The matrices move too much between coupling

@@ -81,17 +81,17 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                                    disable=not progress, unit="speed")):
         path = None if folder is None else point_file(folder, key, speed)
         res = None if path is None else load_or_none(path, MixedResult.load)
-        levels = (res,)
+        coarser = []                        # the point on each coarsening of the grid
         if res is None:
             sliding = dict(speed=float(speed)) if slide_to_roll is None else dict(
                 speed=float(slide_to_roll * speed), entrainment=float(speed))
-            levels = solve_nested(gap, spacing, factors, load=load, **sliding,
-                                  lubricant=lubricant, face=face, settings=settings,
-                                  previous=previous)
-            res, coarse = levels[0], _coarse(levels)
-            if coarse is not None:
-                res = replace(res, meta={**res.meta, COARSE_CF: coarse.friction_coefficient,
-                                         "seconds_coarse": coarse.meta["seconds"]})
+            res, *coarser = solve_nested(gap, spacing, factors, load=load, **sliding,
+                                         lubricant=lubricant, face=face, settings=settings,
+                                         previous=previous)
+            if coarser:
+                res = replace(res, meta={**res.meta,
+                                         COARSE_CF: coarser[0].friction_coefficient,
+                                         "seconds_coarse": coarser[0].meta["seconds"]})
             if path is not None:
                 res.save(path)
         if error_estimate and "error_estimate" not in res.meta:
@@ -99,7 +99,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
             estimate = friction_error(res, gap, spacing, factors, load=load,
                                       lubricant=lubricant, face=face, settings=settings,
                                       entrainment=res.meta.get("entrainment"),
-                                      coarse=_coarse(levels))
+                                      coarse=coarser[0] if coarser else None)
             res = replace(res, meta={**res.meta, "error_estimate": estimate,
                                      "seconds_estimate": time.perf_counter() - t0})
             if path is not None:
@@ -108,7 +108,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
             vtu = res.write_vtu(fields / f"mu{lubricant.viscosity:g}_{i:03d}.vtu", origin)
             entries.append((float(res.speed), vtu))            # ParaView time = U [m/s]
         records.append(_record(res))
-        previous = (res, *levels[1:])
+        previous = (res, *coarser)
     if fields is not None:
         write_pvd(fields / f"stribeck_mu{lubricant.viscosity:g}.pvd", entries)
     get = lambda name: np.array([r[name] for r in records])  # noqa: E731
@@ -125,11 +125,6 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         friction_error=None if errors is None else errors.pop("total"),
         friction_error_parts=errors,
         coarse_friction_coefficient=get(COARSE_CF))
-
-
-def _coarse(levels):
-    """A point's solution on the grid coarsened by two, or None."""
-    return levels[1] if len(levels) > 1 else None
 
 
 def _record(res: MixedResult) -> dict:
