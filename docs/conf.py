@@ -65,12 +65,15 @@ def example_argv(gallery_conf, script_vars):
     return [str(target), "--quick"]
 
 
-skip = [] if SHARED.is_dir() else ["06_real_roughness"]   # needs ../shared/topographies
+# examples that read ../shared/topographies are shown but not run when it is absent
+NEEDS_SHARED = [] if SHARED.is_dir() else sorted(
+    path.stem[:2] for path in (ROOT / "examples").glob("[0-9][0-9]_*.py")
+    if '"shared" / "topographies"' in path.read_text(encoding="utf-8"))
 sphinx_gallery_conf = {
     "examples_dirs": str(ROOT / "examples"),
     "gallery_dirs": "auto_examples",
-    "filename_pattern": r"/\d\d_",
-    "ignore_pattern": r"(__init__|" + "|".join(skip or ["^$"]) + r")\.py",
+    "filename_pattern": r"/(?!" + "|".join(NEEDS_SHARED or ["$^"]) + r")\d\d_",
+    "ignore_pattern": r"__init__\.py",
     "reset_argv": example_argv,
     "plot_gallery": os.environ.get("FEM_TWIN_DOCS_GALLERY", "1") != "0",
     "download_all_examples": False,
