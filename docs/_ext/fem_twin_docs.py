@@ -116,9 +116,9 @@ def check_gallery(app, exception) -> None:
     if exception is not None or not conf.get("plot_gallery", True):
         return
     images = Path(app.srcdir) / "auto_examples" / "images"
-    skipped = conf.get("ignore_pattern", "")
+    ran = conf.get("filename_pattern", "")
     missing = [p.stem for p in sorted(Path(conf["examples_dirs"]).glob("[0-9][0-9]_*.py"))
-               if not re.search(skipped, p.name)
+               if re.search(ran, str(p))
                and not (images / f"sphx_glr_{p.stem}_001.png").is_file()]
     if missing:
         raise RuntimeError(f"gallery examples without a figure: {missing}")
