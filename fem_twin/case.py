@@ -20,18 +20,21 @@ class CaseError(InputError):
 
 #: a warm Stribeck point of a pin at 128^2 [s], its growth with the pixels, and the cost of
 #: a main-curve point with its C_f error estimate in plain points: fitted to the bundled
-#: case (main sweeps 23 s, band 17 s, 2026-11-25 afternoon) and the paper case (sweeps,
-#: band and results 249 s at 256^2, the same hour)
-POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 1.1, 0.7, 1.28
+#: case and the paper case (2026-11-26, 13:20-13:45, the probe of :mod:`fem_twin.speed`
+#: at 0.17-0.19 s: sweeps, band and results 54 s and 282 s)
+POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 1.38, 0.7, 1.28
+#: a ball's warm point at 73^2 (Newton coupling) [s] and its growth with the grid's side
+#: (the bundled ball case, the same hour: 30 points in 70 s on 2 cores)
+BALL_POINT_SECONDS, BALL_POINT_GROWTH = 3.9, 2.4
 #: a band point in main-curve points, by ``[run] band_grid``: the band's sweeps converge to
 #: 1e-4 and carry no error estimate, and "coarse" runs them on the coarsened grid (bundled
 #: case, 2026-11-25: 0.157 s on the coarse grid, 0.59 s on the full one, against 1.28 s a
 #: main point with its error estimate)
 BAND_POINT_COST = {"coarse": 0.14, "full": 0.54}
 #: micro stage cost per cell pixel, time step and separation on one core [s] (the cell
-#: problems, the periodic contact and the coarsened cell of the error estimate: 2.3e-6 on
-#: the paper case, 2.7e-6 on the bundled one, 2026-11-25)
-MICRO_SECONDS = 2.5e-6
+#: problems, the periodic contact and the coarsened cell of the error estimate: 3.5e-6 on
+#: the bundled case (54.5 s) and 3.6e-6 on the paper case (420 s), the same hour)
+MICRO_SECONDS = 3.5e-6
 #: separations an adaptive h0 sample solves per patch pair, for the time estimate:
 #: ``a + k / sqrt(h0_tol)`` (at most the candidates), fitted to the paper case's six patch
 #: pairs at 256^2 x 32 (2026-11-25: 30.5, 27, 22.3 and 18.8 a pair at h0_tol = 0.01, 0.02,
@@ -58,18 +61,18 @@ class Case:
     defaulted: tuple[str, ...] = ()          # sections absent from the file (defaults used)
 
     def estimated_seconds(self, cores: int = 2) -> float:
-        """Rough wall time of ``fem-twin run`` on ``cores`` cores [s], from the costs measured
-        on this project's 2-core machine: ``MICRO_SECONDS`` per cell pixel, time step and
-        separation of the micro stage on one core (adaptive h0 solves ``ADAPTIVE_H0``
-        of the candidates); a warm Stribeck point of a pin ``POINT_SECONDS`` at 128^2
-        growing as N^``POINT_GROWTH`` (pixels), ``ESTIMATE_COST`` times that on the main
-        curves (their C_f error estimates), one sweep per viscosity and, with ``[run]
-        patch_band``, one more per patch (a point at ``BAND_POINT_COST`` by ``[run]
-        band_grid``); a ball's point ~2.5 s at 73^2 (Newton coupling).  Measured
-        against it (2026-11-25, late afternoon): the bundled case 86 s (estimated 73 s), 137 s
-        with its band on the full grid (121 s), the paper case 538 s (525 s), the ball case
-        64 s (61 s); the bundled case at 20 steps and the Galerkin contact load since: 0.96x
-        (about 82 s)."""
+        """Rough wall time of ``fem-twin run`` on ``cores`` cores of the calibration
+        machine [s] (``fem-twin run`` scales it to this machine now by
+        :func:`fem_twin.speed.slowdown`), from the costs measured there:
+        ``MICRO_SECONDS`` per cell pixel, time step and separation of the micro stage on
+        one core (adaptive h0 solves ``ADAPTIVE_H0`` of the candidates); a warm Stribeck
+        point of a pin ``POINT_SECONDS`` at 128^2 growing as N^``POINT_GROWTH`` (pixels),
+        ``ESTIMATE_COST`` times that on the main curves (their C_f error estimates), one
+        sweep per viscosity and, with ``[run] patch_band``, one more per patch (a point at
+        ``BAND_POINT_COST`` by ``[run] band_grid``); a ball's point ``BALL_POINT_SECONDS``
+        at 73^2.  Measured against it (2026-11-26, 13:20-13:45, tests/test_cli.py): the
+        bundled case 114 s (estimated 108 s), 173 s with its band on the full grid, the
+        paper case 709 s, the ball case 102 s."""
         patches = len(self.geometry.patches)
         h0 = self.micro.h0_count
         if self.micro.h0_tol:
@@ -77,8 +80,9 @@ class Case:
             h0 = min(h0, a + k / math.sqrt(self.micro.h0_tol))
         pixels = self.micro.resolution[0] * self.micro.resolution[1]
         micro = MICRO_SECONDS * pixels * self.micro.steps * h0 * patches / max(cores, 1)
-        if self.tribometer.ball:         # Newton coupling: ~2.5 s a point at 73^2 measured
-            point, estimate = 2.5 * (self.macro.grid / 73) ** 2.4, 1.0
+        if self.tribometer.ball:         # Newton coupling
+            point = BALL_POINT_SECONDS * (self.macro.grid / 73) ** BALL_POINT_GROWTH
+            estimate = 1.0
         else:
             res = self.macro_geometry.resolution or (256, 256)
             point = POINT_SECONDS * ((res[0] * res[1]) / 128 ** 2) ** POINT_GROWTH

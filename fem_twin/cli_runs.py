@@ -17,26 +17,37 @@ from .io.layout import RunLayout
 LONG_RUN_SECONDS = 10 * 60
 
 
-def _confirm_cost(case, yes: bool) -> bool:
-    """Say which sections take defaults and what the run will cost; refuse a long run
-    without ``--yes``."""
+def _confirm_cost(case, yes: bool) -> float | None:
+    """Say which sections take defaults and what the run will cost on this machine now
+    (:func:`fem_twin.speed.slowdown`); the estimate [s], or None (refused: a long run
+    without ``--yes``)."""
+    from .speed import slowdown
     if case.defaulted:
         print(f"fem-twin run: sections not in {case.source.name}, defaults used: " + ", ".join(
             f"[{s}]" for s in case.defaulted), file=sys.stderr)
     cores = case.run.workers or os.cpu_count() or 1
-    seconds = case.estimated_seconds(cores)
+    speed = slowdown()
+    seconds = case.estimated_seconds(cores) * speed
     mc = case.micro
     print(f"fem-twin run: {len(case.geometry.patches)} patch pairs at {mc.resolution[0]}x"
           f"{mc.resolution[1]}, {mc.h0_count} h0 x {mc.steps} steps"
           f"{f' (adaptive h0, tolerance {mc.h0_tol:g})' if mc.h0_tol else ''}; "
           f"{len(case.lubricant.viscosities)} x {case.sweep.count} speeds; estimated "
-          f"{seconds / 60:.0f} min on {cores} cores", file=sys.stderr)
+          f"{duration(seconds)} on {cores} cores (this machine takes {speed:.2g}x the "
+          "calibration machine's time now)", file=sys.stderr)
     if seconds > LONG_RUN_SECONDS and not yes:
-        print(f"fem-twin run: error: this run is estimated at {seconds / 60:.0f} min (the "
-              "bundled case: about 1 min); check the case and run again with --yes",
+        print(f"fem-twin run: error: this run is estimated at {duration(seconds)} (the "
+              "bundled case: about 2 min); check the case and run again with --yes",
               file=sys.stderr)
-        return False
-    return True
+        return None
+    return seconds
+
+
+def duration(seconds: float) -> str:
+    """``seconds`` for a person: "85 s", "4.2 min", "25 min"."""
+    if seconds < 100:
+        return f"{seconds:.0f} s"
+    return f"{seconds / 60:.1f} min" if seconds < 600 else f"{seconds / 60:.0f} min"
 
 
 def run(args):
@@ -50,12 +61,14 @@ def run(args):
     if args.from_fit is not None:
         from .fitting import apply_fit, read_fit, run_from_fit
         fitted = apply_fit(case, read_fit(args.from_fit))        # checked before any work
-    if not _confirm_cost(fitted, args.yes):
+    estimate = _confirm_cost(fitted, args.yes)
+    if estimate is None:
         return 2
     if args.from_fit is None:
-        summary = run(case, args.output, progress=not args.no_progress)
+        summary = run(case, args.output, progress=not args.no_progress, estimated_s=estimate)
     else:
-        summary = run_from_fit(case, args.from_fit, args.output, progress=not args.no_progress)
+        summary = run_from_fit(case, args.from_fit, args.output, progress=not args.no_progress,
+                               estimated_s=estimate)
     print(_short_summary(summary, args.output))
     if "prediction" in summary:
         p = summary["prediction"]
@@ -89,8 +102,11 @@ def traction(args):
 def _short_summary(summary: dict, out: Path) -> str:
     """A few lines for the terminal; everything is in ``OUT/summary.json``."""
     stages = summary["stages"]
-    lines = [f"fem-twin run: {summary['case']} done in {summary['wall_time_s']:.0f} s ("
-             + ", ".join(f"{k} {v:.0f} s" for k, v in summary["seconds"].items()) + ")"]
+    estimated = (f"estimated {duration(summary['estimated_s'])}; "
+                 if summary.get("estimated_s") else "")
+    lines = [f"fem-twin run: {summary['case']} done in {duration(summary['wall_time_s'])} ("
+             + estimated + ", ".join(f"{k} {v:.0f} s" for k, v in summary["seconds"].items())
+             + ")"]
     for c in stages["stribeck"]["curves"]:
         lo, hi = c["friction_coefficient_range"]
         lines.append(f"  mu_0 = {c['viscosity_Pa_s']:g} Pa s: C_f from {lo:.4f} to {hi:.4f}")
@@ -128,7 +144,7 @@ def fit(args):
     if not args.case.is_file():
         raise MissingFile(f"case file not found: {args.case}")
     case = load_case(args.case)
-    if not _confirm_cost(case, args.yes):
+    if _confirm_cost(case, args.yes) is None:
         return 2
     result = fit_case(case, args.measured, args.output,
                       [p.strip() for p in args.params.split(",") if p.strip()],

@@ -136,17 +136,19 @@ def read_fit(path) -> dict:
     return result
 
 
-def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=None) -> dict:
+def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=None,
+                 **options) -> dict:
     """Run ``case`` with the parameters fitted in ``fit_path`` (:func:`apply_fit`): at
     another load or oil temperature than the fit's; ``OUT/prediction.csv`` gives each
     curve with the 95 % band of the fitted parameters' covariance (a fitted load share
     by two more sweeps at its interval's ends) and the curve's C_f error estimate.
-    Returns the run's summary with ``"prediction"``."""
+    Returns the run's summary with ``"prediction"``; ``options`` go to ``run``
+    (:func:`fem_twin.pipeline.run`)."""
     result = read_fit(fit_path)
     fitted = apply_fit(case, result)
     if run is None:
         from .pipeline import run
-    summary = run(fitted, outdir, progress=progress)
+    summary = run(fitted, outdir, progress=progress, **options)
     out = RunLayout(outdir)
     curves = read_stribeck_csv(out.stribeck_csv)
     lb, tr = fitted.lubricant, fitted.tribometer

@@ -33,8 +33,10 @@ log = logging.getLogger("fem_twin")
 
 
 @one_thread
-def run(case: Case, outdir, *, progress: bool = True) -> dict:
-    """Run the whole pipeline of ``case`` into ``outdir``; return the summary."""
+def run(case: Case, outdir, *, progress: bool = True, estimated_s: float | None = None) -> dict:
+    """Run the whole pipeline of ``case`` into ``outdir``; return the summary.
+    ``estimated_s``, the run's estimated wall time [s] (``fem-twin run`` passes what it
+    printed), is kept in the summary beside the measured one."""
     out = RunLayout(outdir)
     outdir = out.root
     if outdir.exists() and not outdir.is_dir():
@@ -52,6 +54,8 @@ def run(case: Case, outdir, *, progress: bool = True) -> dict:
         _run_stages(case, out, executor, progress, summary,
                     ("stribeck", lambda: stribeck_curves(case, out, executor, progress)))
     summary["wall_time_s"] = time.perf_counter() - t0
+    if estimated_s is not None:
+        summary["estimated_s"] = float(estimated_s)
     summary["task_graph"] = _task_graph(case, out)
     with atomic_path(out.summary) as tmp:
         tmp.write_text(json.dumps(summary, indent=2))

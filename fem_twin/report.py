@@ -134,6 +134,8 @@ def tables_section(summary: dict) -> str:
     stages = summary.get("stages", {})
     micro = stages.get("micro", {})
     rows = [("wall time", f"{summary.get('wall_time_s', float('nan')):.1f} s")]
+    if "estimated_s" in summary:
+        rows.append(("estimated before the run", f"{summary['estimated_s']:.0f} s"))
     rows += [(f"stage {k}", f"{v:.1f} s") for k, v in summary.get("seconds", {}).items()]
     graph = summary.get("task_graph") or {}
     rows += [(f"its {graph['tasks']} tasks on {w} workers (task graph)", f"{v:.1f} s")
