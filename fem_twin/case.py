@@ -38,8 +38,8 @@ MICRO_SECONDS = 3.5e-6
 #: separations an adaptive h0 sample solves per patch pair, for the time estimate:
 #: ``a + k / sqrt(h0_tol)`` (at most the candidates), fitted to the paper case's six patch
 #: pairs at 256^2 x 32 (2026-11-25: 30.5, 27, 22.3 and 18.8 a pair at h0_tol = 0.01, 0.02,
-#: 0.03 and 0.05; the bundled case solves all its 16)
-ADAPTIVE_H0 = (9.3, 2.1)
+#: 0.03 and 0.05; 2026-11-26: 16.5 at 0.05, 12.0 at 0.1; the bundled case solves all its 16)
+ADAPTIVE_H0 = (5.5, 2.7)
 
 
 @dataclass(frozen=True)
@@ -72,7 +72,7 @@ class Case:
         ``BAND_POINT_COST`` by ``[run] band_grid``); a ball's point ``BALL_POINT_SECONDS``
         at 73^2.  Measured against it (2026-11-26, 13:20-13:45, tests/test_cli.py): the
         bundled case 114 s (estimated 108 s), 173 s with its band on the full grid, the
-        paper case 709 s, the ball case 102 s."""
+        paper case 709 s at ``h0_tol = 0.05`` and 605 s at 0.1, the ball case 102 s."""
         patches = len(self.geometry.patches)
         h0 = self.micro.h0_count
         if self.micro.h0_tol:

@@ -93,7 +93,7 @@ def test_run_files_are_named_only_by_the_run_layout():
 LAYERS = {"topography": 1, "io.files": 1, "io": 1, "contact": 2, "micro": 3, "macro": 4,
           "stribeck": 5, "case": 6, "sections": 6, "stages": 6, "pipeline": 6, "compare": 6,
           "calibration": 6, "fitting": 6, "results": 6, "report": 6, "samples": 6, "fvm": 6,
-          "taskgraph": 6,
+          "taskgraph": 6, "speed": 6,
           "cli": 7, "cli_runs": 7, "cli_stages": 7}
 
 

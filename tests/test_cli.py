@@ -805,8 +805,8 @@ def test_run_time_estimates_hold():
     """Issue 28 item 5: fem-twin run's estimate on the calibration machine lies within 30 %
     of the wall time measured there on 2 cores the same hour (2026-11-26, 13:20-13:45, the
     probe of fem_twin.speed at 0.17-0.19 s): the bundled case 114 s with its band on the
-    coarse grid and 173 s with it on the full grid, the paper case 709 s, the bundled
-    ball-on-disk case 102 s.  (It said 55 min for the paper case when it took 25.5; the
+    coarse grid and 173 s with it on the full grid, the paper case 605 s (at h0_tol = 0.1;
+    709 s at 0.05), the bundled ball-on-disk case 102 s.  (It said 55 min for the paper case when it took 25.5; the
     constants of the day before gave 0.60-0.74x of these times, on a machine that ran
     1.45x faster in the micro stage.)"""
     from dataclasses import replace
@@ -815,7 +815,8 @@ def test_run_time_estimates_hold():
 
     def run(case, **kw):
         return replace(case, run=replace(case.run, **kw))
-    for case, measured in ((cases["pin_on_disk"], 114), (cases["paper"], 709),
+    paper_05 = replace(cases["paper"], micro=replace(cases["paper"].micro, h0_tol=0.05))
+    for case, measured in ((cases["pin_on_disk"], 114), (cases["paper"], 605), (paper_05, 709),
                            (run(cases["pin_on_disk"], band_grid="full"), 173),
                            (cases["ball_on_disk"], 102)):
         estimate = case.estimated_seconds(2)
