@@ -27,8 +27,8 @@ from .topography.synthetic import self_affine
 REFERENCE_SECONDS = 0.18
 #: timed repeats of the miniature (the best counts: the machine's speed, not a hiccup)
 REPEATS = 5
-#: the slowdown is kept within these bounds (a probe is 0.3 s: it can misjudge, a run
-#: estimate off by more than 4x says more about the machine than about the case)
+#: the slowdown is kept within these bounds (a probe sees about a second and can misjudge;
+#: an estimate off by more than 4x says more about the machine than about the case)
 BOUNDS = (0.25, 4.0)
 
 
