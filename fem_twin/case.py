@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field, fields
+from dataclasses import MISSING, dataclass, field, fields
 from pathlib import Path
 
 from .checks import QUANTITIES
@@ -286,7 +286,8 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
         _plausible(name, f, table[f.name], where)
         _choice(name, f, table[f.name], where)
         v = table[f.name]
-        default = getattr(cls(), f.name)
+        # the declared default: an instance's may be normalised (time_tol 0 -> None)
+        default = f.default if f.default is not MISSING else getattr(cls(), f.name)
         if isinstance(default, tuple):
             if not isinstance(v, list) or not all(isinstance(x, (int, float)) for x in v):
                 raise CaseError(f"{where} [{name}] {f.name}: expected a list of numbers")

@@ -10,7 +10,7 @@ import tomllib
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from fem_twin import Topography
@@ -42,6 +42,7 @@ def _parse(data):
 
 @settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(st.tuples(st.sampled_from(KEYS), values), min_size=1, max_size=3))
+@example([(("micro", "time_tol"), "0")])    # found by CI: a setting whose 0 means off
 def test_case_parser_accepts_or_refuses_cleanly(changes):
     data = {s: dict(t) if isinstance(t, dict) else t for s, t in CASE.items()}
     for (section, key), value in changes:
