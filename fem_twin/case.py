@@ -31,6 +31,10 @@ BALL_POINT_SECONDS, BALL_POINT_GROWTH = 3.9, 2.4
 #: case, 2026-11-25: 0.157 s on the coarse grid, 0.59 s on the full one, against 1.28 s a
 #: main point with its error estimate)
 BAND_POINT_COST = {"coarse": 0.14, "full": 0.54}
+#: a band point on a grid coarsened once more, against one on the grid before ("coarsest"
+#: on grids from 256^2; the paper case, 2026-11-26: a 32-speed sweep 6.0 s at 64^2 against
+#: 18.4 s at 128^2)
+BAND_LEVEL_COST = 0.33
 #: micro stage cost per cell pixel, time step and separation on one core [s] (the cell
 #: problems, the periodic contact and the coarsened cell of the error estimate: 3.5e-6 on
 #: the bundled case (54.5 s) and 3.6e-6 on the paper case (420 s), the same hour)
@@ -69,10 +73,13 @@ class Case:
         point of a pin ``POINT_SECONDS`` at 128^2 growing as N^``POINT_GROWTH`` (pixels),
         ``ESTIMATE_COST`` times that on the main curves (their C_f error estimates), one
         sweep per viscosity and, with ``[run] patch_band``, one more per patch (a point at
-        ``BAND_POINT_COST`` by ``[run] band_grid``); a ball's point ``BALL_POINT_SECONDS``
+        ``BAND_POINT_COST`` by ``[run] band_grid``, ``BAND_LEVEL_COST`` for each further
+        coarsening); a ball's point ``BALL_POINT_SECONDS``
         at 73^2.  Measured against it (2026-11-26, 13:20-13:45, tests/test_cli.py): the
         bundled case 114 s (estimated 108 s), 173 s with its band on the full grid, the
-        paper case 709 s at ``h0_tol = 0.05`` and 605 s at 0.1, the ball case 102 s."""
+        paper case with its band at 128^2 709 s at ``h0_tol = 0.05`` and 605 s at 0.1, the
+        ball case 102 s; the paper case with its band at 64^2 (the default), 484 s at 16:00
+        with the probe at 0.87x (estimated 522 s on the calibration machine)."""
         patches = len(self.geometry.patches)
         h0 = self.micro.h0_count
         if self.micro.h0_tol:
@@ -90,10 +97,20 @@ class Case:
         n_mu = len(self.lubricant.viscosities)
         points = self.sweep.count * (1 + 0.5 * self.sweep.refine)   # refinement: ~+50 %
         band = patches if self.run.patch_band and patches > 1 else 0
-        band *= BAND_POINT_COST[self.run.band_grid]
+        band *= self._band_point_cost()
         sweeps = n_mu * (1 + (patches if band else 0))
         macro = point * points * n_mu * (estimate + band) / max(1, min(cores, sweeps))
         return micro + macro
+
+    def _band_point_cost(self) -> float:
+        """A band point in main-curve points, by ``[run] band_grid`` and the macro grid
+        (``BAND_LEVEL_COST`` for each coarsening beyond the first)."""
+        from .macro.nested import nested_levels
+        if self.run.band_grid != "coarsest":
+            return BAND_POINT_COST[self.run.band_grid]
+        side = min(self.macro_geometry.resolution or (256, 256))
+        levels = 1 if self.tribometer.ball else max(1, nested_levels((side,)))
+        return BAND_POINT_COST["coarse"] * BAND_LEVEL_COST ** (levels - 1)
 
 
 def load_case(path) -> Case:

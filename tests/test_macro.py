@@ -407,7 +407,7 @@ def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors)
     fine-grid iterations (sample pin 1 at 112^2, mixed lubrication 0.05 -> 0.03 m/s:
     measured 24 against 42); its coarse point is the one the error estimate solves."""
     from fem_twin.macro.estimate import friction_error
-    from fem_twin.macro.nested import coarsened, solve_nested
+    from fem_twin.macro.nested import coarsened, nested_levels, solve_nested
     from fem_twin.stribeck import stribeck_sweep
     gap, dx, face = macro_case(112)
     kw = dict(load=150.0, lubricant=Lubricant(0.066), face=face,
@@ -423,10 +423,12 @@ def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors)
     again = solve_mixed(gap2, dx2, factors, speed=0.03, initial=nested,
                         **{**kw, "face": face2})
     assert abs(again.friction_coefficient - coarse.friction_coefficient) < 1e-6 * 0.19245
-    # a sweep keeps each point's coarse C_f: the patch band's coarse average curve
+    # a sweep keeps each point's C_f on every nested grid: the patch band's average curve
     curve = stribeck_sweep(gap, dx, factors, [0.05, 0.03], **kw)
-    assert abs(curve.coarse_friction_coefficient[1] - again.friction_coefficient) < 1e-6 * 0.19245
-    assert curve.coarse_friction_coefficient[0] == first_coarse.friction_coefficient
+    assert curve.coarse_friction_coefficient.shape == (nested_levels(gap.shape), 2) == (1, 2)
+    assert abs(curve.coarse_friction_coefficient[0, 1]
+               - again.friction_coefficient) < 1e-6 * 0.19245
+    assert curve.coarse_friction_coefficient[0, 0] == first_coarse.friction_coefficient
     est = friction_error(nested, gap, dx, factors, coarse=coarse, **kw)
     ref = friction_error(nested, gap, dx, factors, **kw)
     assert est["total"] == pytest.approx(ref["total"], rel=1e-3, abs=1e-6 * 0.19245)
@@ -454,6 +456,12 @@ def test_nested_levels_each_start_from_the_next_coarser_change(factors, monkeypa
     assert abs(warm[1].friction_coefficient - alone.friction_coefficient) < 1e-6 * 0.19245
     plain = solve_mixed(gap, dx, factors, speed=0.03, initial=first[0], face=face, **kw)
     assert abs(warm[0].friction_coefficient - plain.friction_coefficient) < 1e-6 * 0.19245
+    # a sweep keeps C_f on every level (the band's "coarsest" grid reads the last row)
+    from fem_twin.stribeck import stribeck_sweep
+    assert nest.nested_levels(gap.shape) == 2
+    curve = stribeck_sweep(gap, dx, factors, [0.05, 0.03], face=face, **kw)
+    assert np.allclose(curve.coarse_friction_coefficient, [
+        [r.friction_coefficient for r in (first[k], warm[k])] for k in (1, 2)], rtol=1e-9)
 
 
 def exponential_factors(scale=40e-9, p0=1e10):

@@ -38,6 +38,15 @@ def coarsened(gap, spacing, face):
             None if face is None else np.asarray(face, bool)[::2, ::2])
 
 
+def nested_levels(shape) -> int:
+    """How many coarsenings by two :func:`solve_nested` solves below a grid of ``shape``
+    (down to sides of :data:`~fem_twin.macro.mixed.COARSE_START` to twice that)."""
+    side, levels = min(shape), 0
+    while side >= 2 * COARSE_START:
+        side, levels = (side + 1) // 2, levels + 1
+    return levels
+
+
 def solve_nested(gap, spacing, factors, *, previous: tuple[MixedResult, ...] = (),
                  face=None, **point) -> tuple[MixedResult, ...]:
     """One sweep point on its grid and on each coarsening by two down to the coarse start

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 import logging
-import time
+from concurrent.futures import wait
 from dataclasses import fields, replace
 from pathlib import Path
 
@@ -16,7 +16,7 @@ from tqdm import tqdm
 from ..case import Case
 from ..io.layout import RunLayout
 from ..macro import MacroSettings, MixedResult
-from ..macro.nested import coarsened
+from ..macro.nested import coarsened, nested_levels
 from ..macro.figures import plot_point_fields
 from ..macro.point_contact import film_against_hamrock_dowson
 from ..micro import FlowFactors
@@ -122,34 +122,45 @@ def refined_curves(case: Case, common: dict, executor=None, progress: bool = Tru
 
 def band_tasks(case: Case, out: RunLayout, common: dict) -> list:
     """The sweep tasks of the scatter band (``[run] patch_band``): one per patch and
-    viscosity, on the macro grid coarsened by two with ``[run] band_grid = "coarse"``."""
+    viscosity, on the macro grid coarsened :func:`band_coarsening` times."""
     sweeps = band_sweeps(case, out, common) if case.run.patch_band else []
-    if sweeps and case.run.band_grid == "coarse":
-        gap, spacing, face = coarsened(common["gap"], common["spacing"], common["face"])
+    for _ in range(band_coarsening(case, common["gap"]) if sweeps else 0):
+        gap, spacing, face = coarsened(sweeps[0]["gap"], sweeps[0]["spacing"],
+                                       sweeps[0]["face"])
         sweeps = [dict(kw, gap=gap, spacing=spacing, face=face) for kw in sweeps]
     return [(kw, lub) for kw in sweeps for lub in case.lubricant.lubricants()]
+
+
+def band_coarsening(case: Case, gap) -> int:
+    """Coarsenings by two of the band's grid (``[run] band_grid``): none ("full"), one
+    ("coarse"), or down to the main sweeps' coarsest nested grid ("coarsest", at least one:
+    64^2 for the grids 128^2 to 1024^2)."""
+    return {"full": 0, "coarse": 1}.get(case.run.band_grid,
+                                        max(1, nested_levels(np.shape(gap))))
 
 
 def band_curves(case: Case, common: dict, curves, tasks, swept, executor=None,
                 progress: bool = True):
     """The single-patch curves of the scatter band, one list per patch over the
     viscosities, from the curves ``swept`` of :func:`band_tasks`' ``tasks``, and the tasks
-    (with any sweep added here).  Swept on the coarse grid, they are corrected by the
+    (with any sweep added here).  Swept on a coarsened grid, they are corrected by the
     main ``curves``' change to the full grid
-    (:func:`~fem_twin.stribeck.analysis.defect_corrected`): the main sweeps' own coarse
-    points give that change, or, where a point has none (a coarse solve that failed,
-    checkpoints of an earlier version), the average factors are swept on the coarse grid
-    too."""
+    (:func:`~fem_twin.stribeck.analysis.defect_corrected`): the main sweeps' own points on
+    that grid (their nested solves) give that change, or, where a point has none (a coarse
+    solve that failed, checkpoints of an earlier version), the average factors are swept
+    on the band's grid too."""
     n = len(case.lubricant.lubricants())
     swept = [c.with_load_share(case.tribometer.load_share) for c in swept]
     per_patch = [swept[i:i + n] for i in range(0, len(swept), n)]
-    if not per_patch or case.run.band_grid != "coarse":
+    level = band_coarsening(case, common["gap"])
+    if not per_patch or level == 0:
         return per_patch, tasks
-    if all(c.coarse_friction_coefficient is not None and np.all(
-            np.isfinite(c.coarse_friction_coefficient)) for c in curves):
+    coarse = [c.coarse_friction_coefficient for c in curves]
+    if all(cf is not None and cf.shape[0] >= level and np.all(np.isfinite(cf[level - 1]))
+           for cf in coarse):
         return defect_corrected(per_patch, curves, [
-            replace(c, friction_coefficient=c.coarse_friction_coefficient)
-            for c in curves]), tasks
+            replace(c, friction_coefficient=cf[level - 1])
+            for c, cf in zip(curves, coarse)]), tasks
     kw = tasks[0][0]
     average = [(dict(common, gap=kw["gap"], spacing=kw["spacing"], face=kw["face"],
                      fields=None), lub) for lub in case.lubricant.lubricants()]
@@ -294,10 +305,9 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     keys = {_sweep_key(kw, lub) for kw, lub in tasks if kw.get("factors_key")}
     folder = tasks[0][0].get("checkpoint")
     with tqdm(total=total, desc=desc, unit="point", disable=not progress) as bar:
-        while not all(f.done() for f in futures):
+        while wait(futures, timeout=0.5).not_done:            # the bar, twice a second
             if folder is not None and keys:                   # points finished so far
                 bar.update(sum(point_key(p) in keys for p in point_files(folder)) - bar.n)
-            time.sleep(0.5)
         bar.update(total - bar.n)
     return [f.result() for f in futures]
 

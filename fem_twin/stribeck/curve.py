@@ -54,8 +54,9 @@ class StribeckCurve:
     friction_error: the estimated discretisation error of C_f [-] (absolute, both scales,
     :mod:`fem_twin.macro.estimate`) and friction_error_parts its parts by name, when the
     sweep estimated them (None otherwise); coarse_friction_coefficient: C_f of the same
-    points on the macro grid coarsened by two (the nested solves' coarse points, NaN where
-    none was solved), when the sweep kept them.
+    points on the macro grid coarsened by two, four, ..., as ``(levels, points)`` (the
+    nested solves' coarse points, finest first; NaN where none was solved), when the sweep
+    kept them.
     """
 
     speed: np.ndarray

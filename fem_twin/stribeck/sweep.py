@@ -19,7 +19,8 @@ from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from .curve import StribeckCurve, hersey_number
 
-#: a point's ``meta`` entry for C_f on the grid coarsened by two (its nested coarse solve)
+#: a point's ``meta`` entry for C_f on the grids coarsened by two, four, ... (its nested
+#: coarse solves, finest first; a float in checkpoints of before 2026-11-26: by two only)
 COARSE_CF = "coarse_friction_coefficient"
 
 
@@ -90,7 +91,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                                          previous=previous)
             if coarser:
                 res = replace(res, meta={**res.meta,
-                                         COARSE_CF: coarser[0].friction_coefficient,
+                                         COARSE_CF: [c.friction_coefficient for c in coarser],
                                          "seconds_coarse": coarser[0].meta["seconds"]})
             if path is not None:
                 res.save(path)
@@ -124,15 +125,24 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         iterations=get("iterations"),
         friction_error=None if errors is None else errors.pop("total"),
         friction_error_parts=errors,
-        coarse_friction_coefficient=get(COARSE_CF))
+        coarse_friction_coefficient=_levels([r[COARSE_CF] for r in records]))
 
 
 def _record(res: MixedResult) -> dict:
     """The numbers of a point the curve keeps (no fields)."""
     return {**{name: getattr(res, name) for name in (
         "friction_coefficient", "hydrodynamic_friction", "boundary_friction", "contact_load",
-        "h_d", "iterations")}, COARSE_CF: res.meta.get(COARSE_CF, np.nan),
+        "h_d", "iterations")}, COARSE_CF: np.atleast_1d(res.meta.get(COARSE_CF, np.nan)),
         "error_estimate": res.meta.get("error_estimate")}
+
+
+def _levels(rows) -> np.ndarray:
+    """C_f of each point on each coarsened grid as ``(levels, points)``, NaN where a point
+    has no such level (a failed coarse solve leaves it and the coarser ones out)."""
+    out = np.full((max(len(r) for r in rows), len(rows)), np.nan)
+    for j, r in enumerate(rows):
+        out[:len(r), j] = r
+    return out
 
 
 def sweep_key(gap, spacing, factors, load, lubricant, settings, face,
