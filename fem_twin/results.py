@@ -138,15 +138,17 @@ def fields_dataset(points, origin=(0.0, 0.0)):
 
 
 def write_netcdf(path, groups: dict, attrs: dict | None = None) -> Path:
-    """Datasets {group: Dataset} into one NetCDF-4 file, atomically (zlib-compressed); the
-    group None is the file's root."""
+    """Datasets {group: Dataset} into one NetCDF-4 file, atomically (zlib level 1 after a
+    byte shuffle, lossless: the paper case's fields.nc, 63 points at 256^2, in 5.5 s and
+    159 MB against 9.1 s and 183 MB at level 4 without the shuffle, 2026-11-26); the group
+    None is the file's root."""
     path = Path(path)
     with atomic_path(path) as tmp:
         mode = "w"
         for name, ds in groups.items():
             ds = ds.copy()
             ds.attrs.update(attrs or {})
-            enc = {v: {"zlib": True, "complevel": 4} for v in ds.data_vars}
+            enc = {v: {"zlib": True, "complevel": 1, "shuffle": True} for v in ds.data_vars}
             ds.to_netcdf(tmp, mode=mode, group=name, engine=ENGINE, encoding=enc)
             mode = "a"
     return path
