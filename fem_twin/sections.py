@@ -180,10 +180,10 @@ class RunSpec:
     patch_band: bool = setting(True, "one more sweep per patch: the roughness scatter band "
                                "(Figure 13)", unit="true or false")
     # "coarsest" from the paper case (2026-11-26, 6 patches, 32 speeds, against the band
-    # swept at 256^2): edges within 0.80 % C_f,b at 64^2 and 0.21 % at 128^2 on a band
-    # 45.9 % C_f,b wide; a 32-speed sweep 6.0 s at 64^2 against 18.4 s at 128^2 ("coarse")
+    # swept at 256^2): a patch's C_f within 0.45 % C_f,b at 64^2 and 0.14 % at 128^2 on a
+    # band 45.9 % C_f,b wide; a 32-speed sweep 6.0 s at 64^2 against 18.4 s at 128^2
     band_grid: str = setting("coarsest", "the band's macro grid, C_f corrected by the "
-                             "average curve's change to the full grid: \"coarsest\" (the "
+                             "average curve's relative change to the full grid: \"coarsest\" (the "
                              "main sweeps' coarsest nested grid, 48-95 px a side: 64^2 from "
                              '128^2 to 1024^2), "coarse" (every other node) or "full"',
                              unit="coarsest, coarse or full",

@@ -669,11 +669,11 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
 
     Issue 28 item 2: the band swept on the macro grid coarsened by two (the default
     [run] band_grid = "coarsest" is that grid below 96^2), each patch's C_f corrected by the
-    average curve's change to the full grid, against the band swept on the full grid.  The correction leaves the
-    difference of the patches' grid errors: on the bundled case (128^2 against 64^2) at
-    most 0.89 % C_f,b on a band up to 45.7 % C_f,b wide; here, at 48^2 against 24^2 (a
-    coarse grid of 24^2 nodes over the pin), 4.5 % of the band's width (0.0014 on 0.030,
-    2026-11-25); asserted below a tenth of it."""
+    average curve's relative change to the full grid, against the band swept on the full
+    grid.  On the bundled case (64^2 against 128^2) a patch's C_f is then within 0.31 %
+    C_f,b on a band up to 46.2 % C_f,b wide (docs/accuracy.md); here, at 24^2 against 48^2
+    (a coarse grid of 24^2 nodes over the pin), 2.9 % of the band's width (0.00072 on
+    0.025, 2026-11-26); asserted below a tenth of it."""
     from fem_twin.macro import MixedResult
     from fem_twin.results import open_run
     from fem_twin.stribeck.curve import HEADERS

@@ -144,7 +144,7 @@ def band_curves(case: Case, common: dict, curves, tasks, swept, executor=None,
     """The single-patch curves of the scatter band, one list per patch over the
     viscosities, from the curves ``swept`` of :func:`band_tasks`' ``tasks``, and the tasks
     (with any sweep added here).  Swept on a coarsened grid, they are corrected by the
-    main ``curves``' change to the full grid
+    main ``curves``' relative change to the full grid
     (:func:`~fem_twin.stribeck.analysis.defect_corrected`): the main sweeps' own points on
     that grid (their nested solves) give that change, or, where a point has none (a coarse
     solve that failed, checkpoints of an earlier version), the average factors are swept
