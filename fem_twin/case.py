@@ -102,15 +102,23 @@ class Case:
         macro = point * points * n_mu * (estimate + band) / max(1, min(cores, sweeps))
         return micro + macro
 
+    def band_coarsening(self, shape) -> int:
+        """Coarsenings by two of the band's grid below a macro grid of ``shape``
+        (``[run] band_grid``): none ("full"), one ("coarse"), or down to the main sweeps'
+        coarsest nested grid ("coarsest", at least one: 64^2 for the grids 128^2 to
+        1024^2)."""
+        from .macro.nested import nested_levels
+        return {"full": 0, "coarse": 1}.get(self.run.band_grid,
+                                            max(1, nested_levels(shape)))
+
     def _band_point_cost(self) -> float:
         """A band point in main-curve points, by ``[run] band_grid`` and the macro grid
         (``BAND_LEVEL_COST`` for each coarsening beyond the first)."""
-        from .macro.nested import nested_levels
         if self.run.band_grid != "coarsest":
             return BAND_POINT_COST[self.run.band_grid]
-        side = min(self.macro_geometry.resolution or (256, 256))
-        levels = 1 if self.tribometer.ball else max(1, nested_levels((side,)))
-        return BAND_POINT_COST["coarse"] * BAND_LEVEL_COST ** (levels - 1)
+        shape = ((self.macro.grid,) * 2 if self.tribometer.ball
+                 else self.macro_geometry.resolution or (256, 256))
+        return BAND_POINT_COST["coarse"] * BAND_LEVEL_COST ** (self.band_coarsening(shape) - 1)
 
 
 def load_case(path) -> Case:

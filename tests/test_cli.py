@@ -649,18 +649,17 @@ def test_the_band_grid_is_the_coarsest_nested_grid():
     "coarse" halves the grid once and "full" keeps it."""
     from dataclasses import replace
     from fem_twin.macro.nested import coarsened
-    from fem_twin.stages.curves import band_coarsening
     case = load_case(ROOT / "examples" / "paper.toml")
     assert case.run.band_grid == "coarsest"
     for side, levels in ((48, 1), (128, 1), (200, 2), (256, 2), (1024, 4)):
         gap = np.zeros((side, side))
-        assert band_coarsening(case, gap) == levels
+        assert case.band_coarsening(gap.shape) == levels
         for _ in range(levels):
             gap = coarsened(gap, (1.0, 1.0), None)[0]
         assert 48 <= gap.shape[0] < 96 or side < 96
     for grid, levels in (("coarse", 1), ("full", 0)):
         other = replace(case, run=replace(case.run, band_grid=grid))
-        assert band_coarsening(other, np.zeros((256, 256))) == levels
+        assert other.band_coarsening((256, 256)) == levels
 
 
 def test_results_as_data_and_the_patch_scatter_band(tmp_path):

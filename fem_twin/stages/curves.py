@@ -16,7 +16,7 @@ from tqdm import tqdm
 from ..case import Case
 from ..io.layout import RunLayout
 from ..macro import MacroSettings, MixedResult
-from ..macro.nested import coarsened, nested_levels
+from ..macro.nested import coarsened
 from ..macro.figures import plot_point_fields
 from ..macro.point_contact import film_against_hamrock_dowson
 from ..micro import FlowFactors
@@ -122,21 +122,14 @@ def refined_curves(case: Case, common: dict, executor=None, progress: bool = Tru
 
 def band_tasks(case: Case, out: RunLayout, common: dict) -> list:
     """The sweep tasks of the scatter band (``[run] patch_band``): one per patch and
-    viscosity, on the macro grid coarsened :func:`band_coarsening` times."""
+    viscosity, on the macro grid coarsened :meth:`~fem_twin.case.Case.band_coarsening`
+    times."""
     sweeps = band_sweeps(case, out, common) if case.run.patch_band else []
-    for _ in range(band_coarsening(case, common["gap"]) if sweeps else 0):
+    for _ in range(case.band_coarsening(np.shape(common["gap"])) if sweeps else 0):
         gap, spacing, face = coarsened(sweeps[0]["gap"], sweeps[0]["spacing"],
                                        sweeps[0]["face"])
         sweeps = [dict(kw, gap=gap, spacing=spacing, face=face) for kw in sweeps]
     return [(kw, lub) for kw in sweeps for lub in case.lubricant.lubricants()]
-
-
-def band_coarsening(case: Case, gap) -> int:
-    """Coarsenings by two of the band's grid (``[run] band_grid``): none ("full"), one
-    ("coarse"), or down to the main sweeps' coarsest nested grid ("coarsest", at least one:
-    64^2 for the grids 128^2 to 1024^2)."""
-    return {"full": 0, "coarse": 1}.get(case.run.band_grid,
-                                        max(1, nested_levels(np.shape(gap))))
 
 
 def band_curves(case: Case, common: dict, curves, tasks, swept, executor=None,
@@ -152,7 +145,7 @@ def band_curves(case: Case, common: dict, curves, tasks, swept, executor=None,
     n = len(case.lubricant.lubricants())
     swept = [c.with_load_share(case.tribometer.load_share) for c in swept]
     per_patch = [swept[i:i + n] for i in range(0, len(swept), n)]
-    level = band_coarsening(case, common["gap"])
+    level = case.band_coarsening(np.shape(common["gap"]))
     if not per_patch or level == 0:
         return per_patch, tasks
     coarse = [c.coarse_friction_coefficient for c in curves]
