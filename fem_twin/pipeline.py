@@ -21,6 +21,7 @@ from contextlib import contextmanager
 from .case import Case
 from .errors import InputError, RunLocked
 from .io.atomic import atomic_path
+from .io.figure import Figures
 from .io.layout import RunLayout
 from .stages.curves import stribeck_curves
 from .stages.factors import homogenise_patches
@@ -51,8 +52,11 @@ def run(case: Case, outdir, *, progress: bool = True, estimated_s: float | None 
     with (_lock(out), _logfile(out.log),
           executor_for(case.run.workers, case.run.scheduler) as executor):
         log.info("case %s -> %s", case.source, outdir)
+        figures = Figures(executor)         # drawn beside the stages that follow
         _run_stages(case, out, executor, progress, summary,
-                    ("stribeck", lambda: stribeck_curves(case, out, executor, progress)))
+                    ("stribeck", lambda: stribeck_curves(case, out, executor, progress,
+                                                         figures)), figures)
+        figures.wait()
     summary["wall_time_s"] = time.perf_counter() - t0
     if estimated_s is not None:
         summary["estimated_s"] = float(estimated_s)
@@ -62,13 +66,15 @@ def run(case: Case, outdir, *, progress: bool = True, estimated_s: float | None 
     return summary
 
 
-def _run_stages(case: Case, out: RunLayout, executor, progress, summary, last) -> None:
+def _run_stages(case: Case, out: RunLayout, executor, progress, summary, last,
+                figures: Figures | None = None) -> None:
     """The stages up to the flow factors, then ``last`` (name, callable), each timed and
-    logged into ``summary``."""
+    logged into ``summary``; the flow factors' figure on ``figures`` (else at once)."""
     invalidate_changed_stages(case, out)
     stages = (("geometry", lambda: reconstruct_geometry(case, out, progress)),
               ("levelling", lambda: level_pins(case, out, progress)),
-              ("micro", lambda: homogenise_patches(case, out, executor, progress)), last)
+              ("micro", lambda: homogenise_patches(case, out, executor, progress,
+                                                   figures=figures)), last)
     for name, stage in stages:
         t = time.perf_counter()
         log.info("stage %s", name)

@@ -105,3 +105,25 @@ def test_instrument_files_load_in_si_units(shared_topographies, name, shape, siz
     assert np.allclose(t.size, size, rtol=0.01)
     assert abs(t.rms_height() / sq - 1) < 0.02
     assert t.meta["reader"].endswith("Reader")
+
+
+def test_figures_are_drawn_on_worker_processes(tmp_path):
+    """fem_twin.io.figure.Figures: a figure writer runs on the executor's processes (the
+    arguments pickled, its interpolants left behind), the file is there after wait(), and
+    a writer's error reaches the caller at wait()."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from fem_twin.io.figure import Figures
+    from fem_twin.micro import FlowFactors
+    from fem_twin.micro.output import plot_flow_factors
+    factors = FlowFactors.smooth()
+    factors.contact_pressure(np.array([1e-6]))               # a cache that does not pickle
+    with ProcessPoolExecutor(1) as pool:
+        figures = Figures(pool)
+        figures.draw(plot_flow_factors, [factors], tmp_path / "ff.png")
+        figures.wait()
+        assert (tmp_path / "ff.png").stat().st_size > 1000
+        figures.draw(plot_flow_factors, ["not factors"], tmp_path / "bad.png")
+        with pytest.raises(AttributeError):
+            figures.wait()
+    assert not (tmp_path / "bad.png").exists() and figures.pending == []

@@ -189,6 +189,27 @@ def test_newton_coupling_reaches_the_same_state_on_the_pin(case32, factors, spee
     assert newton.contact_load == pytest.approx(fixed.contact_load, rel=1e-5, abs=1e-9)
 
 
+def test_a_singular_newton_matrix_is_a_non_convergence(case32, factors, monkeypatch):
+    """A singular pressure block of the Newton matrix (SuperLU's RuntimeError) ends the
+    Newton coupling with MixedNotConverged and its history (which the callers handle:
+    a sweep's nested levels, the band), not with an internal error."""
+    import pickle
+
+    from fem_twin.errors import MixedNotConverged
+    from fem_twin.macro import jacobian
+
+    def singular(*args, **kwargs):
+        raise RuntimeError("Factor is exactly singular")
+    gap, spacing, face = case32
+    kw = dict(load=150.0, face=face, lubricant=Lubricant(0.066),
+              settings=MacroSettings(coupling="newton"))
+    start = solve_mixed(gap, spacing, factors, speed=0.004, **kw)
+    monkeypatch.setattr(jacobian.spla, "splu", singular)
+    with pytest.raises(MixedNotConverged, match="singular") as err:
+        solve_mixed(gap, spacing, factors, speed=0.003, initial=start, **kw)
+    assert "singular" in str(pickle.loads(pickle.dumps(err.value)))
+
+
 def test_hersey_invariance_and_stribeck_limits(case32, factors):
     """Isoviscous: the state depends on mu_0 U only, so C_f is a function of the Hersey
     number (eq 46); C_f rises toward C_f,b at low speed and falls with speed when the film

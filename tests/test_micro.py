@@ -400,6 +400,10 @@ def test_interpolation_rules(small_factors):
     assert loc.p_con[1, 1] > ff.p_con[0] and np.allclose(loc.A[1, 1], ff.A[0])
     with pytest.raises(ValueError):
         ff.at([-1e-7])
+    import pickle                         # to a worker after use: the interpolants stay
+    back = pickle.loads(pickle.dumps(ff))
+    assert "_pchip" not in back.__dict__ and "_pchip" in ff.__dict__
+    assert np.array_equal(back.contact_pressure(field), ff.contact_pressure(field))
 
 
 def test_average_over_patches(small_factors):

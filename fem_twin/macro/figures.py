@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io.figure import save_figure
+from .result import MixedResult
 
 #: (field, colour-bar label, scale to the plotted unit)
 PANELS = (("pressure_gauge", "hydrodynamic pressure $p - p_{amb}$ [MPa]", 1e-6),
@@ -38,3 +39,13 @@ def plot_point_fields(results, path, titles=None) -> Path:
         title = titles[row] if titles else f"U = {res.speed:g} m/s"
         ax[row, 0].set_title(title, loc="left", fontsize="medium")
     return save_figure(fig, path, dpi=100)
+
+
+def plot_point_files(files, path, viscosity: float) -> Path:
+    """:func:`plot_point_fields` of the points checkpointed in ``files`` (one
+    :class:`MixedResult` each), titled with the viscosity ``viscosity`` [Pa s], the speed
+    and C_f: a figure a worker process draws from the files alone."""
+    results = [MixedResult.load(f) for f in files]
+    return plot_point_fields(results, path, titles=[
+        f"$\\mu_0$ = {viscosity:g} Pa s, U = {r.speed:.3g} m/s, "
+        f"$C_f$ = {r.friction_coefficient:.4f}" for r in results])

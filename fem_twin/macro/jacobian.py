@@ -16,6 +16,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..errors import SolverError
 from .cavitation import cavitation_model
 from .contact_load import contact_load
 from .evaluation import NewtonEvaluation
@@ -132,7 +133,10 @@ class Preconditioner:
         O = np.setdiff1d(np.arange(nI), sI)
         self.O = O
         J = J_pp.tocsr()
-        self.lu = spla.splu(J[O][:, O].tocsc())
+        try:
+            self.lu = spla.splu(J[O][:, O].tocsc())
+        except RuntimeError as err:                   # SuperLU: "Factor is exactly singular"
+            raise SolverError(f"the Newton matrix of the pressures is singular: {err}") from err
         if sI.size == 0:
             return
         JOS = J[O][:, sI]

@@ -23,7 +23,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import MixedNotConverged
+from ..errors import MixedNotConverged, SolverError
 from .cavitation import cavitation_model
 from .couette import couette, couette_matrix
 from .evaluation import NewtonEvaluation
@@ -98,15 +98,19 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
     for it in range(1, max_iter + 1):
         sizes = scales(ev, s, load)
         f = merit(ev, sizes)
-        step, gm, pre = newton_step(P, ev, load, pre=pre, rtol=min(1e-3, max(1e-8, 0.1 * f)))
-        if gm > REBUILD_AFTER:
-            pre = None
-        trial, ev_t, f_t, alpha, downhill = line_search(P, x, ev, step, load, sizes, f)
-        short = short + 1 if alpha < SHORT_STEP else 0
-        if not downhill or short >= STALL:
-            # no decrease, or steps so short that the iteration stalls at a kink
-            trial, ev_t, f_t, alpha = clamped_step(P, x, step[0], load, sizes)
-            downhill, short = f_t < f, 0
+        try:
+            step, gm, pre = newton_step(P, ev, load, pre=pre,
+                                        rtol=min(1e-3, max(1e-8, 0.1 * f)))
+            if gm > REBUILD_AFTER:
+                pre = None
+            trial, ev_t, f_t, alpha, downhill = line_search(P, x, ev, step, load, sizes, f)
+            short = short + 1 if alpha < SHORT_STEP else 0
+            if not downhill or short >= STALL:
+                # no decrease, or steps so short that the iteration stalls at a kink
+                trial, ev_t, f_t, alpha = clamped_step(P, x, step[0], load, sizes)
+                downhill, short = f_t < f, 0
+        except (SolverError, ValueError) as err:      # a singular matrix, NaN in a step
+            raise MixedNotConverged(f"Newton coupling, iteration {it}: {err}", history) from err
         uphill = 0 if downhill else uphill + 1
         if uphill > WATCHDOG or not np.isfinite(f_t):
             raise MixedNotConverged(f"Newton coupling: the residual did not decrease in "

@@ -192,6 +192,11 @@ class FlowFactors:
             values[below] = np.maximum(v[0] + slope * (flat[below] - self.h0[0]), floor)
         return values
 
+    def __getstate__(self):
+        """Pickled without the interpolants (a cache, rebuilt on first use): the factors
+        go to worker processes after the main process has read them."""
+        return {k: v for k, v in self.__dict__.items() if k != "_pchip"}
+
     def _interpolant(self, name):
         """The interpolant of ``name`` in ``log h0`` (see :meth:`at`)."""
         cache = self.__dict__.setdefault("_pchip", {})

@@ -14,17 +14,18 @@ import numpy as np
 from tqdm import tqdm
 
 from ..case import Case
+from ..io.figure import Figures
 from ..io.layout import RunLayout
 from ..macro import MacroSettings, MixedResult
 from ..macro.nested import coarsened
-from ..macro.figures import plot_point_fields
+from ..macro.figures import plot_point_files
 from ..macro.point_contact import film_against_hamrock_dowson
 from ..micro import FlowFactors
 from ..stribeck import plot_stribeck, read_measured_csv, stribeck_sweep, write_stribeck_csv
 from ..stribeck.accuracy import error_summary, range_summary
 from ..stribeck.analysis import (defect_corrected, hersey_collapse, patch_band,
                                  transition_speeds)
-from ..stribeck.sweep import point_files, point_key, sweep_key
+from ..stribeck.sweep import point_files, point_key, point_speed, sweep_key
 from ..stribeck.validation import validate_curves
 from ..threads import worker_heap
 from .geometry import ball_contact, face_load, hersey_length, macro_geometry
@@ -48,10 +49,15 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
     return settings
 
 
-def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = True) -> dict:
+def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = True,
+                    figures: Figures | None = None) -> dict:
     """One Stribeck sweep per viscosity (in parallel on ``executor``), refined where the
     curve turns, and the patch scatter band (``[run] patch_band``); CSV, plots, fields,
-    ``results.nc`` and ``fields.nc``.  Returns the stage's summary."""
+    ``results.nc`` and ``fields.nc``.  Returns the stage's summary.  The figures are drawn
+    on ``figures`` (the caller waits for them), or on the executor's workers beside the
+    result files and waited for here."""
+    own = figures is None
+    figures = Figures(executor) if own else figures
     gap, spacing, face, origin = macro_geometry(case, out)
     tr = case.tribometer
     ball = dict(slide_to_roll=tr.slide_to_roll) if tr.ball else {}
@@ -70,10 +76,10 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     _prune_points(common["checkpoint"], tasks + patch_tasks)
     write_stribeck_csv(out.stribeck_csv, curves, band)
     summary = _summary(case, out, curves, band)
-    plot_curves(case, curves, band, out)
+    plot_curves(case, curves, band, out, figures)
+    _plot_fields(out, common["checkpoint"], tasks, figures)
     points = sweep_points(common["checkpoint"], tasks)
     summary["h0_range"] = _range_check(common, points, patch_tasks)
-    _plot_fields(out, points, case.lubricant.viscosities)
     _log_points(curves)
     if len(curves) > 1:
         summary["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, tr.boundary_friction)
@@ -84,6 +90,8 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
             curves, case.measured, tr.boundary_friction, curve_labels(case, curves),
             out.validation_csv, out.validation_png)
     write_run_results(case, out, curves, patch_curves, points, origin)
+    if own:
+        figures.wait()
     return summary
 
 
@@ -195,14 +203,14 @@ def _labelled(points: dict, factors: str):
             for (mu, u), res in points.items())
 
 
-def _plot_fields(out: RunLayout, points, viscosities) -> None:
-    """The fields of the fastest, a middle and the slowest point of each curve."""
-    for mu in viscosities:
-        u = sorted((v for m, v in points if m == mu), reverse=True)      # fast to slow
-        res = [points[mu, u[i]] for i in sorted({0, len(u) // 2, len(u) - 1})]
-        plot_point_fields(res, out.fields_png(mu), titles=[
-            f"$\\mu_0$ = {mu:g} Pa s, U = {r.speed:.3g} m/s, "
-            f"$C_f$ = {r.friction_coefficient:.4f}" for r in res])
+def _plot_fields(out: RunLayout, folder: Path, tasks, figures: Figures) -> None:
+    """The fields of the fastest, a middle and the slowest point of each main sweep
+    ``tasks``, from their checkpoints in ``folder``."""
+    for kw, lub in tasks:
+        files = sorted(point_files(folder, _sweep_key(kw, lub)), key=point_speed,
+                       reverse=True)                                     # fast to slow
+        chosen = [files[i] for i in sorted({0, len(files) // 2, len(files) - 1})]
+        figures.draw(plot_point_files, chosen, out.fields_png(lub.viscosity), lub.viscosity)
 
 
 def _log_points(curves) -> None:
@@ -242,18 +250,21 @@ def ehl_film(case: Case, points) -> dict:
     return film
 
 
-def plot_curves(case: Case, curves, band, out: RunLayout) -> None:
-    """C_f versus speed and versus Hersey number, with the band and measured curves."""
+def plot_curves(case: Case, curves, band, out: RunLayout,
+                figures: Figures | None = None) -> None:
+    """C_f versus speed and versus Hersey number, with the band and measured curves (on
+    ``figures``, else at once)."""
+    figures = figures or Figures()
     measured = [read_measured_csv(m) if m is not None else None for m in case.measured]
     measured += [None] * (len(curves) - len(measured))
     tr = case.tribometer
     for x in ("speed", "hersey"):
-        plot_stribeck(curves, out.stribeck_png(x), x=x,
-                      labels=curve_labels(case, curves), boundary=tr.boundary_friction,
-                      bands=band, measured=measured, diameter=hersey_length(case),
-                      load=tr.load, speed_label=("entrainment speed $u_m$ [m/s], SRR "
-                                                 f"{tr.slide_to_roll:g}" if tr.ball else
-                                                 "sliding speed $U$ [m/s]"))
+        figures.draw(plot_stribeck, curves, out.stribeck_png(x), x=x,
+                     labels=curve_labels(case, curves), boundary=tr.boundary_friction,
+                     bands=band, measured=measured, diameter=hersey_length(case),
+                     load=tr.load, speed_label=("entrainment speed $u_m$ [m/s], SRR "
+                                                f"{tr.slide_to_roll:g}" if tr.ball else
+                                                "sliding speed $U$ [m/s]"))
 
 
 def sweep_points(folder: Path, tasks) -> dict:

@@ -13,6 +13,7 @@ from tqdm import tqdm
 
 from ..case import Case
 from ..io.checkpoint import load_or_none
+from ..io.figure import Figures
 from ..io.files import read_topography
 from ..io.layout import RunLayout
 from ..micro import CellSettings, FlowFactors, average, homogenise
@@ -24,12 +25,13 @@ log = logging.getLogger("fem_twin")
 
 
 def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool = True,
-                       h0=None):
+                       h0=None, figures: Figures | None = None):
     """Flow factors of every patch pair (checkpointed per h0) and their average (``h0``:
     the case's range unless given).  With an executor the patches run side by side (a
     thread each hands its h0 tasks to the shared pool), so the pool is not left idle at
     the end of a patch or of a round of adaptive h0, and a cluster gets every patch's
-    tasks at once."""
+    tasks at once.  The figure is drawn on ``figures`` (the caller waits for it), else at
+    once."""
     out.micro.mkdir(parents=True, exist_ok=True)
     mc = case.micro
     h0 = np.geomspace(mc.h0_min, mc.h0_max, mc.h0_count) if h0 is None else np.asarray(h0)
@@ -48,8 +50,9 @@ def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool
     mean = average(factors)
     mean.save(out.flow_factors)
     mean.write_csv(out.flow_factors_csv)
-    plot_flow_factors([*factors, mean], out.flow_factors_png,
-                      labels=[f"patch {i + 1}" for i in range(len(factors))] + ["average"])
+    (figures or Figures()).draw(
+        plot_flow_factors, [*factors, mean], out.flow_factors_png,
+        labels=[f"patch {i + 1}" for i in range(len(factors))] + ["average"])
     estimate = mean.meta.get("error_estimate", {})
     return {"patches": len(factors), "h0_m": [float(h0[0]), float(h0[-1]), len(h0)],
             "h0_solved": [len(f) for f in factors], "h0_tol": mc.h0_tol,

@@ -39,6 +39,11 @@ def point_key(path) -> str:
     return Path(path).name.split("_")[1]
 
 
+def point_speed(path) -> float:
+    """The sweep speed [m/s] in the name of a point checkpoint (:func:`point_file`)."""
+    return float(Path(path).stem.rsplit("_", 1)[1])
+
+
 @one_thread
 def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    lubricant: Lubricant, diameter: float = 8e-3, face=None,
