@@ -9,8 +9,10 @@ the same pattern; the factorisation is 85 % of the roughness-scale time.  Two ba
 ``"pardiso"``
     MKL PARDISO, sparse Cholesky (matrix type 2) through ``ctypes``: the METIS ordering and
     symbolic analysis run once per pattern (phase 11), each new matrix only repeats the
-    numeric factorisation (phase 22).  About 3x faster than SuperLU on a 256^2 cell
-    (``benchmarks/run.py micro``).  Needs ``libmkl_rt`` from the ``mkl`` wheel, which
+    numeric factorisation (phase 22), by the two-level algorithm (``iparm[23] = 1``: the
+    cell Cholesky in 0.60-0.78x the time from 64^2 to 256^2, the macro Newton LU in
+    0.77-0.92x, sequential MKL 2026.2, 2026-11-26).  About 3x faster than SuperLU on a
+    256^2 cell (``benchmarks/run.py micro``).  Needs ``libmkl_rt`` from the ``mkl`` wheel, which
     ``pip install "fem-twin[pardiso]"`` installs; MKL is under the Intel Simplified Software
     License, so it stays an optional extra, not a core dependency.  MKL runs sequentially
     (``MKL_THREADING_LAYER=SEQUENTIAL``): parallel speed comes from processes.
@@ -72,8 +74,9 @@ class SPDSolver:
     more right-hand sides (columns).  ``symmetric=False``: general square matrices (LU;
     PARDISO matrix type 11 with pivot perturbation, whose count after ``factor`` is
     ``perturbed``: a caller that needs an exact step checks it).  ``single=True`` (PARDISO
-    only): the factors in single precision, half the memory and about 1.3x faster to
-    compute (667k unknowns of the 3x3 stencil: 0.97 against 1.28 GiB); ``solve`` is then
+    only): the factors in single precision, half the memory (667k unknowns of the 3x3
+    stencil: 0.97 against 1.28 GiB), not always faster (2026-11-26, one Xeon: 1.2-1.5x
+    slower to 256^2, level at 512^2; on another machine 1.3x faster); ``solve`` is then
     accurate to about 1e-5 relative and the caller refines.  ``release()`` frees the
     factors and keeps the analysis.
     """
@@ -173,6 +176,7 @@ class SPDSolver:
         lib = _mkl_rt()
         iparm = np.zeros(64, dtype=np.int32)
         iparm[[0, 1, 9, 34]] = 1, 2, 8, 1           # own settings, METIS, eps 1e-8, 0-based
+        iparm[23] = 1                               # the two-level factorisation
         iparm[27] = self.dtype == np.float32        # single precision arrays and factors
         if not self.symmetric:
             iparm[9] = 13                            # pivot perturbation 1e-13

@@ -3,11 +3,13 @@
 The Newton matrix ``J = K diag(pos) + B diag(dtheta)`` of the interior lives on a pattern
 fixed per grid: PARDISO's ordering and symbolic factorisation are computed once per grid,
 and where each entry of ``K`` and ``B`` lands in that pattern once per sparsity pattern
-of theirs, so a step costs one numeric factorisation and two solves (the kept maps made a
-bundled-case sweep 12 % faster).  The factors are single precision, refined with the
-residual in double precision (one refinement step reaches ``STEP_RTOL`` on the
-equilibrated matrix; 512^2 scale point: 0.85x the time and 0.87x the peak memory of double
-precision, C_f the same to 2e-14).  The factors are freed after each step: they are never
+of theirs, so a step costs one numeric factorisation and a solve (the kept maps made a
+bundled-case sweep 12 % faster).  On grids of more than ``SINGLE_UNKNOWNS`` unknowns the
+factors are single precision, refined with the residual in double precision (one
+refinement step reaches ``STEP_RTOL`` on the equilibrated matrix; half the factors' memory:
+2.06 GiB at 2048^2); below, where memory is no concern, double precision factorises in
+0.64-0.87x the time (real Newton matrices of 3k-53k unknowns, 2026-11-26; level at 214k)
+and needs no refinement.  The factors are freed after each step: they are never
 reused, and at 2048^2 (2.06 GiB) the evaluation between steps no longer stacks on them.  A
 step is returned only when it solves ``J x = rhs`` to ``STEP_RTOL``.
 
@@ -32,9 +34,11 @@ STEP_RTOL = 1e-8
 #: iterative refinement steps (residual in double precision) with the single-precision
 #: factors; each gains about five digits
 REFINEMENTS = 4
-#: the largest entry of the equilibrated matrix a single-precision factorisation takes
+#: the largest entry of the equilibrated matrix a factorisation takes
 #: (float32 overflows at 3.4e38; beyond this the step goes to SuperLU in double precision)
 SINGLE_MAX = 1e30
+#: grids of more unknowns factorise in single precision (memory: 2048^2 has 3.4M)
+SINGLE_UNKNOWNS = 1 << 20
 #: grids whose patterns and PARDISO analyses are kept (a sweep with error estimates
 #: alternates between the grid and its coarsening) ...
 GRIDS = 3
@@ -78,7 +82,7 @@ class _Grid:
         self.diagonal = np.flatnonzero(np.repeat(np.arange(self.n), self.counts)
                                        == self.indices)
         self.solver = SPDSolver(self.indptr, self.indices, "pardiso", symmetric=False,
-                                single=True)
+                                single=self.n > SINGLE_UNKNOWNS)
         self._maps = []                       # [(digest, at, keep)]
 
     def locate(self, M):
@@ -119,15 +123,16 @@ class _Grid:
         is equilibrated first, ``S J S`` with ``S`` the inverse square root of its diagonal:
         PARDISO's pivot threshold is absolute, and the film's ``h^3`` spans 1e9 over a pin
         face (a 20 nm film beside the 40 um edge).  ``J`` is built twice, so that no double
-        precision copy of it is alive during the factorisation (0.25 GB at 2048^2)."""
+        precision copy of it is alive during the factorisation (0.25 GB at 2048^2); it is
+        scaled straight into the factors' precision."""
         data = values()
         d = np.abs(data[self.diagonal])
         scale = 1 / np.sqrt(np.where(d > 0, d, max(float(d.max()), 1e-300)))
-        scale32 = scale.astype(np.float32)
+        own = scale.astype(self.solver.dtype)
         with np.errstate(over="ignore", invalid="ignore"):
-            scaled = np.repeat(scale32, self.counts)      # single precision, the factors'
-            scaled *= data                                # own: no double copy alive
-            scaled *= scale32[self.indices]
+            scaled = np.repeat(own, self.counts)          # the factors' precision: no
+            scaled *= data                                # second double copy alive
+            scaled *= own[self.indices]
         del data
         if not np.abs(scaled).max() < SINGLE_MAX:         # inf or nan too
             return None                       # beyond single precision: the general path
