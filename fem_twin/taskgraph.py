@@ -9,7 +9,8 @@ A run's independent work is a graph of tasks, each timed as it ran:
 * the macro scale, after every patch: one sweep per viscosity over the case's speeds (a
   chain of warm-started points: one task, the sum of its points' solve, nested coarse solve
   and error-estimate seconds), the refinement's added speeds of each (after all first
-  passes), and the patch band's sweeps (beside the refinement).
+  passes), and the patch band's sweeps (after the refinement: they start from the main
+  points' nested solves on their grid).
 
 The rounds are replayed from the checkpoints (the sampler is deterministic), so the graph
 of any finished run can be read back.  :func:`makespan` schedules the graph greedily on
@@ -37,7 +38,7 @@ from .micro import FlowFactors
 from .micro.sampling import adaptive_separations
 from .micro.sliding import factors_from_moments
 from .micro.store import load_point
-from .stribeck.sweep import point_files, point_key
+from .stribeck.sweep import LEVEL_OF, point_files, point_key
 
 
 @dataclass(frozen=True)
@@ -106,13 +107,15 @@ def _seconds(moments) -> float:
 
 
 def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task]:
-    """The sweeps of the macro scale: first passes, then the refinements with the band's
-    beside them (beside the first passes without refinement)."""
+    """The sweeps of the macro scale: first passes, then the refinements, then the band's
+    (the nested levels the main points kept for the band are part of those points)."""
     first = np.asarray(case.sweep.speeds, float)
     sweeps = defaultdict(list)
     for path in point_files(out.points):
         with np.load(path) as data:
             meta, scalars = json.loads(str(data["meta"])), json.loads(str(data["scalars"]))
+        if LEVEL_OF in meta:
+            continue
         speed = meta.get("entrainment") if case.tribometer.ball else scalars["speed"]
         seconds = sum(meta.get(k, 0.0) for k in ("seconds", "seconds_coarse",
                                                    "seconds_estimate"))
@@ -126,7 +129,7 @@ def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task
     passes = [Task(f"sweep {key}", s[0], micro) for key, s in split.items()]
     refined = [Task(f"refinement {key}", s[1], tuple(t.name for t in passes))
                for key, s in split.items()]
-    band_after = tuple(t.name for t in passes) if case.sweep.refine else micro
+    band_after = tuple(t.name for t in (refined if case.sweep.refine else passes))
     return passes + refined + [Task(f"band sweep {key}", sum(s for _, s, _ in v), band_after)
                                for key, v in sweeps.items() if key not in main]
 

@@ -65,13 +65,14 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
                   speeds=case.sweep.speeds, load=face_load(case), diameter=hersey_length(case),
                   face=face, **ball, settings=macro_settings(case), checkpoint=out.points,
                   fields=out.fields, origin=origin, factors_key=stage_keys(case)["micro"])
-    band_at = lambda speeds: band_tasks(case, out, dict(common, speeds=speeds))  # noqa: E731
-    curves, speeds, (band_sweeps_run, swept) = refined_curves(
-        case, common, executor, progress, beside=band_at)
+    curves, speeds = refined_curves(case, common, executor, progress)
     tasks = [(dict(common, speeds=speeds, error_estimate=True), lub)
              for lub in case.lubricant.lubricants()]
-    patch_curves, patch_tasks = band_curves(case, dict(common, speeds=speeds), curves,
-                                            band_sweeps_run, swept, executor, progress)
+    band_run = band_tasks(case, out, dict(common, speeds=speeds))
+    patch_curves, patch_tasks = band_curves(
+        case, dict(common, speeds=speeds), curves, band_run,
+        run_sweeps(band_run, executor, progress, desc="patch band points"), executor,
+        progress)
     band = patch_band(patch_curves) if patch_curves else None
     _prune_points(common["checkpoint"], tasks + patch_tasks)
     write_stribeck_csv(out.stribeck_csv, curves, band)
@@ -95,49 +96,47 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     return summary
 
 
-def refined_curves(case: Case, common: dict, executor=None, progress: bool = True,
-                   beside=lambda speeds: []):
+def refined_curves(case: Case, common: dict, executor=None, progress: bool = True):
     """The main curves (with their C_f error estimates) over the case's speeds, then
-    ``[sweep] refine`` passes adding the midpoints where C_f jumps; ``(curves, speeds,
-    (others, their_curves))``.  ``beside(speeds)``: more sweep tasks (the patch band) that
-    run on the executor beside the final pass, so that no worker waits for the last main
-    sweep; ``others`` are those tasks, made once."""
+    ``[sweep] refine`` passes adding the midpoints where C_f jumps; ``(curves, speeds)``.
+    With the patch band on, each point also keeps its solve on the band's grid
+    (``keep_level``), which the band's sweeps start from."""
     tr, step = case.tribometer, case.sweep.refine_step * case.tribometer.boundary_friction
     lubricants = case.lubricant.lubricants()
     speeds = case.sweep.speeds
+    keep = case.band_coarsening(np.shape(common["gap"])) if case.run.patch_band else 0
 
-    def sweeps(final):            # the fields (VTU) and the other tasks with the final pass
-        tasks = [(dict(common, speeds=speeds, error_estimate=True,
+    def sweeps(final):                                    # the fields with the final pass
+        tasks = [(dict(common, speeds=speeds, error_estimate=True, keep_level=keep,
                        fields=common["fields"] if final else None), lub) for lub in lubricants]
-        more = beside(speeds) if final else []
-        swept = run_sweeps(tasks + more, executor, progress)
-        return ([c.with_load_share(tr.load_share) for c in swept[:len(tasks)]],
-                (more, swept[len(tasks):]))
+        return [c.with_load_share(tr.load_share) for c in run_sweeps(tasks, executor, progress)]
 
     for level in range(case.sweep.refine + 1):
         final = level == case.sweep.refine
-        curves, others = sweeps(final)
+        curves = sweeps(final)
         extra = transition_speeds(curves, step)
         if final or extra.size == 0:
             break
         log.info("sweep refinement %d: %d speeds added where C_f changes by more than "
                  "%.3g", level + 1, extra.size, step)
         speeds = np.unique(np.r_[speeds, extra])[::-1]
-    if not final:                 # every main point checkpointed: the fields, the others
-        curves, others = sweeps(True)
-    return curves, speeds, others
+    if not final:                          # every main point checkpointed: the fields
+        curves = sweeps(True)
+    return curves, speeds
 
 
 def band_tasks(case: Case, out: RunLayout, common: dict) -> list:
     """The sweep tasks of the scatter band (``[run] patch_band``): one per patch and
     viscosity, on the macro grid coarsened :meth:`~fem_twin.case.Case.band_coarsening`
-    times."""
+    times, each guided by the average factors' points on that grid (the main sweeps'
+    nested level, ``keep_level``; :func:`~fem_twin.stribeck.sweep.stribeck_sweep`)."""
     sweeps = band_sweeps(case, out, common) if case.run.patch_band else []
     for _ in range(case.band_coarsening(np.shape(common["gap"])) if sweeps else 0):
         gap, spacing, face = coarsened(sweeps[0]["gap"], sweeps[0]["spacing"],
                                        sweeps[0]["face"])
         sweeps = [dict(kw, gap=gap, spacing=spacing, face=face) for kw in sweeps]
-    return [(kw, lub) for kw in sweeps for lub in case.lubricant.lubricants()]
+    return [(dict(kw, guide=_sweep_key(dict(kw, factors_key=common["factors_key"]), lub)), lub)
+            for kw in sweeps for lub in case.lubricant.lubricants()]
 
 
 def band_curves(case: Case, common: dict, curves, tasks, swept, executor=None,
@@ -331,8 +330,8 @@ def _sweep_key(kwargs: dict, lubricant) -> str:
 
 
 def _prune_points(folder: Path, tasks) -> None:
-    """Remove the Stribeck checkpoints of no current sweep (changed inputs)."""
-    keys = {_sweep_key(kw, lub) for kw, lub in tasks}
+    """Remove the Stribeck checkpoints of no current sweep or guide (changed inputs)."""
+    keys = {_sweep_key(kw, lub) for kw, lub in tasks} | {kw.get("guide") for kw, _ in tasks}
     stale = [p for p in point_files(folder) if point_key(p) not in keys]
     for p in stale:
         p.unlink()
