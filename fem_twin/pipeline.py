@@ -71,8 +71,8 @@ def _run_stages(case: Case, out: RunLayout, executor, progress, summary, last,
     """The stages up to the flow factors, then ``last`` (name, callable), each timed and
     logged into ``summary``; the flow factors' figure on ``figures`` (else at once)."""
     invalidate_changed_stages(case, out)
-    stages = (("geometry", lambda: reconstruct_geometry(case, out, progress)),
-              ("levelling", lambda: level_pins(case, out, progress)),
+    stages = (("geometry", lambda: reconstruct_geometry(case, out, progress, executor)),
+              ("levelling", lambda: level_pins(case, out, progress, executor)),
               ("micro", lambda: homogenise_patches(case, out, executor, progress,
                                                    figures=figures)), last)
     for name, stage in stages:

@@ -73,6 +73,16 @@ def quiet_worker() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+def run_jobs(executor, job, items):
+    """``job(item)`` for each of ``items``, yielded in order: on the workers of ``executor``
+    (all submitted at once; ``job`` and the items pickle), or here one by one without one."""
+    if executor is None:
+        yield from map(job, items)
+        return
+    for future in [executor.submit(job, item) for item in items]:
+        yield future.result()
+
+
 def process_pool(workers: int) -> ProcessPoolExecutor:
     """A local pool of ``workers`` processes started by :func:`quiet_worker`."""
     return ProcessPoolExecutor(workers, initializer=quiet_worker)
