@@ -21,7 +21,7 @@ from contextlib import contextmanager
 from .case import Case
 from .errors import InputError, RunLocked
 from .io.atomic import atomic_path
-from .io.figure import Figures
+from .io.writers import Writers
 from .io.layout import RunLayout
 from .stages.curves import stribeck_curves
 from .stages.factors import homogenise_patches
@@ -52,29 +52,30 @@ def run(case: Case, outdir, *, progress: bool = True, estimated_s: float | None 
     with (_lock(out), _logfile(out.log),
           executor_for(case.run.workers, case.run.scheduler) as executor):
         log.info("case %s -> %s", case.source, outdir)
-        figures = Figures(executor)         # drawn beside the stages that follow
+        writers = Writers(executor)         # files written beside the stages that follow
         _run_stages(case, out, executor, progress, summary,
                     ("stribeck", lambda: stribeck_curves(case, out, executor, progress,
-                                                         figures)), figures)
-        figures.wait()
+                                                         writers)), writers)
+        graph = None if executor is None else executor.submit(_task_graph, case, out)
+        writers.wait()
+        summary["task_graph"] = _task_graph(case, out) if graph is None else graph.result()
     summary["wall_time_s"] = time.perf_counter() - t0
     if estimated_s is not None:
         summary["estimated_s"] = float(estimated_s)
-    summary["task_graph"] = _task_graph(case, out)
     with atomic_path(out.summary) as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     return summary
 
 
 def _run_stages(case: Case, out: RunLayout, executor, progress, summary, last,
-                figures: Figures | None = None) -> None:
+                writers: Writers | None = None) -> None:
     """The stages up to the flow factors, then ``last`` (name, callable), each timed and
-    logged into ``summary``; the flow factors' figure on ``figures`` (else at once)."""
+    logged into ``summary``; the flow factors' figure on ``writers`` (else at once)."""
     invalidate_changed_stages(case, out)
     stages = (("geometry", lambda: reconstruct_geometry(case, out, progress, executor)),
               ("levelling", lambda: level_pins(case, out, progress, executor)),
               ("micro", lambda: homogenise_patches(case, out, executor, progress,
-                                                   figures=figures)), last)
+                                                   writers=writers)), last)
     for name, stage in stages:
         t = time.perf_counter()
         log.info("stage %s", name)
@@ -110,7 +111,8 @@ def traction(case: Case, outdir, entrainment: float, ratios, *, progress: bool =
 
 def _task_graph(case: Case, out: RunLayout) -> dict:
     """The run's task graph and its wall time on more workers
-    (:func:`fem_twin.taskgraph.scaling`); an empty dict, logged, if it cannot be read."""
+    (:func:`fem_twin.taskgraph.scaling`; on a worker beside the last files, 1.5 s of the
+    bundled case); an empty dict, logged, if it cannot be read."""
     from .taskgraph import scaling
     try:
         return scaling(case, out.root)

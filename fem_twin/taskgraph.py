@@ -25,7 +25,6 @@ more of it).
 from __future__ import annotations
 
 import heapq
-import json
 from collections import defaultdict
 from dataclasses import dataclass
 
@@ -38,7 +37,7 @@ from .micro import FlowFactors
 from .micro.sampling import adaptive_separations
 from .micro.sliding import factors_from_moments
 from .micro.store import load_point
-from .stribeck.sweep import LEVEL_OF, point_files, point_key
+from .stribeck.sweep import LEVEL_OF, point_files, point_key, point_meta
 
 
 @dataclass(frozen=True)
@@ -112,8 +111,7 @@ def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task
     first = np.asarray(case.sweep.speeds, float)
     sweeps = defaultdict(list)
     for path in point_files(out.points):
-        with np.load(path) as data:
-            meta, scalars = json.loads(str(data["meta"])), json.loads(str(data["scalars"]))
+        scalars, meta = point_meta(path)
         if LEVEL_OF in meta:
             continue
         speed = meta.get("entrainment") if case.tribometer.ball else scalars["speed"]

@@ -153,11 +153,16 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
     # every node below (h0_min 1 m) the share is the point's whole contact load
     assert summary["stages"]["stribeck"]["h0_range"]["max_load_share_below"] < 0.01
     from fem_twin.macro import MixedResult
+    from fem_twin.micro import FlowFactors
     from fem_twin.stribeck.accuracy import range_summary
-    point = max((MixedResult.load(p) for p in (ref / "stribeck" / "checkpoints").iterdir()),
-                key=lambda r: r.contact_load)
+    from fem_twin.stribeck.sweep import LOAD_BELOW, point_meta
+    path = max((ref / "stribeck" / "checkpoints").iterdir(),
+               key=lambda p: MixedResult.load(p).contact_load)
+    point = MixedResult.load(path)
     assert point.contact_load > 0.3 * point.normal_load
-    below = range_summary([("the slowest", point)], 1.0)
+    h0_min = FlowFactors.load(RunLayout(ref).flow_factors).h0[0]
+    assert point_meta(path)[1][LOAD_BELOW] == point.contact_load_below(h0_min)
+    below = range_summary([(point.contact_load_below(1.0), "the slowest")], 1.0)
     assert below["points_above"] == 1
     assert below["max_load_share_below"] == pytest.approx(
         point.contact_load / point.normal_load, rel=1e-9)

@@ -107,23 +107,23 @@ def test_instrument_files_load_in_si_units(shared_topographies, name, shape, siz
     assert t.meta["reader"].endswith("Reader")
 
 
-def test_figures_are_drawn_on_worker_processes(tmp_path):
-    """fem_twin.io.figure.Figures: a figure writer runs on the executor's processes (the
+def test_files_are_written_on_worker_processes(tmp_path):
+    """fem_twin.io.writers.Writers: a file writer (a figure) runs on the executor's processes (the
     arguments pickled, its interpolants left behind), the file is there after wait(), and
     a writer's error reaches the caller at wait()."""
     from concurrent.futures import ProcessPoolExecutor
 
-    from fem_twin.io.figure import Figures
+    from fem_twin.io.writers import Writers
     from fem_twin.micro import FlowFactors
     from fem_twin.micro.output import plot_flow_factors
     factors = FlowFactors.smooth()
     factors.contact_pressure(np.array([1e-6]))               # a cache that does not pickle
     with ProcessPoolExecutor(1) as pool:
-        figures = Figures(pool)
-        figures.draw(plot_flow_factors, [factors], tmp_path / "ff.png")
-        figures.wait()
+        writers = Writers(pool)
+        writers.write(plot_flow_factors, [factors], tmp_path / "ff.png")
+        writers.wait()
         assert (tmp_path / "ff.png").stat().st_size > 1000
-        figures.draw(plot_flow_factors, ["not factors"], tmp_path / "bad.png")
+        writers.write(plot_flow_factors, ["not factors"], tmp_path / "bad.png")
         with pytest.raises(AttributeError):
-            figures.wait()
-    assert not (tmp_path / "bad.png").exists() and figures.pending == []
+            writers.wait()
+    assert not (tmp_path / "bad.png").exists() and writers.pending == []

@@ -14,7 +14,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ..case import Case
-from ..io.figure import Figures
+from ..io.writers import Writers
 from ..io.layout import RunLayout
 from ..macro import MacroSettings, MixedResult
 from ..macro.nested import coarsened
@@ -25,7 +25,8 @@ from ..stribeck import plot_stribeck, read_measured_csv, stribeck_sweep, write_s
 from ..stribeck.accuracy import error_summary, range_summary
 from ..stribeck.analysis import (defect_corrected, hersey_collapse, patch_band,
                                  transition_speeds)
-from ..stribeck.sweep import point_files, point_key, point_speed, sweep_key
+from ..stribeck.sweep import (LOAD_BELOW, point_files, point_key, point_meta, point_speed,
+                              sweep_key)
 from ..stribeck.validation import validate_curves
 from ..threads import worker_heap
 from .geometry import ball_contact, face_load, hersey_length, macro_geometry
@@ -50,14 +51,14 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
 
 
 def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = True,
-                    figures: Figures | None = None) -> dict:
+                    writers: Writers | None = None) -> dict:
     """One Stribeck sweep per viscosity (in parallel on ``executor``), refined where the
     curve turns, and the patch scatter band (``[run] patch_band``); CSV, plots, fields,
-    ``results.nc`` and ``fields.nc``.  Returns the stage's summary.  The figures are drawn
-    on ``figures`` (the caller waits for them), or on the executor's workers beside the
+    ``results.nc`` and ``fields.nc``.  Returns the stage's summary.  The writers are drawn
+    on ``writers`` (the caller waits for them), or on the executor's workers beside the
     result files and waited for here."""
-    own = figures is None
-    figures = Figures(executor) if own else figures
+    own = writers is None
+    writers = Writers(executor) if own else writers
     gap, spacing, face, origin = macro_geometry(case, out)
     tr = case.tribometer
     ball = dict(slide_to_roll=tr.slide_to_roll) if tr.ball else {}
@@ -77,22 +78,21 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     _prune_points(common["checkpoint"], tasks + patch_tasks)
     write_stribeck_csv(out.stribeck_csv, curves, band)
     summary = _summary(case, out, curves, band)
-    plot_curves(case, curves, band, out, figures)
-    _plot_fields(out, common["checkpoint"], tasks, figures)
-    points = sweep_points(common["checkpoint"], tasks)
-    summary["h0_range"] = _range_check(common, points, patch_tasks)
+    plot_curves(case, curves, band, out, writers)
+    _plot_fields(out, common["checkpoint"], tasks, writers)
+    writers.write(write_run_results, case, out, curves, patch_curves, tasks, origin)
+    summary["h0_range"] = _range_check(common, tasks + patch_tasks)
     _log_points(curves)
     if len(curves) > 1:
         summary["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, tr.boundary_friction)
     if tr.ball:
-        summary["ehl_film"] = ehl_film(case, points)
+        summary["ehl_film"] = ehl_film(case, sweep_points(common["checkpoint"], tasks))
     if any(case.measured):
         summary["validation"] = validate_curves(
             curves, case.measured, tr.boundary_friction, curve_labels(case, curves),
             out.validation_csv, out.validation_png)
-    write_run_results(case, out, curves, patch_curves, points, origin)
     if own:
-        figures.wait()
+        writers.wait()
     return summary
 
 
@@ -183,33 +183,38 @@ def _summary(case: Case, out: RunLayout, curves, band) -> dict:
     return summary
 
 
-def _range_check(common: dict, points: dict, band_tasks) -> dict:
-    """:func:`~fem_twin.stribeck.accuracy.range_summary` over the main curves' ``points``
-    and the band sweeps' (whose single patches reach lower separations), the band's read
-    one sweep at a time (all 448 of the paper case at once held 0.71 GiB)."""
-    def labelled():
-        yield from _labelled(points, "average")
-        for kw, lub in band_tasks:
+def _range_check(common: dict, tasks) -> dict:
+    """:func:`~fem_twin.stribeck.accuracy.range_summary` over the points of the sweeps
+    ``tasks`` (the main curves' and the band's, whose single patches reach lower
+    separations), each share read from its checkpoint's meta (``LOAD_BELOW``: the 252
+    points of the bundled case took 1.3 s to load whole; a checkpoint of before
+    2026-11-27 is)."""
+    h0_min = common["factors"].h0[0]
+
+    def shares():
+        for kw, lub in tasks:
             name = kw["factors_key"].rsplit("-", 1)[-1]
-            yield from _labelled(sweep_points(common["checkpoint"], [(kw, lub)]),
-                                 name if name.startswith("patch") else "average")
-    return range_summary(labelled(), common["factors"].h0[0])
+            factors = name if name.startswith("patch") else "average"
+            for path in point_files(common["checkpoint"], _sweep_key(kw, lub)):
+                scalars, meta = point_meta(path)
+                share = meta.get(LOAD_BELOW)
+                if share is None:
+                    share = MixedResult.load(path).contact_load_below(h0_min)
+                speed = scalars["speed"] if kw.get("slide_to_roll") is None else meta[
+                    "entrainment"]
+                yield share, (f"{factors} factors, mu_0 = {lub.viscosity:g} Pa s, "
+                              f"U = {speed:.3g} m/s")
+    return range_summary(shares(), h0_min)
 
 
-def _labelled(points: dict, factors: str):
-    """``(label, MixedResult)`` of ``{(viscosity, speed): MixedResult}``, one at a time."""
-    return ((f"{factors} factors, mu_0 = {mu:g} Pa s, U = {u:.3g} m/s", res)
-            for (mu, u), res in points.items())
-
-
-def _plot_fields(out: RunLayout, folder: Path, tasks, figures: Figures) -> None:
+def _plot_fields(out: RunLayout, folder: Path, tasks, writers: Writers) -> None:
     """The fields of the fastest, a middle and the slowest point of each main sweep
     ``tasks``, from their checkpoints in ``folder``."""
     for kw, lub in tasks:
         files = sorted(point_files(folder, _sweep_key(kw, lub)), key=point_speed,
                        reverse=True)                                     # fast to slow
         chosen = [files[i] for i in sorted({0, len(files) // 2, len(files) - 1})]
-        figures.draw(plot_point_files, chosen, out.fields_png(lub.viscosity), lub.viscosity)
+        writers.write(plot_point_files, chosen, out.fields_png(lub.viscosity), lub.viscosity)
 
 
 def _log_points(curves) -> None:
@@ -250,15 +255,15 @@ def ehl_film(case: Case, points) -> dict:
 
 
 def plot_curves(case: Case, curves, band, out: RunLayout,
-                figures: Figures | None = None) -> None:
+                writers: Writers | None = None) -> None:
     """C_f versus speed and versus Hersey number, with the band and measured curves (on
-    ``figures``, else at once)."""
-    figures = figures or Figures()
+    ``writers``, else at once)."""
+    writers = writers or Writers()
     measured = [read_measured_csv(m) if m is not None else None for m in case.measured]
     measured += [None] * (len(curves) - len(measured))
     tr = case.tribometer
     for x in ("speed", "hersey"):
-        figures.draw(plot_stribeck, curves, out.stribeck_png(x), x=x,
+        writers.write(plot_stribeck, curves, out.stribeck_png(x), x=x,
                      labels=curve_labels(case, curves), boundary=tr.boundary_friction,
                      bands=band, measured=measured, diameter=hersey_length(case),
                      load=tr.load, speed_label=("entrainment speed $u_m$ [m/s], SRR "
@@ -277,9 +282,11 @@ def sweep_points(folder: Path, tasks) -> dict:
     return points
 
 
-def write_run_results(case: Case, out: RunLayout, curves, patch_curves, points, origin) -> None:
+def write_run_results(case: Case, out: RunLayout, curves, patch_curves, tasks,
+                      origin) -> None:
     """``results.nc`` (flow factors per patch and average, Stribeck curves with the band,
-    settings and error estimates) and ``fields.nc`` (the macro fields of ``points``)."""
+    settings and error estimates) and ``fields.nc`` (the macro fields of the points of the
+    main sweeps ``tasks``, read from their checkpoints)."""
     from dataclasses import asdict
 
     from ..results import fields_dataset, flow_factor_dataset, stribeck_dataset, write_netcdf
@@ -291,7 +298,8 @@ def write_run_results(case: Case, out: RunLayout, curves, patch_curves, points, 
                  {"flow_factors": flow_factor_dataset(factors, [str(i + 1) for i in range(n)]
                                                       + ["average"]),
                   "stribeck": stribeck_dataset(curves, patch_curves)}, attrs)
-    write_netcdf(out.fields_nc, {None: fields_dataset(points, origin)}, attrs)
+    write_netcdf(out.fields_nc, {None: fields_dataset(sweep_points(out.points, tasks),
+                                                      origin)}, attrs)
 
 
 def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points"):

@@ -13,7 +13,7 @@ from tqdm import tqdm
 
 from ..case import Case
 from ..io.checkpoint import load_or_none
-from ..io.figure import Figures
+from ..io.writers import Writers
 from ..io.files import read_topography
 from ..io.layout import RunLayout
 from ..micro import CellSettings, FlowFactors, average, homogenise
@@ -25,12 +25,12 @@ log = logging.getLogger("fem_twin")
 
 
 def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool = True,
-                       h0=None, figures: Figures | None = None):
+                       h0=None, writers: Writers | None = None):
     """Flow factors of every patch pair (checkpointed per h0) and their average (``h0``:
     the case's range unless given).  With an executor the patches run side by side (a
     thread each hands its h0 tasks to the shared pool), so the pool is not left idle at
     the end of a patch or of a round of adaptive h0, and a cluster gets every patch's
-    tasks at once.  The figure is drawn on ``figures`` (the caller waits for it), else at
+    tasks at once.  The figure is drawn on ``writers`` (the caller waits for it), else at
     once."""
     out.micro.mkdir(parents=True, exist_ok=True)
     mc = case.micro
@@ -50,7 +50,7 @@ def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool
     mean = average(factors)
     mean.save(out.flow_factors)
     mean.write_csv(out.flow_factors_csv)
-    (figures or Figures()).draw(
+    (writers or Writers()).write(
         plot_flow_factors, [*factors, mean], out.flow_factors_png,
         labels=[f"patch {i + 1}" for i in range(len(factors))] + ["average"])
     estimate = mean.meta.get("error_estimate", {})

@@ -47,12 +47,13 @@ def error_summary(curves, boundary: float, tolerance: float) -> dict:
 EXTRAPOLATED_LOAD = 0.01
 
 
-def range_summary(points, h0_min: float) -> dict:
-    """The largest share of the load carried where h0 < ``h0_min`` [m] over ``points``
-    (an iterable of ``(label, MixedResult)``: the main curves' and the band's), with a logged
-    warning naming the worst point when it exceeds :data:`EXTRAPOLATED_LOAD`: below its
-    range :meth:`FlowFactors.at` continues p_con linearly, which no error estimate covers."""
-    shares = [(res.contact_load_below(h0_min), label) for label, res in points]
+def range_summary(shares, h0_min: float) -> dict:
+    """The largest share of the load carried where h0 < ``h0_min`` [m] over the points'
+    ``shares`` (an iterable of ``(share, label)``: the main curves' and the band's points,
+    :meth:`~fem_twin.macro.MixedResult.contact_load_below`), with a logged warning naming
+    the worst point when it exceeds :data:`EXTRAPOLATED_LOAD`: below its range
+    :meth:`FlowFactors.at` continues p_con linearly, which no error estimate covers."""
+    shares = list(shares)
     worst, where = max(shares, default=(0.0, ""))
     above = sum(share > EXTRAPOLATED_LOAD for share, _ in shares)
     if above:

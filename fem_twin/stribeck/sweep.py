@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -25,6 +26,10 @@ COARSE_CF = "coarse_friction_coefficient"
 #: the ``meta`` entry of a nested level kept as a checkpoint (``keep_level``): the key of
 #: the sweep whose point solved it (its time is that point's)
 LEVEL_OF = "level_of"
+#: the ``meta`` entry of a point's share of its load carried below its factors' smallest
+#: separation (:meth:`~fem_twin.macro.MixedResult.contact_load_below`), read without the
+#: point's fields by the run's range check
+LOAD_BELOW = "load_share_below_h0_min"
 
 
 def point_file(folder, key: str, speed: float) -> Path:
@@ -40,6 +45,12 @@ def point_files(folder, key: str = "*") -> list[Path]:
 def point_key(path) -> str:
     """The sweep key of a point checkpoint (:func:`point_file`)."""
     return Path(path).name.split("_")[1]
+
+
+def point_meta(path) -> tuple[dict, dict]:
+    """``(scalars, meta)`` of a point checkpoint (:func:`point_file`) without its fields."""
+    with np.load(path) as data:
+        return json.loads(str(data["scalars"])), json.loads(str(data["meta"]))
 
 
 def point_speed(path) -> float:
@@ -113,6 +124,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
             res, *coarser = solve_nested(gap, spacing, factors, load=load, **sliding,
                                          lubricant=lubricant, face=face, settings=settings,
                                          previous=guided.start(speeds, i, previous))
+            res = replace(res, meta={**res.meta,
+                                     LOAD_BELOW: res.contact_load_below(factors.h0[0])})
             if coarser:
                 res = replace(res, meta={**res.meta,
                                          COARSE_CF: [c.friction_coefficient for c in coarser],
