@@ -54,9 +54,10 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
                     writers: Writers | None = None) -> dict:
     """One Stribeck sweep per viscosity (in parallel on ``executor``), refined where the
     curve turns, and the patch scatter band (``[run] patch_band``); CSV, plots, fields,
-    ``results.nc`` and ``fields.nc``.  Returns the stage's summary.  The writers are drawn
-    on ``writers`` (the caller waits for them), or on the executor's workers beside the
-    result files and waited for here."""
+    ``results.nc`` and ``fields.nc``.  Returns the stage's summary.  The figures and
+    NetCDF files are written on ``writers`` (the caller waits for them), or on the
+    executor's workers and waited for here; the fields' as soon as the main curves are
+    done, beside the band's sweeps."""
     own = writers is None
     writers = Writers(executor) if own else writers
     gap, spacing, face, origin = macro_geometry(case, out)
@@ -69,6 +70,8 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     curves, speeds = refined_curves(case, common, executor, progress)
     tasks = [(dict(common, speeds=speeds, error_estimate=True), lub)
              for lub in case.lubricant.lubricants()]
+    _plot_fields(out, common["checkpoint"], tasks, writers)       # beside the band's sweeps
+    writers.write(write_run_fields, case, out, tasks, origin)
     band_run = band_tasks(case, out, dict(common, speeds=speeds))
     patch_curves, patch_tasks = band_curves(
         case, dict(common, speeds=speeds), curves, band_run,
@@ -78,9 +81,8 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     _prune_points(common["checkpoint"], tasks + patch_tasks)
     write_stribeck_csv(out.stribeck_csv, curves, band)
     summary = _summary(case, out, curves, band)
+    writers.write(write_run_results, case, out, curves, patch_curves)
     plot_curves(case, curves, band, out, writers)
-    _plot_fields(out, common["checkpoint"], tasks, writers)
-    writers.write(write_run_results, case, out, curves, patch_curves, tasks, origin)
     summary["h0_range"] = _range_check(common, tasks + patch_tasks)
     _log_points(curves)
     if len(curves) > 1:
@@ -282,24 +284,32 @@ def sweep_points(folder: Path, tasks) -> dict:
     return points
 
 
-def write_run_results(case: Case, out: RunLayout, curves, patch_curves, tasks,
-                      origin) -> None:
-    """``results.nc`` (flow factors per patch and average, Stribeck curves with the band,
-    settings and error estimates) and ``fields.nc`` (the macro fields of the points of the
-    main sweeps ``tasks``, read from their checkpoints)."""
-    from dataclasses import asdict
-
-    from ..results import fields_dataset, flow_factor_dataset, stribeck_dataset, write_netcdf
+def write_run_results(case: Case, out: RunLayout, curves, patch_curves) -> None:
+    """``results.nc``: flow factors per patch and average, Stribeck curves with the band,
+    settings and error estimates."""
+    from ..results import flow_factor_dataset, stribeck_dataset, write_netcdf
     n = len(case.geometry.patches)
     factors = [FlowFactors.load(out.patch_factors(k)) for k in [*range(1, n + 1), None]]
-    attrs = {"case": json.dumps(asdict(case), default=str), "case_name": case.name,
-             "provenance": json.dumps(provenance(case))}
     write_netcdf(out.results,
                  {"flow_factors": flow_factor_dataset(factors, [str(i + 1) for i in range(n)]
                                                       + ["average"]),
-                  "stribeck": stribeck_dataset(curves, patch_curves)}, attrs)
+                  "stribeck": stribeck_dataset(curves, patch_curves)}, _attributes(case))
+
+
+def write_run_fields(case: Case, out: RunLayout, tasks, origin) -> None:
+    """``fields.nc``: the macro fields of the points of the main sweeps ``tasks``, read
+    from their checkpoints (written beside the band's sweeps: they need only the main
+    curves)."""
+    from ..results import fields_dataset, write_netcdf
     write_netcdf(out.fields_nc, {None: fields_dataset(sweep_points(out.points, tasks),
-                                                      origin)}, attrs)
+                                                      origin)}, _attributes(case))
+
+
+def _attributes(case: Case) -> dict:
+    """The global attributes of a run's NetCDF files: the case and its provenance."""
+    from dataclasses import asdict
+    return {"case": json.dumps(asdict(case), default=str), "case_name": case.name,
+            "provenance": json.dumps(provenance(case))}
 
 
 def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points"):
