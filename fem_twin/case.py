@@ -154,6 +154,9 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if run.workers < 0:
         raise CaseError(f"{where} [run] workers: a number of processes >= 0 (0: all cores), "
                         f"got {run.workers}")
+    if not 0 < run.band_tol < 1:
+        raise CaseError(f"{where} [run] band_tol: a coupling tolerance in (0, 1), got "
+                        f"{run.band_tol}")
     radius = macro_geometry.level_radius
     if not tribometer.ball and radius is not None and not 0 < radius <= tribometer.pin_diameter:
         raise CaseError(f"{where} [preprocessing] level_radius = {radius}: the mean-plane radius "

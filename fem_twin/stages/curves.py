@@ -131,14 +131,17 @@ def band_tasks(case: Case, out: RunLayout, common: dict) -> list:
     """The sweep tasks of the scatter band (``[run] patch_band``): one per patch and
     viscosity, on the macro grid coarsened :meth:`~fem_twin.case.Case.band_coarsening`
     times, each guided by the average factors' points on that grid (the main sweeps'
-    nested level, ``keep_level``; :func:`~fem_twin.stribeck.sweep.stribeck_sweep`)."""
+    nested level, ``keep_level``; :func:`~fem_twin.stribeck.sweep.stribeck_sweep`), at the
+    coupling tolerance ``[run] band_tol``."""
     sweeps = band_sweeps(case, out, common) if case.run.patch_band else []
     for _ in range(case.band_coarsening(np.shape(common["gap"])) if sweeps else 0):
         gap, spacing, face = coarsened(sweeps[0]["gap"], sweeps[0]["spacing"],
                                        sweeps[0]["face"])
         sweeps = [dict(kw, gap=gap, spacing=spacing, face=face) for kw in sweeps]
-    return [(dict(kw, guide=_sweep_key(dict(kw, factors_key=common["factors_key"]), lub)), lub)
-            for kw in sweeps for lub in case.lubricant.lubricants()]
+    band = replace(common["settings"], tol=case.run.band_tol)
+    return [(dict(kw, settings=band, guide=_sweep_key(
+        dict(kw, factors_key=common["factors_key"]), lub)), lub)
+        for kw in sweeps for lub in case.lubricant.lubricants()]
 
 
 def band_curves(case: Case, common: dict, curves, tasks, swept, executor=None,
