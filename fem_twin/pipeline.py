@@ -16,6 +16,7 @@ import json
 import logging
 import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 
 from .case import Case
@@ -70,22 +71,30 @@ def run(case: Case, outdir, *, progress: bool = True, estimated_s: float | None 
 def _run_stages(case: Case, out: RunLayout, executor, progress, summary, last,
                 writers: Writers | None = None) -> None:
     """The stages up to the flow factors, then ``last`` (name, callable), each timed and
-    logged into ``summary``; the flow factors' figure on ``writers`` (else at once)."""
+    logged into ``summary``; the flow factors' figure on ``writers`` (else at once).  The
+    levelling (the pins) runs in a thread beside the micro stage (the patches), its pins on
+    the same workers: on the bundled case it took 1.5 s before the micro stage began."""
     invalidate_changed_stages(case, out)
-    stages = (("geometry", lambda: reconstruct_geometry(case, out, progress, executor)),
-              ("levelling", lambda: level_pins(case, out, progress, executor)),
-              ("micro", lambda: homogenise_patches(case, out, executor, progress,
-                                                   writers=writers)), last)
-    for name, stage in stages:
+
+    def stage(name, work):
         t = time.perf_counter()
         log.info("stage %s", name)
         try:
-            summary["stages"][name] = stage()
+            summary["stages"][name] = work()
         except BaseException:
             log.exception("stage %s failed", name)    # run.log only (see cli)
             raise
         summary["seconds"][name] = round(time.perf_counter() - t, 2)
         log.info("stage %s done in %.1f s", name, summary["seconds"][name])
+
+    stage("geometry", lambda: reconstruct_geometry(case, out, progress, executor))
+    with ThreadPoolExecutor(1) as beside:
+        levelling = beside.submit(stage, "levelling",
+                                  lambda: level_pins(case, out, progress, executor))
+        stage("micro", lambda: homogenise_patches(case, out, executor, progress,
+                                                  writers=writers))
+        levelling.result()
+    stage(*last)
 
 
 @one_thread
