@@ -44,3 +44,23 @@ class Anderson:
             return x + self.beta * f
         gamma = np.linalg.lstsq(self.df[:k].T, f, rcond=1e-10)[0]
         return x + self.beta * f - gamma @ self.dx[:k] - self.beta * (gamma @ self.df[:k])
+
+    def pairs(self, k: int):
+        """The last ``min(k, stored)`` differences ``(dx, df)``, oldest first, as copies
+        ``(m, n)``."""
+        m = min(k, self.count, self.depth)
+        if m == 0:
+            return np.empty((0, 0)), np.empty((0, 0))
+        slots = [(self.count - m + j) % self.depth for j in range(m)]
+        return self.dx[slots].copy(), self.df[slots].copy()
+
+    def seed(self, dx, df):
+        """Start the history from the differences ``(dx, df)`` (``(m, n)``, oldest first,
+        ``m <= depth``) of a related problem: the first step already mixes them out of the
+        residual (a coarser grid's pairs carry its slow, smooth modes)."""
+        m = min(len(dx), self.depth)
+        if m == 0 or self.depth == 0:
+            return
+        self.dx, self.df = np.empty((2, self.depth, dx.shape[1]))
+        self.dx[:m], self.df[:m] = dx[-m:], df[-m:]
+        self.count = m

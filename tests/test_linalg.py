@@ -161,3 +161,103 @@ def test_anderson_mixing_is_gmres_on_a_linear_map():
         x = G @ x + c
     assert plain == pytest.approx(np.linalg.norm(x - exact) / np.linalg.norm(exact), rel=1e-12)
     assert plain > 0.5
+
+
+def test_gmres_takes_one_iteration_per_changed_column():
+    """fem_twin.linalg.gmres preconditioned by the exact inverse of a matrix whose m
+    columns were since replaced (the Newton matrix of a switch after m nodes changed
+    between film and cavity): the preconditioned operator is the identity plus rank m, so
+    GMRES converges in m + 1 iterations (Saad 2003, Prop. 6.24), and gives up with fewer."""
+    from fem_twin.linalg import gmres
+    rng = np.random.default_rng(3)
+    A0 = diffusion(12, seed=2)
+    lu = spla.splu(A0.tocsc())
+    b = rng.normal(size=A0.shape[0])
+    for m in (1, 3, 6):
+        A = A0.tolil()
+        for j in rng.choice(A0.shape[0], m, replace=False):
+            A[:, j] = 0
+            A[j, j] = 1.0
+        A = A.tocsr()
+        x, its = gmres(A.dot, lu.solve, b, 1e-10, m + 1)
+        assert its <= m + 1 and np.linalg.norm(A @ x - b) < 1e-9 * np.linalg.norm(b)
+        assert gmres(A.dot, lu.solve, b, 1e-10, m - 1 or 1)[0] is None or m == 1
+    assert gmres(A0.dot, lu.solve, 0 * b, 1e-10, 3)[1] == 0
+
+
+def test_pardiso_runs_the_threads_fem_twin_threads_allows():
+    """FEM_TWIN_THREADS=2 when MKL first loads: MKL's OpenMP layer and two PARDISO threads
+    (a lone large point; more CPU time than wall time), the same factors to round-off as
+    the default sequential layer (one process each: the layer is chosen at load)."""
+    if _mkl_rt() is None:
+        pytest.skip("MKL not installed")
+    import json
+    import os
+    import subprocess
+    import sys
+    script = (
+        "import json, time, numpy as np, sys\n"
+        "sys.path.insert(0, 'tests')\n"
+        "from test_linalg import diffusion\n"
+        "from fem_twin.linalg import SPDSolver\n"
+        "from threadpoolctl import threadpool_info\n"
+        "K = diffusion(200, seed=1)\n"
+        "s = SPDSolver(K.indptr, K.indices, 'pardiso').factor(K.data)\n"
+        "w, c = time.perf_counter(), time.process_time()\n"
+        "for _ in range(3): s.factor(K.data)\n"
+        "w, c = time.perf_counter() - w, time.process_time() - c\n"
+        "x = s.solve(np.ones(K.shape[0]))\n"
+        "layer = [i.get('threading_layer') for i in threadpool_info() if i['internal_api'] == 'mkl']\n"
+        "print(json.dumps({'x': x[:50].tolist(), 'cpu_over_wall': c / w, 'layer': layer}))\n")
+    out = {}
+    for threads in ("1", "2"):
+        env = {k: v for k, v in os.environ.items() if not k.startswith("MKL_")}
+        env["FEM_TWIN_THREADS"] = threads
+        run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                             env=env, cwd=os.path.dirname(os.path.dirname(__file__)),
+                             check=True)
+        out[threads] = json.loads(run.stdout.splitlines()[-1])
+    assert out["1"]["layer"] == ["sequential"] and out["2"]["layer"] == ["intel"]
+    assert out["1"]["cpu_over_wall"] < 1.1 < out["2"]["cpu_over_wall"]
+    assert np.allclose(out["1"]["x"], out["2"]["x"], rtol=1e-10, atol=0)
+
+
+def test_anderson_seeded_with_the_pairs_of_a_related_map():
+    """Anderson.seed: started from the differences of a run on the same linear map (as a
+    coarser grid's solve hands its last pairs to the finer one), the first step already
+    mixes the slow modes out: with pairs spanning the space it lands on the fixed point at
+    once, and with pairs of a perturbed map it still needs fewer steps than from nothing;
+    pairs() gives the last differences oldest first."""
+    from fem_twin.anderson import Anderson
+    rng = np.random.default_rng(7)
+    n = 6
+    Q = np.linalg.qr(rng.normal(size=(n, n)))[0]
+    G = Q @ np.diag(np.linspace(-0.95, 0.95, n)) @ Q.T
+    c = rng.normal(size=n)
+    exact = np.linalg.solve(np.eye(n) - G, c)
+
+    def run(G, mixer, steps):
+        x = np.zeros(n)
+        for _ in range(steps):
+            x = mixer.step(x, G @ x + c - x)
+        return x
+
+    first = Anderson(8, 0.5)
+    run(G, first, n + 1)
+    dx, df = first.pairs(n)
+    assert dx.shape == (n, n) and np.allclose(df, dx @ (G - np.eye(n)).T)
+    seeded = Anderson(8, 0.5)
+    seeded.seed(dx, df)
+    assert np.linalg.norm(run(G, seeded, 1) - exact) < 1e-9 * np.linalg.norm(exact)
+    near = G + 0.02 * Q @ np.diag(rng.uniform(-1, 1, n)) @ Q.T
+    exact = np.linalg.solve(np.eye(n) - near, c)
+
+    def steps(mixer):
+        x = np.zeros(n)
+        for k in range(1, 100):
+            x = mixer.step(x, near @ x + c - x)
+            if np.linalg.norm(x - exact) < 1e-8 * np.linalg.norm(exact):
+                return k
+    seeded = Anderson(8, 0.5)
+    seeded.seed(*first.pairs(4))
+    assert steps(seeded) < steps(Anderson(8, 0.5))

@@ -582,3 +582,21 @@ def test_contact_quadrature_converges_on_the_pin(factors):
     change = {rule: abs(cf[96, rule] - cf[48, rule]) for rule in ("gauss", "nodal")}
     assert change["gauss"] < change["nodal"] / 4
     assert abs(cf[96, "gauss"] - cf[96, "nodal"]) < abs(cf[48, "gauss"] - cf[48, "nodal"])
+
+
+def test_a_cold_nested_point_starts_from_the_coarse_levels_anderson_pairs(factors):
+    """fem_twin.macro.nested: the fine level of a cold point starts its Anderson coupling
+    from the coarse level's last differences (Secants), interpolated, and converges to the
+    point that the same start without them reaches (C_f within 1e-6 C_f,b: both stop at
+    the coupling tolerance 1e-6) in fewer iterations (sample pin 1 at 192^2, 0.03 m/s,
+    measured 2026-11-27: 18 against 22)."""
+    from fem_twin.macro.mixed import seeded_point
+    from fem_twin.macro.nested import solve_nested
+    gap, dx, face = macro_case(192)
+    kw = dict(load=150.0, lubricant=Lubricant(0.066), face=face,
+              settings=MacroSettings(tol=TIGHT))
+    levels = solve_nested(gap, dx, factors, speed=0.03, **kw)
+    plain, secants = seeded_point(gap, dx, factors, speed=0.03, initial=levels[1], **kw)
+    assert secants.dx.shape == secants.df.shape == (4, 192 * 192 + 1)
+    assert abs(levels[0].friction_coefficient - plain.friction_coefficient) < 1e-6 * 0.19245
+    assert levels[0].iterations < plain.iterations

@@ -233,3 +233,49 @@ def test_poiseuille_reassembly_equals_the_scikit_fem_form(block, monkeypatch):
     assert abs(fe_poiseuille(g, dx) - ref).max() < 1e-14 * abs(ref).max()
     with pytest.raises(ValueError, match="shape"):
         fe_poiseuille(g, dx, A[:-1])
+
+
+def test_a_newton_step_reuses_the_factors_of_its_inner_solve(monkeypatch):
+    """fem_twin.macro.stencil_solver: within one inner solve (K and B fixed) a Newton step
+    whose switch differs from the factorised one in a few nodes is solved by GMRES with the
+    kept factors to STEP_RTOL, without a new factorisation; one with more switched nodes
+    than half a factorisation's cost allows factorises anew; release() frees the factors."""
+    import scipy.sparse as sp
+
+    from fem_twin.linalg import SPDSolver, default_backend
+    from fem_twin.macro import stencil_solver as ss
+    from fem_twin.macro.couette import couette_matrix
+    from fem_twin.macro.reynolds import fe_poiseuille
+    if default_backend() != "pardiso":
+        pytest.skip("the stencil solver needs MKL PARDISO")
+    rng = np.random.default_rng(4)
+    n, dx, scale = 48, (1e-4, 1e-4), 1e5
+    h = 1e-6 * (1 + rng.uniform(0, 4, (n, n)))
+    K = fe_poiseuille(h ** 3 / (12 * MU), dx)
+    B = couette_matrix(h * U / 2, 0 * h, dx)
+    dirichlet = np.zeros((n, n), bool)
+    dirichlet[[0, -1]] = dirichlet[:, [0, -1]] = True
+    interior = np.flatnonzero(~dirichlet)
+    factorisations = []
+    monkeypatch.setattr(SPDSolver, "factor", lambda self, v, f=SPDSolver.factor:
+                        factorisations.append(1) or f(self, v))
+    step = ss.newton_solver(dirichlet.shape, dirichlet.ravel(), interior, K, B)
+    pos = rng.uniform(size=interior.size) < 0.7
+    rhs = rng.normal(size=interior.size)
+
+    def solved(pos):
+        x = step(pos, np.where(pos, 0.0, 1 / scale), rhs)
+        J = (K @ sp.diags(np.isin(np.arange(n * n), interior[pos]) * 1.0)
+             + B @ sp.diags(np.where(np.isin(np.arange(n * n), interior[pos]), 0, 1 / scale))
+             )[interior][:, interior]
+        return np.linalg.norm(J @ x - rhs) / np.linalg.norm(rhs)
+
+    assert solved(pos) < ss.STEP_RTOL and len(factorisations) == 1
+    few = pos.copy()                          # 2116 unknowns: a budget of 3 solves
+    few[rng.choice(pos.size, 1, replace=False)] ^= True
+    assert solved(few) < ss.STEP_RTOL and len(factorisations) == 1
+    many = pos.copy()
+    many[rng.choice(pos.size, 40, replace=False)] ^= True
+    assert solved(many) < ss.STEP_RTOL and len(factorisations) == 2
+    step.release()
+    assert ss._grid(dirichlet.shape, dirichlet.ravel(), interior).budget() == 0

@@ -77,6 +77,22 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
     initial : a result to warm-start from (e.g. the neighbouring speed of a sweep)
     progress : optional callable ``progress(iteration, residual)``
     """
+    return seeded_point(gap, spacing, factors, load=load, speed=speed,
+                        entrainment=entrainment, lubricant=lubricant, face=face,
+                        settings=settings, initial=initial, progress=progress)[0]
+
+
+@one_thread
+def seeded_point(gap, spacing, factors: FlowFactors, *, load: float, speed: float,
+                 entrainment: float | None = None, lubricant: Lubricant, face=None,
+                 settings: MacroSettings = MacroSettings(),
+                 initial: MixedResult | None = None, secants=None, progress=None):
+    """:func:`solve_mixed` whose Anderson coupling starts from ``secants``, the last
+    differences of the same point's coupling on a coarser grid
+    (:class:`~fem_twin.macro.fixed_point.Secants`, interpolated).  Returns ``(result,
+    secants)``, the second this solve's own (None where the coupling is not Anderson):
+    :func:`~fem_twin.macro.nested.solve_nested` hands them from level to level.
+    """
     h_g = np.asarray(gap, float)
     if h_g.ndim != 2 or min(h_g.shape) < 3:
         raise InputError(f"gap must be a 2D field of at least 3 x 3 nodes, got {h_g.shape}")
@@ -96,33 +112,36 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
         raise InputError(f"face mask {face.shape} does not match the gap {h_g.shape}")
     t0 = time.perf_counter()
     if initial is None and min(h_g.shape) >= 2 * COARSE_START:
-        initial = _coarse_start(h_g, dx, factors, load, speed, entrainment, lubricant, face,
-                                settings)
+        initial, secants = _coarse_start(h_g, dx, factors, load, speed, entrainment,
+                                         lubricant, face, settings)
     if initial is not None:
         initial = on_grid(initial, h_g.shape, dx)
     P = macro_problem(h_g, dx, factors, lubricant, settings, speed, u_m)
     if settings.coupling == "newton" or (settings.coupling == "auto" and initial is not None
                                          and initial.meta.get("coupling") == "newton"):
-        return _solve_newton(P, load, face, initial, progress, t0)
+        return _solve_newton(P, load, face, initial, progress, t0), None
     try:
-        ev, h_el, h_d, it, history = solve_fixed_point(P, load, face, initial, progress)
+        ev, h_el, h_d, it, history, secants = solve_fixed_point(P, load, face, initial,
+                                                                progress, secants)
     except (MixedNotConverged, Concentrated):
         if settings.coupling != "auto":
             raise
-        return _solve_newton(P, load, face, initial, progress, t0)
-    return mixed_result(ev, h_el, h_d, P, load, face, it, history, time.perf_counter() - t0)
+        return _solve_newton(P, load, face, initial, progress, t0), None
+    return mixed_result(ev, h_el, h_d, P, load, face, it, history,
+                        time.perf_counter() - t0), secants
 
 
 def _coarse_start(h_g, dx, factors, load, speed, entrainment, lubricant, face, settings):
-    """The point solved on the grid coarsened by 2 (recursively), to a looser tolerance, or
-    None when that grid is too coarse to resolve the contact."""
+    """The point solved on the grid coarsened by 2 (recursively), to a looser tolerance,
+    with its coupling's secants, or ``(None, None)`` when that grid is too coarse to resolve
+    the contact."""
     try:
-        return solve_mixed(h_g[::2, ::2], (2 * dx[0], 2 * dx[1]), factors, load=load,
+        return seeded_point(h_g[::2, ::2], (2 * dx[0], 2 * dx[1]), factors, load=load,
                            speed=speed, entrainment=entrainment, lubricant=lubricant,
                            face=face[::2, ::2], settings=replace(settings,
                                                                   tol=max(settings.tol, 1e-4)))
     except MixedNotConverged:
-        return None
+        return None, None
 
 
 def _solve_newton(P, load, face, initial, progress, t0):

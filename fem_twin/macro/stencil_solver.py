@@ -9,9 +9,20 @@ factors are single precision, refined with the residual in double precision (one
 refinement step reaches ``STEP_RTOL`` on the equilibrated matrix; half the factors' memory:
 2.06 GiB at 2048^2); below, where memory is no concern, double precision factorises in
 0.64-0.87x the time (real Newton matrices of 3k-53k unknowns, 2026-11-26; level at 214k)
-and needs no refinement.  The factors are freed after each step: they are never
-reused, and at 2048^2 (2.06 GiB) the evaluation between steps no longer stacks on them.  A
-step is returned only when it solves ``J x = rhs`` to ``STEP_RTOL``.
+and needs no refinement.
+
+The factors of a step are kept for the next steps of the same inner solve (``K`` and
+``B`` do not change within it, only which nodes are film and which cavity).  A step whose
+matrix differs from the factorised one in ``m`` columns (``m`` nodes switched) is solved by
+GMRES preconditioned with those factors, each pass refined in double precision: the
+preconditioned matrix is the identity plus rank ``m``, so GMRES takes about ``m + 2``
+solves, and the step tries it when that is at most half a factorisation's cost
+(:meth:`_Grid.budget`; else it factorises anew).  On the cold 512^2 point of
+``benchmarks/run.py scale`` the exact inner solves switch 1745, 823, 200, 22 and 2 nodes
+in their first steps and 1-10 in the later ones; the finest level factorised 18 times
+instead of 23 (5 steps from the kept factors, none failing).  The factors are freed when
+the inner solve ends (``step.release()``).  A step is returned only when it solves
+``J x = rhs`` to ``STEP_RTOL``.
 
 Tried and dropped (2026-11-25, bundled case, 12 speeds at 128^2): the last factorisation
 as a GMRES preconditioner for the next step.  The matrices move too much between coupling
@@ -27,7 +38,7 @@ from collections import OrderedDict
 import numpy as np
 import scipy.sparse as sp
 
-from ..linalg import SPDSolver, default_backend
+from ..linalg import SPDSolver, default_backend, gmres
 
 #: relative residual ``|J x - rhs| / |rhs|`` a step must reach
 STEP_RTOL = 1e-8
@@ -37,6 +48,15 @@ REFINEMENTS = 4
 #: the largest entry of the equilibrated matrix a factorisation takes
 #: (float32 overflows at 3.4e38; beyond this the step goes to SuperLU in double precision)
 SINGLE_MAX = 1e30
+#: the most solves with kept factors a step may spend before it factorises anew (and the
+#: GMRES basis it keeps: 16 vectors of the grid, 0.43 GB at 2048^2) ...
+REUSE_SOLVES = 16
+#: ... and at most half a factorisation's time: GMRES takes about one solve per node that
+#: switched since the factorisation, plus two.  A factorisation costs about
+#: ``1.44 n^0.2`` solves of the grid's ``n`` unknowns (PARDISO, one thread, 2026-11-27:
+#: 16.7 at 214k unknowns, 22 at 859k; 20-40 at 3.4M), a rule of the size rather than of
+#: measured times so that a run repeats to the last bit
+REUSE_SHARE = 0.5 * 1.44
 #: grids of more unknowns factorise in single precision (memory: 2048^2 has 3.4M)
 SINGLE_UNKNOWNS = 1 << 20
 #: grids whose patterns and PARDISO analyses are kept (a sweep with error estimates
@@ -52,7 +72,9 @@ def newton_solver(shape, dirichlet, interior, K, B):
     """``step(pos, dtheta, rhs)`` solving ``(K diag(pos) + B diag(dtheta)) x = rhs`` on the
     interior with PARDISO, or None without PARDISO or when ``K`` or ``B`` leave the 3x3
     stencil.  A step returns None (the caller then uses SuperLU) when pivots were perturbed
-    or it does not reach ``STEP_RTOL``."""
+    or it does not reach ``STEP_RTOL``.  The factors of a step serve the next ones (see the
+    module docstring) until ``step.release()``, which the caller calls when its solve
+    ends."""
     if shape is None or default_backend() != "pardiso":
         return None
     grid = _grid(shape, dirichlet, interior)
@@ -61,12 +83,23 @@ def newton_solver(shape, dirichlet, interior, K, B):
     if any(found is None for found in maps):
         return None
 
+    kept = {}                                 # the switch of the kept factorisation
+
     def step(pos, dtheta, rhs):
         def values():
             v = grid.entries(K, maps[0], pos)
             v += grid.entries(B, maps[1], dtheta)
             return v
-        return grid.factor_and_solve(values, rhs)
+        if kept and np.count_nonzero(pos != kept["pos"]) + 2 <= grid.budget():
+            x = grid.solve_kept(values(), rhs)
+            if x is not None:
+                return x
+        kept.clear()
+        x = grid.factor_and_solve(values, rhs)
+        if x is not None:
+            kept["pos"] = pos.copy()
+        return x
+    step.release = grid.release
     return step
 
 
@@ -84,6 +117,7 @@ class _Grid:
         self.solver = SPDSolver(self.indptr, self.indices, "pardiso", symmetric=False,
                                 single=self.n > SINGLE_UNKNOWNS)
         self._maps = []                       # [(digest, at, keep)]
+        self.scale = None                     # the equilibration of the kept factors
 
     def locate(self, M):
         """``(at, keep)``: the position ``at`` in the pattern of each interior entry ``keep``
@@ -125,6 +159,7 @@ class _Grid:
         face (a 20 nm film beside the 40 um edge).  ``J`` is built twice, so that no double
         precision copy of it is alive during the factorisation (0.25 GB at 2048^2); it is
         scaled straight into the factors' precision."""
+        self.release()                        # the kept factors go before new ones come
         data = values()
         d = np.abs(data[self.diagonal])
         scale = 1 / np.sqrt(np.where(d > 0, d, max(float(d.max()), 1e-300)))
@@ -136,14 +171,57 @@ class _Grid:
         del data
         if not np.abs(scaled).max() < SINGLE_MAX:         # inf or nan too
             return None                       # beyond single precision: the general path
-        try:
-            self.solver.factor(scaled)
-            del scaled
-            return None if self.solver.perturbed else self._refined(values(), rhs, scale)
-        finally:                              # the factors are never reused across steps
-            self.solver.release()
+        self.solver.factor(scaled)
+        del scaled
+        self.scale = scale
+        x = None if self.solver.perturbed else self._refined(values(), rhs)
+        if x is None:
+            self.release()
+        return x
 
-    def _refined(self, data, rhs, scale):
+    def solve_kept(self, data, rhs):
+        """``x`` solving ``J x = rhs`` (CSR data ``data``) to ``STEP_RTOL`` by GMRES with the
+        kept factors of another switch as the preconditioner, each pass refined in double
+        precision; None (and the factors freed) when it takes more than
+        :meth:`budget` solves."""
+        J = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+        x, residual, budget = np.zeros_like(rhs), rhs, self.budget()
+        target = STEP_RTOL * np.linalg.norm(rhs)
+        while budget > 0 and np.linalg.norm(residual) > target:
+            rtol = max(target / np.linalg.norm(residual), 1e-4)
+            dx, used = gmres(J.dot, self._precondition, residual, rtol, budget)
+            budget -= used + 1
+            if dx is None or not np.all(np.isfinite(dx)):
+                break
+            x = x + dx
+            residual = rhs - J @ x
+        if np.linalg.norm(residual) <= target:
+            return x
+        self.release()
+        return None
+
+    def budget(self) -> int:
+        """Solves with the kept factors a step may take: half a factorisation's cost, at
+        most ``REUSE_SOLVES`` (0 without kept factors)."""
+        if self.scale is None:
+            return 0
+        return int(min(REUSE_SOLVES, REUSE_SHARE * self.n ** 0.2))
+
+    def release(self):
+        """Free the kept factors (the analysis stays)."""
+        self.solver.release()
+        self.scale = None
+
+    def _precondition(self, r):
+        """The kept factors' solution of ``J x = r`` (the solve sees ``r`` over its size:
+        no overflow in single precision)."""
+        b = self.scale * r
+        size = np.abs(b).max()
+        if not 0 < size < np.inf:
+            return np.full_like(r, np.nan)
+        return self.scale * self.solver.solve(b / size) * size
+
+    def _refined(self, data, rhs):
         """``x`` solving ``J x = rhs`` to ``STEP_RTOL`` by refinement with the factors of the
         equilibrated ``J`` (CSR data ``data``), or None."""
         J = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
@@ -152,11 +230,7 @@ class _Grid:
         for _ in range(1 + REFINEMENTS):
             if np.linalg.norm(residual) <= target:
                 return x
-            b = scale * residual
-            size = np.abs(b).max()            # the solve sees b / size: no overflow
-            if not 0 < size < np.inf:
-                return None
-            x = x + scale * self.solver.solve(b / size) * size
+            x = x + self._precondition(residual)
             if not np.all(np.isfinite(x)):
                 return None
             residual = rhs - J @ x

@@ -55,6 +55,17 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
 
     newton = newton_solver(tuple(dirichlet.shape) if dirichlet.ndim == 2 else None,
                             dirichlet.ravel(), interior, K, B)
+    try:
+        return _newton_loop(K, B, dirichlet, interior, scale, phi, residual, newton, tol,
+                            max_iter, inexact)
+    finally:
+        if newton is not None:
+            newton.release()
+
+
+def _newton_loop(K, B, dirichlet, interior, scale, phi, residual, newton, tol, max_iter,
+                 inexact):
+    """The semismooth Newton iteration of :func:`solve_complementarity` from ``phi``."""
     history, active_old = [], None
     r, pos, res = residual(phi)
     for it in range(1, max_iter + 1):
