@@ -20,6 +20,9 @@ the same pattern; the factorisation is 85 % of the roughness-scale time.  Two ba
     large point such as the 2048^2 grids of the resolution study) gets MKL's OpenMP layer
     and N PARDISO threads: a 1024^2 Newton LU factorised in 0.62x the time on 2 threads
     (1.46 against 2.37 s, solves 0.52x; sequential and one OpenMP thread take the same).
+    Its idle threads sleep at once (``KMP_BLOCKTIME=0``): spinning for the default 200 ms
+    after each call, they took a core from the numpy work between the solves (the 512^2
+    cold point of ``benchmarks/run.py scale`` 20.4 against 17.9 s).
 
 ``backend=None`` takes the environment variable ``FEM_TWIN_SPARSE`` (``auto``, ``superlu``
 or ``pardiso``); ``auto`` (the default) is PARDISO when ``libmkl_rt`` loads, else SuperLU.
@@ -57,6 +60,8 @@ def _mkl_rt():
         threaded = thread_limit() > 1 and bool(glob.glob(os.path.join(
             os.path.dirname(os.path.abspath(path)), "libiomp5.so*")))
         os.environ.setdefault("MKL_THREADING_LAYER", "INTEL" if threaded else "SEQUENTIAL")
+        if threaded:                # idle OpenMP threads sleep at once instead of spinning
+            os.environ.setdefault("KMP_BLOCKTIME", "0")     # beside the numpy work between
         try:
             lib = ctypes.CDLL(path)
         except OSError:
