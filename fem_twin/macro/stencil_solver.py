@@ -156,10 +156,12 @@ class _Grid:
         None if pivots were perturbed or the step falls short of ``STEP_RTOL``.  The matrix
         is equilibrated first, ``S J S`` with ``S`` the inverse square root of its diagonal:
         PARDISO's pivot threshold is absolute, and the film's ``h^3`` spans 1e9 over a pin
-        face (a 20 nm film beside the 40 um edge).  ``J`` is built twice, so that no double
-        precision copy of it is alive during the factorisation (0.25 GB at 2048^2); it is
-        scaled straight into the factors' precision."""
+        face (a 20 nm film beside the 40 um edge).  With single-precision factors ``J`` is
+        built twice, so that no double precision copy of it is alive during the
+        factorisation (0.25 GB at 2048^2); it is scaled straight into the factors'
+        precision."""
         self.release()                        # the kept factors go before new ones come
+        single = self.solver.dtype == np.float32
         data = values()
         d = np.abs(data[self.diagonal])
         scale = 1 / np.sqrt(np.where(d > 0, d, max(float(d.max()), 1e-300)))
@@ -168,13 +170,15 @@ class _Grid:
             scaled = np.repeat(own, self.counts)          # the factors' precision: no
             scaled *= data                                # second double copy alive
             scaled *= own[self.indices]
-        del data
+        if single:
+            del data
         if not np.abs(scaled).max() < SINGLE_MAX:         # inf or nan too
             return None                       # beyond single precision: the general path
         self.solver.factor(scaled)
         del scaled
         self.scale = scale
-        x = None if self.solver.perturbed else self._refined(values(), rhs)
+        x = None if self.solver.perturbed else self._refined(values() if single else data,
+                                                              rhs)
         if x is None:
             self.release()
         return x
