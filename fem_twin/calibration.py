@@ -6,7 +6,11 @@ reference curve, at the case's first viscosity:
 ``filter``
     Gaussian FWHM of the macro geometry [px] (0: unfiltered); reference 11 px
 ``resolution``
-    macro grid size [px]; reference: the largest
+    macro grid size [px]; by default the paper's study (Figure 10): 128, 256, 500, 999 and
+    1997 px interpolated from the measured maps, the two finest keeping every measured
+    point, the reference the maps' own resolution (500 px, as the paper's) or else the
+    largest, and the grids finer than the reference swept at the paper's five speeds
+    (:data:`FINE_SPEEDS`) only
 ``disk``
     measured disks against a flat disk; reference: measured
 ``pins``
@@ -15,7 +19,8 @@ reference curve, at the case's first viscosity:
     flow factors of every single patch against the patch average; reference: the average
 
 The micro scale is computed once (it does not depend on the macro choices) and shared by
-the variants; every variant keeps its own checkpoints, so an interrupted study resumes.
+the variants; each variant's sweep is a task on the study's workers (``[run] workers``),
+its points checkpointed as they finish, so an interrupted study resumes.
 """
 
 from __future__ import annotations
@@ -28,48 +33,70 @@ import numpy as np
 from .case import Case
 from .errors import InputError
 from .io.atomic import atomic_path
+from .io.checkpoint import input_key
 from .io.figure import save_figure
+from .io.files import read_topography
 from .io.layout import RunLayout
 from .micro import FlowFactors
-from .stages.curves import macro_settings
+from .stages.curves import macro_settings, run_sweeps
 from .stages.factors import homogenise_patches
 from .stages.geometry import face_load, level_pins, macro_geometry, reconstruct_geometry
-from .stribeck import friction_deviation, plot_stribeck, stribeck_sweep, write_stribeck_csv
+from .stribeck import friction_deviation, plot_stribeck, write_stribeck_csv
 from .threads import executor_for
 
 STUDIES = ("filter", "resolution", "disk", "pins", "patches")
+#: the paper's resolution study (3.2, Figure 10): macro grids [px] interpolated from its
+#: measured 500^2 maps (the reference), 999 and 1997 keeping every measured point
+PAPER_RESOLUTIONS = (128, 256, 500, 999, 1997)
+#: ... and the speeds [m/s] at which it swept the grids finer than the reference, "in
+#: order to save computational resources" (the other grids sweep these too)
+FINE_SPEEDS = (0.1, 0.08, 0.06, 0.04, 0.02)
 
 
 def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
-    """``{label: (case, patch index or None)}`` of a study and the reference label."""
+    """``{label: (case, patch index or None, speeds [m/s] or None for the case's)}`` of a
+    study and the reference label."""
     g = case.macro_geometry
     if study == "filter":
         values = values or [0, 3, 5, 7, 9, 11]
         out = {f"fwhm {v:g} px": (replace(case, macro_geometry=replace(g, fwhm_px=float(v))),
-                                  None) for v in values}
+                                  None, None) for v in values}
         ref = max(values, key=lambda v: (v == 11, v))
         return out, f"fwhm {ref:g} px"
     if study == "resolution":
-        values = values or [64, 128, 256]
-        out = {f"{int(v)} px": (replace(case, macro_geometry=replace(
-            g, resolution=(int(v), int(v)))), None) for v in values}
-        return out, f"{int(max(values))} px"
+        return _resolutions(case, [int(v) for v in values or PAPER_RESOLUTIONS])
     if study == "disk":
         if not case.geometry.disks:
             raise InputError("the disk study needs measured disks in [geometry] disks")
         flat = replace(case, geometry=replace(case.geometry, disks=()))
-        return {"measured disk": (case, None), "flat disk": (flat, None)}, "measured disk"
+        return {"measured disk": (case, None, None), "flat disk": (flat, None, None)}, \
+            "measured disk"
     if study == "pins":
-        out = {"set average": (replace(case, macro=replace(case.macro, pin="average")), None)}
+        out = {"set average": (replace(case, macro=replace(case.macro, pin="average")), None,
+                               None)}
         for k in range(1, len(case.geometry.pins) + 1):
-            out[f"pin {k}"] = (replace(case, macro=replace(case.macro, pin=k)), None)
+            out[f"pin {k}"] = (replace(case, macro=replace(case.macro, pin=k)), None, None)
         return out, "set average"
     if study == "patches":
-        out = {"patch average": (case, None)}
+        out = {"patch average": (case, None, None)}
         for k in range(1, len(case.geometry.patches) + 1):
-            out[f"patch {k}"] = (case, k)
+            out[f"patch {k}"] = (case, k, None)
         return out, "patch average"
     raise InputError(f"unknown study {study!r}; choose one of {STUDIES}")
+
+
+def _resolutions(case: Case, values) -> tuple[dict, str]:
+    """The resolution study's variants: the reference is the measured maps' own resolution
+    if among ``values`` (no interpolation), else the largest; finer grids sweep
+    :data:`FINE_SPEEDS`, the others the case's speeds and those."""
+    measured = (read_topography(case.geometry.pins[0]).shape[0] if case.geometry.pins
+                else None)
+    ref = measured if measured in values else max(values)
+    both = np.array(sorted({*case.sweep.speeds, *FINE_SPEEDS}, reverse=True))
+    out = {f"{v} px": (replace(case, macro_geometry=replace(case.macro_geometry,
+                                                            resolution=(v, v))), None,
+                       np.array(FINE_SPEEDS) if v > ref else both) for v in values}
+    return out, f"{ref} px"
 
 
 def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = True) -> dict:
@@ -78,30 +105,25 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     out = RunLayout(outdir)
     out.root.mkdir(parents=True, exist_ok=True)
     cases, ref_label = variants(case, study, values)
-    reconstruct_geometry(case, out, progress)
-    with executor_for(case.run.workers, case.run.scheduler) as executor:
-        homogenise_patches(case, out, executor, progress)
     lub = case.lubricant.lubricants()[0]
-    curves = {}
-    for i, (label, (variant, patch)) in enumerate(cases.items()):
-        folder = out.sub(f"variant_{i + 1}")
-        reconstruct_geometry(variant, folder, progress)
-        level_pins(variant, folder, progress)
-        factors = FlowFactors.load(out.patch_factors(patch))
-        gap, spacing, face, _ = macro_geometry(variant, folder)
-        curves[label] = stribeck_sweep(
-            gap, spacing, factors, variant.sweep.speeds, load=face_load(variant),
-            lubricant=lub, diameter=variant.tribometer.pin_diameter, face=face,
-            settings=macro_settings(variant),
-            checkpoint=folder.points, progress=progress).with_load_share(
-                variant.tribometer.load_share)
+    with executor_for(case.run.workers, case.run.scheduler) as executor:
+        reconstruct_geometry(case, out, progress, executor)
+        homogenise_patches(case, out, executor, progress)
+        tasks = [_sweep(variant, out.sub(f"variant_{i + 1}"), out, patch, speeds, progress,
+                        executor)
+                 for i, (variant, patch, speeds) in enumerate(cases.values())]
+        swept = run_sweeps([(kw, lub) for kw in tasks], executor, progress,
+                           desc="calibration points")
+    curves = {label: c.with_load_share(variant.tribometer.load_share)
+              for (label, (variant, _, _)), c in zip(cases.items(), swept)}
     ref = curves[ref_label]
-    dev = {k: friction_deviation(c.friction_coefficient, ref.friction_coefficient)
+    dev = {k: friction_deviation(c.friction_coefficient, _at(ref, c.speed))
            for k, c in curves.items()}
     labels = list(curves)
     write_stribeck_csv(out.stribeck_csv, curves.values())
     plot_stribeck(list(curves.values()), out.stribeck_png("speed"), labels=labels)
-    _plot_deviation(out.deviation_png, ref.speed, dev, ref_label, study)
+    _plot_deviation(out.deviation_png, {k: c.speed for k, c in curves.items()}, dev,
+                    ref_label, study)
     summary = {"study": study, "reference": ref_label, "viscosity_Pa_s": lub.viscosity,
                "variants": {k: {"folder": out.sub(f"variant_{i + 1}").root.name,
                                 "max_abs_cf_dev": float(np.abs(dev[k]).max())}
@@ -113,11 +135,33 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     return summary
 
 
-def _plot_deviation(path, speed, dev, ref_label, study):
+def _sweep(variant: Case, folder: RunLayout, out: RunLayout, patch, speeds, progress,
+           executor) -> dict:
+    """The sweep task of one variant (:func:`~fem_twin.stages.curves.run_sweeps`): its
+    geometry and levelled pins in ``folder``, its points in the study's checkpoints."""
+    reconstruct_geometry(variant, folder, progress, executor)
+    level_pins(variant, folder, progress, executor)
+    gap, spacing, face, _ = macro_geometry(variant, folder)
+    path = out.patch_factors(patch)
+    return dict(gap=gap, spacing=spacing, factors=FlowFactors.load(path),
+                factors_key=input_key(np.frombuffer(path.read_bytes(), np.uint8)),
+                speeds=variant.sweep.speeds if speeds is None else speeds,
+                load=face_load(variant), diameter=variant.tribometer.pin_diameter, face=face,
+                settings=macro_settings(variant), checkpoint=out.points)
+
+
+def _at(curve, speeds):
+    """``curve``'s C_f at ``speeds`` [m/s], each one of its own speeds."""
+    return np.array([curve.friction_coefficient[np.flatnonzero(np.isclose(
+        curve.speed, u, rtol=1e-12, atol=0))[0]] for u in speeds])
+
+
+def _plot_deviation(path, speeds, dev, ref_label, study):
+    """C_f,dev [%] of each variant at its speeds (``{label: speeds}``) against speed."""
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6, 4))
     for label, d in dev.items():
-        ax.semilogx(speed, 100 * d, "o-", ms=3, label=label)
+        ax.semilogx(speeds[label], 100 * d, "o-", ms=3, label=label)
     ax.set_xlabel("sliding speed U [m/s]")
     ax.set_ylabel(f"C_f,dev vs {ref_label} [%] (eq 35)")
     ax.set_title(f"calibration study: {study}")

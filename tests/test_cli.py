@@ -343,6 +343,39 @@ def test_calibration_studies(tmp_path):
     assert len(summary["variants"]) == 2                       # two patches in the small case
 
 
+def test_resolution_study_follows_the_papers_protocol(tmp_path, monkeypatch):
+    """calibrate --study resolution (paper 3.2, Figure 10): by default 128, 256, 500, 999
+    and 1997 px, the reference the measured maps' own 500 px, the two finer grids at the
+    paper's five speeds only, the others at the case's speeds and those.  Run small (maps
+    taken as 32 px, grids 24, 32, 48): the reference deviates by zero, the finer grid is
+    compared at its five speeds, every variant has its points in stribeck.csv."""
+    from fem_twin import calibration
+    case = load_case(small_case(tmp_path))
+    cases, ref = calibration.variants(case, "resolution")
+    assert list(cases) == ["128 px", "256 px", "500 px", "999 px", "1997 px"]
+    assert ref == "500 px"
+    fine = np.array(calibration.FINE_SPEEDS)
+    for label, (variant, patch, speeds) in cases.items():
+        n = int(label.split()[0])
+        assert variant.macro_geometry.resolution == (n, n) and patch is None
+        assert np.array_equal(speeds, fine) == (n > 500)
+        assert n > 500 or set(fine) | set(case.sweep.speeds) == set(speeds)
+
+    class Maps:
+        shape = (32, 32)
+    monkeypatch.setattr(calibration, "read_topography", lambda path: Maps)
+    out = tmp_path / "res"
+    assert main(["calibrate", str(small_case(tmp_path)), "--study", "resolution",
+                 "--values", "24", "32", "48", "-o", str(out), "--no-progress"]) == 0
+    summary = json.loads((out / "calibration.json").read_text())
+    assert summary["reference"] == "32 px"
+    assert summary["variants"]["32 px"]["max_abs_cf_dev"] == 0
+    assert all(0 < summary["variants"][k]["max_abs_cf_dev"] < 1 for k in ("24 px", "48 px"))
+    rows = list(csv.DictReader(open(out / "stribeck.csv")))
+    assert len(rows) == 10 + 10 + 5
+    assert sorted(float(r["speed_m_s"]) for r in rows[20:]) == sorted(fine)
+
+
 def test_sliding_direction_turns_the_roughness_patches_too(tmp_path):
     """Issue 18: with ``sliding_direction = "+x2"`` the measured maps are turned so that
     x1 is the sliding direction, patches included (they were cut unturned before, so
