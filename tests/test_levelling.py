@@ -54,3 +54,30 @@ def test_torque_residuals_need_contact():
     x = np.zeros((3, 3))
     with pytest.raises(ValueError, match="no contact"):
         torque_residuals(x, x, x)
+
+
+def test_a_fine_pin_is_levelled_on_every_other_pixel(tmp_path):
+    """fem_twin.stages.geometry.levelled_pin: a pin of more than LEVELLING_GRID pixels a
+    side is levelled on every k-th pixel and tilted by the result.  Sample pin 1 on disk 1
+    at 999 px (the measured 500 px points and one between each pair), levelled on every
+    other pixel: the tilt within 1e-7 rad of the 500 px pin's own (measured 5e-9 and
+    4.2e-8 rad, 0.2 nm over the 4 mm face radius; levelling all 999 px took 40 s against
+    3.5 s, and moved the tilt by 1.4e-7 rad); the grid and the holder are the pin's own."""
+    from fem_twin.case import load_case
+    from fem_twin.stages import geometry
+    from fem_twin.topography.prepare import prepare_disk
+    case = load_case(SAMPLE.parent.parent / "examples" / "pin_on_disk.toml")
+    pin_map, disk_map = read_topography(SAMPLE / "pin_1.npz"), read_topography(SAMPLE / "disk_1.npz")
+
+    def levelled(n):
+        opts = MacroOptions(resolution=(n, n))
+        pin = prepare_pin(pin_map, opts)
+        return pin, geometry.levelled_pin(pin, prepare_disk(disk_map, opts), case)
+
+    _, measured = levelled(500)
+    pin, fine = levelled(999)
+    assert fine.shape == pin.shape == (999, 999)
+    assert np.abs(np.subtract(fine.meta["tilt_rad"], measured.meta["tilt_rad"])).max() < 1e-7
+    face = pin.heights > -0.5e-3
+    assert np.array_equal(fine.heights[~face], pin.heights[~face])
+    assert np.array_equal(fine.heights, tilt_pin(pin, fine.meta["tilt_rad"]).heights)
