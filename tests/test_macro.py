@@ -421,6 +421,37 @@ def test_friction_error_parts(case32, factors):
     assert est["time"] == est["grid"] == est["h0"] == 0 and est["total"] == est["macro"] > 0
 
 
+def test_the_micro_parts_of_a_fine_grid_are_solved_on_a_coarser_level(factors, monkeypatch):
+    """fem_twin.macro.estimate: on grids of more than twice ``MICRO_PARTS_SIDE`` a side the
+    micro parts are solved on the coarsest nested level with at least that many nodes a
+    side (lowered here to 32: a 128^2 point's 32^2 level), warm from the point there; the
+    macro part stays on the grid coarsened by two, and a level the nested solve already has
+    is not solved again (here: the 64^2 one, so 4 solves: the 32^2 point and 3 variants)."""
+    import fem_twin.macro.estimate as E
+    from fem_twin.macro.nested import solve_nested
+    assert [E.micro_parts_level((n, n)) for n in (128, 512, 1024, 1997, 2048)] == [1, 1, 2,
+                                                                                3, 3]
+    monkeypatch.setattr(E, "MICRO_PARTS_SIDE", 32)
+    gap, dx, face = macro_case(128)
+    kw = dict(load=150.0, lubricant=Lubricant(0.066), settings=MacroSettings())
+    point, *levels = solve_nested(gap, dx, factors, speed=0.05, face=face, **kw)
+    assert [lv.pressure.shape for lv in levels] == [(64, 64)]
+    solves = []
+    counted = E.solve_mixed
+    monkeypatch.setattr(E, "solve_mixed", lambda *a, **k: solves.append(1) or counted(*a, **k))
+    est = E.friction_error(point, gap, dx, factors, face=face, levels=levels, **kw)
+    assert len(solves) == 4
+    assert est["macro"] == pytest.approx(abs(point.friction_coefficient
+                                             - levels[0].friction_coefficient)
+                                         / (2 ** E.MACRO_ORDER - 1), rel=1e-12)
+    four = dict(face=face[::4, ::4], speed=0.05, **kw)
+    base = counted(gap[::4, ::4], (4 * dx[0], 4 * dx[1]), factors, initial=levels[0], **four)
+    time = counted(gap[::4, ::4], (4 * dx[0], 4 * dx[1]), factors.variants()["time"],
+                   initial=base, **four)
+    assert est["time"] == pytest.approx(abs(time.friction_coefficient
+                                            - base.friction_coefficient), rel=1e-9)
+
+
 def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors):
     """fem_twin.macro.nested: a sweep point started from the previous one moved by the
     coarse grid's change (FAS correction) converges to the point a plain warm start
@@ -450,7 +481,7 @@ def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors)
     assert abs(curve.coarse_friction_coefficient[0, 1]
                - again.friction_coefficient) < 1e-6 * 0.19245
     assert curve.coarse_friction_coefficient[0, 0] == first_coarse.friction_coefficient
-    est = friction_error(nested, gap, dx, factors, coarse=coarse, **kw)
+    est = friction_error(nested, gap, dx, factors, levels=(coarse,), **kw)
     ref = friction_error(nested, gap, dx, factors, **kw)
     assert est["total"] == pytest.approx(ref["total"], rel=1e-3, abs=1e-6 * 0.19245)
 

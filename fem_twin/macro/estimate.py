@@ -11,11 +11,14 @@ Both scales contribute, and each part is a change of C_f [-]:
 ``"time"``, ``"grid"``, ``"h0"``
     the flow factors' own error estimates carried into C_f: the point solved with each
     variant of the factors (:meth:`FlowFactors.variants`: every other instant, the
-    coarsened cell's difference added, every other separation), on the coarse grid and
-    warm from the coarse point, minus the coarse point.  The sensitivity of C_f to the
-    factors needs no finer grid than that: the coarse grid changes C_f itself by a few
-    tenths of a per cent of C_f,b.  The ``"h0"`` variant's interpolation error is that of
-    twice the spacing, ``H0_SPACING_RATIO`` times the error of the computed sample.
+    coarsened cell's difference added, every other separation), on a coarser grid and
+    warm from the point there, minus that point.  The sensitivity of C_f to the factors
+    needs no fine grid (the coarse grid changes C_f itself by a few tenths of a per cent of
+    C_f,b): the grid coarsened by two, and on grids of more than twice
+    ``MICRO_PARTS_SIDE`` a side the coarsest nested level with at least that many
+    nodes a side (:func:`micro_parts_level`).  The ``"h0"`` variant's interpolation error
+    is that of twice the spacing, ``H0_SPACING_RATIO`` times the error of the computed
+    sample.
 
 ``"total"`` is the sum of the parts' magnitudes: their root sum of squares (independent
 errors of unknown sign), tried on 2026-11-26, fell to 0.62-0.87 of the truth on the
@@ -53,39 +56,48 @@ MACRO_ORDER = 1.5
 H0_SPACING_RATIO = 4.0
 #: the parts of an estimate, in the order of the CSV and NetCDF outputs
 PARTS = ("macro", "time", "grid", "h0")
+#: the fewest nodes a side of the grid the micro parts are solved on.  Measured on the
+#: bundled case's factors and sample pin 1 at 1024^2 (2026-11-27; docs/accuracy.md): the
+#: sum of the parts on the 256^2 level within 3.3 % of the 512^2 one at 0.03, 0.05 and
+#: 0.1 m/s (the parts are 1.2-26 times their own true changes), in 4.0-6.1 s against
+#: 29-40 s
+MICRO_PARTS_SIDE = 192
+
+
+def micro_parts_level(shape) -> int:
+    """How many coarsenings by two of a grid of ``shape`` the micro parts are solved on:
+    the most that leave at least :data:`MICRO_PARTS_SIDE` nodes a side, at least one
+    (512^2: 1; 1024^2: 2, to 256^2; 1997^2: 3, to 250^2)."""
+    side, level = min(shape), 0
+    while (side + 1) // 2 >= MICRO_PARTS_SIDE or level == 0:
+        side, level = (side + 1) // 2, level + 1
+    return level
 
 
 def friction_error(result, gap, spacing, factors, *, load: float, lubricant, face=None,
-                   settings, entrainment: float | None = None, coarse=None) -> dict:
+                   settings, entrainment: float | None = None, levels=()) -> dict:
     """Estimated discretisation error of ``result.friction_coefficient`` per part and in
     total (see the module docstring), for the point ``result`` that
-    :func:`~fem_twin.macro.solve_mixed` returned for these arguments; ``coarse``: the same
-    point already solved on the coarsened grid (:func:`.nested.solve_nested`'s), which is
-    then not solved again."""
+    :func:`~fem_twin.macro.solve_mixed` returned for these arguments; ``levels``: the same
+    point already solved on the grid's coarsenings by two, finest first
+    (:func:`.nested.solve_nested`'s levels after the first), which are then not solved
+    again."""
     face = np.ones(np.shape(gap), bool) if face is None else face
-    gap2, spacing2, face2 = coarsened(gap, spacing, face)
     common = dict(load=load, speed=result.speed, entrainment=entrainment,
-                  lubricant=lubricant, face=face2, settings=settings)
-    out, failed = {}, []
+                  lubricant=lubricant, settings=settings)
+    solve = _Levels(result, gap, spacing, face, factors, levels, common)
     try:
-        base = coarse or solve_mixed(gap2, spacing2, factors, initial=result, **common)
+        base = solve(1)
     except MixedNotConverged as err:
         return {**{part: np.nan for part in PARTS}, "total": np.nan,
                 "failed": [f"coarse grid: {err.args[0]}"]}
-    cf = base.friction_coefficient
-    signed = {"macro": (cf - result.friction_coefficient) / (2 ** MACRO_ORDER - 1)}
-    for kind, variant in factors.variants().items():
-        try:
-            moved = solve_mixed(gap2, spacing2, variant, initial=base, **common)
-        except MixedNotConverged as err:
-            out[kind] = np.nan
-            failed.append(f"{kind}: {err.args[0]}")
-            continue
-        signed[kind] = (moved.friction_coefficient - cf) / (
-            H0_SPACING_RATIO if kind == "h0" else 1.0)
+    signed = {"macro": (base.friction_coefficient - result.friction_coefficient)
+              / (2 ** MACRO_ORDER - 1)}
+    out, failed = _micro_parts(solve, factors, micro_parts_level(np.shape(gap)))
+    signed.update(out)
     smooth = factors.meta.get("smooth", False)              # no roughness: no micro error
     for kind in set(PARTS) - set(signed):
-        signed[kind] = out.get(kind, 0.0 if smooth else np.nan)
+        signed[kind] = 0.0 if smooth else np.nan
     out = {part: abs(float(signed[part])) for part in PARTS}
     out["total"] = float(np.nansum(list(out.values())))
     out["signed"] = {part: float(signed[part]) for part in PARTS}
@@ -95,3 +107,58 @@ def friction_error(result, gap, spacing, factors, *, load: float, lubricant, fac
     if failed:
         out["failed"] = failed
     return out
+
+
+def _micro_parts(solve, factors, level) -> tuple[dict, list]:
+    """``({kind: signed change of C_f}, failures)`` of the factors' variants, solved on
+    the grid coarsened ``level`` times, warm from the point there (NaN where a solve
+    failed)."""
+    variants = factors.variants()
+    if not variants:
+        return {}, []
+    try:
+        base = solve(level)
+    except MixedNotConverged as err:
+        return {kind: np.nan for kind in variants}, [f"level {level}: {err.args[0]}"]
+    signed, failed = {}, []
+    for kind, variant in variants.items():
+        try:
+            moved = solve(level, variant, base)
+        except MixedNotConverged as err:
+            signed[kind] = np.nan
+            failed.append(f"{kind}: {err.args[0]}")
+            continue
+        signed[kind] = (moved.friction_coefficient - base.friction_coefficient) / (
+            H0_SPACING_RATIO if kind == "h0" else 1.0)
+    return signed, failed
+
+
+class _Levels:
+    """``solve(level, factors=None, initial=None)``: the point on the grid coarsened
+    ``level`` times, with ``factors`` (default: the point's own) warm from ``initial``; a
+    known level of the point's own factors is taken, not solved again (nor twice)."""
+
+    def __init__(self, result, gap, spacing, face, factors, levels, common):
+        self.result, self.factors, self.common = result, factors, common
+        self.grids, self.known = [(gap, spacing, face)], {}
+        for k, level in enumerate(levels, 1):
+            if level.pressure.shape != np.shape(self.grid(k)[0]):
+                break                                     # a level the nested solve left out
+            self.known[k] = level
+
+    def grid(self, level):
+        while len(self.grids) <= level:
+            self.grids.append(coarsened(*self.grids[-1]))
+        return self.grids[level]
+
+    def __call__(self, level, factors=None, initial=None):
+        if factors is None and level in self.known:
+            return self.known[level]
+        gap, spacing, face = self.grid(level)
+        if initial is None:
+            initial = self.known.get(level - 1, self.result)
+        point = solve_mixed(gap, spacing, self.factors if factors is None else factors,
+                            face=face, initial=initial, **self.common)
+        if factors is None:
+            self.known[level] = point
+        return point

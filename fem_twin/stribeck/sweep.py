@@ -141,7 +141,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
             estimate = friction_error(res, gap, spacing, factors, load=load,
                                       lubricant=lubricant, face=face, settings=settings,
                                       entrainment=res.meta.get("entrainment"),
-                                      coarse=coarser[0] if coarser else None)
+                                      levels=coarser)
             res = replace(res, meta={**res.meta, "error_estimate": estimate,
                                      "seconds_estimate": time.perf_counter() - t0})
             if path is not None:
