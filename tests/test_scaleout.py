@@ -146,3 +146,28 @@ def test_the_task_graph_of_a_finished_run(tmp_path):
     graph = summary["task_graph"]                 # the run's summary holds the same numbers
     assert graph["tasks"] == len(tasks) and graph["cpu_s"] == pytest.approx(cpu, abs=0.1)
     assert graph["wall_s"]["2"] == pytest.approx(makespan(tasks, 2), abs=0.1)
+
+
+def test_the_largest_sweeps_are_submitted_first(monkeypatch):
+    """stages.curves.run_sweeps submits the sweeps by nodes times speeds, largest first (the
+    resolution study's 1997^2 sweep must not start last on a busy pool), and returns the
+    curves in the order of its tasks."""
+    from concurrent.futures import Future
+
+    import fem_twin.stages.curves as curves
+    monkeypatch.setattr(curves, "_sweep_task", lambda args: args[0]["gap"].shape[0])
+
+    class Recording:
+        order = []
+
+        def submit(self, fn, args):
+            self.order.append(args[0]["gap"].shape[0])
+            done = Future()
+            done.set_result(fn(args))
+            return done
+
+    pool = Recording()
+    tasks = [(dict(gap=np.zeros((n, n)), speeds=np.ones(k)), None)
+             for n, k in ((128, 17), (999, 5), (1997, 5), (256, 17))]
+    assert curves.run_sweeps(tasks, pool, progress=False) == [128, 999, 1997, 256]
+    assert pool.order == [1997, 999, 256, 128]

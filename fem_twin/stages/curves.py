@@ -319,12 +319,17 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     """Sweeps ``tasks`` [(sweep kwargs, lubricant)]: serial, or one process task each on
     ``executor``.
 
-    In parallel the bar counts the finished points of all sweeps (their checkpoint files,
-    written as each point finishes in its worker)."""
+    In parallel the largest sweeps (nodes times speeds) are submitted first, so that the
+    longest one does not start last (the resolution study's 1997^2 sweep), and the bar
+    counts the finished points of all sweeps (their checkpoint files, written as each
+    point finishes in its worker).  The curves come back in the order of ``tasks``."""
     if executor is None or len(tasks) <= 1:
         return [_sweep_task((dict(kw, progress=progress), lub)) for kw, lub in tasks]
-    futures = [executor.submit(_sweep_task, (dict(kw, progress=False), lub))
-               for kw, lub in tasks]
+    order = sorted(range(len(tasks)), key=lambda i: -np.size(tasks[i][0]["gap"])
+                   * len(tasks[i][0]["speeds"]))
+    submitted = {i: executor.submit(_sweep_task, (dict(tasks[i][0], progress=False),
+                                                  tasks[i][1])) for i in order}
+    futures = [submitted[i] for i in range(len(tasks))]
     total = sum(len(kw["speeds"]) for kw, _ in tasks)
     keys = {_sweep_key(kw, lub) for kw, lub in tasks if kw.get("factors_key")}
     folder = tasks[0][0].get("checkpoint")
