@@ -9,7 +9,9 @@ factors are single precision, refined with the residual in double precision (one
 refinement step reaches ``STEP_RTOL`` on the equilibrated matrix; half the factors' memory:
 2.06 GiB at 2048^2); below, where memory is no concern, double precision factorises in
 0.64-0.87x the time (real Newton matrices of 3k-53k unknowns, 2026-11-26; level at 214k)
-and needs no refinement.
+and needs no refinement.  The products ``J x`` of the refinement and of GMRES (below) are
+taken from ``K`` and ``B`` themselves: ``J``'s entries are built once per factorisation,
+and no double-precision copy of them is kept.
 
 The factors of a step are kept for the next steps of the same inner solve (``K`` and
 ``B`` do not change within it, only which nodes are film and which cavity).  A step whose
@@ -90,12 +92,18 @@ def newton_solver(shape, dirichlet, interior, K, B):
             v = grid.entries(K, maps[0], pos)
             v += grid.entries(B, maps[1], dtheta)
             return v
+
+        def product(x):
+            """``J x`` from ``K`` and ``B`` themselves (no copy of ``J`` in double)."""
+            u, v = np.zeros(K.shape[0]), np.zeros(K.shape[0])
+            u[interior], v[interior] = pos * x, dtheta * x
+            return (K @ u + B @ v)[interior]
         if kept and np.count_nonzero(pos != kept["pos"]) + 2 <= grid.budget():
-            x = grid.solve_kept(values(), rhs)
+            x = grid.solve_kept(product, rhs)
             if x is not None:
                 return x
         kept.clear()
-        x = grid.factor_and_solve(values, rhs)
+        x = grid.factor_and_solve(values(), product, rhs)
         if x is not None:
             kept["pos"] = pos.copy()
         return x
@@ -151,18 +159,15 @@ class _Grid:
         self._maps = [*self._maps[-1:], (digest, at.astype(np.int32), keep)]
         return self._maps[-1]
 
-    def factor_and_solve(self, values, rhs):
-        """Factorise ``J`` (its CSR data in the pattern's order is ``values()``) and solve;
-        None if pivots were perturbed or the step falls short of ``STEP_RTOL``.  The matrix
-        is equilibrated first, ``S J S`` with ``S`` the inverse square root of its diagonal:
+    def factor_and_solve(self, data, product, rhs):
+        """Factorise ``J`` (its CSR data in the pattern's order: ``data``, which this takes
+        over) and solve, refined with ``product(x) = J x`` in double precision; None if
+        pivots were perturbed or the step falls short of ``STEP_RTOL``.  The matrix is
+        equilibrated first, ``S J S`` with ``S`` the inverse square root of its diagonal:
         PARDISO's pivot threshold is absolute, and the film's ``h^3`` spans 1e9 over a pin
-        face (a 20 nm film beside the 40 um edge).  With single-precision factors ``J`` is
-        built twice, so that no double precision copy of it is alive during the
-        factorisation (0.25 GB at 2048^2); it is scaled straight into the factors'
-        precision."""
+        face (a 20 nm film beside the 40 um edge).  It is scaled straight into the factors'
+        precision, and ``data`` is freed before the factorisation (0.25 GB at 2048^2)."""
         self.release()                        # the kept factors go before new ones come
-        single = self.solver.dtype == np.float32
-        data = values()
         d = np.abs(data[self.diagonal])
         scale = 1 / np.sqrt(np.where(d > 0, d, max(float(d.max()), 1e-300)))
         own = scale.astype(self.solver.dtype)
@@ -170,35 +175,32 @@ class _Grid:
             scaled = np.repeat(own, self.counts)          # the factors' precision: no
             scaled *= data                                # second double copy alive
             scaled *= own[self.indices]
-        if single:
-            del data
+        del data
         if not np.abs(scaled).max() < SINGLE_MAX:         # inf or nan too
             return None                       # beyond single precision: the general path
         self.solver.factor(scaled)
         del scaled
         self.scale = scale
-        x = None if self.solver.perturbed else self._refined(values() if single else data,
-                                                              rhs)
+        x = None if self.solver.perturbed else self._refined(product, rhs)
         if x is None:
             self.release()
         return x
 
-    def solve_kept(self, data, rhs):
-        """``x`` solving ``J x = rhs`` (CSR data ``data``) to ``STEP_RTOL`` by GMRES with the
-        kept factors of another switch as the preconditioner, each pass refined in double
-        precision; None (and the factors freed) when it takes more than
+    def solve_kept(self, product, rhs):
+        """``x`` solving ``J x = rhs`` (``product(x) = J x``) to ``STEP_RTOL`` by GMRES with
+        the kept factors of another switch as the preconditioner, each pass refined in
+        double precision; None (and the factors freed) when it takes more than
         :meth:`budget` solves."""
-        J = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
         x, residual, budget = np.zeros_like(rhs), rhs, self.budget()
         target = STEP_RTOL * np.linalg.norm(rhs)
         while budget > 0 and np.linalg.norm(residual) > target:
             rtol = max(target / np.linalg.norm(residual), 1e-4)
-            dx, used = gmres(J.dot, self._precondition, residual, rtol, budget)
+            dx, used = gmres(product, self._precondition, residual, rtol, budget)
             budget -= used + 1
             if dx is None or not np.all(np.isfinite(dx)):
                 break
             x = x + dx
-            residual = rhs - J @ x
+            residual = rhs - product(x)
         if np.linalg.norm(residual) <= target:
             return x
         self.release()
@@ -225,10 +227,9 @@ class _Grid:
             return np.full_like(r, np.nan)
         return self.scale * self.solver.solve(b / size) * size
 
-    def _refined(self, data, rhs):
-        """``x`` solving ``J x = rhs`` to ``STEP_RTOL`` by refinement with the factors of the
-        equilibrated ``J`` (CSR data ``data``), or None."""
-        J = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+    def _refined(self, product, rhs):
+        """``x`` solving ``J x = rhs`` (``product(x) = J x``) to ``STEP_RTOL`` by refinement
+        with the factors of the equilibrated ``J``, or None."""
         x, residual = np.zeros_like(rhs), rhs
         target = STEP_RTOL * np.linalg.norm(rhs)
         for _ in range(1 + REFINEMENTS):
@@ -237,7 +238,7 @@ class _Grid:
             x = x + self._precondition(residual)
             if not np.all(np.isfinite(x)):
                 return None
-            residual = rhs - J @ x
+            residual = rhs - product(x)
         return x if np.linalg.norm(residual) <= target else None
 
 
