@@ -106,8 +106,7 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     out.root.mkdir(parents=True, exist_ok=True)
     cases, ref_label = variants(case, study, values)
     lub = case.lubricant.lubricants()[0]
-    lend = any(variant.lends_threads() for variant, _, _ in cases.values())
-    with executor_for(case.run.workers, case.run.scheduler, lend=lend) as executor:
+    with executor_for(case.run.workers, case.run.scheduler) as executor:
         reconstruct_geometry(case, out, progress, executor)
         homogenise_patches(case, out, executor, progress)
         tasks = [_sweep(variant, out.sub(f"variant_{i + 1}"), out, patch, speeds, progress,

@@ -11,7 +11,6 @@ from .checks import QUANTITIES
 from .errors import InputError
 from .sections import (SECTIONS, Geometry, LubricantSpec, MacroSpec, Materials, MicroSpec,
                        RunSpec, SweepSpec, Tribometer)
-from .threads import LEND_UNKNOWNS
 from .topography.prepare import MacroOptions
 
 
@@ -92,7 +91,7 @@ class Case:
             point = BALL_POINT_SECONDS * (self.macro.grid / 73) ** BALL_POINT_GROWTH
             estimate = 1.0
         else:
-            res = self.macro_shape()
+            res = self.macro_geometry.resolution or (256, 256)
             point = POINT_SECONDS * ((res[0] * res[1]) / 128 ** 2) ** POINT_GROWTH
             estimate = ESTIMATE_COST
         n_mu = len(self.lubricant.viscosities)
@@ -117,21 +116,9 @@ class Case:
         (``BAND_LEVEL_COST`` for each coarsening beyond the first)."""
         if self.run.band_grid != "coarsest":
             return BAND_POINT_COST[self.run.band_grid]
-        return BAND_POINT_COST["coarse"] * BAND_LEVEL_COST ** (
-            self.band_coarsening(self.macro_shape()) - 1)
-
-    def macro_shape(self) -> tuple[int, int]:
-        """Rows and columns of the macro grid: a ball's ``[macro] grid``, the pin's
-        ``[preprocessing] resolution`` (256^2 when unset)."""
-        return ((self.macro.grid,) * 2 if self.tribometer.ball
-                else tuple(self.macro_geometry.resolution or (256, 256)))
-
-    def lends_threads(self) -> bool:
-        """Whether the run's local pool lends idle workers' threads to large solves
-        (:func:`fem_twin.threads.process_pool`): macro grids of at least
-        :data:`~fem_twin.threads.LEND_UNKNOWNS` nodes."""
-        rows, cols = self.macro_shape()
-        return rows * cols >= LEND_UNKNOWNS
+        shape = ((self.macro.grid,) * 2 if self.tribometer.ball
+                 else self.macro_geometry.resolution or (256, 256))
+        return BAND_POINT_COST["coarse"] * BAND_LEVEL_COST ** (self.band_coarsening(shape) - 1)
 
 
 def load_case(path) -> Case:

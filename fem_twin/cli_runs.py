@@ -22,13 +22,10 @@ def _confirm_cost(case, yes: bool) -> float | None:
     (:func:`fem_twin.speed.slowdown`); the estimate [s], or None (refused: a long run
     without ``--yes``)."""
     from .speed import slowdown
-    from .threads import allow_lending
     if case.defaulted:
         print(f"fem-twin run: sections not in {case.source.name}, defaults used: " + ", ".join(
             f"[{s}]" for s in case.defaulted), file=sys.stderr)
     cores = case.run.workers or os.cpu_count() or 1
-    if case.lends_threads():            # before the probe loads MKL
-        allow_lending()
     speed = slowdown()
     seconds = case.estimated_seconds(cores) * speed
     mc = case.micro

@@ -14,16 +14,15 @@ the same pattern; the factorisation is 85 % of the roughness-scale time.  Two ba
     0.77-0.92x, sequential MKL 2026.2, 2026-11-26).  About 3x faster than SuperLU on a
     256^2 cell (``benchmarks/run.py micro``).  Needs ``libmkl_rt`` from the ``mkl`` wheel, which
     ``pip install "fem-twin[pardiso]"`` installs; MKL is under the Intel Simplified Software
-    License, so it stays an optional extra, not a core dependency.  MKL runs sequentially:
-    parallel speed comes from processes.  Threads only fill cores that would idle: a
-    process that allows more when it first loads MKL (``FEM_TWIN_THREADS=N``) or a run
-    with macro grids from 362^2 up (whose last tasks borrow the idle workers' cores:
-    :func:`~fem_twin.threads.lent_threads`) gets MKL's OpenMP layer, and each call runs on
-    the threads it may use.  A 1024^2 Newton LU factorised in 0.62x
-    the time on 2 threads (1.46 against 2.37 s, solves 0.52x).  Idle OpenMP threads sleep at once
-    (``KMP_BLOCKTIME=0``): spinning for the default 200 ms after each call, they took a
-    core from the numpy work between the solves (the 512^2 cold point of
-    ``benchmarks/run.py scale`` 20.4 against 17.9 s).
+    License, so it stays an optional extra, not a core dependency.  MKL runs sequentially
+    (``MKL_THREADING_LAYER=SEQUENTIAL``): parallel speed comes from processes.  A process
+    that allows more threads when it first loads MKL (``FEM_TWIN_THREADS=N``, for a lone
+    large point such as the 2048^2 grids of the resolution study) gets MKL's OpenMP layer
+    and N PARDISO threads: a 1024^2 Newton LU factorised in 0.62x the time on 2 threads
+    (1.46 against 2.37 s, solves 0.52x; sequential and one OpenMP thread take the same).
+    Its idle threads sleep at once (``KMP_BLOCKTIME=0``): spinning for the default 200 ms
+    after each call, they took a core from the numpy work between the solves (the 512^2
+    cold point of ``benchmarks/run.py scale`` 20.4 against 17.9 s).
 
 ``backend=None`` takes the environment variable ``FEM_TWIN_SPARSE`` (``auto``, ``superlu``
 or ``pardiso``); ``auto`` (the default) is PARDISO when ``libmkl_rt`` loads, else SuperLU.
@@ -44,7 +43,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .errors import InputError, MissingDependency, NotPositiveDefinite, SolverError
-from .threads import lent_threads, may_borrow, thread_limit
+from .threads import thread_limit
 
 BACKENDS = ("superlu", "pardiso")
 
@@ -52,14 +51,13 @@ BACKENDS = ("superlu", "pardiso")
 @lru_cache(maxsize=1)
 def _mkl_rt():
     """The loaded ``libmkl_rt``, or None when MKL is not installed.  Its threading layer
-    is chosen here, once per process (and inherited by forked workers): OpenMP (``INTEL``)
-    when :func:`thread_limit` allows more than one thread or a run will lend idle workers'
-    threads (:func:`~fem_twin.threads.allow_lending`), and Intel's OpenMP runtime lies
-    beside MKL; else ``SEQUENTIAL`` (a user's ``MKL_THREADING_LAYER`` wins)."""
+    is chosen here, once per process: OpenMP (``INTEL``) when :func:`thread_limit` allows
+    more than one thread and Intel's OpenMP runtime lies beside MKL, else ``SEQUENTIAL``
+    (a user's ``MKL_THREADING_LAYER`` wins)."""
     candidates = [os.environ.get("FEM_TWIN_MKL_RT"), ctypes.util.find_library("mkl_rt"),
                   *sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*")), key=len)]
     for path in filter(None, candidates):
-        threaded = (thread_limit() > 1 or may_borrow()) and bool(glob.glob(os.path.join(
+        threaded = thread_limit() > 1 and bool(glob.glob(os.path.join(
             os.path.dirname(os.path.abspath(path)), "libiomp5.so*")))
         os.environ.setdefault("MKL_THREADING_LAYER", "INTEL" if threaded else "SEQUENTIAL")
         if threaded:                # idle OpenMP threads sleep at once instead of spinning
@@ -208,8 +206,7 @@ class SPDSolver:
             return ctypes.byref(ctypes.c_int32(v))
 
         # this thread's MKL threads for the call (no effect on the sequential layer)
-        previous = lib.MKL_Set_Num_Threads_Local(ctypes.c_int(thread_limit()
-                                                             + lent_threads(self.n)))
+        previous = lib.MKL_Set_Num_Threads_Local(ctypes.c_int(thread_limit()))
         lib.pardiso(self._pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), ref(1), ref(1),
                     ref(mtype), ref(phase), ref(self.n), a.ctypes.data_as(ctypes.c_void_p),
                     self._ia.ctypes.data_as(i32), self._ja.ctypes.data_as(i32),

@@ -51,8 +51,7 @@ def run(case: Case, outdir, *, progress: bool = True, estimated_s: float | None 
     summary = {"case": case.name, "provenance": provenance(case), "stages": {},
                "seconds": {}}
     with (_lock(out), _logfile(out.log),
-          executor_for(case.run.workers, case.run.scheduler,
-                       lend=case.lends_threads()) as executor):
+          executor_for(case.run.workers, case.run.scheduler) as executor):
         log.info("case %s -> %s", case.source, outdir)
         writers = Writers(executor)         # files written beside the stages that follow
         _run_stages(case, out, executor, progress, summary,
@@ -112,8 +111,7 @@ def traction(case: Case, outdir, entrainment: float, ratios, *, progress: bool =
     out.root.mkdir(parents=True, exist_ok=True)
     summary = {"case": case.name, "stages": {}, "seconds": {}}
     with (_lock(out), _logfile(out.log),
-          executor_for(case.run.workers, case.run.scheduler,
-                       lend=case.lends_threads()) as executor):
+          executor_for(case.run.workers, case.run.scheduler) as executor):
         _run_stages(case, out, executor, progress, summary,
                     ("traction", lambda: traction_curves(case, out, entrainment, ratios,
                                                          executor, progress)))

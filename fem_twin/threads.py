@@ -83,86 +83,9 @@ def run_jobs(executor, job, items):
         yield future.result()
 
 
-def process_pool(workers: int, lend: bool = False) -> ProcessPoolExecutor:
-    """A local pool of ``workers`` processes started by :func:`quiet_worker`.  ``lend``:
-    its tasks may borrow the threads of its idle workers for large PARDISO solves
-    (:func:`lent_threads`), which needs MKL's OpenMP layer in the workers: they inherit
-    their parent's, which :func:`allow_lending` chooses before MKL's first call."""
-    if lend and workers > 1:
-        return _LendingPool(workers)
+def process_pool(workers: int) -> ProcessPoolExecutor:
+    """A local pool of ``workers`` processes started by :func:`quiet_worker`."""
     return ProcessPoolExecutor(workers, initializer=quiet_worker)
-
-
-def allow_lending() -> None:
-    """Let this process and its forked workers load MKL's OpenMP layer (one thread a call
-    unless lent: :func:`lent_threads`), for runs with macro grids of at least
-    :data:`LEND_UNKNOWNS` nodes.  Call it before MKL's first call (the CLI does, before
-    its speed probe); afterwards the layer stays as loaded and nothing is lent.  Not the
-    default: the OpenMP layer on one thread made the bundled case's cells about 5 %
-    slower (micro stage 25.5-26.3 s sequential, 26.2-28.2 s OpenMP, 2026-11-27)."""
-    global _LENDING
-    _LENDING = True
-
-
-#: the fewest unknowns of a sparse system whose factorisation borrows idle workers' threads
-#: (a 1024^2 Newton LU: 0.62x the time on 2 threads; small cells gain nothing)
-LEND_UNKNOWNS = 1 << 17
-
-
-def lent_threads(unknowns: int) -> int:
-    """Threads a task of a local pool may borrow now for a system of ``unknowns``
-    unknowns: the cores of the pool's idle workers shared among its busy ones (2 workers
-    on 2 cores, one task left: 1); 0 outside such a pool, below :data:`LEND_UNKNOWNS`, or
-    when ``FEM_TWIN_THREADS`` is set (the user's choice)."""
-    if _LENDER is None or unknowns < LEND_UNKNOWNS or "FEM_TWIN_THREADS" in os.environ:
-        return 0
-    idle, workers = _LENDER[0].value, _LENDER[1]
-    cores = min(workers, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-                else os.cpu_count() or 1)
-    return max(0, cores // max(1, workers - idle) - 1)
-
-
-def may_borrow() -> bool:
-    """Whether :func:`allow_lending` was called in this process (or its parent)."""
-    return _LENDING
-
-
-class _LendingPool(ProcessPoolExecutor):
-    """A process pool that publishes how many of its workers are idle (a shared integer
-    its workers read: :func:`lent_threads`)."""
-
-    def __init__(self, workers: int):
-        import multiprocessing
-        import threading
-        self._idle = multiprocessing.Value("i", workers, lock=False)
-        self._workers, self._outstanding, self._count = workers, 0, threading.Lock()
-        super().__init__(workers, initializer=_pool_worker, initargs=(self._idle, workers))
-
-    def submit(self, fn, /, *args, **kwargs):
-        self._track(+1)
-        try:
-            future = super().submit(fn, *args, **kwargs)
-        except BaseException:
-            self._track(-1)
-            raise
-        future.add_done_callback(lambda _: self._track(-1))
-        return future
-
-    def _track(self, change: int) -> None:
-        with self._count:
-            self._outstanding += change
-            self._idle.value = max(0, self._workers - self._outstanding)
-
-
-def _pool_worker(idle, workers: int) -> None:
-    """Initializer of a :class:`_LendingPool`'s workers."""
-    global _LENDER
-    _LENDER = (idle, workers)
-    quiet_worker()
-
-
-_LENDER = None
-_LENDING = False
 
 
 def stop_pool(pool: ProcessPoolExecutor, failed: bool = False) -> None:
@@ -195,7 +118,7 @@ DASK_ENVIRONMENT = {"DASK_" + k.upper().replace(".", "__").replace("-", "_"): st
 
 
 @contextmanager
-def executor_for(workers: int = 0, scheduler: str | None = None, lend: bool = False):
+def executor_for(workers: int = 0, scheduler: str | None = None):
     """Local process pool of ``workers`` processes (0 = all cores; ``[run] workers``) or the
     executor of the Dask cluster at ``scheduler`` (``[run] scheduler``: an address, or
     ``"local"`` for a LocalCluster of ``workers`` processes of one thread each, with
@@ -211,9 +134,7 @@ def executor_for(workers: int = 0, scheduler: str | None = None, lend: bool = Fa
     if workers <= 1:
         yield None
         return
-    if lend:
-        allow_lending()
-    pool = process_pool(workers, lend)
+    pool = process_pool(workers)
     pool.n_workers = workers
     try:
         yield pool

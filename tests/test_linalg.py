@@ -1,6 +1,5 @@
 """Sparse SPD solves with a fixed pattern (fem_twin.linalg): SuperLU and MKL PARDISO."""
 
-import os
 import pickle
 
 import numpy as np
@@ -188,9 +187,8 @@ def test_gmres_takes_one_iteration_per_changed_column():
 
 def test_pardiso_runs_the_threads_fem_twin_threads_allows():
     """FEM_TWIN_THREADS=2 when MKL first loads: MKL's OpenMP layer and two PARDISO threads
-    (a lone large point; more CPU time than wall time: needs the two cores free), the same
-    factors to round-off as the default sequential layer (one process each: the layer is
-    chosen at load)."""
+    (a lone large point; more CPU time than wall time), the same factors to round-off as
+    the default sequential layer (one process each: the layer is chosen at load)."""
     if _mkl_rt() is None:
         pytest.skip("MKL not installed")
     import json
@@ -222,50 +220,6 @@ def test_pardiso_runs_the_threads_fem_twin_threads_allows():
     assert out["1"]["layer"] == ["sequential"] and out["2"]["layer"] == ["intel"]
     assert out["1"]["cpu_over_wall"] < 1.1 < out["2"]["cpu_over_wall"]
     assert np.allclose(out["1"]["x"], out["2"]["x"], rtol=1e-10, atol=0)
-
-
-def _lent():
-    import time
-
-    from threadpoolctl import threadpool_info
-
-    from fem_twin.threads import LEND_UNKNOWNS, lent_threads
-    time.sleep(0.3)                                     # the other task is submitted
-    _mkl_rt()
-    layer = [i.get("threading_layer") for i in threadpool_info() if i["internal_api"] == "mkl"]
-    lent = lent_threads(LEND_UNKNOWNS), lent_threads(LEND_UNKNOWNS - 1), layer
-    time.sleep(1.0)                                     # and still runs when it reads
-    return lent
-
-
-def test_a_lone_task_of_a_pool_borrows_the_idle_workers_threads():
-    """threads.lent_threads: in a lending pool of 2 workers (MKL's OpenMP layer, chosen by
-    allow_lending before MKL's first call) a lone task may run a large system's PARDISO on
-    the idle worker's thread as well, two tasks at once may not, nor small systems, nor a
-    process outside such a pool; a plain pool lends nothing (a process of its own: the
-    layer is chosen once per process)."""
-    if _mkl_rt() is None:
-        pytest.skip("MKL not installed")
-    import subprocess
-    import sys
-    script = (
-        "import sys; sys.path.insert(0, 'tests')\n"
-        "from fem_twin.threads import LEND_UNKNOWNS, executor_for, lent_threads\n"
-        "with executor_for(2, lend=sys.argv[1] == 'lend') as pool:\n"
-        "    from test_linalg import _lent  # loads MKL (its layer) before the workers fork\n"
-        "    [f.result() for f in [pool.submit(_lent) for _ in range(2)]]  # both started\n"
-        "    print(pool.submit(_lent).result())\n"
-        "    print([f.result()[:2] for f in [pool.submit(_lent) for _ in range(2)]])\n"
-        "print(lent_threads(LEND_UNKNOWNS))\n")
-    env = {k: v for k, v in os.environ.items()
-           if not k.startswith("MKL_") and k != "FEM_TWIN_THREADS"}
-    out = {kind: subprocess.run([sys.executable, "-c", script, kind], capture_output=True,
-                                text=True, env=env, check=True,
-                                cwd=os.path.dirname(os.path.dirname(__file__))).stdout
-           for kind in ("lend", "plain")}
-    assert out["lend"].split("\n")[:3] == ["(1, 0, ['intel'])", "[(0, 0), (0, 0)]", "0"]
-    assert out["plain"].split("\n")[:3] == ["(0, 0, ['sequential'])", "[(0, 0), (0, 0)]",
-                                             "0"]
 
 
 def test_anderson_seeded_with_the_pairs_of_a_related_map():
