@@ -93,8 +93,8 @@ def friction_error(result, gap, spacing, factors, *, load: float, lubricant, fac
                 "failed": [f"coarse grid: {err.args[0]}"]}
     signed = {"macro": (base.friction_coefficient - result.friction_coefficient)
               / (2 ** MACRO_ORDER - 1)}
-    out, failed = _micro_parts(solve, factors, micro_parts_level(np.shape(gap)))
-    signed.update(out)
+    micro, failed = _micro_parts(solve, factors, micro_parts_level(np.shape(gap)))
+    signed.update(micro)
     smooth = factors.meta.get("smooth", False)              # no roughness: no micro error
     for kind in set(PARTS) - set(signed):
         signed[kind] = 0.0 if smooth else np.nan
