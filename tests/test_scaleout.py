@@ -171,3 +171,49 @@ def test_the_largest_sweeps_are_submitted_first(monkeypatch):
              for n, k in ((128, 17), (999, 5), (1997, 5), (256, 17))]
     assert curves.run_sweeps(tasks, pool, progress=False) == [128, 999, 1997, 256]
     assert pool.order == [1997, 999, 256, 128]
+
+
+def test_a_sweep_longer_than_a_workers_share_runs_as_chains(monkeypatch):
+    """stages.curves.run_sweeps cuts a sweep that costs more than an even share of a pool's
+    workers into chains of consecutive speeds (the resolution study's 1997^2 sweep: three
+    chains on two workers, the other grids whole), submits them largest first and joins
+    each sweep's chains back into one curve in speed order; a sweep that writes fields
+    stays whole."""
+    from concurrent.futures import Future
+
+    import fem_twin.stages.curves as curves
+    from fem_twin.stribeck import StribeckCurve
+
+    def sweep(args):
+        kw, speeds = args[0], np.asarray(args[0]["speeds"])
+        one = np.full(speeds.size, kw["gap"].shape[0], float)
+        return StribeckCurve(speeds, speeds, speeds / 10, 0.066, one, one, one, one, one,
+                             friction_error=speeds / 100,
+                             friction_error_parts={"macro": speeds / 100},
+                             coarse_friction_coefficient=np.vstack([speeds] * 2))
+    monkeypatch.setattr(curves, "_sweep_task", sweep)
+
+    class Pool:
+        n_workers, order = 2, []
+
+        def submit(self, fn, args):
+            self.order.append((args[0]["gap"].shape[0], len(args[0]["speeds"])))
+            done = Future()
+            done.set_result(fn(args))
+            return done
+
+    speeds = {128: 17, 256: 17, 500: 17, 999: 5, 1997: 5}
+    tasks = [(dict(gap=np.zeros((n, n)), speeds=np.geomspace(2, 0.005, k)), None)
+             for n, k in speeds.items()]
+    pool = Pool()
+    out = curves.run_sweeps(tasks, pool, progress=False)
+    assert pool.order == [(1997, 2), (1997, 2), (999, 5), (500, 17), (1997, 1), (256, 17),
+                          (128, 17)]
+    for (kw, _), c in zip(tasks, out):
+        assert np.array_equal(c.speed, kw["speeds"])
+        assert np.array_equal(c.friction_coefficient, kw["speeds"] / 10)
+        assert np.array_equal(c.friction_error_parts["macro"], kw["speeds"] / 100)
+        assert c.coarse_friction_coefficient.shape == (2, kw["speeds"].size)
+    fields = [(dict(kw, fields="somewhere"), lub) for kw, lub in tasks]
+    assert len(curves.chains(fields, 2)) == len(tasks)
+    assert len(curves.chains(tasks, 1)) == len(tasks)

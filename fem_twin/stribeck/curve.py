@@ -101,6 +101,32 @@ class StribeckCurve:
         return np.where(inside, PchipInterpolator(x, y)(np.clip(h, x[0], x[-1])), np.nan)
 
 
+def joined(curves) -> StribeckCurve:
+    """One curve of the points of ``curves`` (pieces of one sweep at one viscosity, in
+    order); the coarse levels' C_f padded with NaN where a piece has fewer levels."""
+    first = curves[0]
+    if len(curves) == 1:
+        return first
+    if any(c.viscosity != first.viscosity for c in curves):
+        raise InputError("joined: the pieces of a curve share one viscosity")
+    arrays = {name: np.concatenate([getattr(c, name) for c in curves])
+              for name in COLUMNS if name != "viscosity"}
+    error = None if first.friction_error is None else np.concatenate(
+        [c.friction_error for c in curves])
+    parts = None if first.friction_error_parts is None else {
+        k: np.concatenate([c.friction_error_parts[k] for c in curves])
+        for k in first.friction_error_parts}
+    coarse = None
+    if first.coarse_friction_coefficient is not None:
+        levels = max(c.coarse_friction_coefficient.shape[0] for c in curves)
+        coarse = np.concatenate([np.pad(c.coarse_friction_coefficient,
+                                        ((0, levels - c.coarse_friction_coefficient.shape[0]),
+                                         (0, 0)), constant_values=np.nan) for c in curves],
+                                axis=1)
+    return replace(first, **arrays, friction_error=error, friction_error_parts=parts,
+                   coarse_friction_coefficient=coarse)
+
+
 def write_stribeck_csv(path, curves, band=None) -> Path:
     """All curves into one CSV (:data:`HEADERS`, SI units), atomically; ``cf_err``, the
     estimated discretisation error of C_f, when a curve has it; ``band``: optional
