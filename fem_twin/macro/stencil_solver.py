@@ -7,11 +7,13 @@ of theirs, so a step costs one numeric factorisation and a solve (the kept maps 
 bundled-case sweep 12 % faster).  On grids of more than ``SINGLE_UNKNOWNS`` unknowns the
 factors are single precision, refined with the residual in double precision (one
 refinement step reaches ``STEP_RTOL`` on the equilibrated matrix; half the factors' memory:
-2.06 GiB at 2048^2); below, where memory is no concern, double precision factorises in
-0.64-0.87x the time (real Newton matrices of 3k-53k unknowns, 2026-11-26; level at 214k)
-and needs no refinement.  The products ``J x`` of the refinement and of GMRES (below) are
-taken from ``K`` and ``B`` themselves: ``J``'s entries are built once per factorisation,
-and no double-precision copy of them is kept.
+2.06 GiB at 2048^2).  Single precision factorises the same Newton matrices in 0.82x the
+time at 13k unknowns, 0.75x at 53k, 0.67x at 214k and 0.60x at 859k (PARDISO, one thread,
+AMD EPYC, 2026-11-27); below ``SINGLE_UNKNOWNS`` the refinement's extra solve and product
+cost about what that saves, and double precision needs no refinement.  The products
+``J x`` of the refinement and of GMRES (below) are taken from ``K`` and ``B`` themselves:
+``J``'s entries are built once per factorisation, and no double-precision copy of them is
+kept.
 
 The factors of a step are kept for the next steps of the same inner solve (``K`` and
 ``B`` do not change within it, only which nodes are film and which cavity).  A step whose
@@ -59,8 +61,11 @@ REUSE_SOLVES = 16
 #: 16.7 at 214k unknowns, 22 at 859k; 20-40 at 3.4M), a rule of the size rather than of
 #: measured times so that a run repeats to the last bit
 REUSE_SHARE = 0.5 * 1.44
-#: grids of more unknowns factorise in single precision (memory: 2048^2 has 3.4M)
-SINGLE_UNKNOWNS = 1 << 20
+#: grids of more unknowns factorise in single precision (from about 181^2 nodes; the cold
+#: and warm points of ``benchmarks/run.py scale`` against 2^20, twice each, 2026-11-27:
+#: 0.87-0.94x and 0.85-0.90x at 256^2, 0.86-0.89x and 0.84-0.87x at 512^2, 0.78-0.79x and
+#: 0.73-0.75x at 1024^2, peak memory 0.83x there, C_f the same to 1e-13)
+SINGLE_UNKNOWNS = 1 << 15
 #: grids whose patterns and PARDISO analyses are kept (a sweep with error estimates
 #: alternates between the grid and its coarsening) ...
 GRIDS = 3
