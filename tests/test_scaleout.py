@@ -175,8 +175,8 @@ def test_the_largest_sweeps_are_submitted_first(monkeypatch):
 
 def test_a_sweep_longer_than_a_workers_share_runs_as_chains(monkeypatch):
     """stages.curves.run_sweeps cuts a sweep that costs more than an even share of a pool's
-    workers into chains of consecutive speeds (the resolution study's 1997^2 sweep: three
-    chains on two workers, the other grids whole), submits them largest first and joins
+    workers into chains of consecutive speeds (the resolution study's 1997^2 sweep: four
+    chains on two workers, started before the 500^2 sweep; the other grids whole), submits them largest first and joins
     each sweep's chains back into one curve in speed order; a sweep that writes fields
     stays whole."""
     from concurrent.futures import Future
@@ -207,8 +207,8 @@ def test_a_sweep_longer_than_a_workers_share_runs_as_chains(monkeypatch):
              for n, k in speeds.items()]
     pool = Pool()
     out = curves.run_sweeps(tasks, pool, progress=False)
-    assert pool.order == [(1997, 2), (1997, 2), (999, 5), (500, 17), (1997, 1), (256, 17),
-                          (128, 17)]
+    assert pool.order == [(1997, 2), (1997, 1), (1997, 1), (1997, 1), (999, 5), (500, 17),
+                          (256, 17), (128, 17)]
     for (kw, _), c in zip(tasks, out):
         assert np.array_equal(c.speed, kw["speeds"])
         assert np.array_equal(c.friction_coefficient, kw["speeds"] / 10)

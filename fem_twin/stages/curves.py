@@ -33,6 +33,12 @@ from ..threads import worker_heap
 from .geometry import ball_contact, face_load, hersey_length, macro_geometry
 from .provenance import provenance, stage_keys
 
+#: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH: the resolution
+#: study (2026-11-27, two points at a time) 9.5 s a point at 500^2, 7.4 min at 1997^2
+#: (N^1.39); the largest-first schedule then starts the 1997^2 points before the 500^2
+#: sweep (by nodes alone it did not, and the study's sweeps took about 2 min longer)
+COST_GROWTH = 1.35
+
 log = logging.getLogger("fem_twin")
 
 
@@ -320,12 +326,11 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     """Sweeps ``tasks`` [(sweep kwargs, lubricant)]: serial, or in process tasks on
     ``executor``.
 
-    In parallel a sweep that costs more than a worker's even share (nodes times speeds,
-    :func:`chains`) is cut into chains of consecutive speeds, each started cold,
-    so that the resolution study's 1997^2 sweep runs on both cores instead of alone on
-    one; the chains are submitted largest first, and the bar counts the finished points of
-    all sweeps (their checkpoint files, written as each point finishes in its worker).  The
-    curves come back in the order of ``tasks``, each chain's points joined."""
+    In parallel a sweep that costs more than a worker's even share (:func:`chains`) is cut
+    into chains of consecutive speeds, each started cold, so that the resolution study's
+    1997^2 sweep runs on both cores instead of alone on one; the chains are submitted
+    largest first, and the bar counts the finished points of all sweeps (their checkpoint
+    files, written as each point finishes in its worker).  The curves come back in the order of ``tasks``, each chain's points joined."""
     if executor is None or len(tasks) == 0:
         return [_sweep_task((dict(kw, progress=progress), lub)) for kw, lub in tasks]
     pieces = chains(tasks, getattr(executor, "n_workers", 1))
@@ -349,7 +354,7 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
 
 def chains(tasks, workers: int) -> list:
     """``[(task, kwargs)]``: each sweep of ``tasks`` as chains of consecutive speeds, in
-    order.  A sweep that writes no fields and costs (nodes times speeds) more than an even
+    order.  A sweep that writes no fields and costs (:func:`_cost`) more than an even
     share of the total over ``workers`` is cut into chains of about equal length, each
     costing at most half such a share (one point at least), so that a largest-first
     schedule keeps every worker busy to the end.  A chain's first point starts cold (from
@@ -368,9 +373,9 @@ def chains(tasks, workers: int) -> list:
     return out
 
 
-def _cost(kwargs) -> int:
-    """A sweep's cost in nodes times speeds."""
-    return int(np.size(kwargs["gap"])) * len(kwargs["speeds"])
+def _cost(kwargs) -> float:
+    """A sweep's cost: speeds times nodes to the power :data:`COST_GROWTH`."""
+    return float(np.size(kwargs["gap"])) ** COST_GROWTH * len(kwargs["speeds"])
 
 
 def _sweep_task(args):
