@@ -38,7 +38,8 @@ from .io.figure import save_figure
 from .io.files import read_topography
 from .io.layout import RunLayout
 from .micro import FlowFactors
-from .stages.curves import macro_settings, run_sweeps
+from .stages.curves import macro_settings
+from .stages.sweeps import run_sweeps
 from .stages.factors import homogenise_patches
 from .stages.geometry import face_load, level_pins, macro_geometry, reconstruct_geometry
 from .stribeck import friction_deviation, plot_stribeck, write_stribeck_csv
@@ -137,7 +138,7 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
 
 def _sweep(variant: Case, folder: RunLayout, out: RunLayout, patch, speeds, progress,
            executor) -> dict:
-    """The sweep task of one variant (:func:`~fem_twin.stages.curves.run_sweeps`): its
+    """The sweep task of one variant (:func:`~fem_twin.stages.sweeps.run_sweeps`): its
     geometry and levelled pins in ``folder``, its points in the study's checkpoints."""
     reconstruct_geometry(variant, folder, progress, executor)
     level_pins(variant, folder, progress, executor)

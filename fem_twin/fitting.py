@@ -18,7 +18,8 @@ from .io.layout import RunLayout
 from .io.table import write_csv
 from .macro.viscosity import WaltherLaw
 from .micro import FlowFactors
-from .stages.curves import macro_settings, run_sweeps
+from .stages.curves import macro_settings
+from .stages.sweeps import run_sweeps
 from .stages.geometry import hersey_length, macro_geometry
 from .stages.provenance import stage_keys
 from .stribeck import read_measured_csv

@@ -9,7 +9,7 @@ from fem_twin import Topography
 from fem_twin.io.files import read_topography
 from fem_twin.macro import Lubricant
 from fem_twin.micro import homogenise
-from fem_twin.stages.curves import run_sweeps
+from fem_twin.stages.sweeps import run_sweeps
 from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 
@@ -149,12 +149,12 @@ def test_the_task_graph_of_a_finished_run(tmp_path):
 
 
 def test_the_largest_sweeps_are_submitted_first(monkeypatch):
-    """stages.curves.run_sweeps submits the sweeps by nodes times speeds, largest first (the
+    """stages.sweeps.run_sweeps submits the sweeps by nodes times speeds, largest first (the
     resolution study's 1997^2 sweep must not start last on a busy pool), and returns the
     curves in the order of its tasks."""
     from concurrent.futures import Future
 
-    import fem_twin.stages.curves as curves
+    import fem_twin.stages.sweeps as curves
     monkeypatch.setattr(curves, "_sweep_task", lambda args: args[0]["gap"].shape[0])
 
     class Recording:
@@ -174,14 +174,14 @@ def test_the_largest_sweeps_are_submitted_first(monkeypatch):
 
 
 def test_a_sweep_longer_than_a_workers_share_runs_as_chains(monkeypatch):
-    """stages.curves.run_sweeps cuts a sweep that costs more than an even share of a pool's
+    """stages.sweeps.run_sweeps cuts a sweep that costs more than an even share of a pool's
     workers into chains of consecutive speeds (the resolution study's 1997^2 sweep: four
-    chains on two workers, started before the 500^2 sweep; the other grids whole), submits them largest first and joins
-    each sweep's chains back into one curve in speed order; a sweep that writes fields
-    stays whole."""
+    chains on two workers, started before the 500^2 sweep; the other grids whole), submits
+    them largest first and joins each sweep's chains back into one curve in speed order; a
+    sweep that writes fields stays whole."""
     from concurrent.futures import Future
 
-    import fem_twin.stages.curves as curves
+    import fem_twin.stages.sweeps as curves
     from fem_twin.stribeck import StribeckCurve
 
     def sweep(args):

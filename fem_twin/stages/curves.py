@@ -6,12 +6,10 @@ from __future__ import annotations
 
 import json
 import logging
-from concurrent.futures import wait
 from dataclasses import fields, replace
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
 from ..case import Case
 from ..io.writers import Writers
@@ -21,23 +19,15 @@ from ..macro.nested import coarsened
 from ..macro.figures import plot_point_files
 from ..macro.point_contact import film_against_hamrock_dowson
 from ..micro import FlowFactors
-from ..stribeck import plot_stribeck, read_measured_csv, stribeck_sweep, write_stribeck_csv
-from ..stribeck.curve import joined
+from ..stribeck import plot_stribeck, read_measured_csv, write_stribeck_csv
 from ..stribeck.accuracy import error_summary, range_summary
 from ..stribeck.analysis import (defect_corrected, hersey_collapse, patch_band,
                                  transition_speeds)
-from ..stribeck.sweep import (LOAD_BELOW, point_files, point_key, point_meta, point_speed,
-                              sweep_key)
+from ..stribeck.sweep import LOAD_BELOW, point_files, point_key, point_meta, point_speed
 from ..stribeck.validation import validate_curves
-from ..threads import worker_heap
 from .geometry import ball_contact, face_load, hersey_length, macro_geometry
 from .provenance import provenance, stage_keys
-
-#: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH: the resolution
-#: study (2026-11-27, two points at a time) 9.5 s a point at 500^2, 7.4 min at 1997^2
-#: (N^1.39); the largest-first schedule then starts the 1997^2 points before the 500^2
-#: sweep (by nodes alone it did not, and the study's sweeps took about 2 min longer)
-COST_GROWTH = 1.35
+from .sweeps import run_sweeps, task_key
 
 log = logging.getLogger("fem_twin")
 
@@ -146,7 +136,7 @@ def band_tasks(case: Case, out: RunLayout, common: dict) -> list:
                                        sweeps[0]["face"])
         sweeps = [dict(kw, gap=gap, spacing=spacing, face=face) for kw in sweeps]
     band = replace(common["settings"], tol=case.run.band_tol)
-    return [(dict(kw, settings=band, guide=_sweep_key(
+    return [(dict(kw, settings=band, guide=task_key(
         dict(kw, factors_key=common["factors_key"]), lub)), lub)
         for kw in sweeps for lub in case.lubricant.lubricants()]
 
@@ -207,7 +197,7 @@ def _range_check(common: dict, tasks) -> dict:
         for kw, lub in tasks:
             name = kw["factors_key"].rsplit("-", 1)[-1]
             factors = name if name.startswith("patch") else "average"
-            for path in point_files(common["checkpoint"], _sweep_key(kw, lub)):
+            for path in point_files(common["checkpoint"], task_key(kw, lub)):
                 scalars, meta = point_meta(path)
                 share = meta.get(LOAD_BELOW)
                 if share is None:
@@ -223,7 +213,7 @@ def _plot_fields(out: RunLayout, folder: Path, tasks, writers: Writers) -> None:
     """The fields of the fastest, a middle and the slowest point of each main sweep
     ``tasks``, from their checkpoints in ``folder``."""
     for kw, lub in tasks:
-        files = sorted(point_files(folder, _sweep_key(kw, lub)), key=point_speed,
+        files = sorted(point_files(folder, task_key(kw, lub)), key=point_speed,
                        reverse=True)                                     # fast to slow
         chosen = [files[i] for i in sorted({0, len(files) // 2, len(files) - 1})]
         writers.write(plot_point_files, chosen, out.fields_png(lub.viscosity), lub.viscosity)
@@ -287,7 +277,7 @@ def sweep_points(folder: Path, tasks) -> dict:
     """{(viscosity, speed): MixedResult} of the checkpoints of the sweeps ``tasks``."""
     points = {}
     for kw, lub in tasks:
-        for path in point_files(folder, _sweep_key(kw, lub)):
+        for path in point_files(folder, task_key(kw, lub)):
             res = MixedResult.load(path)
             speed = res.speed if kw.get("slide_to_roll") is None else res.meta["entrainment"]
             points[lub.viscosity, speed] = res
@@ -322,79 +312,9 @@ def _attributes(case: Case) -> dict:
             "provenance": json.dumps(provenance(case))}
 
 
-def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points"):
-    """Sweeps ``tasks`` [(sweep kwargs, lubricant)]: serial, or in process tasks on
-    ``executor``.
-
-    In parallel a sweep that costs more than a worker's even share (:func:`chains`) is cut
-    into chains of consecutive speeds, each started cold, so that the resolution study's
-    1997^2 sweep runs on both cores instead of alone on one; the chains are submitted
-    largest first, and the bar counts the finished points of all sweeps (their checkpoint
-    files, written as each point finishes in its worker).  The curves come back in the order of ``tasks``, each chain's points joined."""
-    if executor is None or len(tasks) == 0:
-        return [_sweep_task((dict(kw, progress=progress), lub)) for kw, lub in tasks]
-    pieces = chains(tasks, getattr(executor, "n_workers", 1))
-    if len(pieces) <= 1:
-        return [_sweep_task((dict(kw, progress=progress), lub)) for kw, lub in tasks]
-    order = sorted(range(len(pieces)), key=lambda j: -_cost(pieces[j][1]))
-    submitted = {j: executor.submit(_sweep_task, (dict(pieces[j][1], progress=False),
-                                                  tasks[pieces[j][0]][1])) for j in order}
-    futures = [submitted[j] for j in range(len(pieces))]
-    total = sum(len(kw["speeds"]) for kw, _ in tasks)
-    keys = {_sweep_key(kw, lub) for kw, lub in tasks if kw.get("factors_key")}
-    folder = tasks[0][0].get("checkpoint")
-    with tqdm(total=total, desc=desc, unit="point", disable=not progress) as bar:
-        while wait(futures, timeout=0.5).not_done:            # the bar, twice a second
-            if folder is not None and keys:                   # points finished so far
-                bar.update(sum(point_key(p) in keys for p in point_files(folder)) - bar.n)
-        bar.update(total - bar.n)
-    return [joined([f.result() for (i, _), f in zip(pieces, futures) if i == task])
-            for task in range(len(tasks))]
-
-
-def chains(tasks, workers: int) -> list:
-    """``[(task, kwargs)]``: each sweep of ``tasks`` as chains of consecutive speeds, in
-    order.  A sweep that writes no fields and costs (:func:`_cost`) more than an even
-    share of the total over ``workers`` is cut into chains of about equal length, each
-    costing at most half such a share (one point at least), so that a largest-first
-    schedule keeps every worker busy to the end.  A chain's first point starts cold (from
-    the coarsest nested level): on the resolution study's 999^2 grid, five such points took
-    419 s against 438 s for the warm sweep of the same five speeds beside them (2026-11-27,
-    C_f the same to 2e-6).  A sweep that writes fields stays whole (one VTU per speed,
-    numbered along the sweep, and one PVD)."""
-    share = sum(map(_cost, (kw for kw, _ in tasks))) / max(workers, 1)
-    out = []
-    for i, (kw, _) in enumerate(tasks):
-        n = len(kw["speeds"])
-        whole = workers <= 1 or kw.get("fields") is not None or _cost(kw) <= share
-        count = 1 if whole else min(n, int(np.ceil(2 * _cost(kw) / share)))
-        out += [(i, dict(kw, speeds=np.asarray(kw["speeds"])[part]))
-                for part in np.array_split(np.arange(n), count)]
-    return out
-
-
-def _cost(kwargs) -> float:
-    """A sweep's cost: speeds times nodes to the power :data:`COST_GROWTH`."""
-    return float(np.size(kwargs["gap"])) ** COST_GROWTH * len(kwargs["speeds"])
-
-
-def _sweep_task(args):
-    """One viscosity's sweep (a picklable unit of work for process pools and Dask)."""
-    worker_heap()
-    kwargs, lub = args
-    return stribeck_sweep(lubricant=lub, **kwargs)
-
-
-def _sweep_key(kwargs: dict, lubricant) -> str:
-    """Checkpoint key of one sweep task (:func:`~fem_twin.stribeck.sweep.point_file`)."""
-    return sweep_key(kwargs["gap"], kwargs["spacing"], kwargs["factors_key"], kwargs["load"],
-                     lubricant, kwargs["settings"], kwargs["face"],
-                     kwargs.get("slide_to_roll"))
-
-
 def _prune_points(folder: Path, tasks) -> None:
     """Remove the Stribeck checkpoints of no current sweep or guide (changed inputs)."""
-    keys = {_sweep_key(kw, lub) for kw, lub in tasks} | {kw.get("guide") for kw, _ in tasks}
+    keys = {task_key(kw, lub) for kw, lub in tasks} | {kw.get("guide") for kw, _ in tasks}
     stale = [p for p in point_files(folder) if point_key(p) not in keys]
     for p in stale:
         p.unlink()
