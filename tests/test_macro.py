@@ -372,9 +372,10 @@ def test_start_separations_find_analytic_roots():
 
 @pytest.mark.parametrize("speed", [1.0, 0.01])
 def test_inexact_inner_solves_reach_the_exact_state(case32, factors, speed):
-    """One Newton step per Reynolds solve while the coupling is far from converged (the
-    default) ends on the state of inner solves to convergence (``inner_steps=0``, the
-    previous method) within two independent 1e-6 stops, in full film and in mixed
+    """One Newton step per Reynolds solve while the coupling is far from converged, after
+    a first solve stopped once its active set settled (the default), ends on the state of
+    inner solves to convergence (``inner_steps=0``, the previous method) within two
+    independent 1e-6 stops, in full film and in mixed
     lubrication: the outer iteration corrects the truncated solves and stops only after an
     exact one."""
     gap, spacing, face = case32

@@ -6,10 +6,12 @@ JFO cavitation (eq 18) couples the film pressure ``p = p_hd - p_cav`` and the ca
 fraction ``theta`` by ``p theta = 0``, ``p >= 0``, ``theta >= 0``.  A model carries them in
 one unknown per node, ``phi``, and provides:
 
-``solve(K, B, dirichlet, p_boundary, scale, *, phi0, tol, max_iter, inexact)``
+``solve(K, B, dirichlet, p_boundary, scale, *, phi0, tol, max_iter, inexact[, settle])``
     the inner problem ``K p + B (1 - theta) = 0`` on the interior, Dirichlet nodes at
     ``p = p_boundary``, ``theta = 0``; returns ``(phi, iterations, residual history)``
     (the fixed-point couplings, ``solve_reynolds`` and the Newton coupling's cold start);
+    ``settle`` only where the class attribute ``settles`` is true (an active-set solver
+    that can stop once its active set has settled, :func:`.switch.solve_complementarity`);
 ``split(phi, scale)``
     ``(p, theta)`` of the unknown;
 ``unknown(p, theta, scale)``
@@ -39,6 +41,7 @@ class PThetaSwitch:
     set, :func:`fem_twin.macro.switch.solve_complementarity`)."""
 
     name = "switch"
+    settles = True
 
     @staticmethod
     def solve(K, B, dirichlet, p_boundary, scale, **options):
@@ -65,6 +68,7 @@ class FischerBurmeister(PThetaSwitch):
     linearises as the switch; it differs in the inner solve (5-7x slower, same solution)."""
 
     name = "fb"
+    settles = False
 
     @staticmethod
     def solve(K, B, dirichlet, p_boundary, scale, **options):

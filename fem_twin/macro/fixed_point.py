@@ -26,7 +26,9 @@ Converged when, between two iterations, the change of ``h_el`` / h_ref, the upda
 ``p_con`` / p_ref (eq 27), the change of ``p`` / p_ref and the load residual (eq 30) are all
 below ``tol``.  While the residual is above ``INEXACT * tol`` the Reynolds solves are cut
 to ``MacroSettings.inner_steps`` Newton steps (inexact inner solves: the outer iteration
-corrects what they leave); convergence is only accepted after an exact one.
+corrects what they leave); convergence is only accepted after an exact one.  The first
+solve, from the start's film, runs until its active set has settled (``SETTLE``; for
+a cavitation model that settles, else to convergence).
 """
 
 from __future__ import annotations
@@ -63,6 +65,18 @@ INEXACT = 10.0
 #: coupling iterations against 14, the 256^2 one 12 against 15; 1024^2 9 against 10;
 #: 2 to 6 pairs did as well, 1 and 8 worse)
 SEED_PAIRS = 4
+#: the first Reynolds solve of a coupling stops at the first Newton step that switches at
+#: most this fraction of the nodes its first step switched (``settle`` of
+#: :func:`.switch.solve_complementarity`), instead of solving to convergence: from a
+#: coarser grid's film the steps switch 3407, 1646, 327, 34, then 1-4 nodes five times
+#: (the cold 1024^2 point of ``benchmarks/run.py scale``), and that tail took 14 of the
+#: fine level's 62 s.  Measured on that benchmark's points (2026-11-27, one thread): 0.01
+#: stops after the 34 (warm: after 6 of 4090) and gave 0.82x and 0.86x the cold and warm
+#: 2048^2 points (384 against 468 s, 288 against 334 s; 7 and 6 coupling iterations
+#: against 7 and 5; C_f within 3e-10), with 0.1 the warm 2048^2 point took 14 iterations
+#: and 1.35x the time (it stops with hundreds of nodes still to switch); stopping after
+#: one step (a plain inexact first solve) took 15 coupling iterations against 10 at 512^2
+SETTLE = 0.01
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,10 +117,13 @@ def solve_fixed_point(P, load: float, face, initial=None, progress=None, secants
     outer = _Pid(s) if s.coupling == "pid" else _Mixing(P, load, face, secants)
     history, good, retries, row, res = [], None, 0, (np.nan,) * 4, np.inf
     for it in range(1, s.max_iter + 1):
-        exact = not s.inner_steps or it == 1 or res < INEXACT * s.tol
+        exact = (not s.inner_steps or res < INEXACT * s.tol
+                 or (it == 1 and not inner.model.settles))
+        settle = SETTLE if it == 1 and not exact else 0.0
         try:
             ev = inner.evaluate(h_el, h_d, p_con if s.coupling == "pid" else None,
-                                steps=None if exact else s.inner_steps)
+                                steps=None if exact or settle else s.inner_steps,
+                                settle=settle)
         except ReynoldsNotConverged as err:     # an over-long step (gap far too thin)
             retries += 1
             if good is None or retries > RETRIES:
@@ -162,11 +179,11 @@ class _Reynolds:
         """A cold inner start (the state is far from the last one)."""
         self.phi, self.p = None, np.full(self.P.shape, self.p_amb_rel)
 
-    def evaluate(self, h_el, h_d, p_con=None, steps=None) -> FixedPointEvaluation:
+    def evaluate(self, h_el, h_d, p_con=None, steps=None, settle=0.0) -> FixedPointEvaluation:
         """Solve at ``h0 = h_d + h_g + h_el`` (eq 19); ``p_con`` [Pa] is used in the load and
         the deformation when given (``"pid"``), else ``p_con(h0)``; ``steps`` cuts the solve
-        to that many Newton steps (an inexact inner solve).  Returns every field the updates
-        and the result need."""
+        to that many Newton steps, ``settle`` stops it once its active set has settled
+        (inexact inner solves).  Returns every field the updates and the result need."""
         P, s = self.P, self.P.settings
         h0 = np.maximum(h_d + P.gap + h_el, s.gap_floor)
         p_prev = self.p
@@ -178,6 +195,8 @@ class _Reynolds:
         loc = replace(loc, A=None, b=None)
         del g, q
         cut = {} if steps is None else dict(max_iter=steps, inexact=True)
+        if settle:
+            cut = dict(settle=settle)
         phi, its, _ = self.model.solve(K, B, P.boundary, self.p_amb_rel, s.p_ref,
                                        phi0=self.phi, **cut)
         del K, B

@@ -24,12 +24,16 @@ ROUND_OFF = 1e3 * np.finfo(float).eps
 
 
 def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=1e-10,
-                          max_iter=200, inexact=False):
+                          max_iter=200, inexact=False, settle=0.0):
     """Semismooth Newton on ``K p + B (1 - theta) = 0`` with the p-theta switch ``phi``.
 
     Dirichlet nodes keep ``p = p_boundary``, ``theta = 0``.  ``phi0`` warm-starts the
     interior; ``inexact`` returns the iterate after ``max_iter`` steps instead of raising (a
-    truncated inner solve of a fixed point that ends on an exact one).
+    truncated inner solve of a fixed point that ends on an exact one).  ``settle`` > 0
+    also returns, after two steps or more, the iterate of the first step that switches at
+    most ``settle`` times as many nodes between film and cavity as the first step did (the
+    active set has settled; the tail of one- and two-node steps at a degenerate free
+    boundary is left to the fixed point's next solves).
     Returns ``phi``, the number of iterations and the residual history (scaled by the size
     of each node's fluxes, ``|K| p + |B| 1``).  Each Newton step is solved by
     :func:`.stencil_solver.newton_solver`, else by SuperLU in a nested-dissection order of
@@ -57,16 +61,16 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
                             dirichlet.ravel(), interior, K, B)
     try:
         return _newton_loop(K, B, dirichlet, interior, scale, phi, residual, newton, tol,
-                            max_iter, inexact)
+                            max_iter, inexact, settle)
     finally:
         if newton is not None:
             newton.release()
 
 
 def _newton_loop(K, B, dirichlet, interior, scale, phi, residual, newton, tol, max_iter,
-                 inexact):
+                 inexact, settle):
     """The semismooth Newton iteration of :func:`solve_complementarity` from ``phi``."""
-    history, active_old = [], None
+    history, active_old, first = [], None, None
     r, pos, res = residual(phi)
     for it in range(1, max_iter + 1):
         history.append(res)
@@ -75,6 +79,11 @@ def _newton_loop(K, B, dirichlet, interior, scale, phi, residual, newton, tol, m
         if res < tol and active_old is not None and (np.array_equal(pos, active_old)
                                                      or res < ROUND_OFF):
             return phi, it, history
+        if settle and active_old is not None:
+            switched = np.count_nonzero(pos != active_old)
+            first = switched if first is None else first
+            if it > 2 and switched <= settle * first:
+                return phi, it, history
         active_old = pos
         dtheta = np.where(pos, 0.0, 1.0 / scale)       # d(1 - theta)/dphi = +1/scale
         step = None if newton is None else newton(pos[interior], dtheta[interior], -r)
