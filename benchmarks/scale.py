@@ -6,8 +6,9 @@ factors (sample patch 1 at 64^2, 30 h0 x 8 steps), 150 N, 0.066 Pa s: a cold poi
 0.025 m/s from it, both as a sweep solves them (:func:`fem_twin.macro.nested.solve_nested`:
 the point on every coarsening first).  Each grid runs in a process of its own, so its peak
 memory (maximum resident set) is its own.  ``FEM_TWIN_SCALE_MAX`` (default 1024) is the
-largest grid: 2048 takes 6.3 min for its cold point and 7.8 GiB with ``FEM_TWIN_THREADS=2``
-(2026-11-27; the threads a lone point's PARDISO may use, inherited by each grid's process).
+largest grid: 2048 takes 6.4 min for its cold point and 7.7 GiB on one thread (2026-11-27;
+``FEM_TWIN_THREADS``, the threads a lone point's PARDISO may use, is inherited by each grid's
+process).
 Baseline: the cold point at 128^2.  The growth exponent is ``log(t_n / t_(n/2)) / log 4``,
 in the number of nodes N.
 """
