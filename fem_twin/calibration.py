@@ -26,6 +26,7 @@ its points checkpointed as they finish, so an interrupted study resumes.
 from __future__ import annotations
 
 import json
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
 import numpy as np
@@ -41,7 +42,7 @@ from .micro import FlowFactors
 from .stages.curves import macro_settings
 from .stages.sweeps import run_sweeps
 from .stages.factors import homogenise_patches
-from .stages.geometry import face_load, level_pins, macro_geometry, reconstruct_geometry
+from .stages.geometry import face_load, macro_geometry, prepare_pins, reconstruct_geometry
 from .stribeck import friction_deviation, plot_stribeck, write_stribeck_csv
 from .threads import executor_for
 
@@ -107,12 +108,17 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     out.root.mkdir(parents=True, exist_ok=True)
     cases, ref_label = variants(case, study, values)
     lub = case.lubricant.lubricants()[0]
+    folders = [out.sub(f"variant_{i + 1}") for i in range(len(cases))]
     with executor_for(case.run.workers, case.run.scheduler) as executor:
         reconstruct_geometry(case, out, progress, executor)
-        homogenise_patches(case, out, executor, progress)
-        tasks = [_sweep(variant, out.sub(f"variant_{i + 1}"), out, patch, speeds, progress,
-                        executor)
-                 for i, (variant, patch, speeds) in enumerate(cases.values())]
+        with ThreadPoolExecutor(1) as beside:      # the variants' pins beside the micro stage
+            pins = beside.submit(prepare_pins, [(v, f) for (v, _, _), f in
+                                                zip(cases.values(), folders)], progress,
+                                 executor)
+            homogenise_patches(case, out, executor, progress)
+            pins.result()
+        tasks = [_sweep(variant, folder, out, patch, speeds)
+                 for folder, (variant, patch, speeds) in zip(folders, cases.values())]
         swept = run_sweeps([(kw, lub) for kw in tasks], executor, progress,
                            desc="calibration points")
     curves = {label: c.with_load_share(variant.tribometer.load_share)
@@ -136,12 +142,10 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     return summary
 
 
-def _sweep(variant: Case, folder: RunLayout, out: RunLayout, patch, speeds, progress,
-           executor) -> dict:
-    """The sweep task of one variant (:func:`~fem_twin.stages.sweeps.run_sweeps`): its
-    geometry and levelled pins in ``folder``, its points in the study's checkpoints."""
-    reconstruct_geometry(variant, folder, progress, executor)
-    level_pins(variant, folder, progress, executor)
+def _sweep(variant: Case, folder: RunLayout, out: RunLayout, patch, speeds) -> dict:
+    """The sweep task of one variant (:func:`~fem_twin.stages.sweeps.run_sweeps`) on its
+    levelled pins in ``folder`` (:func:`~fem_twin.stages.geometry.prepare_pins`), its
+    points in the study's checkpoints."""
     gap, spacing, face, _ = macro_geometry(variant, folder)
     path = out.patch_factors(patch)
     return dict(gap=gap, spacing=spacing, factors=FlowFactors.load(path),

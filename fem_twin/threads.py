@@ -45,20 +45,24 @@ def one_thread(fn):
 
 
 def worker_heap() -> None:
-    """In a worker process (glibc): serve temporaries up to 64 MB from the heap.
+    """In a worker process (glibc): serve temporaries up to 32 MB from the heap.
 
     Dask's nanny starts workers with ``MALLOC_TRIM_THRESHOLD_=65536``, which fixes glibc's
     mmap threshold at 128 KB, so every grid-sized temporary becomes an mmap/munmap pair with
     fresh zeroed pages: the micro stage of one patch pair ran 2x slower in a Dask worker
-    (33.7 s against 17.0 s without that setting, contact 2.8x).  Called by the worker tasks
-    (also when they run in the calling process), once per process; a no-op without glibc."""
+    (33.7 s against 17.0 s without that setting, contact 2.8x).  32 MB, glibc's own largest
+    threshold, keeps the 1997^2 grids (31.9 MB a field) on the heap and maps the 2048^2 ones
+    (33.5 MB), which a heap would hold beyond their use: a 2048^2 point of
+    ``benchmarks/run.py scale`` peaked at 8.04 GiB with 64 MB, 7.63 GiB with 32 MB
+    (7.60 GiB without the setting; 2026-11-27).  Called by the worker tasks (also when they
+    run in the calling process), once per process; a no-op without glibc."""
     global _HEAP_SET
     if _HEAP_SET or not sys.platform.startswith("linux"):
         return
     _HEAP_SET = True
     try:
         libc = ctypes.CDLL("libc.so.6")
-        libc.mallopt(-3, 64 << 20)         # M_MMAP_THRESHOLD
+        libc.mallopt(-3, 32 << 20)         # M_MMAP_THRESHOLD
         libc.mallopt(-1, 128 << 20)        # M_TRIM_THRESHOLD
     except (OSError, AttributeError):      # not glibc
         pass

@@ -376,6 +376,28 @@ def test_resolution_study_follows_the_papers_protocol(tmp_path, monkeypatch):
     assert sorted(float(r["speed_m_s"]) for r in rows[20:]) == sorted(fine)
 
 
+def test_a_studys_pins_are_prepared_together_as_one_at_a_time(tmp_path):
+    """prepare_pins (a study's variants: each step's jobs over all variants, finest first)
+    writes the same pins, disks and levelled pins, byte for byte, as reconstruct_geometry
+    and level_pins variant by variant."""
+    from dataclasses import replace
+    from fem_twin.stages.geometry import level_pins, prepare_pins, reconstruct_geometry
+    case = load_case(small_case(tmp_path))
+    runs = [replace(case, macro_geometry=replace(case.macro_geometry, resolution=(n, n)))
+            for n in (24, 40)]
+    together = [RunLayout(tmp_path / f"together_{i}") for i in range(2)]
+    prepare_pins(list(zip(runs, together)), progress=False)
+    for i, variant in enumerate(runs):
+        alone = RunLayout(tmp_path / f"alone_{i}")
+        reconstruct_geometry(variant, alone, False)
+        level_pins(variant, alone, False)
+        files = [f.relative_to(alone.root) for f in alone.root.rglob("pin_*.npz")]
+        files += [f.relative_to(alone.root) for f in alone.root.rglob("disk_*.npz")]
+        assert len(files) == 3 * len(case.geometry.pins) + 1
+        for f in files:
+            assert (together[i].root / f).read_bytes() == (alone.root / f).read_bytes(), f
+
+
 def test_sliding_direction_turns_the_roughness_patches_too(tmp_path):
     """Issue 18: with ``sliding_direction = "+x2"`` the measured maps are turned so that
     x1 is the sliding direction, patches included (they were cut unturned before, so

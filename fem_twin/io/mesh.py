@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import json
 import xml.etree.ElementTree as ET
+import zlib
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -203,7 +205,7 @@ def write_vtu(path, gm: GridMesh, point_data: dict | None = None, *,
     if path.suffix != ".vtu":
         raise InputError(f"VTU files end in .vtu, got {path.name}")
     m = to_meshio(gm, point_data, elevation=elevation)
-    with atomic_path(path) as tmp:
+    with atomic_path(path) as tmp, _fast_zlib():
         meshio.write(tmp, m, file_format="vtu", binary=True)
         # meshio reads but does not write VTU FieldData: add the grid description ourselves
         grid = m.field_data["fem_twin_grid"]
@@ -213,6 +215,35 @@ def write_vtu(path, gm: GridMesh, point_data: dict | None = None, *,
         text = tmp.read_text()
         tmp.write_text(text.replace("<UnstructuredGrid>", "<UnstructuredGrid>" + field, 1))
     return path
+
+
+#: zlib level of the VTU data blocks (meshio compresses at zlib's default, 6): a 1997^2
+#: macro geometry (points, quads, three fields) is written in 4.4 s against 10.1 s, 146.7
+#: against 146.9 MB (2026-11-27; heights hardly compress at any level, the mesh at any)
+VTU_LEVEL = 1
+
+
+class _Zlib:
+    """zlib at :data:`VTU_LEVEL`, for meshio's VTU writer."""
+
+    @staticmethod
+    def compress(data: bytes) -> bytes:
+        return zlib.compress(data, VTU_LEVEL)
+
+
+@contextmanager
+def _fast_zlib():
+    """meshio's VTU writer compressing at :data:`VTU_LEVEL` (its module's ``zlib``, swapped
+    for the write; unchanged where meshio keeps it elsewhere)."""
+    vtu = getattr(getattr(meshio, "vtu", None), "_vtu", None)
+    if vtu is None or getattr(vtu, "zlib", None) is not zlib:
+        yield
+        return
+    vtu.zlib = _Zlib
+    try:
+        yield
+    finally:
+        vtu.zlib = zlib
 
 
 def read_vtu(path, *, periodic: bool | None = None) -> tuple[GridMesh, dict]:

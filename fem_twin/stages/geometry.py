@@ -123,20 +123,47 @@ def level_pins(case: Case, out: RunLayout, progress: bool = True, executor=None)
                          "apex_m": list(fit.apex), "form_error_rms_m": fit.form_error_rms,
                          "grid": list(cap.shape), "spacing_m": list(cap.spacing)}}
     out.levelling.mkdir(parents=True, exist_ok=True)
-    holder = case.macro_geometry.holder_height
     n = len(case.geometry.pins)
     levelled = list(tqdm(run_jobs(executor, _levelled, [(case, out, i) for i in range(n)]),
                          total=n, desc="levelling", disable=not progress, unit="pin"))
-    result = {"pins": [{"file": out.levelled_pin(i + 1).name,
-                        "tilt_rad": pin.meta.get("tilt_rad")} for i, pin in enumerate(levelled)]}
-    avg_out = out.levelled_pin("average")
-    if n > 1 and load_or_none(avg_out, read_topography) is None:
-        write_topography(avg_out, levelled_pin(
-            average_pins(levelled, radius=case.macro_geometry.level_radius,
-                         truncation=case.macro_geometry.truncation, holder_height=holder),
-            read_topography(out.disk(1)), case))
-    result["macro_pin"] = macro_pin_file(case, out).name
-    return result
+    _averaged((case, out))
+    return {"pins": [{"file": out.levelled_pin(i + 1).name,
+                      "tilt_rad": pin.meta.get("tilt_rad")} for i, pin in enumerate(levelled)],
+            "macro_pin": macro_pin_file(case, out).name}
+
+
+def prepare_pins(runs, progress: bool = True, executor=None) -> None:
+    """The pins of several runs ``[(case, out)]`` (the variants of a calibration study)
+    prepared (:func:`reconstruct_geometry`, pins only) and levelled (:func:`level_pins`),
+    each step one set of jobs over all runs on the workers of ``executor``, the finest
+    grids first: prepared one run at a time, a run's third pin kept one of two workers
+    idle (the resolution study's variants: 89 s before its sweeps)."""
+    runs = sorted((r for r in runs if not r[0].tribometer.ball),
+                  key=lambda r: -np.prod(r[0].macro_geometry.resolution or (0, 0)))
+    for case, out in runs:
+        out.geometry.mkdir(parents=True, exist_ok=True)
+        out.levelling.mkdir(parents=True, exist_ok=True)
+    pins = [(case, out, i) for case, out in runs for i in range(len(case.geometry.pins))]
+    steps = (("geometry", _surface, [(case, out, "pin", i) for case, out, i in pins]),
+             ("levelling", _levelled, pins), ("average pin", _averaged, runs))
+    for desc, job, items in steps:
+        for _ in tqdm(run_jobs(executor, job, items), total=len(items), desc=desc,
+                      disable=not progress, unit="pin"):
+            pass
+
+
+def _averaged(job) -> None:
+    """The levelled set average of ``(case, out)`` levelled against the first disk and
+    written (when the set has more than one pin and the file is missing or unreadable)."""
+    case, out = job
+    n, path = len(case.geometry.pins), out.levelled_pin("average")
+    if n < 2 or load_or_none(path, read_topography) is not None:
+        return
+    levelled = [read_topography(out.levelled_pin(i + 1)) for i in range(n)]
+    g = case.macro_geometry
+    write_topography(path, levelled_pin(
+        average_pins(levelled, radius=g.level_radius, truncation=g.truncation,
+                     holder_height=g.holder_height), read_topography(out.disk(1)), case))
 
 
 def _levelled(job):
