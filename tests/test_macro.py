@@ -632,3 +632,17 @@ def test_a_cold_nested_point_starts_from_the_coarse_levels_anderson_pairs(factor
     assert secants.dx.shape == secants.df.shape == (4, 192 * 192 + 1)
     assert abs(levels[0].friction_coefficient - plain.friction_coefficient) < 1e-6 * 0.19245
     assert levels[0].iterations < plain.iterations
+
+
+@pytest.mark.parametrize("speed", [0.003, 0.03])
+def test_a_pin_node_in_rigid_contact_does_not_make_the_coupling_newton(factors, speed):
+    """The ``"auto"`` coupling takes the Newton coupling for concentrated contacts, judged by
+    the elastic deformation over the thinnest film under pressure at the first iterate.  On
+    sample pin 1 at 500 px, coarsened to 63^2 (the coarse start of the 500, 999 and 1997 px
+    grids), one node under pressure sits at the gap floor (the rigid start's contact, no
+    film): counted, it made the ratio 25-252 and every level of the point Newton-coupled
+    (a 1997^2 point ran out of 24 GB).  Left out, the conformal pin keeps the fixed point."""
+    gap, spacing, face = macro_case(500)
+    res = solve_mixed(gap[::8, ::8], (8 * spacing[0], 8 * spacing[1]), factors, load=150.0,
+                      speed=speed, face=face[::8, ::8], lubricant=Lubricant(0.066))
+    assert res.meta["coupling"] != "newton"
