@@ -137,7 +137,8 @@ def prepare_pins(runs, progress: bool = True, executor=None) -> None:
     prepared (:func:`reconstruct_geometry`, pins only) and levelled (:func:`level_pins`),
     each step one set of jobs over all runs on the workers of ``executor``, the finest
     grids first: prepared one run at a time, a run's third pin kept one of two workers
-    idle (the resolution study's variants: 89 s before its sweeps)."""
+    idle (the resolution study's sweeps began after 114 s, now after 75 s, the variants'
+    pins beside the micro stage; 2026-11-27)."""
     runs = sorted((r for r in runs if not r[0].tribometer.ball),
                   key=lambda r: -np.prod(r[0].macro_geometry.resolution or (0, 0)))
     for case, out in runs:
