@@ -94,12 +94,14 @@ class SPDSolver:
     stencil: 0.97 against 1.28 GiB), not always faster (2026-11-26, one Xeon: 1.2-1.5x
     slower to 256^2, level at 512^2; 2026-11-27, AMD EPYC: the macro Newton LU in
     0.60-0.82x the time from 13k to 859k unknowns); ``solve`` is then
-    accurate to about 1e-5 relative and the caller refines.  ``release()`` frees the
-    factors and keeps the analysis.
+    accurate to about 1e-5 relative and the caller refines.  ``order`` (PARDISO only): the
+    unknowns in the order of elimination, a fill-reducing order the caller knows better
+    than METIS (a grid's nested dissection, :mod:`fem_twin.ordering`); None: METIS.
+    ``release()`` frees the factors and keeps the analysis.
     """
 
     def __init__(self, indptr, indices, backend: str | None = None, symmetric: bool = True,
-                 single: bool = False):
+                 single: bool = False, order=None):
         self.backend = default_backend() if backend is None else backend
         if self.backend not in BACKENDS:
             raise InputError(f"backend must be one of {BACKENDS}, got {self.backend!r}")
@@ -124,6 +126,12 @@ class SPDSolver:
         self._lu = None
         self.dtype = np.float32 if single and self.backend == "pardiso" else np.float64
         self._a = None
+        self._order = (np.zeros(self.n, np.int32) if order is None
+                       else np.asarray(order, dtype=np.int32))   # read by PARDISO: kept alive
+        self._own_order = order is not None
+        if order is not None and not (self._order.size == self.n and np.all(
+                np.bincount(self._order, minlength=self.n) == 1)):
+            raise InputError(f"order must be a permutation of the {self.n} unknowns")
         self._pt = np.zeros(64, dtype=np.int64)     # PARDISO's opaque handle
         self._analysed = False
 
@@ -194,6 +202,7 @@ class SPDSolver:
         iparm = np.zeros(64, dtype=np.int32)
         iparm[[0, 1, 9, 34]] = 1, 2, 8, 1           # own settings, METIS, eps 1e-8, 0-based
         iparm[23] = 1                               # the two-level factorisation
+        iparm[4] = self._own_order                  # the caller's order instead of METIS
         iparm[27] = self.dtype == np.float32        # single precision arrays and factors
         if not self.symmetric:
             iparm[9] = 13                            # pivot perturbation 1e-13
@@ -211,7 +220,7 @@ class SPDSolver:
         lib.pardiso(self._pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), ref(1), ref(1),
                     ref(mtype), ref(phase), ref(self.n), a.ctypes.data_as(ctypes.c_void_p),
                     self._ia.ctypes.data_as(i32), self._ja.ctypes.data_as(i32),
-                    np.zeros(self.n, dtype=np.int32).ctypes.data_as(i32), ref(b.shape[1]),
+                    self._order.ctypes.data_as(i32), ref(b.shape[1]),
                     iparm.ctypes.data_as(i32), ref(0), b.ctypes.data_as(ctypes.c_void_p),
                     x.ctypes.data_as(ctypes.c_void_p), ctypes.byref(error))
         lib.MKL_Set_Num_Threads_Local(ctypes.c_int(previous))

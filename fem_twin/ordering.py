@@ -11,25 +11,57 @@ import numpy as np
 
 from .errors import SolverError
 
+#: the pieces a sub-grid's order (:func:`subgrid_order`) stops bisecting at: PARDISO's LU
+#: of the macro Newton matrices (3x3 stencil, 2026-11-27, one thread) in the order of
+#: leaf 2 against leaf 4: 9.29 against 9.67 s at 2048^2, the same (1.76 s) at 1024^2;
+#: SuperLU the same at 256^2 and 512^2
+SUBGRID_LEAF = 2
+#: the deepest bisection whose base-3 keys fit in 64 bits (sides up to about 2^19 pixels)
+MAX_DEPTH = 39
+
 
 def _dissect(rows, cols, nx, out, leaf):
-    if len(rows) * len(cols) <= leaf * leaf or min(len(rows), len(cols)) < 3:
-        out.append((rows[:, None] * nx + cols[None, :]).ravel())
-    elif len(cols) >= len(rows):
-        m = len(cols) // 2
-        _dissect(rows, cols[:m], nx, out, leaf)
-        _dissect(rows, cols[m + 1:], nx, out, leaf)
-        out.append(rows * nx + cols[m])
+    """Append the nested-dissection order of the rectangle ``rows`` x ``cols`` (contiguous
+    ranges) of a grid ``nx`` wide to ``out``: both halves, then the separator, recursively
+    bisected along the longer side until at most ``leaf`` x ``leaf`` pixels or a side below
+    3 remain (each piece row-major).  The boxes of one depth are split at once; each piece
+    gets a base-3 key, one digit per depth (0 first half, 1 second half, 2 separator,
+    padded with 0 below where it stops), and the pieces follow in the order of their keys
+    (a 2048^2 grid in 0.3 s instead of 4.8 s for a recursion)."""
+    box = [np.array([v]) for v in (rows[0], len(rows), cols[0], len(cols), 0, 0)]
+    pieces = []
+    for _ in range(MAX_DEPTH + 1):
+        r0, h, c0, w, key, depth = box
+        split = (h * w > leaf * leaf) & (np.minimum(h, w) >= 3)
+        pieces.append([v[~split] for v in box])
+        if not split.any():
+            break
+        r0, h, c0, w, key, depth = (v[split] for v in box)
+        across = w >= h                               # split the columns
+        length = np.where(across, w, h)
+        m = length // 2
+        starts = [np.zeros_like(m), m + 1, m]         # first half, second half, separator
+        lengths = [m, length - m - 1, np.ones_like(m)]
+        halves = [[np.where(across, r0, r0 + s), np.where(across, h, n),
+                   np.where(across, c0 + s, c0), np.where(across, n, w)]
+                  for s, n in zip(starts, lengths)]
+        pieces.append([*halves[2], 3 * key + 2, depth + 1])
+        box = [np.concatenate(v) for v in zip(*(
+            [*halves[d], 3 * key + d, depth + 1] for d in (0, 1)))]
     else:
-        m = len(rows) // 2
-        _dissect(rows[:m], cols, nx, out, leaf)
-        _dissect(rows[m + 1:], cols, nx, out, leaf)
-        out.append(rows[m] * nx + cols)
+        raise SolverError("nested dissection deeper than its keys hold")
+    r0, h, c0, w, key, depth = (np.concatenate(v) for v in zip(*pieces))
+    sort = np.argsort(key * 3 ** (depth.max() - depth))
+    r0, h, c0, w = r0[sort], h[sort], c0[sort], w[sort]
+    counts = h * w
+    piece = np.repeat(np.arange(counts.size), counts)
+    k = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    out.append((r0[piece] + k // w[piece]) * nx + c0[piece] + k % w[piece])
 
 
 def _checked(out, n):
     order = np.concatenate(out)
-    if order.size != n or np.unique(order).size != n:   # guard against a wrong partition
+    if order.size != n or not np.all(np.bincount(order, minlength=n) == 1):  # a wrong partition
         raise SolverError("nested dissection lost or repeated pixels")
     return order
 
@@ -59,3 +91,15 @@ def nested_dissection_torus(shape, leaf: int = 4) -> np.ndarray:
         out.append(cy * nx + cols)                # row ny/2
     out.append(np.unique(np.r_[np.arange(ny) * nx, np.arange(ny) * nx + cx]))
     return _checked(out, ny * nx)
+
+
+def subgrid_order(shape, position, leaf: int = SUBGRID_LEAF) -> np.ndarray:
+    """The unknowns of a subset of the pixels of a non-periodic ``(ny, nx)`` grid in the
+    order of :func:`nested_dissection` (the subset's unknown numbers; ``position``: each
+    pixel's number, flat, -1 outside the subset).  For a pin face inside its grid, PARDISO
+    factorises the macro Newton matrices in this order in 0.67x METIS's time at 2048^2
+    (9.3 against 13.8 s; fill 425M against 483M), 0.86x at 1024^2 (1.76 against 2.05 s),
+    the same to 512^2, and its analysis takes a quarter of the time (one thread,
+    2026-11-27)."""
+    order = np.asarray(position)[nested_dissection(shape, leaf)]
+    return order[order >= 0]

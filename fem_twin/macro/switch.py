@@ -15,7 +15,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import ReynoldsNotConverged
-from ..ordering import nested_dissection
+from ..ordering import subgrid_order
 from .stencil_solver import newton_solver
 
 
@@ -122,10 +122,9 @@ def _interior_order(shape, dirichlet, interior):
         return np.arange(interior.size)
     key = (shape, dirichlet.tobytes())
     if _ORDER_CACHE.get("key") != key:
-        full = nested_dissection(shape)
         position = np.full(dirichlet.size, -1)
         position[interior] = np.arange(interior.size)
-        _ORDER_CACHE.update(key=key, order=position[full][position[full] >= 0])
+        _ORDER_CACHE.update(key=key, order=subgrid_order(shape, position))
     return _ORDER_CACHE["order"]
 
 
