@@ -646,3 +646,15 @@ def test_a_pin_node_in_rigid_contact_does_not_make_the_coupling_newton(factors, 
     res = solve_mixed(gap[::8, ::8], (8 * spacing[0], 8 * spacing[1]), factors, load=150.0,
                       speed=speed, face=face[::8, ::8], lubricant=Lubricant(0.066))
     assert res.meta["coupling"] != "newton"
+
+
+def test_the_newton_merit_of_an_overflowing_trial_step_is_inf():
+    """A trial step whose load residual overflows has merit inf (the line search rejects
+    it) instead of raising OverflowError from Python float arithmetic."""
+    from types import SimpleNamespace
+
+    from fem_twin.macro.newton import merit
+    ev = SimpleNamespace(R=np.ones(3), G=np.ones(3), L=1e300)
+    assert merit(ev, (1.0, 1.0, 1e-200)) == np.inf
+    ev = SimpleNamespace(R=np.ones(3), G=np.ones(3), L=3.0)
+    assert merit(ev, (1.0, 2.0, 1.0)) == pytest.approx(np.sqrt(1 + 0.25 + 9), rel=1e-14)

@@ -80,7 +80,8 @@ def merit(ev: NewtonEvaluation, sizes: tuple) -> float:
     trial step that overflows, which the line search then rejects."""
     with np.errstate(over="ignore"):
         return float(np.sqrt(np.mean((ev.R / sizes[0]) ** 2)
-                             + np.mean((ev.G / sizes[1]) ** 2) + (ev.L / sizes[2]) ** 2))
+                             + np.mean((ev.G / sizes[1]) ** 2)
+                             + np.square(np.float64(ev.L) / sizes[2])))
 
 
 def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progress=None):
