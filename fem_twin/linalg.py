@@ -43,6 +43,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .errors import InputError, MissingDependency, NotPositiveDefinite, SolverError
+from .ordering import is_permutation
 from .threads import thread_limit
 
 BACKENDS = ("superlu", "pardiso")
@@ -129,8 +130,7 @@ class SPDSolver:
         self._order = (np.zeros(self.n, np.int32) if order is None
                        else np.asarray(order, dtype=np.int32))   # read by PARDISO: kept alive
         self._own_order = order is not None
-        if order is not None and not (self._order.size == self.n and np.all(
-                np.bincount(self._order, minlength=self.n) == 1)):
+        if order is not None and not is_permutation(self._order, self.n):
             raise InputError(f"order must be a permutation of the {self.n} unknowns")
         self._pt = np.zeros(64, dtype=np.int64)     # PARDISO's opaque handle
         self._analysed = False

@@ -31,7 +31,7 @@ def _dissect(rows, cols, nx, out, leaf):
     box = [np.array([v]) for v in (rows[0], len(rows), cols[0], len(cols), 0, 0)]
     pieces = []
     for _ in range(MAX_DEPTH + 1):
-        r0, h, c0, w, key, depth = box
+        h, w = box[1], box[3]
         split = (h * w > leaf * leaf) & (np.minimum(h, w) >= 3)
         pieces.append([v[~split] for v in box])
         if not split.any():
@@ -59,9 +59,15 @@ def _dissect(rows, cols, nx, out, leaf):
     out.append((r0[piece] + k // w[piece]) * nx + c0[piece] + k % w[piece])
 
 
+def is_permutation(order, n: int) -> bool:
+    """Whether ``order`` holds each of ``0 .. n-1`` exactly once."""
+    order = np.asarray(order)
+    return order.size == n and bool(np.all(np.bincount(order, minlength=n) == 1))
+
+
 def _checked(out, n):
     order = np.concatenate(out)
-    if order.size != n or not np.all(np.bincount(order, minlength=n) == 1):  # a wrong partition
+    if not is_permutation(order, n):                # guard against a wrong partition
         raise SolverError("nested dissection lost or repeated pixels")
     return order
 

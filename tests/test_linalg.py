@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from fem_twin.fvm import CellSolverFV
 from fem_twin.errors import InputError
 from fem_twin.linalg import SPDSolver, _mkl_rt, default_backend
+from fem_twin.macro.stencil_solver import _stencil_pattern
 from fem_twin.ordering import nested_dissection, subgrid_order
 from fem_twin.micro import CellSolver
 
@@ -303,19 +304,11 @@ def test_pardiso_in_a_grids_dissection_order_solves_as_in_metis_order():
     inside = (x ** 2 + y ** 2 < (0.45 * n) ** 2).ravel()
     position = np.where(inside, np.cumsum(inside) - 1, -1)
     rng = np.random.default_rng(7)
-    idx = np.arange(n * n).reshape(n, n)
-    rows, cols = [], []
-    for di in (-1, 0, 1):
-        for dj in (-1, 0, 1):
-            a = idx[max(0, -di):n - max(0, di), max(0, -dj):n - max(0, dj)].ravel()
-            b = idx[max(0, di):n - max(0, -di), max(0, dj):n - max(0, -dj)].ravel()
-            keep = inside[a] & inside[b]
-            rows.append(position[a[keep]])
-            cols.append(position[b[keep]])
-    rows, cols = np.concatenate(rows), np.concatenate(cols)
     m = int(inside.sum())
-    values = np.where(rows == cols, 10.0, rng.uniform(-1.2, 0.2, rows.size))
-    J = sp.csr_matrix((values, (rows, cols)), shape=(m, m))
+    indptr, indices = _stencil_pattern((n, n), position, m)
+    rows = np.repeat(np.arange(m), np.diff(indptr))
+    values = np.where(rows == indices, 10.0, rng.uniform(-1.2, 0.2, indices.size))
+    J = sp.csr_matrix((values, indices, indptr), shape=(m, m))
     J.sort_indices()
     rhs = rng.standard_normal(m)
     order = subgrid_order((n, n), position)
