@@ -107,10 +107,14 @@ def _operator(shape, spacing, e_reduced, periodic):
         q[0, 0] = np.inf                       # zero mean deformation
         k_hat = 4.0 / (e_reduced * q)           # 2 / (E* q), E* = E'/2
     else:
-        i1 = np.r_[np.arange(nx), np.arange(-nx, 0)] * dx1
-        i2 = np.r_[np.arange(ny), np.arange(-ny, 0)] * dx2
-        kernel = love_rectangle(i1[None, :], i2[:, None], dx1 / 2, dx2 / 2, e_reduced)
-        k_hat = fft.rfft2(kernel)
+        # the kernel is even in both offsets: computed on one quadrant (0 .. n nodes away),
+        # then read at |offset| on the padded grid's wrapped offsets 0 .. n-1, -n .. -1
+        # (4.7 s against 0.9 s at 2048^2; equal to 4e-13 relative)
+        quadrant = love_rectangle((np.arange(nx + 1) * dx1)[None, :],
+                                  (np.arange(ny + 1) * dx2)[:, None], dx1 / 2, dx2 / 2,
+                                  e_reduced)
+        away1, away2 = np.r_[0:nx, nx:0:-1], np.r_[0:ny, ny:0:-1]
+        k_hat = fft.rfft2(quadrant[np.ix_(away2, away1)])
     k_single = k_hat.astype(np.float32 if periodic else np.complex64)
     for k in (k_hat, k_single):
         k.setflags(write=False)

@@ -44,6 +44,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
+from ..assembly import grid_stencil
 from ..errors import InputError
 
 #: the Couette schemes (``MacroSettings.couette``, ``solve_reynolds(couette=...)``)
@@ -92,22 +93,31 @@ def couette(q1, q2, spacing, scheme: str = "central") -> Couette:
 
 def couette_matrix(q1, q2, spacing, scheme: str = "central") -> sp.csr_matrix:
     """``B`` with ``B @ (1 - theta)`` the net Couette outflow of each node's dual cell
-    [m^3/s], :meth:`Couette.matrix` assembled face by face without the face matrices
-    (which a grid would keep: 180 B a node)."""
+    [m^3/s], :meth:`Couette.matrix` added face by face into the grid's 3 x 3 stencil
+    (:func:`fem_twin.assembly.grid_stencil`, the pattern of the Poiseuille matrix, zeros
+    where no face couples): no face matrices kept (which a grid would keep: 180 B a node),
+    no sort of triplets, and one pattern for every coefficient and flow direction (the
+    Newton steps map it into their matrix once per grid)."""
     q1, q2 = _checked(q1, q2, scheme)
-    rows, cols, values = [], [], []
-    for k, q in enumerate((q1.ravel(), q2.ravel())):
-        a, b, width = _face_nodes(q1.shape, spacing, k)
-        q_a, q_b = q[a], q[b]
+    stencil = grid_stencil(q1.shape)
+    S = np.zeros((*q1.shape, 3, 3))
+    for k, q in enumerate((q1, q2)):
+        width = float(spacing[1] if k == 0 else spacing[0])
+        q_a, q_b = (q[:, :-1], q[:, 1:]) if k == 0 else (q[:-1, :], q[1:, :])
         forward = q_a + q_b >= 0
-        up = np.where(forward, a, b)
         flux = width * ((q_a + q_b) / 2 if scheme == "central" else np.where(forward, q_a, q_b))
-        rows += [a, b]
-        cols += [up, up]
-        values += [flux, -flux]
-    n = q1.size
-    return sp.csr_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(n, n))
+        from_a, from_b = np.where(forward, flux, 0.0), np.where(forward, 0.0, flux)
+        # node a's row gains the flux from the upstream node, b's loses it: (row, column
+        # offset) of a -> a and a -> b, then b -> a and b -> b
+        ahead = (1, 2) if k == 0 else (2, 1)
+        behind = (1, 0) if k == 0 else (0, 1)
+        rows_a = (slice(None), slice(0, -1)) if k == 0 else (slice(0, -1), slice(None))
+        rows_b = (slice(None), slice(1, None)) if k == 0 else (slice(1, None), slice(None))
+        S[(*rows_a, 1, 1)] += from_a
+        S[(*rows_a, *ahead)] += from_b
+        S[(*rows_b, *behind)] -= from_a
+        S[(*rows_b, 1, 1)] -= from_b
+    return stencil.csr(S)
 
 
 def _checked(q1, q2, scheme):

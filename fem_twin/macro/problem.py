@@ -61,10 +61,10 @@ class Problem:
         ``h0`` (its ``p_con`` by ``settings.contact_quadrature``, :mod:`.contact_load`; without
         the shear factors, which :func:`.result.mixed_result` evaluates once),
         ``g = rho h_m^3 / (12 mu)`` [m^3/(Pa s)] and ``q = rho h_m u_m`` [m^2/s]."""
-        loc = self.factors.at(h0, friction=False)
-        if self.settings.contact_quadrature != "nodal":
-            loc = replace(loc, p_con=nodal_contact_pressure(
-                self.factors, h0, self.settings.contact_quadrature))
+        rule = self.settings.contact_quadrature
+        loc = self.factors.at(h0, friction=False, contact=rule == "nodal")
+        if rule != "nodal":
+            loc = replace(loc, p_con=nodal_contact_pressure(self.factors, h0, rule))
         p_coef = np.minimum(p, MAX_COEFFICIENT_PRESSURE)
         mu = self.lubricant.viscosity_at(p_coef)
         rho = self.lubricant.density_ratio(p_coef)

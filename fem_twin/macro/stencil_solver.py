@@ -12,22 +12,28 @@ refinement step reaches ``STEP_RTOL`` on the equilibrated matrix; half the facto
 time at 13k unknowns, 0.75x at 53k, 0.67x at 214k and 0.60x at 859k (PARDISO, one thread,
 AMD EPYC, 2026-11-27); below ``SINGLE_UNKNOWNS`` the refinement's extra solve and product
 cost about what that saves, and double precision needs no refinement.  The products
-``J x`` of the refinement and of GMRES (below) are taken from ``K`` and ``B`` themselves:
+``J x`` of the refinement are taken from ``K`` and ``B`` themselves:
 ``J``'s entries are built once per factorisation, and no double-precision copy of them is
 kept.
 
 The factors of a step are kept for the next steps of the same inner solve (``K`` and
 ``B`` do not change within it, only which nodes are film and which cavity).  A step whose
-matrix differs from the factorised one in ``m`` columns (``m`` nodes switched) is solved by
-GMRES preconditioned with those factors, each pass refined in double precision: the
-preconditioned matrix is the identity plus rank ``m``, so GMRES takes about ``m + 2``
-solves, and the step tries it when that is at most half a factorisation's cost
-(:meth:`_Grid.budget`; else it factorises anew).  On the cold 512^2 point of
-``benchmarks/run.py scale`` the exact inner solves switch 1745, 823, 200, 22 and 2 nodes
-in their first steps and 1-10 in the later ones; the finest level factorised 18 times
-instead of 23 (5 steps from the kept factors, none failing).  The factors are freed when
-the inner solve ends (``step.release()``).  A step is returned only when it solves
-``J x = rhs`` to ``STEP_RTOL``.
+matrix differs from the factorised one ``J_0`` in the ``m`` columns of the nodes switched
+since is solved with those factors updated by the Woodbury identity (Hager 1989,
+"Updating the inverse of a matrix", SIAM Review 31): ``J = J_0 + U V^T``, ``V^T x`` the
+switched entries of ``x``, ``W = J_0^-1 U`` (one solve per switched column, kept per node
+for the later steps), and ``J^-1 = J_0^-1 - W (I + V^T W)^-1 V^T J_0^-1``, applied as the
+preconditioner of the same refinement in double precision as a new factorisation's.  A
+step tries it when its new columns plus ``REFINEMENTS`` passes take at most
+:meth:`_Grid.budget` solves (about half a factorisation; else it factorises anew).  It
+replaced GMRES with the kept factors, which lost its Krylov space at every refinement pass
+and had to find the switched columns again: on the cold 2048^2 point of
+``benchmarks/run.py scale`` 3 of the last exact solve's 5 GMRES attempts failed their
+budget of 14 solves (4 switched nodes: GMRES passes of 6, 3 and 3 solves, the true
+residual 0.36 after the first pass at GMRES's estimate of 1e-4), where the update
+solved the same step to 1.5e-11 in 4 + 3 solves (2026-11-27).  The factors are freed when
+the inner solve ends (``step.release()``).  A step is returned only when it solves ``J x =
+rhs`` to ``STEP_RTOL``.
 
 Tried and dropped (2026-11-25, bundled case, 12 speeds at 128^2): the last factorisation
 as a GMRES preconditioner for the next step.  The matrices move too much between coupling
@@ -43,7 +49,8 @@ from collections import OrderedDict
 import numpy as np
 import scipy.sparse as sp
 
-from ..linalg import SPDSolver, default_backend, gmres
+from ..assembly import grid_stencil
+from ..linalg import SPDSolver, default_backend
 from ..ordering import subgrid_order
 
 #: relative residual ``|J x - rhs| / |rhs|`` a step must reach
@@ -54,11 +61,11 @@ REFINEMENTS = 4
 #: the largest entry of the equilibrated matrix a factorisation takes
 #: (float32 overflows at 3.4e38; beyond this the step goes to SuperLU in double precision)
 SINGLE_MAX = 1e30
-#: the most solves with kept factors a step may spend before it factorises anew (and the
-#: GMRES basis it keeps: 16 vectors of the grid, 0.43 GB at 2048^2) ...
+#: the most switched columns the kept factors are updated for (``W``: 16 vectors of the
+#: grid, 0.43 GB at 2048^2), and the most solves a step may spend with them ...
 REUSE_SOLVES = 16
-#: ... and at most half a factorisation's time: GMRES takes about one solve per node that
-#: switched since the factorisation, plus two.  A factorisation costs about
+#: ... which is at most half a factorisation's time: a step takes one solve per node newly
+#: switched, plus about two refinement passes.  A factorisation costs about
 #: ``1.44 n^0.2`` solves of the grid's ``n`` unknowns (PARDISO, one thread, 2026-11-27:
 #: 16.7 at 214k unknowns, 22 at 859k; 20-40 at 3.4M), a rule of the size rather than of
 #: measured times so that a run repeats to the last bit
@@ -105,14 +112,25 @@ def newton_solver(shape, dirichlet, interior, K, B):
             u, v = np.zeros(K.shape[0]), np.zeros(K.shape[0])
             u[interior], v[interior] = pos * x, dtheta * x
             return (K @ u + B @ v)[interior]
-        if kept and np.count_nonzero(pos != kept["pos"]) + 2 <= grid.budget():
-            x = grid.solve_kept(product, rhs)
+
+        def difference(columns):
+            """``(J - J_0)[:, columns]`` (dense, interior rows), ``J_0`` the kept one's."""
+            nodes, at = interior[columns], np.arange(columns.size)
+            dpos = sp.csc_matrix((pos[columns] - kept["pos"][columns].astype(float),
+                                  (nodes, at)), shape=(K.shape[0], columns.size))
+            dtht = sp.csc_matrix((dtheta[columns] - kept["dtheta"][columns], (nodes, at)),
+                                 shape=dpos.shape)
+            return (K @ dpos + B @ dtht).toarray()[interior]
+        if kept:
+            switched = np.flatnonzero((pos != kept["pos"]) | (dtheta != kept["dtheta"]))
+            x = grid.solve_kept(switched, np.c_[pos[switched], dtheta[switched]],
+                                difference, product, rhs)
             if x is not None:
                 return x
         kept.clear()
         x = grid.factor_and_solve(values(), product, rhs)
         if x is not None:
-            kept["pos"] = pos.copy()
+            kept.update(pos=pos.copy(), dtheta=dtheta.copy())
         return x
     step.release = grid.release
     return step
@@ -122,6 +140,7 @@ class _Grid:
     """One grid's stencil pattern, its PARDISO solver and the maps of ``K`` and ``B``."""
 
     def __init__(self, shape, interior):
+        self.shape = tuple(shape)
         self.position = np.full(shape[0] * shape[1], -1)
         self.position[interior] = np.arange(interior.size)
         self.n = interior.size
@@ -134,13 +153,20 @@ class _Grid:
                                 order=subgrid_order(shape, self.position))
         self._maps = []                       # [(digest, at, keep)]
         self.scale = None                     # the equilibration of the kept factors
+        self.columns = {}                     # node: (its state, its column of W)
 
     def locate(self, M):
         """``(at, keep)``: the position ``at`` in the pattern of each interior entry ``keep``
         of the CSR matrix ``M``, or None if ``M`` leaves the stencil.  Kept per sparsity
-        pattern of ``M`` (known by a digest of it: at 2048^2 a copy of the pattern would
-        hold 40 B a node)."""
-        digest = _digest(M)
+        pattern of ``M``, known by a digest of it (at 2048^2 a copy of the pattern would
+        hold 40 B a node), or as the grid's own 3 x 3 stencil
+        (:func:`fem_twin.assembly.grid_stencil`, on which ``K`` and ``B`` are assembled:
+        compared in 0.03 s at 2048^2, where the digest takes 0.13 s)."""
+        stencil = grid_stencil(self.shape)
+        own = (M.shape == (stencil.indptr.size - 1,) * 2
+               and np.array_equal(M.indptr, stencil.indptr)
+               and np.array_equal(M.indices, stencil.indices))
+        digest = b"grid stencil" if own else _digest(M)
         found = next((m for m in self._maps if m[0] == digest), None) or self._map(M, digest)
         return None if found is None else found[1:]
 
@@ -149,6 +175,8 @@ class _Grid:
         ``M`` has none), ``found`` from :meth:`locate` (computed per step, so no copy of
         ``M`` is alive during the factorisation)."""
         at, keep = found
+        if at is None:                        # M's interior entries are the pattern
+            return M.data[keep] * weight[self.indices]
         return np.bincount(at, M.data[keep] * weight[self.indices[at]],
                            minlength=self.indices.size)
 
@@ -163,8 +191,10 @@ class _Grid:
         at = np.searchsorted(keys, entries)
         if not np.array_equal(keys[np.minimum(at, keys.size - 1)], entries):
             return None
-        # ``at`` only feeds bincount, as fast from int32
-        self._maps = [*self._maps[-1:], (digest, at.astype(np.int32), keep)]
+        # ``at`` only feeds bincount, as fast from int32; None where it is every position
+        # of the pattern in order (``M`` on the grid's stencil, as K and B are)
+        at = None if np.array_equal(at, np.arange(keys.size)) else at.astype(np.int32)
+        self._maps = [*self._maps[-1:], (digest, at, keep)]
         return self._maps[-1]
 
     def factor_and_solve(self, data, product, rhs):
@@ -194,25 +224,43 @@ class _Grid:
             self.release()
         return x
 
-    def solve_kept(self, product, rhs):
-        """``x`` solving ``J x = rhs`` (``product(x) = J x``) to ``STEP_RTOL`` by GMRES with
-        the kept factors of another switch as the preconditioner, each pass refined in
-        double precision; None (and the factors freed) when it takes more than
-        :meth:`budget` solves."""
-        x, residual, budget = np.zeros_like(rhs), rhs, self.budget()
-        target = STEP_RTOL * np.linalg.norm(rhs)
-        while budget > 0 and np.linalg.norm(residual) > target:
-            rtol = max(target / np.linalg.norm(residual), 1e-4)
-            dx, used = gmres(product, self._precondition, residual, rtol, budget)
-            budget -= used + 1
-            if dx is None or not np.all(np.isfinite(dx)):
-                break
-            x = x + dx
-            residual = rhs - product(x)
-        if np.linalg.norm(residual) <= target:
-            return x
-        self.release()
-        return None
+    def solve_kept(self, switched, states, difference, product, rhs):
+        """``x`` solving ``J x = rhs`` (``product(x) = J x``) to ``STEP_RTOL`` with the kept
+        factors of ``J_0`` updated for the columns ``switched`` (Woodbury, see the module
+        docstring), refined in double precision; ``states`` (a row per switched column)
+        tell whether a kept ``W`` column still holds, ``difference(columns)`` gives the new
+        ones' ``(J - J_0)[:, columns]``.  None (and the factors freed) when the step would
+        take more than :meth:`budget` solves or falls short of ``STEP_RTOL``."""
+        if switched.size > REUSE_SOLVES:
+            self.release()
+            return None
+        kept = {k: self.columns[k] for k, state in zip(switched, states)
+                if k in self.columns and np.array_equal(self.columns[k][0], state)}
+        new = np.array([k for k in switched if k not in kept], int)
+        if new.size + 2 > self.budget():
+            self.release()
+            return None
+        self.columns = kept                   # columns switched back are dropped
+        for k, state, u in zip(new, states[np.isin(switched, new)], difference(new).T):
+            self.columns[k] = (state, self._precondition(u))
+        W = [self.columns[k][1] for k in switched]                # no (n, m) copy
+        small = np.zeros((switched.size,) * 2)                    # V^T W
+        for k, w in enumerate(W):
+            small[:, k] = w[switched]
+        try:
+            capacitance = np.linalg.inv(np.eye(switched.size) + small)
+        except np.linalg.LinAlgError:
+            capacitance = np.full((switched.size,) * 2, np.nan)
+
+        def updated(r):
+            z = self._precondition(r)
+            for w, c in zip(W, capacitance @ z[switched]):
+                z -= c * w
+            return z
+        x = self._refined(product, rhs, updated)
+        if x is None:
+            self.release()
+        return x
 
     def budget(self) -> int:
         """Solves with the kept factors a step may take: half a factorisation's cost, at
@@ -222,9 +270,9 @@ class _Grid:
         return int(min(REUSE_SOLVES, REUSE_SHARE * self.n ** 0.2))
 
     def release(self):
-        """Free the kept factors (the analysis stays)."""
+        """Free the kept factors and their update's columns (the analysis stays)."""
         self.solver.release()
-        self.scale = None
+        self.scale, self.columns = None, {}
 
     def _precondition(self, r):
         """The kept factors' solution of ``J x = r`` (the solve sees ``r`` over its size:
@@ -235,15 +283,17 @@ class _Grid:
             return np.full_like(r, np.nan)
         return self.scale * self.solver.solve(b / size) * size
 
-    def _refined(self, product, rhs):
+    def _refined(self, product, rhs, inverse=None):
         """``x`` solving ``J x = rhs`` (``product(x) = J x``) to ``STEP_RTOL`` by refinement
-        with the factors of the equilibrated ``J``, or None."""
+        with ``inverse(r)``, an approximate ``J^-1 r`` (default: the factors of the
+        equilibrated ``J``), or None."""
+        inverse = inverse or self._precondition
         x, residual = np.zeros_like(rhs), rhs
         target = STEP_RTOL * np.linalg.norm(rhs)
         for _ in range(1 + REFINEMENTS):
             if np.linalg.norm(residual) <= target:
                 return x
-            x = x + self._precondition(residual)
+            x = x + inverse(residual)
             if not np.all(np.isfinite(x)):
                 return None
             residual = rhs - product(x)

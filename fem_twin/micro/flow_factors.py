@@ -132,7 +132,7 @@ class FlowFactors:
         return write_csv(path, cols)
 
     # -- interpolation -------------------------------------------------------------------
-    def at(self, h0, *, friction: bool = True) -> "LocalFactors":
+    def at(self, h0, *, friction: bool = True, contact: bool = True) -> "LocalFactors":
         """Factors at any separations ``h0`` [m] (e.g. a macro gap field), paper 2.2.2 rules.
 
         Inside the computed range: monotone cubic (PCHIP) interpolation in ``log h0`` (of
@@ -143,7 +143,9 @@ class FlowFactors:
         Below ``h0_min`` (not covered by the paper): ``h_m`` and ``p_con`` continue linearly
         with their end slopes, ``h_m`` floored at 1 nm, and the factors are held at ``h0_min``.
         ``friction=False`` leaves out (None) the shear factors ``C``, ``d`` (eqs 31-32) and the
-        contact fraction, which the Reynolds iterations do not need (48 B a node less).
+        contact fraction, which the Reynolds iterations do not need (48 B a node less);
+        ``contact=False`` leaves out the nodal ``p_con`` (for a caller that integrates it
+        over the elements instead, :mod:`fem_twin.macro.contact_load`).
         """
         x = np.asarray(h0, dtype=float)
         if np.any(~np.isfinite(x)) or np.any(x <= 0):
@@ -165,8 +167,9 @@ class FlowFactors:
         if friction:
             out["contact_fraction"][above] = 0.0
         out["h_m"] = self._extend_below(flat, out["h_m"], "h_m", 1e-9)
-        out["p_con"] = self.contact_pressure(flat)
-        out = {k: v.reshape(x.shape + v.shape[1:]) for k, v in out.items()}
+        out["p_con"] = self.contact_pressure(flat) if contact else None
+        out = {k: None if v is None else v.reshape(x.shape + v.shape[1:])
+               for k, v in out.items()}
         return LocalFactors(h0=x, **{"C": None, "d": None, "contact_fraction": None, **out})
 
     def contact_pressure(self, h0) -> np.ndarray:
@@ -179,9 +182,23 @@ class FlowFactors:
         if len(self) == 1:
             p = np.full(flat.size, self.p_con[0])
         else:
-            p = self._interpolant("p_con")(np.log(np.clip(flat, lo, hi)))
+            # from the first of the last samples without contact on, the interpolant is
+            # flat at the floor (PCHIP's slope is 0 beside a zero secant): p_con = 0 there,
+            # and only the films below are interpolated (a pin face mostly out of contact)
+            p = np.zeros(flat.size)
+            near = flat < self._contact_onset()
+            p[near] = self._interpolant("p_con")(np.log(np.clip(flat[near], lo, hi)))
         p[flat > hi] = 0.0
         return self._extend_below(flat, p, "p_con", 0.0).reshape(x.shape)
+
+    def _contact_onset(self) -> float:
+        """The smallest tabulated ``h0`` [m] from which on every ``p_con`` is zero (inf if
+        the largest one is in contact)."""
+        touching = np.flatnonzero(self.p_con > 0)
+        if not touching.size:
+            return float(self.h0[0])
+        last = touching[-1] + 1
+        return float(self.h0[last]) if last < len(self) else np.inf
 
     def _extend_below(self, flat, values, name, floor):
         """Below ``h0_min``: continue linearly with the end slope, floored."""
@@ -235,12 +252,13 @@ class LocalFactors:
     ``h_m``, ``p_con``, ``contact_fraction`` are shaped like ``h0``; ``A``, ``C`` add
     ``(2, 2)`` and ``b``, ``d`` add ``(2,)`` as trailing axes; ``C``, ``d`` and
     ``contact_fraction`` are None when evaluated without them (``at(h0, friction=False)``),
-    and ``A``, ``b`` where a caller dropped them once the Reynolds matrices were built.
+    ``p_con`` with ``at(h0, contact=False)``, and ``A``, ``b`` where a caller dropped them
+    once the Reynolds matrices were built.
     """
 
     h0: np.ndarray
     h_m: np.ndarray
-    p_con: np.ndarray
+    p_con: np.ndarray | None
     A: np.ndarray | None
     b: np.ndarray | None
     C: np.ndarray | None
