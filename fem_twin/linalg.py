@@ -50,10 +50,10 @@ BACKENDS = ("superlu", "pardiso")
 #: PARDISO uses the threads ``FEM_TWIN_THREADS`` allows only on matrices of at least this
 #: many unknowns.  Measured on the macro Newton LU (2026-11-27, 2 threads against one, AMD
 #: EPYC): the 64^2 level of a cold nested point took 3.4 s against 1.7 s (68 coupling
-#: iterations of small solves, each waking the sleeping threads), the 256^2 level 2.4
-#: against 2.0 s, the 512^2 one the same; a 1024^2 factorisation 0.65x (0.96 against
-#: 1.46 s, 859k unknowns)
-THREADED_UNKNOWNS = 1 << 18
+#: iterations of small solves, each waking the sleeping threads), the 256^2 level (53k
+#: unknowns) 3.1 against 2.7 s, the 512^2 one (214k) 7.5 against 8.6 s; a 1024^2
+#: factorisation 0.65x (0.96 against 1.46 s, 859k unknowns)
+THREADED_UNKNOWNS = 1 << 17
 
 
 @lru_cache(maxsize=1)

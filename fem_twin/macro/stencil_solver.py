@@ -62,7 +62,8 @@ REFINEMENTS = 4
 #: (float32 overflows at 3.4e38; beyond this the step goes to SuperLU in double precision)
 SINGLE_MAX = 1e30
 #: the most switched columns the kept factors are updated for (``W``: 16 vectors of the
-#: grid, 0.43 GB at 2048^2), and the most solves a step may spend with them ...
+#: grid in the factors' precision, 0.22 GB at 2048^2), and the most solves a step may
+#: spend with them ...
 REUSE_SOLVES = 16
 #: ... which is at most half a factorisation's time: a step takes one solve per node newly
 #: switched, plus about two refinement passes.  A factorisation costs about
@@ -242,7 +243,8 @@ class _Grid:
             return None
         self.columns = kept                   # columns switched back are dropped
         for k, state, u in zip(new, states[np.isin(switched, new)], difference(new).T):
-            self.columns[k] = (state, self._precondition(u))
+            # kept in the factors' precision: computed with them, W is no more accurate
+            self.columns[k] = (state, self._precondition(u).astype(self.solver.dtype))
         W = [self.columns[k][1] for k in switched]                # no (n, m) copy
         small = np.zeros((switched.size,) * 2)                    # V^T W
         for k, w in enumerate(W):
