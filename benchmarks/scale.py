@@ -6,9 +6,10 @@ factors (sample patch 1 at 64^2, 30 h0 x 8 steps), 150 N, 0.066 Pa s: a cold poi
 0.025 m/s from it, both as a sweep solves them (:func:`fem_twin.macro.nested.solve_nested`:
 the point on every coarsening first).  Each grid runs in a process of its own, so its peak
 memory (maximum resident set) is its own.  ``FEM_TWIN_SCALE_MAX`` (default 1024) is the
-largest grid: 2048 takes 6.4 min for its cold point and 7.7 GiB on one thread (2026-11-27;
-``FEM_TWIN_THREADS``, the threads a lone point's PARDISO may use, is inherited by each grid's
-process).
+largest grid: 2048 takes 2.8 min for its cold point and 7.5 GiB on two threads (2026-11-27).
+A lone point has the machine to itself, so each grid's process gets as many PARDISO threads
+as the machine has cores (``FEM_TWIN_THREADS``, if set, wins; PARDISO uses them only on
+matrices of ``fem_twin.linalg.THREADED_UNKNOWNS`` or more).
 Baseline: the cold point at 128^2.  The growth exponent is ``log(t_n / t_(n/2)) / log 4``,
 in the number of nodes N.
 """
@@ -38,16 +39,18 @@ def bench_scale():
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "factors.npz")
         _macro_factors().save(path)
+        env = {**os.environ,
+               "FEM_TWIN_THREADS": os.environ.get("FEM_TWIN_THREADS", str(os.cpu_count() or 1))}
         runs = [json.loads(subprocess.run(
             [sys.executable, __file__, str(n), path], check=True, capture_output=True,
-            text=True).stdout.splitlines()[-1]) for n in sizes]
+            text=True, env=env).stdout.splitlines()[-1]) for n in sizes]
     base, rows = runs[0]["cold"], []
     for i, r in enumerate(runs):
         growth = ("" if i == 0 else ", growth N^%.2f cold, N^%.2f warm" % tuple(
             np.log(r[k] / runs[i - 1][k]) / np.log(4) for k in ("cold", "warm")))
         rows.append((f"cold point {r['n']}^2, {COLD} m/s", r["cold"],
                      f"{r['cold_iterations']} it, C_f {r['cf']:.5f}, peak memory "
-                     f"{r['rss_gib']:.2f} GiB{growth}"))
+                     f"{r['rss_gib']:.2f} GiB, {env['FEM_TWIN_THREADS']} threads{growth}"))
         rows.append((f"warm point {r['n']}^2, {WARM} m/s", r["warm"],
                      f"{r['warm_iterations']} it"))
     return base, rows

@@ -18,8 +18,9 @@ the same pattern; the factorisation is 85 % of the roughness-scale time.  Two ba
     (``MKL_THREADING_LAYER=SEQUENTIAL``): parallel speed comes from processes.  A process
     that allows more threads when it first loads MKL (``FEM_TWIN_THREADS=N``, for a lone
     large point such as the 2048^2 grids of the resolution study) gets MKL's OpenMP layer
-    and N PARDISO threads: a 1024^2 Newton LU factorised in 0.62x the time on 2 threads
-    (1.46 against 2.37 s, solves 0.52x; sequential and one OpenMP thread take the same).
+    and N PARDISO threads on matrices of ``THREADED_UNKNOWNS`` or more: a 1024^2 Newton LU
+    factorised in 0.62x the time on 2 threads (1.46 against 2.37 s, solves 0.52x;
+    sequential and one OpenMP thread take the same).
     Its idle threads sleep at once (``KMP_BLOCKTIME=0``): spinning for the default 200 ms
     after each call, they took a core from the numpy work between the solves (the 512^2
     cold point of ``benchmarks/run.py scale`` 20.4 against 17.9 s).

@@ -151,7 +151,7 @@ def resampled(field, spacing, shape, dx) -> np.ndarray:
     """A nodal ``field`` on a grid of ``spacing`` interpolated (linearly, by coordinates from
     the first node, held at the last node beyond it) onto the grid ``shape``, ``dx`` [m]:
     bilinear, one axis after the other (half the time of ``scipy.ndimage.map_coordinates``
-    at 2048^2, equal to 1e-15)."""
+    at 2048^2, equal to 1e-14)."""
     out = np.asarray(field, float)
     for axis, (n_new, d_new, d_old) in enumerate(((shape[0], dx[1], spacing[1]),
                                                  (shape[1], dx[0], spacing[0]))):

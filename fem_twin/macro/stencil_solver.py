@@ -3,9 +3,9 @@
 The Newton matrix ``J = K diag(pos) + B diag(dtheta)`` of the interior lives on a pattern
 fixed per grid: PARDISO's symbolic factorisation is computed once per grid, in the grid's
 nested-dissection order (:func:`fem_twin.ordering.subgrid_order`: 0.67x METIS's
-factorisation time at 2048^2, 0.86x at 1024^2), and where each entry of ``K`` and ``B`` lands in that pattern once per sparsity pattern
-of theirs, so a step costs one numeric factorisation and a solve (the kept maps made a
-bundled-case sweep 12 % faster).  On grids of more than ``SINGLE_UNKNOWNS`` unknowns the
+factorisation time at 2048^2, 0.86x at 1024^2), and where each entry of ``K`` and ``B``
+lands in that pattern once per sparsity pattern of theirs, so a step costs one numeric
+factorisation and a solve (the kept maps made a bundled-case sweep 12 % faster).  On grids of more than ``SINGLE_UNKNOWNS`` unknowns the
 factors are single precision, refined with the residual in double precision (one
 refinement step reaches ``STEP_RTOL`` on the equilibrated matrix; half the factors' memory:
 2.06 GiB at 2048^2).  Single precision factorises the same Newton matrices in 0.82x the
