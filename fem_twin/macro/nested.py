@@ -103,7 +103,8 @@ def _film_from(coarse: MixedResult, start: MixedResult) -> MixedResult:
     previous point's free boundary lies farther from the new one than the coarse solution's
     does (the warm 2048^2 point of ``benchmarks/run.py scale``: its first Reynolds solve
     switched 12143 nodes, then 5678 ... 101 in 8 factorisations, against 6971 ... 44 in 4
-    from the coarse film; the point 0.83x the time, 2026-11-27, two threads)."""
+    from the coarse film; the point 0.89x the time on two threads, 0.86x on one,
+    2026-11-27)."""
     shape, spacing = start.pressure.shape, start.spacing
     return replace(start, pressure=resampled(coarse.pressure, coarse.spacing, shape, spacing),
                    cavity_fraction=np.clip(resampled(coarse.cavity_fraction, coarse.spacing,
