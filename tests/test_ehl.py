@@ -65,6 +65,38 @@ def test_smooth_ball_converges_with_the_acceptance_call(mourier97):
     assert res.pressure.max() == pytest.approx(MOURIER.hertz_pressure, rel=0.10)
 
 
+@pytest.mark.parametrize("block", [1 << 24, 8000])
+def test_newton_preconditioner_inverts_its_matrix(mourier97, monkeypatch, block):
+    """The Newton coupling's preconditioner (sparse LU outside the dense elastic block
+    ``S`` in the grid's nested-dissection order, the Schur complement on ``S`` from
+    ``J_OO^-1`` between ``S``'s neighbours only) solves its matrix ``J_pp + J_ph[:, S] W``
+    exactly: to round-off (1e-10 relative, for a condition number far below 1e5), also
+    with the Schur complement's solves split into blocks of one column (``block`` 8000
+    entries against about 8000 unknowns)."""
+    import scipy.sparse as sp
+
+    from fem_twin.macro import jacobian as jm
+    from fem_twin.macro import newton
+    from fem_twin.macro.problem import macro_problem
+
+    monkeypatch.setattr(jm, "SOLVE_BLOCK", block)
+    res, _, _ = mourier97
+    gap, spacing, _, _ = MOURIER.grid(97)
+    P = macro_problem(gap, spacing, FlowFactors.smooth(),
+                      Lubricant(MOURIER.viscosity, roelands_alpha=MOURIER.alpha), POINT,
+                      2 * MOURIER.entrainment, MOURIER.entrainment)
+    x = newton.state_from(res, P)
+    jac = jm.jacobian(P, newton.evaluate(P, x, MOURIER.load))
+    pre = jm.Preconditioner(P, jac)
+    assert pre.sI.size > 100 and pre.ring.size > 10
+    W = pre.ME * jac["pos"][pre.S]
+    matrix = jac["J_pp"].tolil()
+    matrix[:, pre.sI] = matrix[:, pre.sI] + sp.lil_matrix(pre.JphS @ W)
+    r = np.random.default_rng(1).standard_normal(P.interior.size)
+    x = pre.solve_pressure(r)
+    assert np.linalg.norm(matrix.tocsr() @ x - r) < 1e-10 * np.linalg.norm(r)
+
+
 def test_film_against_hamrock_dowson_and_the_measured_plateau(mourier97):
     """h_c within 10 % of Hamrock-Dowson (their fit's accuracy) and h_min within 15 %: the
     converged h_min of this contact is 8.3 % below the fit (central Couette flux on 49, 97,
