@@ -6,7 +6,7 @@ factors (sample patch 1 at 64^2, 30 h0 x 8 steps), 150 N, 0.066 Pa s: a cold poi
 0.025 m/s from it, both as a sweep solves them (:func:`fem_twin.macro.nested.solve_nested`:
 the point on every coarsening first).  Each grid runs in a process of its own, so its peak
 memory (maximum resident set) is its own.  ``FEM_TWIN_SCALE_MAX`` (default 1024) is the
-largest grid: 2048 takes 2.8 min for its cold point and 7.5 GiB on two threads (2026-11-27).
+largest grid: 2048 takes 2.8 min for its cold point and 7.4 GiB on two threads (2026-11-28).
 A lone point has the machine to itself, so each grid's process gets as many PARDISO threads
 as the machine has cores (``FEM_TWIN_THREADS``, if set, wins; PARDISO uses them only on
 matrices of ``fem_twin.linalg.THREADED_UNKNOWNS`` or more).
@@ -30,6 +30,10 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 COLD, WARM = 0.03, 0.025          # [m/s]
+#: the environment before this process loads MKL, which sets its threading layer there
+#: (``fem_twin.linalg``): a child given more threads must choose its own layer, not
+#: inherit this process's sequential one
+_ENVIRONMENT = dict(os.environ)
 
 
 def bench_scale():
@@ -39,7 +43,7 @@ def bench_scale():
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "factors.npz")
         _macro_factors().save(path)
-        env = {**os.environ,
+        env = {**_ENVIRONMENT,
                "FEM_TWIN_THREADS": os.environ.get("FEM_TWIN_THREADS", str(os.cpu_count() or 1))}
         runs = [json.loads(subprocess.run(
             [sys.executable, __file__, str(n), path], check=True, capture_output=True,
@@ -50,7 +54,8 @@ def bench_scale():
             np.log(r[k] / runs[i - 1][k]) / np.log(4) for k in ("cold", "warm")))
         rows.append((f"cold point {r['n']}^2, {COLD} m/s", r["cold"],
                      f"{r['cold_iterations']} it, C_f {r['cf']:.5f}, peak memory "
-                     f"{r['rss_gib']:.2f} GiB, {env['FEM_TWIN_THREADS']} threads{growth}"))
+                     f"{r['rss_gib']:.2f} GiB, {env['FEM_TWIN_THREADS']} threads (MKL layer "
+                     f"{r['layer']}){growth}"))
         rows.append((f"warm point {r['n']}^2, {WARM} m/s", r["warm"],
                      f"{r['warm_iterations']} it"))
     return base, rows
@@ -73,7 +78,8 @@ def _point(n: int, factors: str) -> dict:
     t2 = time.perf_counter()
     return {"n": n, "cold": t1 - t0, "warm": t2 - t1, "cf": cold[0].friction_coefficient,
             "cold_iterations": cold[0].iterations, "warm_iterations": warm[0].iterations,
-            "rss_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20}
+            "rss_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20,
+            "layer": os.environ.get("MKL_THREADING_LAYER", "no MKL")}
 
 
 if __name__ == "__main__":
