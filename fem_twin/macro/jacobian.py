@@ -135,10 +135,9 @@ class Preconditioner:
         self.y2 = self.solve_pressure(c)
 
     def _factor(self, J_pp, W):
-        """The sparse LU of ``J_pp`` outside ``S`` (in the grid's nested-dissection order,
-        :class:`~fem_twin.linalg.SPDSolver`'s backend) and the dense LU of the Schur
-        complement on ``S``, which needs ``J_OO^-1`` only between the nodes beside ``S``
-        (solved in blocks of columns: no dense ``O x ring`` array)."""
+        """The sparse LU of ``J_pp`` outside ``S`` (:func:`_grid_lu`) and the dense LU of
+        the Schur complement on ``S``, which needs ``J_OO^-1`` only between the nodes beside
+        ``S`` (solved in blocks of columns: no dense ``O x ring`` array)."""
         sI, P = self.sI, self.P
         O = np.setdiff1d(np.arange(J_pp.shape[0]), sI)
         self.O = O
