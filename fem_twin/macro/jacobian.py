@@ -159,7 +159,7 @@ class Preconditioner:
     def _inverse_block(self, rows, cols):
         """``J_OO^-1[rows, cols]``, from solves of at most ``SOLVE_BLOCK`` entries at once."""
         n = self.O.size
-        step = max(1, SOLVE_BLOCK // n)
+        step = max(1, SOLVE_BLOCK // max(n, 1))
         out = np.empty((rows.size, cols.size))
         for k in range(0, cols.size, step):
             unit = np.zeros((n, min(step, cols.size - k)))
