@@ -142,18 +142,19 @@ class Preconditioner:
         O = np.setdiff1d(np.arange(J_pp.shape[0]), sI)
         self.O = O
         J = J_pp.tocsr()
-        self.lu = _grid_lu(J[O][:, O], P.shape, P.interior[O])
+        JO = J[O]
+        self.lu = _grid_lu(JO[:, O], P.shape, P.interior[O])
         if sI.size == 0:
             return
-        JOS, CsO = J[O][:, sI], self.JphS[O]
+        JOS, CsO, JS = JO[:, sI], self.JphS[O], J[sI]
         self.ring = np.flatnonzero(np.asarray(abs(JOS).sum(axis=1)).ravel()
                                    + np.asarray(abs(CsO).sum(axis=1)).ravel())
         self.B_ring = JOS[self.ring].toarray() + CsO[self.ring] @ W
-        C = J[sI][:, O].tocsc()
+        C = JS[:, O].tocsc()
         self.C = C.tocsr()
         cols = np.flatnonzero(np.diff(C.indptr))          # the nodes of O that C reads
         inverse = self._inverse_block(cols, self.ring)    # J_OO^-1 [cols, ring]
-        D = J[sI][:, sI].toarray() + self.JphS[sI] @ W
+        D = JS[:, sI].toarray() + self.JphS[sI] @ W
         self.schur = la.lu_factor(D - (C[:, cols] @ inverse) @ self.B_ring)
 
     def _inverse_block(self, rows, cols):

@@ -12,18 +12,17 @@ start is then the previous fine state plus that change, interpolated:
 for the elastic deformation, contact pressure and ``h_d`` (the full approximation scheme's
 correction, Brandt 1977); the film pressure and cavity fraction, whose free boundary the
 coarse solution places closer, are the coarse solution's, interpolated.  The fine grid
-keeps its own detail
-and needs 8-10 iterations instead of 19-26 (sample pin 1 at 256^2, 8 speeds of the paper's
-sweep: 33.5 s against 46.5 s, C_f the same to 7e-9 C_f,b).  The coarse point is itself
-solved so, from the next coarser grid, down to the coarse start: a sweep keeps every
-level of its last point.  The coarse solution is also the base of the point's macro error
-estimate (:mod:`fem_twin.macro.estimate`), which no longer solves it.  Each level's
-Anderson coupling, in a cold point, also starts from the coarser level's last
+keeps its own detail and needs 8-10 iterations instead of 19-26 (sample pin 1 at 256^2, 8
+speeds of the paper's sweep: 33.5 s against 46.5 s, C_f the same to 7e-9 C_f,b).  The
+coarse point is itself solved so, from the next coarser grid, down to the coarse start: a
+sweep keeps every level of its last point.  The coarse solution is also the base of the
+point's macro error estimate (:mod:`fem_twin.macro.estimate`), which no longer solves it.
+Each level's Anderson coupling, in a cold point, also starts from the coarser level's last
 differences (:class:`~fem_twin.macro.fixed_point.Secants`), which carry the slow modes the
-coarse solve has already found (the 512^2 level of a cold point: 10 iterations against
-14).  A warm point's levels start from the previous point's and gain nothing from them
-(three warm points at 512^2: 92 against 95 iterations over all levels), and at 56^2 from a
-28^2 level they cost iterations (25 against 21).
+coarse solve has already found (the 512^2 level of a cold point: 10 iterations against 14).
+A warm point's levels start from the previous point's and gain nothing from them (three
+warm points at 512^2: 92 against 95 iterations over all levels), and at 56^2 from a 28^2
+level they cost iterations (25 against 21).
 """
 
 from __future__ import annotations

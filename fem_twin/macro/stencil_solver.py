@@ -7,8 +7,8 @@ factorisation time at 2048^2, 0.86x at 1024^2), and where each entry of ``K`` an
 lands in that pattern once per sparsity pattern of theirs, so a step costs one numeric
 factorisation and a solve (the kept maps made a bundled-case sweep 12 % faster).  On grids
 of more than ``SINGLE_UNKNOWNS`` unknowns the factors are single precision, refined with
-the residual in double precision (one
-refinement step reaches ``STEP_RTOL`` on the equilibrated matrix; half the factors' memory:
+the residual in double precision (one refinement step reaches ``STEP_RTOL`` on the
+equilibrated matrix; half the factors' memory:
 2.06 GiB at 2048^2).  Single precision factorises the same Newton matrices in 0.82x the
 time at 13k unknowns, 0.75x at 53k, 0.67x at 214k and 0.60x at 859k (PARDISO, one thread,
 AMD EPYC, 2026-11-27); below ``SINGLE_UNKNOWNS`` the refinement's extra solve and product
@@ -26,9 +26,9 @@ switched entries of ``x``, ``W = J_0^-1 U`` (one solve per switched column, kept
 for the later steps), and ``J^-1 = J_0^-1 - W (I + V^T W)^-1 V^T J_0^-1``, applied as the
 preconditioner of the same refinement in double precision as a new factorisation's.  A
 step tries it when one solve per newly switched column plus two refinement passes take
-at most :meth:`_Grid.budget` solves (about half a factorisation; else it factorises anew).  It
-replaced GMRES with the kept factors, which lost its Krylov space at every refinement pass
-and had to find the switched columns again: on the cold 2048^2 point of
+at most :meth:`_Grid.budget` solves (about half a factorisation; else it factorises
+anew).  It replaced GMRES with the kept factors, which lost its Krylov space at every
+refinement pass and had to find the switched columns again: on the cold 2048^2 point of
 ``benchmarks/run.py scale`` 3 of the last exact solve's 5 GMRES attempts failed their
 budget of 14 solves (4 switched nodes: GMRES passes of 6, 3 and 3 solves, the true
 residual 0.36 after the first pass at GMRES's estimate of 1e-4), where the update
