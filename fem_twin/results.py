@@ -43,8 +43,8 @@ class RunResults:
 def flow_factor_dataset(factors, labels):
     """Flow factors of several patches as a Dataset over (patch, h0), h0 the union of their
     samples: NaN where a patch's adaptive sample skipped an h0 (its interpolant,
-    ``FlowFactors.at``, reads it there); A, b, C, d split into named components (A11, A12,
-    ..., d2)."""
+    ``FlowFactors.at``, reads it there); A, b, C, d and the friction tensor C_F split into
+    named components (A11, A12, ..., d2), the friction factors as sC, fP1 and fP2."""
     import xarray as xr
     h0 = np.unique(np.concatenate([f.h0 for f in factors]))
     where = [np.searchsorted(h0, f.h0) for f in factors]
@@ -64,6 +64,10 @@ def flow_factor_dataset(factors, labels):
     for name, eq in (("b", 14), ("d", 16)):
         for i in range(2):
             data[f"{name}{i + 1}"] = (stack(name)[:, :, i], "1", f"eq {eq}")
+    data["sC"] = (stack("friction_factor"), "1", "Couette friction on the pin, mu u_r s_C / h_m")
+    for i in range(2):
+        data[f"fP{i + 1}"] = (stack("pressure_friction")[:, :, i], "1",
+                              "Poiseuille friction on the pin, -(h_m / 2) fP . grad p")
     ds = xr.Dataset({k: (("patch", "h0"), v, {"units": u, "long_name": n})
                      for k, (v, u, n) in data.items()},
                     coords={"patch": list(labels), "h0": ("h0", h0, {"units": "m"})})

@@ -58,7 +58,8 @@ def smooth_factors():
     n = h0.size
     return FlowFactors(h0=h0, h_m=h0.copy(), p_con=np.zeros(n), A=np.tile(np.eye(2), (n, 1, 1)),
                        b=np.tile([1.0, 0.0], (n, 1)), C=np.tile(np.eye(2), (n, 1, 1)),
-                       d=np.zeros((n, 2)), contact_fraction=np.zeros(n))
+                       d=np.zeros((n, 2)), friction_factor=np.ones(n),
+                       pressure_friction=np.tile([1.0, 0.0], (n, 1)), contact_fraction=np.zeros(n))
 
 
 @pytest.mark.parametrize("assemble", [fe_poiseuille, fvm_poiseuille])
@@ -411,15 +412,25 @@ def test_friction_error_parts(case32, factors):
                        initial=base, **kw)
     assert est["time"] == pytest.approx(abs(time.friction_coefficient
                                             - base.friction_coefficient), rel=1e-3)
+    # the film part: the fine point's friction with half or twice the boundary film, the
+    # larger change, no solve (the Reynolds equation does not read the friction factor)
+    films = [solve_mixed(gap, dx, factors.variants()[k], speed=0.05, face=face, initial=res,
+                         **kw) for k in ("film_thin", "film_thick")]
+    assert all(f.h_d == pytest.approx(res.h_d, rel=1e-4) for f in films)
+    assert films[0].friction_coefficient > res.friction_coefficient > films[1].friction_coefficient
+    assert est["film"] == pytest.approx(    # to the coupling tolerance's 1e-4 of C_f, x3
+        max(abs(f.friction_coefficient - res.friction_coefficient) for f in films),
+        abs=3e-4 * res.friction_coefficient)
     assert est["total"] == pytest.approx(sum(est[p] for p in PARTS))
     assert all(est[p] > 0 for p in PARTS) and "missing" not in est
     bare = replace(factors, meta={})
     est = friction_error(res, gap, dx, bare, face=face, **kw)
-    assert est["missing"] == ["time", "grid", "h0"] and np.isnan(est["grid"])
+    assert est["missing"] == ["time", "grid", "h0", "film"] and np.isnan(est["grid"])
     assert est["total"] == pytest.approx(est["macro"])
     smooth = solve_mixed(gap, dx, FlowFactors.smooth(), speed=1.0, face=face, **kw)
     est = friction_error(smooth, gap, dx, FlowFactors.smooth(), face=face, **kw)
-    assert est["time"] == est["grid"] == est["h0"] == 0 and est["total"] == est["macro"] > 0
+    assert est["time"] == est["grid"] == est["h0"] == est["film"] == 0
+    assert est["total"] == est["macro"] > 0
 
 
 def test_the_micro_parts_of_a_fine_grid_are_solved_on_a_coarser_level(factors, monkeypatch):
@@ -561,6 +572,7 @@ def exponential_factors(scale=40e-9, p0=1e10):
     return FlowFactors(h0=h0, h_m=h0.copy(), p_con=p0 * np.exp(-h0 / scale),
                        A=np.tile(np.eye(2), (n, 1, 1)), b=np.tile([1.0, 0.0], (n, 1)),
                        C=np.tile(np.eye(2), (n, 1, 1)), d=np.zeros((n, 2)),
+                       friction_factor=np.ones(n), pressure_friction=np.tile([1.0, 0.0], (n, 1)),
                        contact_fraction=np.zeros(n))
 
 

@@ -340,14 +340,24 @@ def test_variants_carry_each_estimated_error():
     """The factors with each estimated error added (what the macro scale re-solves for the
     C_f estimate): "time" is the pass of every other instant, "grid" adds the coarsened
     cell's difference to the pass of as many instants (normwise the grid estimate), "h0"
-    keeps every other
-    separation and both ends; they survive save/load and average over patches."""
+    keeps every other separation and both ends, "film_thin" and "film_thick" halve and
+    double the boundary film of the friction; they survive save/load and average over
+    patches."""
     pin, disk = rough_pair(32)
     h0 = np.geomspace(0.12e-6, 0.8e-6, 5)
     ff = homogenise(pin, disk, h0, n_steps=4)
     v = ff.variants()
-    assert sorted(v) == ["grid", "h0", "time"]
+    assert sorted(v) == ["film_thick", "film_thin", "grid", "h0", "time"]
     est = ff.meta["error_estimate"]
+    # the films: only the friction factor moves; a thinner boundary film counts more film
+    for kind in ("film_thin", "film_thick"):
+        assert all(np.array_equal(getattr(v[kind], k), getattr(ff, k)) for k in ARRAYS
+                   if k != "friction_factor")
+    assert np.all(v["film_thin"].friction_factor >= ff.friction_factor)
+    assert np.all(v["film_thick"].friction_factor <= ff.friction_factor)
+    assert max(np.abs(v[k].friction_factor - ff.friction_factor).max() for k in (
+        "film_thin", "film_thick")) / np.abs(ff.friction_factor).max() == pytest.approx(
+        est["film"]["sC"], rel=1e-9)
     for kind in ("time", "grid"):
         assert np.array_equal(v[kind].h0, ff.h0)
     scale = np.abs(ff.b[:, 0]).max()
@@ -408,13 +418,10 @@ def test_interpolation_rules(small_factors):
 
 def test_average_over_patches(small_factors):
     other = FlowFactors(**{k: getattr(small_factors, k) * (1 if k == "h0" else 3)
-                           for k in ("h0", "h_m", "p_con", "A", "b", "C", "d",
-                                     "contact_fraction")}, meta={"patch_id": "x3"})
+                           for k in ARRAYS}, meta={"patch_id": "x3"})
     mean = average([small_factors, other])
     assert np.allclose(mean.A, 2 * small_factors.A) and len(mean.meta["average_of"]) == 2
-    shifted = FlowFactors(**{**{k: getattr(other, k) for k in ("h_m", "p_con", "A", "b", "C",
-                                                               "d", "contact_fraction")},
-                             "h0": other.h0 * 1.01})
+    shifted = FlowFactors(**{**{k: getattr(other, k) for k in ARRAYS}, "h0": other.h0 * 1.01})
     with pytest.raises(ValueError, match="same h0"):
         average([small_factors, shifted])
 
@@ -555,13 +562,13 @@ def analytic_factors(h0, jitter=0.0, seed=0):
         b = np.stack([1 + 0.3 * np.exp(-x), 0 * x], 1)
         d = np.stack([-0.2 * np.exp(-x) + noise, 0 * x], 1)
         return FlowFactors(h0=h0, h_m=h0 * (1 + 0.1 * np.exp(-2 * x)), p_con=1e8 * onset ** 2,
-                           A=A, b=b, C=A.copy(), d=d, contact_fraction=0.1 * onset)
+                           A=A, b=b, C=A.copy(), d=d, friction_factor=1 - 3 * d[:, 0],
+                           pressure_friction=2 * np.eye(2)[0] - b, contact_fraction=0.1 * onset)
     return make(jitter * rng.standard_normal(n)), make(jitter * rng.standard_normal(n))
 
 
 def subset(factors, idx):
-    return FlowFactors(**{k: getattr(factors, k)[idx] for k in ("h0", "h_m", "p_con", "A", "b",
-                                                                "C", "d", "contact_fraction")})
+    return FlowFactors(**{k: getattr(factors, k)[idx] for k in ARRAYS})
 
 
 def test_adaptive_separations_meet_their_tolerance_on_a_dense_sample():

@@ -138,9 +138,12 @@ def small_factors(srr=None):
     variant = {"h0": h0.tolist(), "h_m": h0.tolist(), "p_con": [0.0] * n,
                "A": np.tile(np.eye(2), (n, 1, 1)).tolist(), "b": (b + 0.01).tolist(),
                "C": np.tile(np.eye(2), (n, 1, 1)).tolist(), "d": d.tolist(),
+               "friction_factor": (1 - 3 * d[:, 0]).tolist(),
+               "pressure_friction": np.tile([1.0, 0.0], (n, 1)).tolist(),
                "contact_fraction": [0.0] * n}
     return FlowFactors(h0=h0, h_m=h0 * 1.1, p_con=np.zeros(n), A=np.tile(np.eye(2), (n, 1, 1)),
-                       b=b, C=np.tile(np.eye(2), (n, 1, 1)), d=d, contact_fraction=np.zeros(n),
+                       b=b, C=np.tile(np.eye(2), (n, 1, 1)), d=d, friction_factor=1 - 3 * d[:, 0],
+                       pressure_friction=np.tile([1.0, 0.0], (n, 1)), contact_fraction=np.zeros(n),
                        meta={**meta, "variants": {"time": variant}})
 
 

@@ -20,6 +20,12 @@ Both scales contribute, and each part is a change of C_f [-]:
     is that of twice the spacing, ``H0_SPACING_RATIO`` times the error of the computed
     sample.
 
+``"film"``
+    the friction re-evaluated on the point's own fields with the friction factor of half
+    and of twice the boundary film (:mod:`fem_twin.micro.estimate`), the larger change:
+    the sensitivity to the film friction's cut-off at the contact edges, a model part; no
+    solve, as the Reynolds equation does not read the friction factors.
+
 ``"total"`` is the sum of the parts' magnitudes: their root sum of squares (independent
 errors of unknown sign), tried on 2026-11-26, fell to 0.62-0.87 of the truth on the
 paper-grade patch pair in heavy contact, where the parts' errors add with one sign
@@ -39,7 +45,9 @@ import numpy as np
 
 from ..errors import MixedNotConverged
 from .mixed import solve_mixed
+from ..micro.estimate import FILM_VARIANTS
 from .nested import coarsened
+from .result import friction_with
 
 #: the order assumed in ``|C_f(h) - C_f(2h)| / (2^p - 1)``.  The scheme's is 2 (bundled
 #: pin at 0.03 m/s: 1.97, 1.95 on 128 -> 255 -> 509 -> 1017 px refined in place), but
@@ -55,7 +63,7 @@ MACRO_ORDER = 1.5
 #: one point where it is 0.11 %)
 H0_SPACING_RATIO = 4.0
 #: the parts of an estimate, in the order of the CSV and NetCDF outputs
-PARTS = ("macro", "time", "grid", "h0")
+PARTS = ("macro", "time", "grid", "h0", "film")
 #: the fewest nodes a side of the grid the micro parts are solved on.  Measured on the
 #: bundled case's factors and sample pin 1 at 1024^2 (2026-11-27; docs/accuracy.md): the
 #: sum of the parts on the 256^2 level within 3.3 % of the 512^2 one at 0.03, 0.05 and
@@ -95,6 +103,11 @@ def friction_error(result, gap, spacing, factors, *, load: float, lubricant, fac
               / (2 ** MACRO_ORDER - 1)}
     micro, failed = _micro_parts(solve, factors, micro_parts_level(np.shape(gap)))
     signed.update(micro)
+    films = [v for k, v in factors.variants().items() if k in FILM_VARIANTS]
+    if films:                                 # the friction factor alone: no solve
+        own = friction_with(result, factors, settings, lubricant)
+        moved = [friction_with(result, v, settings, lubricant) - own for v in films]
+        signed["film"] = max(moved, key=abs)
     smooth = factors.meta.get("smooth", False)              # no roughness: no micro error
     for kind in set(PARTS) - set(signed):
         signed[kind] = 0.0 if smooth else np.nan
@@ -113,7 +126,7 @@ def _micro_parts(solve, factors, level) -> tuple[dict, list]:
     """``({kind: signed change of C_f}, failures)`` of the factors' variants, solved on
     the grid coarsened ``level`` times, warm from the point there (NaN where a solve
     failed)."""
-    variants = factors.variants()
+    variants = {k: v for k, v in factors.variants().items() if k not in FILM_VARIANTS}
     if not variants:
         return {}, []
     try:

@@ -1,4 +1,13 @@
-"""Friction on the pin: homogenised shear stress (eq 31), boundary shear (eq 32), eqs 33-34."""
+"""Friction on the pin: the tangential force of the film (eqs 31, 33-34) and of the contacts
+(eq 32).
+
+The default law (``"pin"``) is the force a load cell on the pin holder reads: the wall
+shear plus the film pressure on the pin's asperity flanks (the micro scale's friction
+factors ``friction_factor`` s_C and ``pressure_friction`` ``2 e1 - b``) plus the film
+pressure on the face's own slope.  Its integral equals the force on the disk and the
+film's dissipation over the sliding speed (docs/model.md, "Friction on the pin").
+``"paper"`` is eq 31, the pin's wall shear with ``<1/h>`` read as ``1/h_m``.
+"""
 
 from __future__ import annotations
 
@@ -8,27 +17,41 @@ from .. import tables as T
 
 #: Boundary friction coefficient C_f,b of eq 32 (Bowden and Tabor, pure shearing).
 BOUNDARY_FRICTION = T.BOUNDARY_FRICTION
+#: the friction laws: the force on the pin, or the paper's eq 31
+LAWS = ("pin", "paper")
 
 
-def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, C, d, spacing,
-                       speed, entrainment=None, eyring_stress=None) -> np.ndarray:
-    """tau_hd,31 of eq 31 on the lower surface [Pa], sliding speed ``speed`` along +x1.
+def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing,
+                       speed, *, entrainment=None, eyring_stress=None, law: str = "pin",
+                       ambient_pressure: float = 0.0) -> np.ndarray:
+    """The film's tangential traction on the pin along +x1 [Pa], the disk sliding at
+    ``speed`` u_r along +x1 (``entrainment`` u_m, default u_r / 2: the pin at rest).
 
-    ``tau = -(h_m/2) (C grad p)_1 + (mu / h_m) (-6 u_m d_1 + u_r) (1 - theta)`` with
-    ``u_r = U`` and ``u_m = U/2`` (a stationary pin) or ``entrainment`` (a ball on a disk),
-    with ``d`` at that slide-to-roll ratio (:func:`fem_twin.micro.at_slide_to_roll`, as
-    :func:`~fem_twin.macro.solve_mixed` passes it): the Couette part is then
-    ``(mu u_r / h_m) (1 - 3 d_1)`` in the pin-at-rest ``d``, zero in pure rolling;
-    ``grad p`` by second-order central differences on the grid.  ``eyring_stress`` tau_0
-    [Pa]: the Couette (shear-driven) part becomes ``tau_0 asinh(tau / tau_0)`` (Eyring).
+    ``"pin"``: ``(mu u_r / h_m) s_C (1 - theta) - (h_m/2) (2 e1 - b) . grad p
+    - (p - p_amb) dh_m/dx1``, the last term the film pressure on the face's slope.
+    ``"paper"``: eq 31, ``-(h_m/2) (C grad p)_1 + (mu / h_m) (-6 u_m d_1 + u_r) (1 - theta)``
+    with ``d`` at the slide-to-roll ratio.  ``shear``: the
+    :class:`~fem_twin.micro.LocalFactors` at the point's h0; gradients by central
+    differences; ``eyring_stress`` tau_0 [Pa]: the Couette part becomes
+    ``tau_0 asinh(tau / tau_0)`` (Eyring).
     """
-    dp2, dp1 = np.gradient(np.asarray(pressure, float), spacing[1], spacing[0])
-    u_m = speed / 2 if entrainment is None else entrainment
-    poiseuille = -mean_gap / 2 * (C[..., 0, 0] * dp1 + C[..., 0, 1] * dp2)
-    couette = viscosity / mean_gap * (-6 * u_m * d[..., 0] + speed) * (1 - cavity_fraction)
+    p = np.asarray(pressure, float)
+    dp2, dp1 = np.gradient(p, spacing[1], spacing[0])
+    if law == "paper":
+        u_m = speed / 2 if entrainment is None else entrainment
+        poiseuille = -mean_gap / 2 * (shear.C[..., 0, 0] * dp1 + shear.C[..., 0, 1] * dp2)
+        couette = viscosity / mean_gap * (-6 * u_m * shear.d[..., 0] + speed)
+    else:
+        f = shear.pressure_friction
+        poiseuille = -mean_gap / 2 * (f[..., 0] * dp1 + f[..., 1] * dp2)
+        couette = viscosity / mean_gap * (speed * shear.friction_factor)
+    couette = couette * (1 - cavity_fraction)
     if eyring_stress is not None:
         couette = eyring_stress * np.arcsinh(couette / eyring_stress)
-    return poiseuille + couette
+    if law == "paper":
+        return poiseuille + couette
+    slope = np.gradient(np.asarray(mean_gap, float), spacing[0], axis=1)
+    return poiseuille + couette - (p - ambient_pressure) * slope
 
 
 def boundary_shear(contact_pressure, coefficient: float = BOUNDARY_FRICTION) -> np.ndarray:

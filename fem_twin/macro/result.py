@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io.atomic import atomic_path
+from ..micro.rolling import at_slide_to_roll
 from .friction import boundary_shear, hydrodynamic_shear
 
 #: the grid fields of an operating point and their SI units: declared once, for the
@@ -111,12 +112,9 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
     ``face``."""
     s, dx, area, speed, lubricant = P.settings, P.spacing, P.area, P.speed, P.lubricant
     loc = ev.loc
-    shear = P.factors.at(ev.h0)         # C, d of eqs 31-32 (the iterations read no C, d)
     p_hd = ev.p + s.cavitation_pressure
-    tau_hd = hydrodynamic_shear(p_hd, loc.h_m, ev.theta, ev.mu, shear.C, shear.d, dx, speed,
-                                entrainment=P.entrainment,
-                                eyring_stress=lubricant.eyring_stress)
-    tau_con = boundary_shear(ev.p_con, s.boundary_friction) * (speed > 0)   # 0: no sliding
+    tau_hd, tau_con = pin_friction(p_hd, ev.theta, ev.mu, ev.h0, loc.h_m, ev.p_con, dx,
+                                   P.factors, s, lubricant, speed, P.entrainment)
     cell = dx[0] * dx[1]
     F_hd = float(tau_hd[face].sum() * cell)
     F_con = float(tau_con[face].sum() * cell)
@@ -135,6 +133,35 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
               "lubricant": lubricant.__dict__.copy(), "seconds": seconds,
               "coupling": coupling or ("anderson" if s.coupling == "auto" else s.coupling),
               "entrainment": P.entrainment})
+
+
+def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubricant, speed,
+                 entrainment):
+    """The film's and the contacts' tangential tractions on the pin [Pa] (eqs 31-32, or the
+    force on the pin: ``settings.friction``, :func:`.friction.hydrodynamic_shear`) of a
+    converged state, with ``factors`` at its slide-to-roll ratio."""
+    shear = factors.at(h0)              # the shear factors (the iterations read none)
+    tau_hd = hydrodynamic_shear(p_hd, h_m, theta, mu, shear, dx, speed,
+                                entrainment=entrainment, eyring_stress=lubricant.eyring_stress,
+                                law=settings.friction,
+                                ambient_pressure=settings.ambient_pressure)
+    tau_con = boundary_shear(p_con, settings.boundary_friction) * (speed > 0)  # 0: no sliding
+    return tau_hd, tau_con
+
+
+def friction_with(result: MixedResult, factors, settings, lubricant) -> float:
+    """The friction coefficient of ``result`` with the shear factors of ``factors`` (a
+    :class:`~fem_twin.micro.FlowFactors` at the pin's SRR 2, carried to the point's), the
+    point's fields unchanged: for factors that differ only in what the Reynolds equation
+    does not read (the friction factors)."""
+    u_m = result.meta.get("entrainment") or result.speed / 2
+    moved = at_slide_to_roll(factors, result.speed / u_m)
+    tau_hd, tau_con = pin_friction(result.pressure, result.cavity_fraction, result.viscosity,
+                                   result.h0, result.mean_gap, result.contact_pressure,
+                                   result.spacing, moved, settings, lubricant, result.speed,
+                                   result.meta.get("entrainment"))
+    cell = result.spacing[0] * result.spacing[1]
+    return float((tau_hd + tau_con)[result.face].sum() * cell / result.normal_load)
 
 
 def on_grid(result: MixedResult, shape, dx) -> MixedResult:

@@ -13,7 +13,7 @@ from ..errors import InputError
 from .cavitation import MODELS, cavitation_model
 from .contact_load import RULES
 from .couette import SCHEMES
-from .friction import BOUNDARY_FRICTION
+from .friction import BOUNDARY_FRICTION, LAWS
 
 
 @dataclass(frozen=True)
@@ -27,6 +27,9 @@ class MacroSettings:
     e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", unit="Pa", section="materials")
     boundary_friction: float = setting(BOUNDARY_FRICTION, "C_f,b of eq 32", unit="-",
                                        section="tribometer")
+    friction: str = setting("pin", "friction law: the force on the pin (wall shear and "
+                            "the film pressure on the asperity flanks and the face's slope), "
+                            "or the paper's eq 31 (the pin's wall shear)", choices=LAWS)
     method: str = setting("fe", "Poiseuille term by finite elements or the paper's finite "
                           "volumes", choices=("fe", "fvm"))
     coupling: str = setting("auto", "pressure-deformation-load coupling (auto: Anderson, "

@@ -168,13 +168,14 @@ class CellSolver:
 
     # -- solve ---------------------------------------------------------------------------
     def solve(self, gap: np.ndarray, squeeze: np.ndarray | None = None,
-              couette: bool = True) -> CellSolution:
+              couette: bool = True, film=(0.0,)) -> CellSolution:
         """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady).
 
         ``squeeze`` is ``(1/u_m) dh/dt`` on the grid, already discretised in time; its cell
         mean (non-zero only where the truncation at the gap floor changes the mean gap) is
         removed, as the periodic problem requires.  ``couette=False``: eq 8 without its
-        Couette term (the mean-speed frame, :mod:`fem_twin.micro.sliding`).
+        Couette term (the mean-speed frame, :mod:`fem_twin.micro.sliding`).  ``film``: the
+        thinnest film [m] whose dissipation of chi_1 counts, one moment per value.
         """
         h = np.asarray(gap, float)
         if h.shape != self.shape:
@@ -197,13 +198,15 @@ class CellSolver:
         chi = np.zeros((3, n))
         chi[:, self._free] = X.T
         chi = chi.reshape(3, *self.shape)
-        return CellSolution(chi, self.moments(h_q, chi))
+        return CellSolution(chi, self.moments(h_q, chi, film))
 
-    def moments(self, h_q: np.ndarray, chi: np.ndarray) -> dict:
+    def moments(self, h_q: np.ndarray, chi: np.ndarray, film=(0.0,)) -> dict:
         """Cell averages of one time step, unnormalised (eqs 12-16 divide by h_m later).
 
         h : <h> [m];  h3_grad : <h^3 (I + G)> [m^3], G[i, j] = d chi_{j+2} / dx_i;
-        h3_g1 : <h^3 grad chi_1> [m];  h_grad : <h (I + G)> [m];  h_g1 : <h grad chi_1> [1/m]
+        h3_g1 : <h^3 grad chi_1> [m];  h_grad : <h (I + G)> [m];  h_g1 : <h grad chi_1> [1/m];
+        h3_g1g1 : <h^3 |grad chi_1|^2> where ``h`` exceeds each value of ``film`` [1/m] (the
+        dissipation of the sliding flow in the film, :func:`fem_twin.micro.sliding.film_moments`)
         """
         a_q = h_q ** 3
         n = a_q.size
@@ -213,8 +216,11 @@ class CellSolver:
                            for j in (1, 2)], axis=2)            # <w G[i, j]>: (w, i, j)
         w_mean = weights.mean(axis=1)
         eye = np.eye(2)
+        density = weights[0] * (g1 * g1).sum(axis=0)
         return {"h": float(w_mean[1]),
                 "h3_grad": w_mean[0] * eye + g_mean[0],
                 "h3_g1": g1 @ weights[0] / n,
                 "h_grad": w_mean[1] * eye + g_mean[1],
-                "h_g1": g1 @ weights[1] / n}
+                "h_g1": g1 @ weights[1] / n,
+                "h3_g1g1": np.array([np.mean(np.where(weights[1] > cut, density, 0.0))
+                                     for cut in film])}

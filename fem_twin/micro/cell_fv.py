@@ -115,9 +115,10 @@ class CellSolverFV:
         out += (flux[1] - np.roll(flux[1], 1, axis=0)) * dx1
         return out
 
-    def solve(self, gap, squeeze=None, couette: bool = True) -> CellSolution:
+    def solve(self, gap, squeeze=None, couette: bool = True, film=(0.0,)) -> CellSolution:
         """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady);
-        ``couette=False``: eq 8 without its Couette term (the mean-speed frame)."""
+        ``couette=False``: eq 8 without its Couette term (the mean-speed frame); ``film``:
+        the thinnest films whose dissipation counts, as in :meth:`CellSolver.solve`."""
         h = np.asarray(gap, float)
         if h.shape != self.shape:
             raise InputError(f"gap shape {h.shape} does not match the cell {self.shape}")
@@ -140,10 +141,11 @@ class CellSolverFV:
         chi = np.zeros((3, h.size))
         chi[:, self._free] = X.T
         chi = chi.reshape(3, *self.shape)
-        return CellSolution(chi, self.moments(h, hf, cf, chi))
+        return CellSolution(chi, self.moments(h, hf, cf, chi, film))
 
-    def moments(self, h, hf, cf, chi) -> dict:
-        """Cell averages of one step as face averages of the fluxes (same keys as FE)."""
+    def moments(self, h, hf, cf, chi, film=(0.0,)) -> dict:
+        """Cell averages of one step as face averages of the fluxes (same keys as FE; the
+        dissipation over the faces whose mean gap exceeds each value of ``film``)."""
         dx = self.spacing
 
         def grad(f):                              # D_i f on the faces normal to x_i
@@ -157,4 +159,6 @@ class CellSolverFV:
                 "h3_grad": (cf[:, None] * (eye + G)).mean(axis=(2, 3)),
                 "h3_g1": (cf * g1).mean(axis=(1, 2)),
                 "h_grad": (hf[:, None] * (eye + G)).mean(axis=(2, 3)),
-                "h_g1": (hf * g1).mean(axis=(1, 2))}
+                "h_g1": (hf * g1).mean(axis=(1, 2)),
+                "h3_g1g1": np.array([np.where(hf > cut, cf * g1 * g1, 0.0).mean(axis=(1, 2)).sum()
+                                     for cut in film])}

@@ -25,7 +25,11 @@ What the macro scale needs is the effect of these errors on the friction coeffic
 estimate also keeps, per kind, the factors with that error added (:func:`variants`), which
 the macro scale solves again (:mod:`fem_twin.macro.estimate`): ``"time"`` the factors over
 every other instant, ``"grid"`` the factors plus the difference to the coarsened cell,
-``"h0"`` the factors at every other computed separation (read by the interpolant between).
+``"h0"`` the factors at every other computed separation (read by the interpolant between),
+``"film_thin"`` and ``"film_thick"`` the friction factor with half and twice the boundary
+film (the film friction's cut-off at contact edges, a model sensitivity rather than a
+discretisation error, estimate kind ``"film"``; it moves only the friction, so the macro
+scale re-evaluates the friction instead of solving again).
 """
 
 from __future__ import annotations
@@ -39,7 +43,23 @@ from ..errors import InputError
 #: the quantities estimated, with how each is read from a FlowFactors
 QUANTITIES = {"A11": lambda f: f.A[:, 0, 0], "A22": lambda f: f.A[:, 1, 1],
               "b1": lambda f: f.b[:, 0], "C11": lambda f: f.C[:, 0, 0],
-              "d1": lambda f: f.d[:, 0], "p_con": lambda f: f.p_con, "h_m": lambda f: f.h_m}
+              "d1": lambda f: f.d[:, 0], "sC": lambda f: f.friction_factor,
+              "p_con": lambda f: f.p_con,
+              "h_m": lambda f: f.h_m}
+#: the quantities only the force on the pin reads (``[macro] friction = "pin"``)
+FORCE_QUANTITIES = ("sC",)
+
+
+def watched(friction: str) -> tuple:
+    """The quantities whose interpolation error chooses the adaptive separations for a
+    friction law (``"paper"``: eq 31's, which leaves the paper's sample as it was)."""
+    return tuple(q for q in QUANTITIES if friction != "paper" or q not in FORCE_QUANTITIES)
+
+
+#: the kinds of estimate, in the order of the variants
+KINDS = ("time", "grid", "h0", "film")
+#: the variants of the boundary film (half, twice), estimate kind "film"
+FILM_VARIANTS = ("film_thin", "film_thick")
 
 
 def discrepancy(fine, coarse) -> dict:
@@ -61,13 +81,14 @@ def grid_separations(h0: np.ndarray, count: int = 3) -> np.ndarray:
     return np.unique(np.asarray(h0)[np.linspace(0, len(h0) - 1, count).round().astype(int)])
 
 
-def variants(factors, half=None, grid=None) -> dict:
+def variants(factors, half=None, grid=None, films=(None, None)) -> dict:
     """``{kind: {array: list}}``: ``factors`` (a :class:`FlowFactors`) with each estimated
     error added, as JSON-able arrays: ``half`` (the factors over every other instant),
-    ``grid`` (the factors plus the coarsened cell's difference) and, from five separations
-    on, the factors at every other separation (the ends kept)."""
+    ``grid`` (the factors plus the coarsened cell's difference), ``films`` (the friction
+    factor with half and twice the boundary film, :data:`FILM_VARIANTS`) and, from five
+    separations on, the factors at every other separation (the ends kept)."""
     arrays = [f.name for f in fields(factors) if f.name != "meta"]     # h0 first
-    out = {"time": half, "grid": grid}
+    out = {"time": half, "grid": grid, **dict(zip(FILM_VARIANTS, films))}
     if len(factors) >= 5:
         keep = sorted(set(range(0, len(factors), 2)) | {len(factors) - 1})
         out["h0"] = type(factors)(**{n: getattr(factors, n)[keep] for n in arrays})
@@ -81,7 +102,7 @@ def combine(estimates) -> dict:
     if not estimates:
         return {}
     out = {}
-    for kind in ("time", "grid", "h0"):
+    for kind in KINDS:
         parts = [e[kind] for e in estimates if kind in e]
         if parts:
             out[kind] = {q: max(p[q] for p in parts) for q in parts[0]}

@@ -2,8 +2,10 @@
 
 A :class:`FlowFactors` value is what the micro scale hands to the macro scale: for each
 rigid-body separation ``h0`` the mean gap ``h_m``, the mean asperity contact pressure
-``p_con`` and the factors ``A``, ``b`` (Poiseuille and Couette flow, eq 17) and ``C``, ``d``
-(shear stress, eq 31).  It saves to and loads from ``.npz`` with its metadata, averages over
+``p_con``, the factors ``A``, ``b`` (Poiseuille and Couette flow, eq 17), ``C``, ``d``
+(the pin's wall shear, eq 31) and the friction factors ``friction_factor`` s_C and
+``pressure_friction`` (the force on the pin: wall shear and the film pressure on its
+flanks, from the film's dissipation; docs/model.md "Friction on the pin").  It saves to and loads from ``.npz`` with its metadata, averages over
 patches, and interpolates in ``h0`` with the paper's rules beyond the computed range.
 """
 
@@ -22,12 +24,15 @@ from ..io.table import write_csv
 from .estimate import combine
 
 #: the arrays of a FlowFactors value, in the order of its fields
-ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "contact_fraction")
+ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "friction_factor", "pressure_friction",
+          "contact_fraction")
 #: p_con is interpolated as ``log(p_con + P_CON_FLOOR max p_con)``: it falls by a factor of
 #: about 3 per 40 nm of h0, and linearly between samples 1.17 apart (16 over a decade) the
 #: bundled case's C_f was up to 0.13 % C_f,b off a 46-separation run, in log 0.019 %
 #: (2026-11-25); the floor keeps the log finite where the surfaces separate (p_con = 0)
 P_CON_FLOOR = 1e-6
+#: what the friction needs beyond the Reynolds equation (eqs 31-32, the force on the pin)
+SHEAR = ("C", "d", "friction_factor", "pressure_friction", "contact_fraction")
 #: relative step of the central differences in h0 (:meth:`FlowFactors.slopes`)
 REL_STEP = 1e-6
 
@@ -43,6 +48,11 @@ class FlowFactors:
     b : (n, 2) Couette flow factor, eq 14 [-]
     C : (n, 2, 2) pressure-driven shear factor, eq 15 [-]
     d : (n, 2) shear-driven shear factor, eq 16 [-]
+    friction_factor : (n,) s_C, the Couette friction on the pin per area ``mu u_r s_C / h_m``
+        at any slide-to-roll ratio (eq 31's wall shear alone: ``1 - 3 d1``) [-]
+    pressure_friction : (n, 2) ``2 e1 - b`` of the pin at rest: the Poiseuille friction on
+        the pin along x1 per area ``-(h_m / 2) pressure_friction . grad p`` (eq 31's wall
+        shear alone: the first row of ``C``) [-]
     contact_fraction : (n,) space-time mean fraction of pixels in contact [-]
     meta : JSON-able description (patch ids, grid, materials, method, version, ...)
     """
@@ -54,13 +64,16 @@ class FlowFactors:
     b: np.ndarray
     C: np.ndarray
     d: np.ndarray
+    friction_factor: np.ndarray
+    pressure_friction: np.ndarray
     contact_fraction: np.ndarray
     meta: dict = field(default_factory=dict)
 
     def __post_init__(self):
         n = np.asarray(self.h0).shape
         expect = {"h0": n, "h_m": n, "p_con": n, "A": n + (2, 2), "b": n + (2,),
-                  "C": n + (2, 2), "d": n + (2,), "contact_fraction": n}
+                  "C": n + (2, 2), "d": n + (2,), "friction_factor": n,
+                  "pressure_friction": n + (2,), "contact_fraction": n}
         for name, shape in expect.items():
             v = np.asarray(getattr(self, name), dtype=float)
             if v.shape != shape:
@@ -77,14 +90,17 @@ class FlowFactors:
     @classmethod
     def smooth(cls, h0_range=(1e-10, 1e-2)) -> "FlowFactors":
         """Factors of two perfectly smooth surfaces (the smooth limit of eqs 11-16):
-        ``h_m = h0``, ``p_con = 0``, ``A = C = I``, ``b = e1``, ``d = 0`` at every ``h0``
+        ``h_m = h0``, ``p_con = 0``, ``A = C = I``, ``b = e1``, ``d = 0``, ``s_C = 1``,
+        ``2 e1 - b = e1`` at every ``h0``
         [m] (tabulated at the two ends of ``h0_range``; exact in between and above, and
         below down to the 1 nm floor of :meth:`at`).  What a smooth EHL contact uses."""
         h0 = np.asarray(h0_range, float)
         n = h0.size
         return cls(h0=h0, h_m=h0.copy(), p_con=np.zeros(n), A=np.tile(np.eye(2), (n, 1, 1)),
                    b=np.tile([1.0, 0.0], (n, 1)), C=np.tile(np.eye(2), (n, 1, 1)),
-                   d=np.zeros((n, 2)), contact_fraction=np.zeros(n), meta={"smooth": True})
+                   d=np.zeros((n, 2)), friction_factor=np.ones(n),
+                   pressure_friction=np.tile([1.0, 0.0], (n, 1)), contact_fraction=np.zeros(n),
+                   meta={"smooth": True})
 
     def slopes(self, h0, rel_step: float = REL_STEP) -> dict:
         """Derivatives with respect to ``h0`` of ``h_m`` [-], ``p_con`` [Pa/m], ``A`` and
@@ -128,6 +144,8 @@ class FlowFactors:
                 "A22": self.A[:, 1, 1], "b1": self.b[:, 0], "b2": self.b[:, 1],
                 "C11": self.C[:, 0, 0], "C12": self.C[:, 0, 1], "C21": self.C[:, 1, 0],
                 "C22": self.C[:, 1, 1], "d1": self.d[:, 0], "d2": self.d[:, 1],
+                "sC": self.friction_factor, "fP1": self.pressure_friction[:, 0],
+                "fP2": self.pressure_friction[:, 1],
                 "contact_fraction": self.contact_fraction}
         return write_csv(path, cols)
 
@@ -142,8 +160,8 @@ class FlowFactors:
         Above ``h0_max``: ``h_m = h0``, ``p_con = 0`` and the factors at ``h0_max``.
         Below ``h0_min`` (not covered by the paper): ``h_m`` and ``p_con`` continue linearly
         with their end slopes, ``h_m`` floored at 1 nm, and the factors are held at ``h0_min``.
-        ``friction=False`` leaves out (None) the shear factors ``C``, ``d`` (eqs 31-32) and the
-        contact fraction, which the Reynolds iterations do not need (48 B a node less);
+        ``friction=False`` leaves out (None) the shear factors :data:`SHEAR` (``C``, ``d``,
+        ``friction_factor``, ``pressure_friction``) and the contact fraction, which the Reynolds iterations do not need (48 B a node less);
         ``contact=False`` leaves out the nodal ``p_con`` (for a caller that integrates it
         over the elements instead, :mod:`fem_twin.macro.contact_load`).
         """
@@ -154,7 +172,7 @@ class FlowFactors:
         lo, hi = self.h0[0], self.h0[-1]
         xc = np.log(np.clip(flat, lo, hi))
         out = {}
-        names = ("h_m", "A", "b") + (("C", "d", "contact_fraction") if friction else ())
+        names = ("h_m", "A", "b") + (SHEAR if friction else ())
         for name in names:
             v = getattr(self, name)
             if len(self) == 1:
@@ -170,7 +188,7 @@ class FlowFactors:
         out["p_con"] = self.contact_pressure(flat) if contact else None
         out = {k: None if v is None else v.reshape(x.shape + v.shape[1:])
                for k, v in out.items()}
-        return LocalFactors(h0=x, **{"C": None, "d": None, "contact_fraction": None, **out})
+        return LocalFactors(h0=x, **{**dict.fromkeys(SHEAR), **out})
 
     def contact_pressure(self, h0) -> np.ndarray:
         """``p_con(h0)`` alone [Pa], with the rules of :meth:`at` (cheaper than ``at``)."""
@@ -242,16 +260,19 @@ class FlowFactors:
         """Largest deviation from the smooth-surface factors ``A = C = I, b = e1, d = 0``."""
         eye = np.eye(2)
         return float(max(np.abs(self.A - eye).max(), np.abs(self.C - eye).max(),
-                         np.abs(self.b - [1, 0]).max(), np.abs(self.d).max()))
+                         np.abs(self.b - [1, 0]).max(), np.abs(self.d).max(),
+                         np.abs(self.friction_factor - 1).max(),
+                         np.abs(self.pressure_friction - [1, 0]).max()))
 
 
 @dataclass(frozen=True, eq=False)
 class LocalFactors:
     """Flow factors evaluated at separations ``h0`` of any shape (see :meth:`FlowFactors.at`).
 
-    ``h_m``, ``p_con``, ``contact_fraction`` are shaped like ``h0``; ``A``, ``C`` add
-    ``(2, 2)`` and ``b``, ``d`` add ``(2,)`` as trailing axes; ``C``, ``d`` and
-    ``contact_fraction`` are None when evaluated without them (``at(h0, friction=False)``),
+    ``h_m``, ``p_con``, ``contact_fraction``, ``friction_factor`` are shaped like ``h0``;
+    ``A``, ``C`` add ``(2, 2)`` and ``b``, ``d``, ``pressure_friction`` add ``(2,)`` as
+    trailing axes; the shear factors and ``contact_fraction`` are None when evaluated
+    without them (``at(h0, friction=False)``),
     ``p_con`` with ``at(h0, contact=False)``, and ``A``, ``b`` where a caller dropped them
     once the Reynolds matrices were built.
     """
@@ -263,6 +284,8 @@ class LocalFactors:
     b: np.ndarray | None
     C: np.ndarray | None
     d: np.ndarray | None
+    friction_factor: np.ndarray | None
+    pressure_friction: np.ndarray | None
     contact_fraction: np.ndarray | None
 
 

@@ -22,7 +22,7 @@ from ..errors import InputError
 from ..threads import one_thread
 from ..topography import Topography
 from ..topography.plausibility import check_patch
-from .estimate import discrepancy, variants
+from .estimate import QUANTITIES, discrepancy, variants, watched
 from .flow_factors import ARRAYS, FlowFactors
 from .sampling import adaptive_separations
 from .schedule import Separations, coarse_moments, progress_bar
@@ -38,7 +38,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
                settings: CellSettings | None = None, workers: int = 1, executor=None,
                checkpoint=None, progress: bool = False, patch_id=None,
                error_estimate: bool = True, h0_tol: float | None = None,
-               **shortcuts) -> FlowFactors:
+               friction: str = "pin", **shortcuts) -> FlowFactors:
     """Flow factors of a roughness patch pair versus h0 (eqs 11-16).
 
     Parameters
@@ -81,6 +81,9 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
         interpolant in log h0 misses the factors at the skipped candidates by less than
         this relative tolerance (its bound: ``meta["error_estimate"]["h0"]``).  0 or None
         (off, as in the case file): every ``h0``.
+    friction : the friction law the factors serve (``[macro] friction``): with ``"paper"``
+        the adaptive separations watch eq 31's factors alone, as before the friction
+        factors s_C and C_F existed, which the factors still carry.
     """
     settings = _settings(settings, shortcuts)
     h0_tol = h0_tol or None                                  # 0 means off, as in the case
@@ -101,7 +104,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
         if h0_tol is None:
             chosen, bound = list(range(len(h0))), None
         else:
-            chosen, bound = adaptive_separations(h0, points.factors, h0_tol)
+            chosen, bound = adaptive_separations(h0, points.factors, h0_tol,
+                                                 quantities=watched(friction))
         moments = points.moments(chosen)
         bar.update(len(h0) - len(chosen))             # the candidates interpolated
         coarse = (coarse_moments(points, chosen, z_low, z_up, spacing, settings, checkpoint)
@@ -186,7 +190,10 @@ def estimate_errors(factors, moments, coarse, settings) -> dict:
         grid = replace(factors, meta={}, **{k: getattr(factors, k) + getattr(other, k)
                                             - getattr(same, k) for k in ARRAYS[1:]})
         out["checkpoint_keys"] = [key]
-    out["variants"] = variants(factors, half, grid)
+    films = [replace(factors, meta={}, friction_factor=np.array([m["s_c"][k] for m in moments])
+                     * factors.h_m) for k in (1, 2)]
+    out["film"] = {q: max(discrepancy(factors, f)[q] for f in films) for q in QUANTITIES}
+    out["variants"] = variants(factors, half, grid, films)
     return out
 
 

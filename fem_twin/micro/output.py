@@ -16,17 +16,23 @@ from .sliding import (CellSettings, cell_solver, sliding_cells, sliding_contacts
 
 def plot_flow_factors(factors, path, labels=None) -> Path:
     """Figures 4-5: h_m, p_con, A11 of each patch pair (and their average if given last),
-    and all components of A and b of the last entry, versus h0 [um].  Written atomically."""
+    and all components of A and b of the last entry, versus h0 [um]; beside them the
+    friction on the pin: the Couette friction factor s_C against eq 31's ``1 - 3 d1``, and
+    the Poiseuille friction ``2 - b1`` against eq 31's C11.  Written atomically."""
     import matplotlib.pyplot as plt
 
     factors = [factors] if isinstance(factors, FlowFactors) else list(factors)
     labels = labels or [f.meta.get("patch_id") or f"patch {i + 1}" for i, f in enumerate(factors)]
-    fig, ax = plt.subplots(2, 2, figsize=(10, 8), constrained_layout=True)
+    fig, ax = plt.subplots(2, 3, figsize=(15, 8), constrained_layout=True)
     for f, label in zip(factors, labels):
         x = f.h0 * 1e6
         ax[0, 0].plot(x, (f.h_m - f.h0) * 1e9, label=label)
         ax[0, 1].semilogy(x, np.where(f.p_con > 0, f.p_con * 1e-6, np.nan), ".-", label=label)
         ax[1, 0].plot(x, f.A[:, 0, 0], label=label)
+        line, = ax[0, 2].plot(x, f.friction_factor, label=label)
+        ax[0, 2].plot(x, 1 - 3 * f.d[:, 0], ":", color=line.get_color())
+        line, = ax[1, 2].plot(x, f.pressure_friction[:, 0], label=label)
+        ax[1, 2].plot(x, f.C[:, 0, 0], ":", color=line.get_color())
     last = factors[-1]
     x = last.h0 * 1e6
     for (i, j), style in zip([(0, 0), (0, 1), (1, 0), (1, 1)], ["-", "--", ":", "-."]):
@@ -36,9 +42,12 @@ def plot_flow_factors(factors, path, labels=None) -> Path:
     names = [("$h_m - h_0$ [nm]", "(a) mean gap above $h_0$, eq 12"),
              ("$p_{con}$ [MPa]", "(b) contact pressure, eq 11"),
              ("$A_{11}$ [-]", "(c) pressure flow factor, eq 13"),
-             ("factor [-]", f"(d) A and b of {labels[-1]}")]
+             ("factor [-]", f"(d) A and b of {labels[-1]}"),
+             ("$s_C$ [-]", "(e) Couette friction on the pin (dotted: eq 31, $1 - 3 d_1$)"),
+             ("$2 - b_1$ [-]", "(f) Poiseuille friction on the pin (dotted: eq 31, $C_{11}$)")]
     sq = composite_sq(last)
-    for a, (ylabel, title) in zip(ax.ravel(), names):
+    panels = [ax[0, 0], ax[0, 1], ax[1, 0], ax[1, 1], ax[0, 2], ax[1, 2]]
+    for a, (ylabel, title) in zip(panels, names):
         a.set_xlabel("$h_0$ [µm]")
         a.set_ylabel(ylabel)
         a.set_title(title)

@@ -49,8 +49,10 @@ SCALES = {"d1": 1.0 / 3.0}
 JITTER = 2.0
 
 
-def adaptive_separations(h0, factors_at, tol: float, start: int = START):
-    """Indices into the sorted candidates ``h0`` [m] where the factors are needed.
+def adaptive_separations(h0, factors_at, tol: float, start: int = START,
+                         quantities=tuple(QUANTITIES)):
+    """Indices into the sorted candidates ``h0`` [m] where the factors are needed, for the
+    ``quantities`` of :data:`~fem_twin.micro.estimate.QUANTITIES` watched.
 
     ``factors_at(indices)`` returns the :class:`FlowFactors` at ``h0[indices]`` (sorted
     indices; it computes what it does not hold yet) and those over every other instant
@@ -63,7 +65,7 @@ def adaptive_separations(h0, factors_at, tol: float, start: int = START):
     chosen = sorted({int(i) for i in np.linspace(0, n - 1, min(start, n)).round()})
     chosen = sorted(set(chosen) | set(_midpoints(chosen, range(len(chosen)))))
     while True:
-        misses = leave_one_out(*factors_at(chosen))
+        misses = leave_one_out(*factors_at(chosen), quantities=quantities)
         worst = np.max(np.array(list(misses.values())), axis=0)
         new = set(_midpoints(chosen, np.flatnonzero(worst > tol) + 1))
         if not new:
@@ -85,17 +87,18 @@ def _midpoints(chosen, positions):
     return out
 
 
-def leave_one_out(full, half=None) -> dict:
+def leave_one_out(full, half=None, quantities=tuple(QUANTITIES)) -> dict:
     """Relative miss per quantity at each interior point of ``full`` (a
     :class:`FlowFactors`) of the interpolant through all the others (see
     :func:`interpolation_misses`), zero where it is within ``JITTER`` times the
     time-sampling error ``|f - f_half|`` of that point or a neighbour (``half``: the
     factors over every other instant; one point's estimate may be small by chance where its
-    neighbours' are not)."""
+    neighbours' are not), for the named ``quantities``."""
     inner = np.arange(1, len(full) - 1)
     local = [_without(full, k).at(full.h0[k:k + 1]) for k in inner]
     out = {}
-    for name, get in QUANTITIES.items():
+    for name in quantities:
+        get = QUANTITIES[name]
         f = get(full)[inner]
         miss = np.abs(f - np.concatenate([get(loc) for loc in local]))
         if half is not None:

@@ -73,6 +73,8 @@ class CellSettings:
                               "hardness", section="materials")
     gap_floor: float = setting(1e-9, "smallest film of the cell problems (a contact spot)",
                                unit="m")
+    boundary_film: float = setting(10e-9, "films thinner than this carry no film friction "
+                                   "(contact spots carry the boundary shear, eq 32)", unit="m")
     method: str = setting("fe", "cell problems by Q1 finite elements or the paper's finite "
                           "volumes", choices=("fe", "fvm"))
     moving: str = setting("both", "the cell's frame: the disk at +U/2 and the pin at -U/2 "
@@ -114,11 +116,12 @@ class CellSettings:
             raise InputError("time_tol is a relative tolerance in (0, 1), with "
                              "time_derivative='exact' only")
         if not (self.e_reduced > 0 and self.hardness > 0 and self.gap_floor > 0
-                and self.contact_tol > 0 and self.rate_tol > 0):
-            raise InputError("e_reduced, hardness, gap_floor, contact_tol and rate_tol must "
-                             "be positive (Pa, Pa, m, -, -)")
+                and self.contact_tol > 0 and self.rate_tol > 0 and self.boundary_film > 0):
+            raise InputError("e_reduced, hardness, gap_floor, contact_tol, rate_tol and "
+                             "boundary_film must be positive (Pa, Pa, m, -, -, m)")
         plausible("slide_to_roll", self.slide_to_roll, "slide_to_roll")
-        for name in ("e_reduced", "hardness", "gap_floor", "slide_to_roll"):  # 2e11 = 2e11.0
+        for name in ("e_reduced", "hardness", "gap_floor", "slide_to_roll",
+                     "boundary_film"):                                    # 2e11 = 2e11.0
             object.__setattr__(self, name, float(getattr(self, name)))
         object.__setattr__(self, "steps", int(self.steps))
 
@@ -251,11 +254,45 @@ def sliding_squeeze(contacts, sliding: SlidingPass, spacing, settings: CellSetti
     return out
 
 
-def sliding_cells(gaps, squeezes, solver, couette: bool = True):
-    """Cell solutions of each step for its gap and squeeze term (``couette``: with eq 8's
-    Couette term)."""
-    for h, tau in zip(gaps, squeezes):
-        yield solver.solve(h, tau, couette=couette)
+#: the boundary films of the friction moments, in units of ``CellSettings.boundary_film``:
+#: the setting itself, and half and twice it for the sensitivity (:func:`film_moments`)
+FILM_CUTS = (1.0, 0.5, 2.0)
+
+
+def sliding_cells(contacts, squeezes, solver, settings: CellSettings, couette: bool = True):
+    """Cell solutions of each step for its contact's gap and squeeze term (``couette``:
+    with eq 8's Couette term), with the film dissipation above each of :data:`FILM_CUTS`."""
+    film = tuple(c * settings.boundary_film for c in FILM_CUTS)
+    for r, tau in zip(contacts, squeezes):
+        yield solver.solve(r.gap, tau, couette=couette, film=film)
+
+
+def film_moments(contact, cell: dict, settings: CellSettings) -> dict:
+    """The contact's cell averages of one instant, ``p_con`` (eq 11) and the contact
+    fraction, and the film's dissipation per ``mu u_r^2``, ``s_c = <1/h> + 3 k^2 <h^3
+    |grad chi_1|^2>`` [1/m] (Couette shear and the sliding flow's pressure; ``cell``: the
+    instant's cell moments, ``k = 2 u_m / u_r`` of the cell's frame), the friction on the
+    pin times u_r (docs/model.md, "Friction on the pin"), over the film thicker than
+    ``settings.boundary_film``, then half and twice it (:data:`FILM_CUTS`): contact spots
+    carry the boundary shear (eq 32) instead, and thinner films near them are boundary
+    films.  ``h3_g1_pin``: eq 14's ``<h^3 grad chi_1>`` with the pin at rest (``k`` times
+    the frame's), for the Poiseuille friction ``2 e1 - b``."""
+    k = 2 * frame_speed_ratio(settings)
+    h_inv = np.array([np.mean(np.where(contact.gap > c * settings.boundary_film,
+                                       1.0 / contact.gap, 0.0)) for c in FILM_CUTS])
+    return {"p_con": float(contact.pressure.mean()),
+            "contact_fraction": contact.contact_fraction,
+            "h3_g1_pin": k * cell["h3_g1"], "s_c": h_inv + 3 * k * k * cell["h3_g1g1"]}
+
+
+def frame_speed_ratio(settings: CellSettings) -> float:
+    """u_m / u_r of the cell's frame: 1/SRR with the pin at rest or both moving (the
+    mean-speed frame's moments are the pin's frame's), -1/2 in the disk's frame; chi_1 of
+    the pin at rest is ``2 u_m / u_r`` times the frame's (the same pressure field)."""
+    if settings.moving == "lower":
+        return -0.5
+    # pure rolling: chi_1 = 0 and no Couette friction to weigh (u_r = 0)
+    return 1.0 / settings.slide_to_roll if settings.slide_to_roll else 0.0
 
 
 def instants(sliding, h0, warm, solver, spacing, settings):
@@ -265,9 +302,9 @@ def instants(sliding, h0, warm, solver, spacing, settings):
     squeezes = sliding_squeeze(contacts, sliding, spacing, settings)
     t1 = time.perf_counter()
     steps = [cell.moments for cell in
-             sliding_cells([r.gap for r in contacts], squeezes, solver, sliding.couette)]
+             sliding_cells(contacts, squeezes, solver, settings, sliding.couette)]
     for m, r in zip(steps, contacts):
-        m["p_con"], m["contact_fraction"] = float(r.pressure.mean()), r.contact_fraction
+        m.update(film_moments(r, m, settings))
     return contacts, steps, [t1 - t0, time.perf_counter() - t1]
 
 
@@ -318,10 +355,9 @@ def half_pass_moments(steps, contacts, sliding, solver, spacing, settings):
     half = SlidingPass(sliding.shapes[::2], sliding.moving[::2], 2 * sliding.um_dt,
                        sliding.rigid_rate[::2])
     squeezes = sliding_squeeze(contacts[::2], half, spacing, settings)
-    out = [cell.moments for cell in
-           sliding_cells([r.gap for r in contacts[::2]], squeezes, solver)]
-    for m, full in zip(out, steps[::2]):
-        m["p_con"], m["contact_fraction"] = full["p_con"], full["contact_fraction"]
+    out = [cell.moments for cell in sliding_cells(contacts[::2], squeezes, solver, settings)]
+    for m, r in zip(out, contacts[::2]):
+        m.update(film_moments(r, m, settings))
     return out
 
 
@@ -341,4 +377,6 @@ def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
                        A=get("h3_grad") / h_m[:, None, None] ** 3,
                        b=np.array([1.0, 0.0]) - get("h3_g1") / h_m[:, None],
                        C=get("h_grad") / h_m[:, None, None], d=get("h_g1") * h_m[:, None],
+                       friction_factor=get("s_c")[:, 0] * h_m,
+                       pressure_friction=np.array([1.0, 0.0]) + get("h3_g1_pin") / h_m[:, None],
                        contact_fraction=get("contact_fraction"), meta=meta)

@@ -76,6 +76,7 @@ def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> Flo
     if low.shape != tuple(mc.resolution):
         low, up = resample_cell(low, mc.resolution), resample_cell(up, mc.resolution)
     ff = homogenise(low, up, h0, settings=cell_settings(case), h0_tol=mc.h0_tol,
+                    friction=case.macro.friction,
                     executor=executor,
                     workers=getattr(executor, "n_workers", 1),
                     checkpoint=checkpoints, progress=bar,

@@ -40,4 +40,4 @@ def stage_keys(case: Case) -> dict:
     geometry = key(files, g, case.macro_geometry)
     return {"geometry": geometry,
             "levelling": key(geometry, case.materials, case.macro.pin),
-            "micro": key(geometry, case.micro, case.materials)}
+            "micro": key(geometry, case.micro, case.materials, case.macro.friction)}

@@ -234,7 +234,8 @@ def sweep_key(gap, spacing, factors, load, lubricant, settings, face,
     """Key of a sweep's checkpoints (``point_KEY_*.npz``): a hash of all its inputs, with
     ``factors`` a :class:`FlowFactors` or a key string of their inputs."""
     flow = ((factors.h0, factors.h_m, factors.p_con, factors.A, factors.b, factors.C,
-             factors.d) if isinstance(factors, FlowFactors) else (str(factors),))
+             factors.d, factors.friction_factor, factors.pressure_friction)
+            if isinstance(factors, FlowFactors) else (str(factors),))
     inputs = [load, lubricant.__dict__, settings.__dict__]
     if slide_to_roll is not None:
         inputs.append(slide_to_roll)
