@@ -135,7 +135,8 @@ def _add_case_commands(sub):
     rn = _case_command(sub, "run", "run the pipeline of a case file (TOML) into an output "
                                    "folder", "out", runs.run)
     rn.add_argument("--yes", action="store_true",
-                    help=f"start even if estimated longer than {runs.LONG_RUN_SECONDS // 60} min")
+                    help=f"start even if estimated at more than {runs.LONG_RUN_RATIO:.0f}x "
+                    "the bundled case")
     rn.add_argument("--from-fit", type=Path, metavar="FIT",
                     help="run with the parameters of a fit.json (fem-twin fit) and write "
                          "OUT/prediction.csv, each curve with its 95 %% band")

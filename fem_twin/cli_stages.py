@@ -186,5 +186,3 @@ def sample(args):
         print(path)
     return 0
 
-
-#: runs estimated longer than this ask for --yes (the bundled case: about 1 minute)

@@ -24,6 +24,7 @@ from .io.layout import RunLayout
 from .io.table import write_csv
 from .macro import MixedResult
 from .micro import FlowFactors
+from .micro.flow_factors import ARRAYS
 from .micro.estimate import discrepancy, grid_separations
 from .stribeck import friction_deviation, stribeck_sweep
 from .stages.curves import macro_settings
@@ -44,6 +45,7 @@ def flow_factor_differences(fe: FlowFactors, fvm: FlowFactors) -> dict:
 
     return {"h0": fe.h0, "A": rel(fe.A, fvm.A, (1, 2)), "b": rel(fe.b, fvm.b, 1),
             "C": rel(fe.C, fvm.C, (1, 2)), "d": np.abs(fe.d - fvm.d).max(axis=1),
+            "sC": np.abs(fe.friction_factor / fvm.friction_factor - 1),
             "h_m": np.abs(fe.h_m - fvm.h_m) / fe.h0,
             "p_con": np.abs(fe.p_con - fvm.p_con) / max(float(fvm.p_con.max()), 1e-300)}
 
@@ -65,8 +67,7 @@ def reference_factors(case: Case, outdir: Path, h0, *, executor=None,
         ref_run.geometry.symlink_to(out.geometry.resolve(), target_is_directory=True)
     homogenise_patches(fine, ref_run, executor, progress, h0=grid_separations(h0))
     ref = FlowFactors.load(ref_run.flow_factors)
-    return FlowFactors(**{k: getattr(ref, k) for k in ("h0", "h_m", "p_con", "A", "b", "C",
-                                                     "d", "contact_fraction")},
+    return FlowFactors(**{k: getattr(ref, k) for k in ARRAYS},
                        meta={**ref.meta, "grid": list(fine.micro.resolution),
                              "steps": fine.micro.steps})
 

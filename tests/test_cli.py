@@ -503,19 +503,32 @@ def test_implausible_case_values_are_refused_naming_the_key(tmp_path, old, new, 
                  "--no-progress"]) == 2
 
 
-def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, capsys):
+@pytest.mark.parametrize("slowdown", ["0.25", "4"])
+def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, capsys,
+                                                                      monkeypatch, slowdown):
     """Issue 15 item 3: a case cut off after [geometry] is valid TOML; the defaults (the
     paper's 256^2, 100 h0 x 32 steps) are named before work starts, and a run estimated
-    far above the bundled case's stops with exit 2 unless --yes is given."""
+    at more than ten times the bundled case stops with exit 2 unless --yes is given.
+    Issue 64 item 0: the question does not depend on the machine's speed (the probe forced
+    fast and slow), and the bundled case's figure it quotes is the estimate's."""
+    from fem_twin.cli_runs import BUNDLED_SECONDS, LONG_RUN_SECONDS
+    monkeypatch.setenv("FEM_TWIN_SLOWDOWN", slowdown)
+    bundled = load_case(ROOT / "examples" / "pin_on_disk.toml")
+    assert bundled.estimated_seconds(2) == pytest.approx(BUNDLED_SECONDS, rel=0.02)
     text = (ROOT / "examples" / "pin_on_disk.toml").read_text()
     text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
     cut = tmp_path / "cut.toml"
     cut.write_text(text[:text.index("[preprocessing]")])
+    assert load_case(cut).estimated_seconds(2) > LONG_RUN_SECONDS
     assert main(["run", str(cut), "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "defaults used: [preprocessing], [tribometer]" in err and "[micro]" in err
     assert "256x256, 100 h0 x 32 steps" in err and "--yes" in err
+    assert "x the bundled case" in err and f"takes {float(slowdown):.2g}x" in err
     assert not (tmp_path / "o" / "geometry").exists()
+    for name in ("pin_on_disk", "paper", "ball_on_disk"):    # the examples run unasked
+        assert load_case(ROOT / "examples" / f"{name}.toml").estimated_seconds(2) < (
+            LONG_RUN_SECONDS)
 
 
 def test_failures_are_one_line_with_documented_exit_codes(tmp_path, monkeypatch, capsys):
@@ -778,7 +791,7 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
     for r in rows:
         point = st.sel(viscosity=float(r["viscosity_Pa_s"]), speed=float(r["speed_m_s"]),
                        method="nearest")
-        parts = [float(point[f"cf_err_{p}"]) for p in ("macro", "time", "grid", "h0")]
+        parts = [float(point[f"cf_err_{p}"]) for p in ("macro", "time", "grid", "h0", "film")]
         assert float(r["cf_err"]) == pytest.approx(sum(parts), rel=1e-9)
         assert float(r["cf_err"]) > 0
         assert float(point.cf_err) == pytest.approx(float(r["cf_err"]), rel=1e-9)
@@ -925,6 +938,11 @@ def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     assert "takes 2x the calibration machine's time" in capsys.readouterr().err
     monkeypatch.setattr(speed, "probe_seconds", lambda: 100.0)
     assert speed.slowdown() == speed.BOUNDS[1]
+    monkeypatch.setenv("FEM_TWIN_SLOWDOWN", "0.5")            # forced: no probe
+    assert speed.slowdown() == 0.5
+    monkeypatch.setenv("FEM_TWIN_SLOWDOWN", "fast")
+    with pytest.raises(ValueError, match="FEM_TWIN_SLOWDOWN"):
+        speed.slowdown()
     assert [duration(s) for s in (85, 250, 1529)] == ["85 s", "4.2 min", "25 min"]
 
 

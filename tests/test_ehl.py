@@ -212,17 +212,19 @@ def test_film_depends_on_entrainment_not_on_sliding():
 
 
 def test_eyring_shear_limits():
-    """Eyring shear thinning of eq 31's Couette shear: Newtonian while tau << tau_0, and
-    tau_0 ln(2 tau / tau_0) (logarithmic, bounded traction) when tau >> tau_0."""
+    """Eyring shear thinning of the Couette shear (both friction laws): Newtonian while
+    tau << tau_0, and tau_0 ln(2 tau / tau_0) (logarithmic, bounded traction) when
+    tau >> tau_0."""
     from fem_twin.macro import hydrodynamic_shear
     shape = (5, 5)
     ones, zeros = np.ones(shape), np.zeros(shape)
-    eye, d = np.broadcast_to(np.eye(2), shape + (2, 2)), np.zeros(shape + (2,))
-    for mu, limit in ((1e-3, lambda t: t), (1e6, lambda t: 5e6 * np.log(2 * t / 5e6))):
-        newton = hydrodynamic_shear(zeros, 1e-6 * ones, zeros, mu * ones, eye, d, (1e-5, 1e-5), 1.0)
-        eyring = hydrodynamic_shear(zeros, 1e-6 * ones, zeros, mu * ones, eye, d, (1e-5, 1e-5),
-                                    1.0, eyring_stress=5e6)
-        assert np.allclose(eyring, limit(newton), rtol=1e-6)
+    smooth = FlowFactors.smooth().at(1e-6 * ones)
+    for law in ("pin", "paper"):
+        for mu, limit in ((1e-3, lambda t: t), (1e6, lambda t: 5e6 * np.log(2 * t / 5e6))):
+            args = (zeros, 1e-6 * ones, zeros, mu * ones, smooth, (1e-5, 1e-5), 1.0)
+            newton = hydrodynamic_shear(*args, law=law)
+            eyring = hydrodynamic_shear(*args, law=law, eyring_stress=5e6)
+            assert np.allclose(eyring, limit(newton), rtol=1e-6)
     with pytest.raises(ValueError, match="eyring"):
         Lubricant(0.066, eyring_stress=-1.0)
 

@@ -56,14 +56,18 @@ def test_swapping_the_surfaces_and_their_speeds_gives_the_same_factors(method):
     the same gap with the wall speeds exchanged, SRR -> -SRR.  Eq 8 does not know which wall
     is which, and the relative positions are the same set (in reverse order), so every
     factor is the same, to the contact solver's tolerance; with the pin at rest (SRR 2)
-    its mirror is the disk at rest and the pin moving (SRR -2)."""
+    its mirror is the disk at rest and the pin moving (SRR -2).  So is the friction factor
+    (the force on the lower body per mu u_r: both change sign), while the Poiseuille
+    friction is the other body's, ``2 e1 - (2 e1 - b)``."""
     pin, disk = pair()
     for srr in (0.5, 2.0):
         a = cell(pin, disk, method, moving="upper", slide_to_roll=srr)
         b = cell(flipped(disk), flipped(pin), method, moving="upper", slide_to_roll=-srr)
-        for name in ARRAYS:
+        for name in ARRAYS + ("friction_factor",):
             ref = np.abs(getattr(a, name)).max()
             assert np.abs(getattr(a, name) - getattr(b, name)).max() < 1e-7 * ref, name
+        # the other body's Poiseuille friction: the two take -h_m grad p together
+        assert np.abs(a.pressure_friction + b.pressure_friction - [2, 0]).max() < 1e-7
 
 
 def test_a_common_translation_changes_only_the_couette_factor():

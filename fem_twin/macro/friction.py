@@ -23,12 +23,13 @@ LAWS = ("pin", "paper")
 
 def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing,
                        speed, *, entrainment=None, eyring_stress=None, law: str = "pin",
-                       ambient_pressure: float = 0.0) -> np.ndarray:
+                       ambient_pressure: float = 0.0, face=None) -> np.ndarray:
     """The film's tangential traction on the pin along +x1 [Pa], the disk sliding at
     ``speed`` u_r along +x1 (``entrainment`` u_m, default u_r / 2: the pin at rest).
 
     ``"pin"``: ``(mu u_r / h_m) s_C (1 - theta) - (h_m/2) (2 e1 - b) . grad p
-    - (p - p_amb) dh_m/dx1``, the last term the film pressure on the face's slope.
+    - (p - p_amb) dh_m/dx1``, the last term the film pressure on the slope of the pin's
+    ``face`` (bool grid, default all; one-sided at its edge: not the rim's drop).
     ``"paper"``: eq 31, ``-(h_m/2) (C grad p)_1 + (mu / h_m) (-6 u_m d_1 + u_r) (1 - theta)``
     with ``d`` at the slide-to-roll ratio.  ``shear``: the
     :class:`~fem_twin.micro.LocalFactors` at the point's h0; gradients by central
@@ -50,8 +51,21 @@ def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, sp
         couette = eyring_stress * np.arcsinh(couette / eyring_stress)
     if law == "paper":
         return poiseuille + couette
-    slope = np.gradient(np.asarray(mean_gap, float), spacing[0], axis=1)
-    return poiseuille + couette - (p - ambient_pressure) * slope
+    return poiseuille + couette - (p - ambient_pressure) * face_slope(mean_gap, face, spacing[0])
+
+
+def face_slope(gap, face, dx1: float) -> np.ndarray:
+    """``d gap / dx1`` [-] on the pin ``face`` (bool grid; None: all), by central
+    differences inside it and one-sided ones at its edge, zero off it."""
+    h = np.asarray(gap, float)
+    face = np.ones(h.shape, bool) if face is None else np.asarray(face, bool)
+    left, right = np.zeros_like(face), np.zeros_like(face)
+    left[:, 1:], right[:, :-1] = face[:, :-1], face[:, 1:]
+    back, ahead = np.zeros_like(h), np.zeros_like(h)
+    back[:, 1:], ahead[:, :-1] = h[:, 1:] - h[:, :-1], h[:, 1:] - h[:, :-1]
+    both = left & right
+    slope = np.where(both, (back + ahead) / 2, np.where(left, back, np.where(right, ahead, 0.0)))
+    return np.where(face, slope / dx1, 0.0)
 
 
 def boundary_shear(contact_pressure, coefficient: float = BOUNDARY_FRICTION) -> np.ndarray:

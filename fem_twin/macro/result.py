@@ -114,7 +114,7 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
     loc = ev.loc
     p_hd = ev.p + s.cavitation_pressure
     tau_hd, tau_con = pin_friction(p_hd, ev.theta, ev.mu, ev.h0, loc.h_m, ev.p_con, dx,
-                                   P.factors, s, lubricant, speed, P.entrainment)
+                                   P.factors, s, lubricant, speed, P.entrainment, face)
     cell = dx[0] * dx[1]
     F_hd = float(tau_hd[face].sum() * cell)
     F_con = float(tau_con[face].sum() * cell)
@@ -136,14 +136,14 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
 
 
 def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubricant, speed,
-                 entrainment):
+                 entrainment, face=None):
     """The film's and the contacts' tangential tractions on the pin [Pa] (eqs 31-32, or the
     force on the pin: ``settings.friction``, :func:`.friction.hydrodynamic_shear`) of a
-    converged state, with ``factors`` at its slide-to-roll ratio."""
+    converged state, with ``factors`` at its slide-to-roll ratio, on the pin ``face``."""
     shear = factors.at(h0)              # the shear factors (the iterations read none)
     tau_hd = hydrodynamic_shear(p_hd, h_m, theta, mu, shear, dx, speed,
                                 entrainment=entrainment, eyring_stress=lubricant.eyring_stress,
-                                law=settings.friction,
+                                law=settings.friction, face=face,
                                 ambient_pressure=settings.ambient_pressure)
     tau_con = boundary_shear(p_con, settings.boundary_friction) * (speed > 0)  # 0: no sliding
     return tau_hd, tau_con
@@ -159,7 +159,7 @@ def friction_with(result: MixedResult, factors, settings, lubricant) -> float:
     tau_hd, tau_con = pin_friction(result.pressure, result.cavity_fraction, result.viscosity,
                                    result.h0, result.mean_gap, result.contact_pressure,
                                    result.spacing, moved, settings, lubricant, result.speed,
-                                   result.meta.get("entrainment"))
+                                   result.meta.get("entrainment"), result.face)
     cell = result.spacing[0] * result.spacing[1]
     return float((tau_hd + tau_con)[result.face].sum() * cell / result.normal_load)
 

@@ -85,7 +85,7 @@ def cell_fields(pin, disk, h0: float, *, n_steps: int = 32, method: str = "fe",
     solver = cell_solver(z_low.shape, spacing, method)
     contacts = sliding_contacts(sliding.shapes, spacing, settings, h0)
     squeezes = sliding_squeeze(contacts, sliding, spacing, settings)
-    cells = sliding_cells([r.gap for r in contacts], squeezes, solver, sliding.couette)
+    cells = sliding_cells(contacts, squeezes, solver, settings, sliding.couette)
     out = []
     for r, m, tau, cell in zip(contacts, sliding.moving, squeezes, cells):
         out.append({"pin": -m if moving == "lower" else z_low,
