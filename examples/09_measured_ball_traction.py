@@ -21,10 +21,11 @@ rolling to SRR 1 for one oil at two entrainment speeds:
 
 - u_m = 0.5 m/s, where the film carries 99 % of the load: the traction rises from zero and
   saturates (Eyring), as an MTM's does;
-- u_m = 0.2 m/s, where the asperities carry a fifth of it: this roughness's shear factor
-  d1 exceeds 1/3 there, so eq 31's Couette shear ``(mu u_r / h_m)(1 - 3 d1)`` is negative
-  and the traction falls with SRR.  This is a limit of the paper's shear model in heavy
-  contact (docs/rolling_sliding.md), shown rather than hidden.
+- u_m = 0.2 m/s, where the asperities carry a fifth of it: the boundary shear sets the
+  level and the film's friction (the force on the ball, positive) adds to it with SRR.
+  Eq 31's wall shear (``[macro] friction = "paper"``), whose Couette factor
+  ``1 - 3 d1`` is negative for this roughness there, made it fall with SRR
+  (docs/rolling_sliding.md).
 
 It ends in ``OUT/measured_ball_traction.png``.  About a minute on 2 cores; ``--quick``:
 32 px cells and a 33^2 ball grid.

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import tomllib
 from dataclasses import MISSING, dataclass, field, fields
 from pathlib import Path
@@ -16,6 +17,11 @@ from .topography.prepare import MacroOptions
 
 class CaseError(InputError):
     """A case file that is missing, malformed or inconsistent."""
+
+
+#: local worker processes a case may ask for per core (``[run] workers``): more only add
+#: memory and switching (issue 64: 10000 started about 4600 processes on 2 cores)
+WORKERS_PER_CORE = 4
 
 
 #: a warm Stribeck point of a pin at 128^2 [s], its growth with the pixels, and the cost of
@@ -154,6 +160,11 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if run.workers < 0:
         raise CaseError(f"{where} [run] workers: a number of processes >= 0 (0: all cores), "
                         f"got {run.workers}")
+    most = WORKERS_PER_CORE * (os.cpu_count() or 1)
+    if run.workers > most and run.scheduler in (None, "local"):
+        raise CaseError(f"{where} [run] workers = {run.workers}: at most {WORKERS_PER_CORE} "
+                        f"processes per core on this machine ({most} on its "
+                        f"{os.cpu_count() or 1} cores; 0: one per core)")
     if not 0 < run.band_tol < 1:
         raise CaseError(f"{where} [run] band_tol: a coupling tolerance in (0, 1), got "
                         f"{run.band_tol}")

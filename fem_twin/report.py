@@ -37,8 +37,10 @@ def write_report(outdir, path=None, *, render: bool = True) -> Path:
     work.mkdir(exist_ok=True)
     sections = [geometry_section(out, work, render), levelling_section(out, work),
                 figure_section("Flow factors (Figures 4-5)", [out.flow_factors_png],
-                               "Patch pairs and their average versus the separation h0."),
-                stribeck_section(out), fit_section(out), calibration_section(out),
+                               "Patch pairs and their average versus the separation h0, "
+                               "with the friction factors of the force on the pin."),
+                stribeck_section(out, summary.get("stages", {}).get("stribeck", {})
+                                 .get("friction")), fit_section(out), calibration_section(out),
                 tables_section(summary)]
     page = _PAGE.format(title=html.escape(f"fem_twin report: {summary.get('case', '')}"),
                         body="\n".join(s for s in sections if s))
@@ -94,9 +96,17 @@ def plot_centre_lines(files, path) -> Path:
     return save_figure(fig, path, dpi=110)
 
 
-def stribeck_section(out: RunLayout) -> str:
+#: how the report names each friction law (``[macro] friction``)
+FRICTION_LAWS = {"pin": "the force on the pin: wall shear and the film pressure on the "
+                        "asperity flanks and the face's slope",
+                 "paper": "eq 31, the pin's wall shear (the paper's)"}
+
+
+def stribeck_section(out: RunLayout, friction: str | None = None) -> str:
     pngs = [out.stribeck_png("speed"), out.stribeck_png("hersey")]
-    text = ("Friction coefficient (eq 34) of the patch-average flow factors with the estimated "
+    law = FRICTION_LAWS.get(friction, "eq 31") if friction else "eq 31"
+    text = ("Friction coefficient (eq 34) of the patch-average flow factors, the friction "
+            f"being {law}, with the estimated "
             "discretisation error of each point as error bars; the shaded band spans the "
             "single-patch curves (Figure 13), squares are measured curves.")
     body = figure_section("Stribeck curves (Figure 14)", pngs, text)

@@ -487,7 +487,7 @@ def test_a_lost_micro_checkpoint_does_not_recompute_the_sweep(tmp_path):
     ("resolution = [16, 16]", "resolution = [2, 2]", "resolution"),
     ("resolution = [16, 16]", "resolution = [16.5, 16]", "resolution"),
     ("level_radius = 3e-3", "level_radius = 3", "level_radius"),
-    ("workers = 0", "workers = -1", "workers"),
+    ("workers = 0", "workers = -1", "workers"), ("workers = 0", "workers = 10000", "workers"),
     ("viscosities = [0.066, 0.024] # mu_0 [Pa s] at the temperatures below\n"
      "temperatures = [24.0, 50.0]", "viscosities = []\ntemperatures = []", "viscosities")])
 def test_implausible_case_values_are_refused_naming_the_key(tmp_path, old, new, key):
