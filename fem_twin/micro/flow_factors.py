@@ -5,8 +5,9 @@ rigid-body separation ``h0`` the mean gap ``h_m``, the mean asperity contact pre
 ``p_con``, the factors ``A``, ``b`` (Poiseuille and Couette flow, eq 17), ``C``, ``d``
 (the pin's wall shear, eq 31) and the friction factors ``friction_factor`` s_C and
 ``pressure_friction`` (the force on the pin: wall shear and the film pressure on its
-flanks, from the film's dissipation; docs/model.md "Friction on the pin").  It saves to and loads from ``.npz`` with its metadata, averages over
-patches, and interpolates in ``h0`` with the paper's rules beyond the computed range.
+flanks, from the film's dissipation; docs/model.md "Friction on the pin").  It saves to
+and loads from ``.npz`` with its metadata, averages over patches, and interpolates in
+``h0`` with the paper's rules beyond the computed range.
 """
 
 from __future__ import annotations
@@ -161,7 +162,8 @@ class FlowFactors:
         Below ``h0_min`` (not covered by the paper): ``h_m`` and ``p_con`` continue linearly
         with their end slopes, ``h_m`` floored at 1 nm, and the factors are held at ``h0_min``.
         ``friction=False`` leaves out (None) the shear factors :data:`SHEAR` (``C``, ``d``,
-        ``friction_factor``, ``pressure_friction``) and the contact fraction, which the Reynolds iterations do not need (48 B a node less);
+        ``friction_factor``, ``pressure_friction``) and the contact fraction, which the
+        Reynolds iterations do not need (80 B a node less);
         ``contact=False`` leaves out the nodal ``p_con`` (for a caller that integrates it
         over the elements instead, :mod:`fem_twin.macro.contact_load`).
         """
