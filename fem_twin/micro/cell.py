@@ -205,8 +205,8 @@ class CellSolver:
 
         h : <h> [m];  h3_grad : <h^3 (I + G)> [m^3], G[i, j] = d chi_{j+2} / dx_i;
         h3_g1 : <h^3 grad chi_1> [m];  h_grad : <h (I + G)> [m];  h_g1 : <h grad chi_1> [1/m];
-        h3_g1g1 : <h^3 |grad chi_1|^2> where ``h`` exceeds each value of ``film`` [1/m] (the
-        dissipation of the sliding flow in the film, :func:`fem_twin.micro.sliding.film_moments`)
+        h3_g1g1 : ``<h^3 |grad chi_1|^2>`` where ``h`` exceeds each value of ``film`` [1/m]
+        (the dissipation of the sliding flow in the film, :func:`.sliding.film_moments`)
         """
         a_q = h_q ** 3
         n = a_q.size

@@ -49,11 +49,9 @@ class FlowFactors:
     b : (n, 2) Couette flow factor, eq 14 [-]
     C : (n, 2, 2) pressure-driven shear factor, eq 15 [-]
     d : (n, 2) shear-driven shear factor, eq 16 [-]
-    friction_factor : (n,) s_C, the Couette friction on the pin per area ``mu u_r s_C / h_m``
-        at any slide-to-roll ratio (eq 31's wall shear alone: ``1 - 3 d1``) [-]
-    pressure_friction : (n, 2) ``2 e1 - b`` of the pin at rest: the Poiseuille friction on
-        the pin along x1 per area ``-(h_m / 2) pressure_friction . grad p`` (eq 31's wall
-        shear alone: the first row of ``C``) [-]
+    friction_factor : (n,) s_C, Couette friction on the pin ``mu u_r s_C / h_m`` [-]
+    pressure_friction : (n, 2) ``2 e1 - b`` (pin at rest), Poiseuille friction on the pin
+    ``-(h_m / 2) pressure_friction . grad p`` [-]; eq 31: ``1 - 3 d1`` and ``C``'s first row
     contact_fraction : (n,) space-time mean fraction of pixels in contact [-]
     meta : JSON-able description (patch ids, grid, materials, method, version, ...)
     """
