@@ -26,6 +26,7 @@ its points checkpointed as they finish, so an interrupted study resumes.
 from __future__ import annotations
 
 import json
+import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
@@ -59,14 +60,19 @@ def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
     """``{label: (case, patch index or None, speeds [m/s] or None for the case's)}`` of a
     study and the reference label."""
     g = case.macro_geometry
+    if case.tribometer.ball and study in ("filter", "resolution", "disk", "pins"):
+        raise InputError(f"the {study} study varies a pin's macro geometry; a ball-on-disk "
+                         "case has none (its studies: patches)")
     if study == "filter":
+        if values and not all(0 <= v <= 200 for v in values):
+            raise InputError(f"--values {values}: filter widths FWHM in pixels, 0 to 200")
         values = values or [0, 3, 5, 7, 9, 11]
         out = {f"fwhm {v:g} px": (replace(case, macro_geometry=replace(g, fwhm_px=float(v))),
                                   None, None) for v in values}
         ref = max(values, key=lambda v: (v == 11, v))
         return out, f"fwhm {ref:g} px"
     if study == "resolution":
-        return _resolutions(case, [int(v) for v in values or PAPER_RESOLUTIONS])
+        return _resolutions(case, _grid_sizes(values or PAPER_RESOLUTIONS))
     if study == "disk":
         if not case.geometry.disks:
             raise InputError("the disk study needs measured disks in [geometry] disks")
@@ -87,6 +93,26 @@ def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
     raise InputError(f"unknown study {study!r}; choose one of {STUDIES}")
 
 
+#: bytes a macro node takes at the peak of a point (the 2048^2 scale point: 7.44 GiB)
+BYTES_PER_NODE = 1.9e3
+
+
+def _grid_sizes(values) -> list:
+    """The resolution study's grids [px a side], whole numbers from 16, each within this
+    machine's memory at :data:`BYTES_PER_NODE` (else :class:`InputError` before any work)."""
+    if not all(float(v).is_integer() and v >= 16 for v in values):
+        raise InputError(f"--values {list(values)}: macro grids in pixels a side, whole "
+                         "numbers from 16 (the paper: 128 256 500 999 1997)")
+    memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    need = {int(v): BYTES_PER_NODE * v * v for v in values}
+    too_big = [v for v, b in need.items() if b > 0.8 * memory]
+    if too_big:
+        v = max(too_big)
+        raise InputError(f"--values: a {v}^2 grid needs about {need[v] / 2 ** 30:.0f} GiB, "
+                         f"beyond this machine's {memory / 2 ** 30:.0f} GiB")
+    return [int(v) for v in values]
+
+
 def _resolutions(case: Case, values) -> tuple[dict, str]:
     """The resolution study's variants: the reference is the measured maps' own resolution
     if among ``values`` (no interpolation), else the largest; finer grids sweep
@@ -105,8 +131,8 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     """Run a study into ``outdir``; write ``calibration.json``, ``stribeck.csv`` (all
     variants) and plots of C_f and C_f,dev versus speed.  Returns the summary."""
     out = RunLayout(outdir)
+    cases, ref_label = variants(case, study, values)        # checked before any work
     out.root.mkdir(parents=True, exist_ok=True)
-    cases, ref_label = variants(case, study, values)
     lub = case.lubricant.lubricants()[0]
     folders = [out.sub(f"variant_{i + 1}") for i in range(len(cases))]
     with executor_for(case.run.workers, case.run.scheduler) as executor:

@@ -183,9 +183,26 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
                 sweep=sweep, run=run, measured=measured, source=source, defaulted=defaulted)
 
 
+#: the keys a pin case has no use for, with what sets them (refused, not ignored)
+BALL_ONLY = {("tribometer", "slide_to_roll"): 'kind = "ball-on-disk"',
+             ("tribometer", "ball_radius"): 'kind = "ball-on-disk"',
+             ("tribometer", "track_radius"): 'kind = "ball-on-disk"',
+             ("macro", "grid"): '[tribometer] kind = "ball-on-disk" (a pin\'s grid is '
+                                '[preprocessing] resolution)'}
+
+
 def _tribometer(data, where) -> Tribometer:
-    tribometer = _section(data, "tribometer", Tribometer, where, positive=True,
-                          zero_ok=("slide_to_roll",))
+    srr = data.get("tribometer", {}).get("slide_to_roll")
+    if isinstance(srr, (int, float)) and not isinstance(srr, bool) and not 0 < srr <= 2:
+        raise CaseError(f"{where} [tribometer] slide_to_roll = {srr}: a ball's Stribeck curve "
+                        "slides at u_r / u_m in (0, 2] (2: a stationary ball); pure rolling "
+                        "(0) is fem-twin traction's SRR 0")
+    tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
+    if not tribometer.ball:
+        for (section, key), needs in BALL_ONLY.items():
+            if key in data.get(section, {}):
+                raise CaseError(f"{where} [{section}] {key}: a ball-on-disk setting, unused in "
+                                f"a pin case; remove it, or set {needs}")
     if tribometer.ball and tribometer.load_share != 1.0:
         raise CaseError(f"{where} [tribometer] load_share: a ball carries the whole load "
                         "(load_share = 1); it is a pin face's share")

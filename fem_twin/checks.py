@@ -56,6 +56,45 @@ def plausible(name: str, value, quantity: str):
     return value
 
 
+def number(name: str, value, quantity: str) -> float:
+    """``value`` as one plausible number of ``quantity`` (:func:`plausible`), or
+    :class:`InputError` naming ``name``: an array where a number goes is refused."""
+    if np.ndim(value) != 0 if _numeric(value) else True:
+        raise InputError(f"{name}: expected one number in {QUANTITIES[quantity][2]}, got "
+                         f"{value!r}"[:200])
+    return float(plausible(name, value, quantity))
+
+
+def as_pair(name: str, value) -> tuple[float, float]:
+    """``(v1, v2)`` from a number or a pair of numbers (a pitch ``(dx1, dx2)``), or
+    :class:`InputError` naming ``name``; finiteness and range are the caller's."""
+    try:
+        pair = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected a number or a pair of numbers, got {value!r}") from None
+    if pair.shape not in ((), (1,), (2,)):
+        raise InputError(f"{name}: expected a number or a pair of numbers, got {pair.size} "
+                         "values")
+    v1, v2 = np.broadcast_to(pair, (2,))
+    return float(v1), float(v2)
+
+
+def as_field(name: str, value, min_side: int = 2) -> np.ndarray:
+    """``value`` as a finite 2D float array of at least ``min_side`` a side, or
+    :class:`InputError` naming ``name`` (a gap, a map: SI units are the caller's)."""
+    try:
+        field_ = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected a 2D array of numbers, got {type(value).__name__}"
+                         ) from None
+    if field_.ndim != 2 or min(field_.shape) < min_side:
+        raise InputError(f"{name}: expected a 2D array of at least {min_side} x {min_side}, "
+                         f"got shape {field_.shape}")
+    if not np.all(np.isfinite(field_)):
+        raise InputError(f"{name} must be finite: it contains NaN or inf (fill or repair it)")
+    return field_
+
+
 def _numeric(value) -> bool:
     try:
         array = np.asarray(value)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .checks import number
 from .errors import InputError, MissingFile
 from .io.layout import RunLayout
 
@@ -181,6 +182,9 @@ def calibrate(args):
 
 def html_report(args):
     from .report import write_report
+    if args.output is not None and Path(args.output).is_dir():
+        raise InputError(f"report -o {args.output} is a folder: give the page's file name "
+                         "(e.g. report.html)")
     path = write_report(args.run, args.output, render=not args.no_3d)
     print(f"report: {path}")
     return 0
@@ -194,6 +198,8 @@ def validate(args):
     from .stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
     from .io.table import write_csv
     from .stribeck.curve import read_stribeck_csv
+    if args.radius is not None:
+        number("--radius [m]", args.radius, "length")
     run = RunLayout(args.run)
     csv_path = run.stribeck_csv
     if not csv_path.is_file():
@@ -212,7 +218,8 @@ def validate(args):
     boundary = case.tribometer.boundary_friction if case else BOUNDARY_FRICTION
     measured = read_measured_csv(args.measured, unit="rpm" if args.rpm else "m/s")
     if args.rpm:
-        radius = args.radius or (case.tribometer.sliding_radius if case else None)
+        radius = args.radius if args.radius is not None else (
+            case.tribometer.sliding_radius if case else None)
         if radius is None:
             raise InputError("--rpm needs the sliding radius: give --radius [m]")
         measured = replace(measured, speed=measured.speed * 2 * np.pi * radius / 60)

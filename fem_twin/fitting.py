@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .case import Case
-from .checks import QUANTITIES
+from .checks import QUANTITIES, plausible
 from .errors import InputError
 from .io.atomic import atomic_path
 from .io.layout import RunLayout
@@ -56,6 +56,7 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
                          "temperatures in [lubricant] (the Walther law of ASTM D341)")
     if "load_share" in params and case.tribometer.ball:
         raise InputError("load_share is a pin face's share of the load; a ball carries it all")
+    _check_coverage(case, paths, curves_measured, params)
     law = (WaltherLaw.through(lb.temperatures, lb.viscosities, lb.density)
            if len(set(lb.temperatures)) > 1 else None)
     if run is None:
@@ -80,6 +81,22 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
         _write_prediction(out.prediction(t), [predict(model, result, simulated[0].speed,
                                                       float(t), nominal=nominal)])
     return result
+
+
+def _check_coverage(case: Case, paths, curves, params) -> None:
+    """Refuse, before the run, measured curves whose points inside the case's speed range
+    ([sweep] speed_min to speed_max) are too few for the fitted unknowns (one temperature
+    per curve) plus one, the least that leaves an interval."""
+    sw = case.sweep
+    inside = [int(np.sum((c.speed >= sw.speed_min) & (c.speed <= sw.speed_max)))
+              for c in curves]
+    unknowns = len(params) + (len(curves) - 1 if "temperature" in params else 0)
+    if sum(inside) <= unknowns:
+        where = ", ".join(f"{p.name}: {n} of {c.speed.size}" for p, n, c in
+                          zip(paths, inside, curves))
+        raise InputError(f"the measured points inside the case's speeds ({sw.speed_min:g} to "
+                         f"{sw.speed_max:g} m/s) are too few to fit {unknowns} unknown(s) with "
+                         f"an interval ({where}): measure more speeds there or widen [sweep]")
 
 
 def share_curves(case: Case, out: RunLayout, curve, progress: bool = True,
@@ -132,8 +149,17 @@ def read_fit(path) -> dict:
     try:
         result = json.loads(Path(path).read_text())
         result["fit"]["parameters"], result["case"]["temperatures"]
+        values = {k: float(result[k]["value"]) for k in ("boundary_friction", "load_share")
+                  if k in result}
+        offset = temperature_offset(result)
     except (OSError, ValueError, KeyError, TypeError) as err:
         raise InputError(f"{path}: not a fit.json of fem-twin fit ({err})") from err
+    quantity = {"boundary_friction": "friction", "load_share": "load_share"}
+    for name, value in values.items():          # the case parser's ranges
+        plausible(f"{path} {name}", value, quantity[name])
+    if offset is not None and not -100.0 <= offset <= 100.0:
+        raise InputError(f"{path}: the fitted contact temperature lies {offset:+.3g} K from "
+                         "the oil's; at most 100 K either way")
     return result
 
 

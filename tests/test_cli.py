@@ -598,7 +598,7 @@ def test_one_run_per_output_folder(tmp_path, capsys):
 
 @pytest.mark.parametrize("which,heights,pitch,words", [
     ("patch", 1e3, 1, "Sq = "), ("patch", 1e-3, 1, "Sq = "),
-    ("patch", 1, 1e3, "pixel pitch"), ("pin", 1, 1e3, "against a pin")])
+    ("patch", 1, 1e3, "pixel pitch"), ("pin", 1, 1e3, "give the pitch in metres")])
 def test_unit_slips_in_topographies_are_refused(tmp_path, capsys, which, heights, pitch, words):
     """Issue 15 item 9: a roughness patch 1e3 too high (p_con at the hardness everywhere) or
     too low (a smooth cell), a pitch in mm taken as m: refused before any work, exit 2."""
@@ -606,8 +606,12 @@ def test_unit_slips_in_topographies_are_refused(tmp_path, capsys, which, heights
     text = case.read_text()
     src = (ROOT / "meshes" / "sample" / ("patch_1_pin.npz" if which == "patch" else "pin_1.npz"))
     t = read_topography(src)
-    bad = write_topography(tmp_path / f"bad_{src.name}", t.with_heights(
-        t.heights * heights, spacing=tuple(pitch * v for v in t.spacing)), height_scale=None)
+    bad = write_topography(tmp_path / f"bad_{src.name}", t.with_heights(t.heights * heights),
+                           height_scale=None)
+    with np.load(bad) as z:                   # the pitch as an instrument file would give it
+        arrays = dict(z)
+    arrays["spacing"] = arrays["spacing"] * pitch
+    np.savez(bad, **arrays)
     case.write_text(text.replace(str(src), str(bad)))
     assert main(["run", str(case), "-o", str(tmp_path / "o"), "--no-progress"]) == 2
     err = capsys.readouterr().err
@@ -994,3 +998,83 @@ def test_fit_a_case_to_measured_curves(tmp_path, capsys):
         assert float(p["cf_low"]) < float(p["friction_coefficient"]) < float(p["cf_high"])
     assert main(["run", str(case120), "-o", str(tmp_path / "y"), "--from-fit",
                  str(files[0])]) == 2                                  # not a fit.json
+
+
+def test_fit_validate_and_from_fit_refuse_what_they_cannot_use(tmp_path, capsys):
+    """Issue 64 items 1-2: checked against the case before any work, exit 2 and one line:
+    a fit whose measured speeds lie outside the case's sweep (it returned the starting
+    values with a zero-width interval), a measured C_f below zero, a zero or negative
+    --radius, a fit.json with an implausible C_f,b (it ran and reported C_f up to 4.2)."""
+    case = small_case(tmp_path)
+    far = tmp_path / "far.csv"
+    far.write_text("speed,friction_coefficient\n" + "".join(
+        f"{u!r},0.05\n" for u in (10.0, 20.0, 30.0)))
+    out = tmp_path / "o"
+    assert main(["fit", str(case), str(far), "-o", str(out), "--params", "boundary_friction",
+                 "--no-progress"]) == 2
+    assert "too few" in capsys.readouterr().err and not (out / "geometry").exists()
+    negative = tmp_path / "neg.csv"
+    negative.write_text("speed,friction_coefficient\n0.1,-0.02\n0.2,0.01\n")
+    assert main(["fit", str(case), str(negative), "-o", str(out), "--params",
+                 "boundary_friction", "--no-progress"]) == 2
+    assert "[0, 1]" in capsys.readouterr().err
+    (out / "stribeck.csv").parent.mkdir(parents=True, exist_ok=True)
+    (out / "stribeck.csv").write_text("speed_m_s,hersey,friction_coefficient,viscosity_Pa_s\n"
+                                      "0.1,1e-7,0.01,0.066\n1.0,1e-6,0.02,0.066\n")
+    good = tmp_path / "good.csv"
+    good.write_text("speed,friction_coefficient\n10,0.01\n20,0.02\n")
+    for radius in ("0", "-0.03"):
+        assert main(["validate", str(out), str(good), "--rpm", "--radius", radius]) == 2
+        assert "--radius" in capsys.readouterr().err
+    fit = tmp_path / "fit.json"
+    fit.write_text(json.dumps({"fit": {"parameters": ["boundary_friction"]},
+                               "case": {"temperatures": [24.0, 50.0], "law": None},
+                               "boundary_friction": {"value": 5.0, "low": 4.0, "high": 6.0}}))
+    assert main(["run", str(case), "-o", str(tmp_path / "p"), "--from-fit", str(fit)]) == 2
+    assert "boundary_friction" in capsys.readouterr().err
+    assert not (tmp_path / "p" / "geometry").exists()
+
+
+@pytest.mark.parametrize("srr", ["0", "-1", "3"])
+def test_a_balls_slide_to_roll_has_one_range_and_a_pin_case_has_none(tmp_path, srr):
+    """Issue 64 items 1 and 6: a ball's slide-to-roll ratio outside (0, 2] is refused when
+    the case is read, with one message for every side of the range (0, documented as pure
+    rolling, had passed and the sweep refused it after the micro stage); in a pin case the
+    ball's keys are refused, not silently ignored."""
+    ball = (ROOT / "examples" / "ball_on_disk.toml").read_text().replace(
+        "../meshes/", str(ROOT / "meshes") + "/")
+    assert "slide_to_roll = 2.0" in ball
+    (tmp_path / "ball.toml").write_text(ball.replace("slide_to_roll = 2.0",
+                                                     f"slide_to_roll = {srr}"))
+    with pytest.raises(CaseError, match=r"in \(0, 2\]"):
+        load_case(tmp_path / "ball.toml")
+    pin = small_case(tmp_path).read_text()
+    for key, line in (("slide_to_roll", "slide_to_roll = 0.5"), ("grid", "grid = 97")):
+        section = "[tribometer]" if key == "slide_to_roll" else "[macro]"
+        (tmp_path / "pin.toml").write_text(pin.replace(section, f"{section}\n{line}", 1))
+        with pytest.raises(CaseError, match=f"{key}: a ball-on-disk setting"):
+            load_case(tmp_path / "pin.toml")
+
+
+def test_outputs_and_study_values_are_checked_before_any_work(tmp_path, capsys):
+    """Issue 64 items 1-3: an output folder that is a file, a report page that is a folder,
+    a resolution beyond the machine's memory (it ended in 'internal error: MemoryError',
+    exit 1) or not a whole number, a pin study on a ball case: each one line, exit 2."""
+    case = small_case(tmp_path)
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    assert main(["compare", str(case), "-o", str(afile), "--no-progress"]) == 2
+    assert "is a file" in capsys.readouterr().err
+    assert main(["report", str(tmp_path), "-o", str(tmp_path)]) == 2
+    assert "is a folder" in capsys.readouterr().err
+    for values, words in ((["100000"], "GiB"), (["128.5"], "whole numbers")):
+        assert main(["calibrate", str(case), "--study", "resolution", "--values", *values,
+                     "-o", str(tmp_path / "c"), "--no-progress"]) == 2
+        assert words in capsys.readouterr().err
+    assert not (tmp_path / "c").exists()
+    ball = (ROOT / "examples" / "ball_on_disk.toml").read_text().replace(
+        "../meshes/", str(ROOT / "meshes") + "/")
+    (tmp_path / "ball.toml").write_text(ball)
+    assert main(["calibrate", str(tmp_path / "ball.toml"), "--study", "pins", "-o",
+                 str(tmp_path / "b"), "--no-progress"]) == 2
+    assert "ball-on-disk case has none" in capsys.readouterr().err

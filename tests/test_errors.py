@@ -83,3 +83,55 @@ def test_a_cropped_pin_says_why_it_cannot_be_levelled():
     pin = prepare_pin(crop, MacroOptions(resolution=(48, 48)))
     with pytest.raises(NotConverged, match="cropped"):
         level_pin(pin, load=150.0)
+
+
+# -- issue 64 item 4: only FemTwinError escapes the API, whatever the input -----------------
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from fem_twin.macro import Lubricant, solve_mixed, solve_reynolds  # noqa: E402
+from fem_twin.micro import FlowFactors  # noqa: E402
+
+#: inputs of the wrong type, shape, unit or value, each where an array or a number goes
+BAD = st.sampled_from([
+    None, "1e-6", [], np.zeros(0), np.zeros((0, 0)), np.zeros(3), np.zeros((2, 2, 2)),
+    np.full((8, 8), np.nan), np.full((8, 8), np.inf), np.ones((8, 8), dtype=int),
+    np.ones((8, 8)), -np.ones((8, 8)), 1e3 * np.ones((8, 8)), (1e-6, 1e-6, 1e-6), 0.0, -1.0,
+    np.nan, 1e9, object()])
+GOOD_GAP = 1e-6 * (1 + np.add.outer(np.linspace(-1, 1, 8) ** 2, np.linspace(-1, 1, 8) ** 2))
+
+
+def _calls(bad):
+    """Each entry point with one argument replaced by ``bad``."""
+    z = 1e-7 * np.cos(np.arange(64) / 3).reshape(8, 8)
+    e = contact.reduced_modulus(210e9, 0.3, 210e9, 0.3)
+    yield lambda: Topography(bad, 1e-6)
+    yield lambda: Topography(z, bad)
+    yield lambda: contact.solve(bad, 1e-6, e, load=1.0)
+    yield lambda: contact.solve(z, bad, e, load=1.0)
+    yield lambda: contact.solve(z, 1e-6, bad, load=1.0)
+    yield lambda: homogenise(Topography(z, 1e-6), Topography(z, 1e-6), bad, n_steps=2,
+                             error_estimate=False)
+    yield lambda: solve_reynolds(bad, (1e-4, 1e-4), 1.0, 0.066)
+    yield lambda: solve_reynolds(GOOD_GAP, bad, 1.0, 0.066)
+    yield lambda: solve_mixed(bad, (1e-4, 1e-4), FlowFactors.smooth(), load=1.0, speed=1.0,
+                              lubricant=Lubricant(0.066))
+    yield lambda: solve_mixed(GOOD_GAP, (1e-4, 1e-4), bad, load=1.0, speed=1.0,
+                              lubricant=Lubricant(0.066))
+    yield lambda: solve_mixed(GOOD_GAP, (1e-4, 1e-4), FlowFactors.smooth(), load=bad,
+                              speed=1.0, lubricant=Lubricant(0.066))
+    yield lambda: solve_mixed(GOOD_GAP, (1e-4, 1e-4), FlowFactors.smooth(), load=1.0,
+                              speed=bad, lubricant=Lubricant(0.066))
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(BAD)
+def test_only_fem_twin_errors_escape_the_api(bad):
+    """Wrong types, shapes, units, empty and non-finite arrays at each entry point: the
+    call either works (a plausible value among them) or raises a FemTwinError naming what
+    is wrong, never a numpy, scipy or Python error from inside."""
+    for call in _calls(bad):
+        try:
+            call()
+        except FemTwinError:
+            pass

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from ..checks import plausible
+from ..checks import as_field, as_pair, plausible
 from ..errors import InputError, NotConverged
 from .elastic import elastic_operator
 
@@ -82,7 +82,8 @@ def solve(shape, spacing, e_reduced, *, load=None, separation=None, hardness=np.
     precision FFT pairs (an exact double pair every ``_REFRESH`` iterations) against the
     two double pairs of the textbook method, and works on the loaded points only.
     """
-    plausible("spacing [m]", spacing, "pitch")
+    as_field("shape [m]", shape)
+    plausible("spacing [m]", as_pair("spacing [m]", spacing), "pitch")
     plausible("reduced modulus e_reduced [Pa]", e_reduced, "reduced_modulus")
     if np.isfinite(hardness):                          # inf: purely elastic
         plausible("hardness [Pa]", hardness, "hardness")

@@ -26,6 +26,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..errors import InputError
+
 
 @dataclass(frozen=True)
 class RunLayout:
@@ -34,7 +36,10 @@ class RunLayout:
     root: Path
 
     def __post_init__(self):
-        object.__setattr__(self, "root", Path(self.root))
+        root = Path(self.root)
+        if root.exists() and not root.is_dir():
+            raise InputError(f"{root} is a file: give a folder for the results (-o)")
+        object.__setattr__(self, "root", root)
 
     # -- the run ---------------------------------------------------------------------------
     @property

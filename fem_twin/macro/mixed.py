@@ -30,7 +30,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..checks import plausible
+from ..checks import as_field, as_pair, number, plausible
 from ..errors import InputError, MixedNotConverged
 from ..micro.flow_factors import FlowFactors
 from ..micro.rolling import at_slide_to_roll
@@ -39,6 +39,7 @@ from . import newton
 from .fixed_point import Concentrated, solve_fixed_point
 from .lubricant import Lubricant
 from .problem import macro_problem
+from .reynolds import OPEN_GAP
 from .result import MixedResult, mixed_result, on_grid
 from .settings import MacroSettings
 
@@ -47,6 +48,9 @@ __all__ = ["MacroSettings", "MixedNotConverged", "MixedResult", "solve_mixed"]
 #: Newton iterations per load of the ``"newton"`` coupling (it converges in 5-20), at most
 #: ``MacroSettings.max_iter``
 NEWTON_MAX_ITER = 60
+
+#: the largest rigid gap [m] either way: a pin's holder lies 1 mm below its face
+MAX_GAP = 0.05
 
 #: Cold starts on grids of at least twice this size begin with a solve on the coarser grid.
 COARSE_START = 48
@@ -93,20 +97,23 @@ def seeded_point(gap, spacing, factors: FlowFactors, *, load: float, speed: floa
     secants)``, the second this solve's own (None where the coupling is not Anderson):
     :func:`~fem_twin.macro.nested.solve_nested` hands them from level to level.
     """
-    h_g = np.asarray(gap, float)
-    if h_g.ndim != 2 or min(h_g.shape) < 3:
-        raise InputError(f"gap must be a 2D field of at least 3 x 3 nodes, got {h_g.shape}")
-    if not np.all(np.isfinite(h_g)):
-        raise InputError("gap contains NaN or inf: repair the topography first")
-    plausible("load [N]", load, "load")
+    if not isinstance(factors, FlowFactors):
+        raise InputError(f"factors must be FlowFactors (fem_twin.micro.homogenise, or "
+                         f"FlowFactors.smooth()), got {type(factors).__name__}")
+    h_g = as_field("gap [m]", gap, 3)
+    if np.abs(h_g).max() > MAX_GAP:
+        raise InputError(f"gap [m] spans {h_g.min():.3g} to {h_g.max():.3g} m: implausible for a "
+                         f"pin or a ball (at most {MAX_GAP:g} m either way); give it in metres")
+    if not np.any(h_g[1:-1, 1:-1] < OPEN_GAP):
+        raise InputError(f"the gap is open everywhere inside the grid (above {OPEN_GAP:g} m, "
+                         "the oil bath): nothing carries load; give the gap in metres")
+    load = number("load [N]", load, "load")
     if entrainment is None or speed != 0:                # 0 with u_m: pure rolling
-        plausible("speed [m/s]", speed, "speed")
-    plausible("spacing [m]", spacing, "pitch")
-    u_m = speed / 2 if entrainment is None else float(entrainment)
-    if not (u_m > 0 and np.isfinite(u_m)):
-        raise InputError(f"entrainment speed must be positive [m/s], got {entrainment}")
+        speed = number("speed [m/s]", speed, "speed")
+    dx = as_pair("spacing [m]", spacing)
+    plausible("spacing [m]", dx, "pitch")
+    u_m = speed / 2 if entrainment is None else number("entrainment [m/s]", entrainment, "speed")
     factors = at_slide_to_roll(factors, speed / u_m)
-    dx = tuple(float(v) for v in np.broadcast_to(np.asarray(spacing, float), (2,)))
     face = np.ones(h_g.shape, bool) if face is None else np.asarray(face, bool)
     if face.shape != h_g.shape:
         raise InputError(f"face mask {face.shape} does not match the gap {h_g.shape}")

@@ -32,6 +32,7 @@ import scipy.sparse as sp
 import skfem
 from skfem.helpers import dot, grad
 
+from ..checks import as_field, as_pair
 from ..errors import InputError, ReynoldsNotConverged
 from ..assembly import at_points, grid_stencil, unit_element
 from .cavitation import cavitation_model
@@ -102,11 +103,9 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     couette : ``"central"`` (second order) or ``"upwind"`` (the paper's first order), the
         Couette flux of :mod:`fem_twin.macro.couette`
     """
-    h = np.asarray(gap, dtype=float)
-    if h.ndim != 2 or min(h.shape) < 3:
-        raise InputError(f"gap must be a 2D field of at least 3 x 3 nodes, got shape {h.shape}")
-    if not np.all(np.isfinite(h)) or h.min() <= 0:
-        raise InputError("gap must be finite and positive everywhere [m]")
+    h = as_field("gap [m]", gap, 3)
+    if h.min() <= 0:
+        raise InputError("gap must be positive everywhere [m]")
     lubricant = viscosity if isinstance(viscosity, Lubricant) else None
     mu0 = lubricant.viscosity if lubricant is not None else viscosity
     if not mu0 > 0:
@@ -117,9 +116,14 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
         raise InputError(f"method must be 'fe' or 'fvm', got {method!r}")
     if couette not in SCHEMES:
         raise InputError(f"couette must be one of {SCHEMES}, got {couette!r}")
-    dx = tuple(float(s) for s in np.broadcast_to(np.asarray(spacing, float), (2,)))
+    dx = as_pair("spacing [m]", spacing)
+    if not all(np.isfinite(dx)) or min(dx) <= 0:
+        raise InputError(f"spacing must be positive and finite [m], got {dx}")
     boundary = h > OPEN_GAP
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
+    if boundary.all():
+        raise InputError(f"the gap is open everywhere inside the grid (above {OPEN_GAP:g} m, "
+                         "the oil bath): nothing carries load; give the gap in metres")
     scale = 12 * mu0 * max(abs(speed), 1e-30) / 2 * float(np.mean(dx)) / np.mean(h) ** 2
     model = cavitation_model(complementarity)
     assemble = fe_poiseuille if method == "fe" else fvm_poiseuille

@@ -163,11 +163,15 @@ def _meta(settings: CellSettings, pin, disk, spacing) -> dict:
 
 
 def _check_separations(h0) -> np.ndarray:
-    h0 = np.asarray(h0, dtype=float)
+    try:
+        h0 = np.asarray(h0, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"h0 must be a 1D array of separations [m], got {h0!r}"[:200]) from None
     if h0.ndim != 1 or h0.size == 0 or not np.all(np.isfinite(h0)) or np.any(h0 <= 0):
         raise InputError("h0 must be a non-empty 1D array of positive separations [m]")
     if np.unique(h0).size != h0.size:
         raise InputError("h0 values must be distinct")
+    plausible("h0 [m]", h0, "separation")
     return np.sort(h0)
 
 

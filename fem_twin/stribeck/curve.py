@@ -256,8 +256,14 @@ def read_measured_csv(path, unit: str = "m/s") -> MeasuredCurve:
         raise InputError(f"{path}: speeds must be positive and in m/s (max {speed.max()}; "
                          "for rpm use --rpm)")
     band = ("cf_min" in cols and "cf_max" in cols)
-    return MeasuredCurve(speed, col(cf_key), col("cf_min") if band else None,
-                         col("cf_max") if band else None)
+    cf = col(cf_key)
+    low, high = (col("cf_min"), col("cf_max")) if band else (cf, cf)
+    if np.any(low < 0) or np.any(high > 1):
+        raise InputError(f"{path}: friction coefficients must lie in [0, 1] (found "
+                         f"{min(low.min(), cf.min()):.3g} to {max(high.max(), cf.max()):.3g})")
+    if np.any(low > cf) or np.any(cf > high):
+        raise InputError(f"{path}: cf_min <= friction_coefficient <= cf_max in every row")
+    return MeasuredCurve(speed, cf, low if band else None, high if band else None)
 
 
 def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve,

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..checks import as_pair
 from ..errors import InputError
 
 #: Largest peak-to-valley [m] accepted for a topography.  A pin-on-disk map spans a few
@@ -27,6 +28,8 @@ MAX_PEAK_TO_VALLEY = 0.05
 MAX_SPACING = 1.0
 #: the smallest pixel pitch [m]: below an atomic distance, a unit slip
 MIN_SPACING = 1e-10
+#: the plausible extent of a map [m]: a pitch that makes it larger or smaller wants a unit
+EXTENT = (1e-6, 1.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,18 +57,29 @@ class Topography:
     meta: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        h = np.array(self.heights, dtype=float)
+        try:
+            h = np.array(self.heights, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("heights must be a 2D array of numbers [m]") from None
         if h.ndim != 2:
             raise InputError(f"heights must be a 2D array (ny, nx), got shape {h.shape}")
         if min(h.shape) < 2:
             raise InputError(f"heights need at least 2 x 2 pixels, got shape {h.shape}")
-        spacing = np.broadcast_to(np.asarray(self.spacing, dtype=float), (2,))
+        spacing = np.array(as_pair("spacing [m]", self.spacing))
         if not np.all(np.isfinite(spacing)) or np.any(spacing <= 0):
-            raise InputError(f"spacing must be positive and finite [m], got {tuple(spacing)}")
+            raise InputError(f"spacing must be positive and finite [m], got ({spacing[0]:g}, "
+                             f"{spacing[1]:g})")
         if np.any(spacing > MAX_SPACING) or np.any(spacing < MIN_SPACING):
             raise InputError(
-                f"spacing {tuple(spacing)} m per pixel is implausible: give it in metres "
-                "(e.g. 16e-6 for a 16 um pitch)")
+                f"spacing ({spacing[0]:g}, {spacing[1]:g}) m per pixel is implausible: give it "
+                "in metres (e.g. 16e-6 for a 16 um pitch)")
+        extent = np.array(h.shape[::-1]) * spacing
+        if np.any(extent > EXTENT[1]) or np.any(extent < EXTENT[0]):
+            raise InputError(
+                f"spacing ({spacing[0]:g}, {spacing[1]:g}) m per pixel makes the "
+                f"{h.shape[1]} x {h.shape[0]} px map {extent[0]:.3g} x {extent[1]:.3g} m; a "
+                f"map spans {EXTENT[0]:g} to {EXTENT[1]:g} m: give the pitch in metres (16e-6 "
+                "for 16 um)")
         valid = np.isfinite(h)
         if self.mask is not None:
             m = np.asarray(self.mask)
