@@ -270,3 +270,8 @@ def test_sphere_fit_of_a_ball_cap_recovers_radius_apex_and_form_error():
         cap_gap(sphere, fit_sphere(sphere), 2 * x / x.max() * 1e-3, x)
     with pytest.raises(InputError, match="not convex"):
         fit_sphere(cap.with_heights(-cap.heights))
+    # issue 64 item 5: a flat plate with a trace of curvature (R of 100 m) is named as such
+    x1, x2 = np.meshgrid(cap.x1, cap.x2)
+    plate = cap.with_heights(-(x1 ** 2 + x2 ** 2) / 200.0)
+    with pytest.raises(InputError, match="nearly flat"):
+        fit_sphere(plate)

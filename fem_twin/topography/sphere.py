@@ -46,6 +46,10 @@ class SphereFit:
         return _cap(self.radius, self.apex, self.apex_height, x1, x2)
 
 
+#: the largest ball radius [m] a fitted cap may have: beyond it the map is a flat plate
+MAX_RADIUS = 1.0
+
+
 def _cap(radius, apex, apex_height, x1, x2):
     """Heights [m] of a sphere's cap of ``radius`` with its top ``apex_height`` at ``apex``."""
     r2 = (np.asarray(x1) - apex[0]) ** 2 + (np.asarray(x2) - apex[1]) ** 2
@@ -76,6 +80,10 @@ def fit_sphere(cap: Topography) -> SphereFit:
     p = least_squares(residual, [radius / s, apex[0] / s, apex[1] / s, top / s],
                       x_scale="jac").x * s
     radius, apex, top = float(p[0]), (float(p[1]), float(p[2])), float(p[3])
+    if radius > MAX_RADIUS:
+        raise InputError(f"the fitted sphere's radius is {radius:.3g} m: the map is nearly "
+                         f"flat, no ball cap (a ball's radius is at most {MAX_RADIUS:g} m); "
+                         "measure the ball's top")
     if not (x1.min() <= apex[0] <= x1.max() and x2.min() <= apex[1] <= x2.max()):
         raise InputError(f"the fitted apex {apex} [m] lies outside the map: measure the "
                          "ball's top")
