@@ -26,13 +26,13 @@ its points checkpointed as they finish, so an interrupted study resumes.
 from __future__ import annotations
 
 import json
-import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
 import numpy as np
 
 from .case import Case
+from .checks import within_memory
 from .errors import InputError
 from .io.atomic import atomic_path
 from .io.checkpoint import input_key
@@ -93,23 +93,15 @@ def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
     raise InputError(f"unknown study {study!r}; choose one of {STUDIES}")
 
 
-#: bytes a macro node takes at the peak of a point (the 2048^2 scale point: 7.44 GiB)
-BYTES_PER_NODE = 1.9e3
-
-
 def _grid_sizes(values) -> list:
     """The resolution study's grids [px a side], whole numbers from 16, each within this
-    machine's memory at :data:`BYTES_PER_NODE` (else :class:`InputError` before any work)."""
+    machine's memory (:func:`fem_twin.checks.within_memory`; else :class:`InputError`
+    before any work)."""
     if not all(float(v).is_integer() and v >= 16 for v in values):
         raise InputError(f"--values {list(values)}: macro grids in pixels a side, whole "
                          "numbers from 16 (the paper: 128 256 500 999 1997)")
-    memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    need = {int(v): BYTES_PER_NODE * v * v for v in values}
-    too_big = [v for v, b in need.items() if b > 0.8 * memory]
-    if too_big:
-        v = max(too_big)
-        raise InputError(f"--values: a {v}^2 grid needs about {need[v] / 2 ** 30:.0f} GiB, "
-                         f"beyond this machine's {memory / 2 ** 30:.0f} GiB")
+    for v in values:
+        within_memory(f"--values {int(v)}", int(v) ** 2, "macro")
     return [int(v) for v in values]
 
 

@@ -11,6 +11,7 @@ an example in SI units; the case parser (:mod:`fem_twin.case`) and the public en
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import field
 
 import numpy as np
@@ -54,6 +55,24 @@ def plausible(name: str, value, quantity: str):
         if not lo <= v <= hi:
             raise InputError(f"{name} = {v:g}: implausible; expected {lo:g} to {hi:g} {unit}")
     return value
+
+
+#: peak memory a grid point takes in one process [B]: a macro node (the 2048^2 scale point,
+#: 7.44 GiB) and a cell pixel (PARDISO, 256^2 to 1024^2: 2.6-3.1 kB), measured 2026-11-28
+BYTES_PER_POINT = {"macro": 1.9e3, "cell": 3.2e3}
+
+
+def within_memory(name: str, points: int, grid: str, processes: int = 1,
+                  error=InputError) -> None:
+    """Refuse (``error``, an :class:`InputError`, naming ``name``) a grid of ``points``
+    that would need more than 80 % of this machine's memory in ``processes`` processes at
+    once (:data:`BYTES_PER_POINT`), before any work."""
+    memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    need = BYTES_PER_POINT[grid] * points * processes
+    if need > 0.8 * memory:
+        raise error(f"{name}: {points:,} points in {processes} process(es) need about "
+                         f"{need / 2 ** 30:.0f} GiB, beyond this machine's "
+                         f"{memory / 2 ** 30:.0f} GiB; use a coarser grid or fewer workers")
 
 
 def number(name: str, value, quantity: str) -> float:
