@@ -32,7 +32,7 @@ from dataclasses import replace
 import numpy as np
 
 from .case import Case
-from .checks import within_memory
+from .checks import memory_shortfall
 from .errors import InputError
 from .io.atomic import atomic_path
 from .io.checkpoint import input_key
@@ -95,13 +95,15 @@ def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
 
 def _grid_sizes(values) -> list:
     """The resolution study's grids [px a side], whole numbers from 16, each within this
-    machine's memory (:func:`fem_twin.checks.within_memory`; else :class:`InputError`
+    machine's memory (:func:`fem_twin.checks.memory_shortfall`; else :class:`InputError`
     before any work)."""
     if not all(float(v).is_integer() and v >= 16 for v in values):
         raise InputError(f"--values {list(values)}: macro grids in pixels a side, whole "
                          "numbers from 16 (the paper: 128 256 500 999 1997)")
     for v in values:
-        within_memory(f"--values {int(v)}", int(v) ** 2, "macro")
+        short = memory_shortfall(int(v) ** 2, "macro")
+        if short:
+            raise InputError(f"--values {int(v)}: {short}")
     return [int(v) for v in values]
 
 

@@ -8,7 +8,7 @@ import tomllib
 from dataclasses import MISSING, dataclass, field, fields
 from pathlib import Path
 
-from .checks import QUANTITIES, within_memory
+from .checks import QUANTITIES, memory_shortfall
 from .errors import InputError
 from .sections import (SECTIONS, Geometry, LubricantSpec, MacroSpec, Materials, MicroSpec,
                        RunSpec, SweepSpec, Tribometer)
@@ -250,7 +250,9 @@ def _preprocessing(data, where) -> MacroOptions:
     """[preprocessing]: the macro geometry's options, lengths in metres."""
     opts = _section(data, "preprocessing", MacroOptions, where)
     rows, cols = _int_pair(list(opts.resolution), f"{where} [preprocessing] resolution")
-    within_memory(f"{where} [preprocessing] resolution", rows * cols, "macro", error=CaseError)
+    short = memory_shortfall(rows * cols, "macro")
+    if short:
+        raise CaseError(f"{where} [preprocessing] resolution: {short}")
     if not 0 < opts.clip <= 1e-3:
         raise CaseError(f"{where} [preprocessing] clip: expected metres in (0, 1e-3], "
                         f"got {opts.clip} (20 um is 20e-6)")
@@ -284,8 +286,9 @@ def _micro(data, where) -> MicroSpec:
         raise CaseError(f"{where} [micro] resolution: [rows, columns] of at least 8 pixels each "
                         f"(the error estimate solves the cell coarsened by two), got "
                         f"{list(micro.resolution)}")
-    within_memory(f"{where} [micro] resolution", micro.resolution[0] * micro.resolution[1],
-                  "cell", error=CaseError)
+    short = memory_shortfall(micro.resolution[0] * micro.resolution[1], "cell")
+    if short:
+        raise CaseError(f"{where} [micro] resolution: {short}")
     if not (0 < micro.h0_min < micro.h0_max < 1e-3) or micro.h0_count < 2 or micro.steps < 1:
         raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
                         "h0_count >= 2 and steps >= 1")

@@ -62,17 +62,17 @@ def plausible(name: str, value, quantity: str):
 BYTES_PER_POINT = {"macro": 1.9e3, "cell": 3.2e3}
 
 
-def within_memory(name: str, points: int, grid: str, processes: int = 1,
-                  error=InputError) -> None:
-    """Refuse (``error``, an :class:`InputError`, naming ``name``) a grid of ``points``
-    that would need more than 80 % of this machine's memory in ``processes`` processes at
-    once (:data:`BYTES_PER_POINT`), before any work."""
+def memory_shortfall(points: int, grid: str, processes: int = 1) -> str | None:
+    """Why a grid of ``points`` cannot run here, or None: more than 80 % of this machine's
+    memory in ``processes`` processes at once (:data:`BYTES_PER_POINT`); the caller raises
+    its own error with it, before any work."""
     memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
     need = BYTES_PER_POINT[grid] * points * processes
-    if need > 0.8 * memory:
-        raise error(f"{name}: {points:,} points in {processes} process(es) need about "
-                         f"{need / 2 ** 30:.0f} GiB, beyond this machine's "
-                         f"{memory / 2 ** 30:.0f} GiB; use a coarser grid or fewer workers")
+    if need <= 0.8 * memory:
+        return None
+    return (f"{points:,} points in {processes} process(es) need about {need / 2 ** 30:.0f} "
+            f"GiB, beyond this machine's {memory / 2 ** 30:.0f} GiB; use a coarser grid or "
+            "fewer workers")
 
 
 def number(name: str, value, quantity: str) -> float:
