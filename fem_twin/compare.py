@@ -84,7 +84,12 @@ def field_differences(fe: MixedResult, fvm: MixedResult) -> dict:
 def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     """Run the case's micro and macro stages with both methods, each at every h0 of the case
     (no adaptive subset, so that they meet at the same separations); write ``compare.json``,
-    ``compare_flow_factors.csv``, ``compare_stribeck.csv`` and ``compare.png``."""
+    ``compare_flow_factors.csv``, ``compare_stribeck.csv`` and ``compare.png``.  A
+    ball-on-disk case is refused: its sweeps would need the entrainment speeds and the
+    slide-to-roll ratio this study does not pass."""
+    if case.tribometer.ball:
+        raise InputError("fem-twin compare runs on pin-on-disk cases; for a ball, compare FE "
+                         "and FVM by [micro] method and [macro] method in two runs")
     out = RunLayout(outdir)
     out.root.mkdir(parents=True, exist_ok=True)
     reconstruct_geometry(case, out, progress)

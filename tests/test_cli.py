@@ -1062,7 +1062,8 @@ def test_a_balls_slide_to_roll_has_one_range_and_a_pin_case_has_none(tmp_path, s
 def test_outputs_and_study_values_are_checked_before_any_work(tmp_path, capsys):
     """Issue 64 items 1-3: an output folder that is a file, a report page that is a folder,
     a resolution beyond the machine's memory (it ended in 'internal error: MemoryError',
-    exit 1) or not a whole number, a pin study on a ball case: each one line, exit 2."""
+    exit 1) or not a whole number, a study or compare on a ball case (they swept it at the
+    stationary ball's SRR 2): each one line, exit 2."""
     case = small_case(tmp_path)
     afile = tmp_path / "afile"
     afile.write_text("x")
@@ -1078,6 +1079,10 @@ def test_outputs_and_study_values_are_checked_before_any_work(tmp_path, capsys):
     ball = (ROOT / "examples" / "ball_on_disk.toml").read_text().replace(
         "../meshes/", str(ROOT / "meshes") + "/")
     (tmp_path / "ball.toml").write_text(ball)
-    assert main(["calibrate", str(tmp_path / "ball.toml"), "--study", "pins", "-o",
-                 str(tmp_path / "b"), "--no-progress"]) == 2
-    assert "ball-on-disk case has none" in capsys.readouterr().err
+    for study in ("pins", "patches"):
+        assert main(["calibrate", str(tmp_path / "ball.toml"), "--study", study, "-o",
+                     str(tmp_path / "b"), "--no-progress"]) == 2
+        assert "pin-on-disk cases" in capsys.readouterr().err
+    assert main(["compare", str(tmp_path / "ball.toml"), "-o", str(tmp_path / "b"),
+                 "--no-progress"]) == 2                     # issue 63 item 1: refused
+    assert "pin-on-disk cases" in capsys.readouterr().err and not (tmp_path / "b").exists()
