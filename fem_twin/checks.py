@@ -10,8 +10,11 @@ an example in SI units; the case parser (:mod:`fem_twin.case`) and the public en
 
 from __future__ import annotations
 
+import functools
+import inspect
 import math
 import os
+from collections.abc import Collection
 from dataclasses import field
 
 import numpy as np
@@ -112,6 +115,64 @@ def as_field(name: str, value, min_side: int = 2) -> np.ndarray:
     if not np.all(np.isfinite(field_)):
         raise InputError(f"{name} must be finite: it contains NaN or inf (fill or repair it)")
     return field_
+
+
+def arguments(**kinds):
+    """Decorator of a public function: its named arguments are checked before the call,
+    each against its kind, and a wrong one is an :class:`InputError` naming the function
+    and the argument.  A kind is a class (or a tuple of classes: ``isinstance``), a
+    sequence of one (``[cls]``: a non-empty collection of such), or one of ``"path"``
+    (a str or path), ``"number"`` (one finite real), ``"numbers"`` (a non-empty numeric
+    array, finite), ``"field"`` (:func:`as_field`), ``"pair"`` (:func:`as_pair`),
+    ``"shape"`` (two positive whole numbers).  None is accepted where it is the default."""
+    def wrap(func):
+        signature = inspect.signature(func)
+
+        @functools.wraps(func)
+        def checked(*args, **kwargs):
+            bound = signature.bind_partial(*args, **kwargs).arguments
+            for name, kind in kinds.items():
+                if name in bound and not (bound[name] is None
+                                          and signature.parameters[name].default is None):
+                    check(f"{func.__qualname__}: {name}", bound[name], kind)
+            return func(*args, **kwargs)
+        return checked
+    return wrap
+
+
+def check(name: str, value, kind) -> None:
+    """One argument against its kind (:func:`arguments`), or :class:`InputError` naming
+    ``name``."""
+    if isinstance(kind, list):
+        if (isinstance(value, (str, bytes)) or not isinstance(value, Collection)
+                or len(value) == 0):
+            raise InputError(f"{name}: expected a non-empty list of {kind[0].__name__}")
+        for item in value:
+            check(name, item, kind[0])
+    elif isinstance(kind, (type, tuple)):
+        if not isinstance(value, kind):
+            names = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
+            raise InputError(f"{name}: expected {names}, got {type(value).__name__}")
+    elif kind == "path":
+        if not isinstance(value, (str, os.PathLike)):
+            raise InputError(f"{name}: expected a file path, got {type(value).__name__}")
+    elif kind == "number":
+        if not (_numeric(value) and np.ndim(value) == 0 and math.isfinite(float(value))):
+            raise InputError(f"{name}: expected one finite number, got {value!r}"[:200])
+    elif kind == "numbers":
+        if not _numeric(value) or np.size(value) == 0 or not np.all(np.isfinite(value)):
+            raise InputError(f"{name}: expected finite numbers, got {type(value).__name__}")
+    elif kind == "field":
+        as_field(name, value)
+    elif kind == "pair":
+        as_pair(name, value)
+    elif kind == "shape":
+        if not (isinstance(value, (tuple, list)) and len(value) == 2
+                and all(isinstance(v, (int, np.integer)) and v > 0 for v in value)):
+            raise InputError(f"{name}: expected (rows, columns), two positive whole numbers, "
+                             f"got {value!r}"[:200])
+    else:
+        raise InputError(f"{name}: unknown argument kind {kind!r}")
 
 
 def _numeric(value) -> bool:

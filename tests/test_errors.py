@@ -135,3 +135,52 @@ def test_only_fem_twin_errors_escape_the_api(bad):
             call()
         except FemTwinError:
             pass
+
+
+#: the public API: every callable these modules export
+PUBLIC = ["fem_twin", "fem_twin.topography", "fem_twin.contact", "fem_twin.micro",
+          "fem_twin.macro", "fem_twin.stribeck", "fem_twin.io", "fem_twin.fvm"]
+#: wrong types, empty, non-finite and integer arrays, each given to every required argument
+WRONG = [None, "x", object(), np.zeros(0), np.zeros((0, 0)), np.full((6, 6), np.nan),
+         np.ones((6, 6), dtype=int)]
+
+
+def public_callables():
+    import importlib
+    import inspect
+    seen = {}
+    for name in PUBLIC:
+        module = importlib.import_module(name)
+        for attr in getattr(module, "__all__", []):
+            obj = getattr(module, attr)
+            if callable(obj) and not (inspect.isclass(obj) and issubclass(obj, BaseException)):
+                seen.setdefault(id(obj), (f"{name}.{attr}", obj))
+    return list(seen.values())
+
+
+def test_every_public_function_refuses_wrong_arguments_with_a_fem_twin_error():
+    """Issue 64 item 4: every callable of the public API (the subpackages' ``__all__``),
+    its required arguments all wrong (types, empty and non-finite arrays, integers where
+    metres go), raises a FemTwinError naming what is wrong, never a numpy, scipy or
+    Python error from inside."""
+    import inspect
+    calls = public_callables()
+    assert len(calls) >= 60
+    escaped = []
+    for name, obj in calls:
+        try:
+            params = inspect.signature(obj).parameters.values()
+        except (TypeError, ValueError):
+            continue
+        required = [p for p in params if p.default is inspect.Parameter.empty
+                    and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)]
+        for bad in WRONG:
+            args = [bad for p in required if p.kind != p.KEYWORD_ONLY]
+            kwargs = {p.name: bad for p in required if p.kind == p.KEYWORD_ONLY}
+            try:
+                obj(*args, **kwargs)
+            except FemTwinError:
+                pass
+            except Exception as err:                     # noqa: BLE001 (what escapes)
+                escaped.append(f"{name}({type(bad).__name__}): {type(err).__name__}: {err}")
+    assert not escaped, "\n".join(escaped)

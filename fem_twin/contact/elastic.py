@@ -16,7 +16,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.fft as fft
 
-from ..checks import plausible
+from ..checks import arguments, plausible
 from ..errors import InputError
 
 
@@ -29,6 +29,7 @@ def reduced_modulus(e1: float, nu1: float, e2: float, nu2: float) -> float:
     return 2.0 / ((1 - nu1 ** 2) / e1 + (1 - nu2 ** 2) / e2)
 
 
+@arguments(x="numbers", y="numbers", a="number", b="number", e_reduced="number")
 def love_rectangle(x, y, a: float, b: float, e_reduced: float):
     """Deformation [m per Pa] at ``(x, y)`` under unit pressure on ``|x|<a, |y|<b``.
 
@@ -88,6 +89,7 @@ def _with_kernel(op: ElasticOperator, pressure, kernel_hat) -> np.ndarray:
     return fft.irfft(rows, n=2 * nx, axis=1)[:, :nx]
 
 
+@arguments(shape="shape", spacing="pair", e_reduced="number")
 def elastic_operator(shape, spacing, e_reduced: float, periodic: bool = False) -> ElasticOperator:
     """The (cached) operator for a grid; kernel FFTs are computed once per grid."""
     sp = tuple(float(v) for v in np.broadcast_to(np.asarray(spacing, float), (2,)))

@@ -14,6 +14,7 @@ import numpy as np
 import scipy.ndimage as ndi
 
 from .. import tables as T
+from ..checks import arguments
 from ..errors import InputError
 from ..topography.core import Topography
 from ..topography.geometry import pin_face
@@ -43,6 +44,7 @@ class LevellingResult:
     history: np.ndarray
 
 
+@arguments(pressure="field", x1="field", x2="field")
 def torque_residuals(pressure: np.ndarray, x1: np.ndarray, x2: np.ndarray) -> np.ndarray:
     """Dimensionless torque residuals (r_x1, r_x2) of eqs 1-4 (pixel area cancels)."""
     t1, t2 = -x2 * pressure, x1 * pressure
@@ -52,6 +54,7 @@ def torque_residuals(pressure: np.ndarray, x1: np.ndarray, x2: np.ndarray) -> np
     return np.array([t1.sum() / n1, t2.sum() / n2])
 
 
+@arguments(pin=Topography, tilt="pair")
 def tilt_pin(pin: Topography, tilt, holder_height: float = -1e-3) -> Topography:
     """Eq 7 on the pin face: ``x3_low = x3_low0 + x2 tan(a_x1) - x1 tan(a_x2)``.
 
@@ -63,6 +66,7 @@ def tilt_pin(pin: Topography, tilt, holder_height: float = -1e-3) -> Topography:
     return pin.with_heights(np.where(face, tilted, holder_height))
 
 
+@arguments(pin=Topography, disk=Topography, load="number")
 def level_pin(pin: Topography, disk: Topography | None = None, *, load: float = TABLE4["load"],
               e_reduced: float = TABLE4["e_reduced"], hardness: float = TABLE4["hardness"],
               method: str = "broyden", tol: float = 1e-6, max_iter: int = 200,
@@ -159,6 +163,7 @@ def _initial_jacobian(evaluate, tilt, r, pin, holder_height):
     return jac
 
 
+@arguments(pins=[Topography])
 def average_pins(pins, *, radius: float = 3e-3, truncation: float = -20e-6,
                  holder_height: float = -1e-3) -> Topography:
     """Set average of levelled pins (paper 2.2.1, Figure 3).

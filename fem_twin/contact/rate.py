@@ -19,11 +19,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import arguments
 from ..errors import InputError
 from .elastic import elastic_operator
 from .solver import ContactNotConverged, ContactResult
 
 
+@arguments(result=ContactResult, shape_rate="field", spacing="pair", e_reduced="number")
 def contact_rate(result: ContactResult, shape_rate, spacing, e_reduced: float, *,
                  hardness: float = np.inf, p_min: float = 0.0, periodic: bool = True,
                  tol: float = 1e-10, max_iter: int = 2000):

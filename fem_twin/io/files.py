@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import arguments
 from ..errors import InputError, MissingFile
 from ..topography.core import Topography
 from .atomic import atomic_path
@@ -35,6 +36,7 @@ class TopographyFileError(InputError):
     """A file that cannot be read as a topography (unknown format, corrupt, no data)."""
 
 
+@arguments(path="path")
 def read_topography(path, *, spacing=None, unit: str = "m") -> Topography:
     """Read a topography from ``path`` and return it in SI units.
 
@@ -66,6 +68,7 @@ def read_topography(path, *, spacing=None, unit: str = "m") -> Topography:
         raise TopographyFileError(f"cannot read topography from {path}: {err}") from err
 
 
+@arguments(path="path", topo=Topography)
 def write_topography(path, topo: Topography, *, height_scale: float | None = None) -> Path:
     """Write ``topo`` atomically; the format follows the suffix (.npz, .npy, .txt, .xyz).
 

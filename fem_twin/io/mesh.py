@@ -25,7 +25,8 @@ import numpy as np
 import scipy.sparse as sp
 import skfem
 
-from ..errors import InputError
+from ..checks import arguments
+from ..errors import InputError, MissingFile
 from .atomic import atomic_path
 
 
@@ -86,6 +87,7 @@ class GridMesh:
         return nodal.reshape(*self.node_shape, *nodal.shape[1:])[:ny, :nx]
 
 
+@arguments(shape="shape", spacing="pair")
 def grid_mesh(shape, spacing, origin=(0.0, 0.0), *, periodic: bool = False,
               kind: str = "quad") -> GridMesh:
     """Structured mesh with one node per pixel of a ``(ny, nx)`` grid of pitch ``spacing`` [m].
@@ -118,6 +120,7 @@ def grid_mesh(shape, spacing, origin=(0.0, 0.0), *, periodic: bool = False,
 
 
 # -- meshio ------------------------------------------------------------------------------
+@arguments(gm=GridMesh)
 def to_meshio(gm: GridMesh, point_data: dict | None = None, *,
               elevation: str | None = None) -> meshio.Mesh:
     """A ``meshio.Mesh`` of ``gm`` with grid fields ``(ny, nx[, ...])`` as point data.
@@ -138,6 +141,7 @@ def to_meshio(gm: GridMesh, point_data: dict | None = None, *,
                        field_data=field_data)
 
 
+@arguments(mesh=meshio.Mesh)
 def from_meshio(mesh: meshio.Mesh, *, periodic: bool | None = None) -> tuple[GridMesh, dict]:
     """Recover the grid and its fields ``(ny, nx)`` from a ``meshio.Mesh``.
 
@@ -198,6 +202,7 @@ def _nearest(u: np.ndarray, c: np.ndarray) -> np.ndarray:
 
 
 # -- VTK files ---------------------------------------------------------------------------
+@arguments(path="path", gm=GridMesh)
 def write_vtu(path, gm: GridMesh, point_data: dict | None = None, *,
               elevation: str | None = None) -> Path:
     """Write grid fields on ``gm`` to a binary VTU file for ParaView, atomically."""
@@ -246,11 +251,15 @@ def _fast_zlib():
         vtu.zlib = zlib
 
 
+@arguments(path="path")
 def read_vtu(path, *, periodic: bool | None = None) -> tuple[GridMesh, dict]:
     """Read a VTU written by :func:`write_vtu` (or any structured-grid VTU) back to grids."""
+    if not Path(path).is_file():
+        raise MissingFile(f"{path}: no such VTU file")
     return from_meshio(meshio.read(path), periodic=periodic)
 
 
+@arguments(path="path", entries=[tuple])
 def write_pvd(path, entries) -> Path:
     """Write a ParaView collection ``path`` (.pvd) of ``(time, vtu_path)`` entries."""
     path = Path(path)

@@ -20,9 +20,11 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..checks import arguments
 from ..errors import ReynoldsNotConverged
 
 
+@arguments(K=sp.spmatrix, B=sp.spmatrix, scale="number")
 def solve_complementarity_fb(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=1e-10,
                              max_iter=200, inexact=False):
     """FBNS on the interior nodes; same arguments and results as

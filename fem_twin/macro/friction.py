@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import arguments
 from .. import tables as T
 
 #: Boundary friction coefficient C_f,b of eq 32 (Bowden and Tabor, pure shearing).
@@ -21,6 +22,7 @@ BOUNDARY_FRICTION = T.BOUNDARY_FRICTION
 LAWS = ("pin", "paper")
 
 
+@arguments(pressure="field", mean_gap="field", spacing="pair", speed="number")
 def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing,
                        speed, *, entrainment=None, eyring_stress=None, law: str = "pin",
                        ambient_pressure: float = 0.0, face=None) -> np.ndarray:
@@ -68,6 +70,7 @@ def face_slope(gap, face, dx1: float) -> np.ndarray:
     return np.where(face, slope / dx1, 0.0)
 
 
+@arguments(contact_pressure="numbers", coefficient="number")
 def boundary_shear(contact_pressure, coefficient: float = BOUNDARY_FRICTION) -> np.ndarray:
     """tau_con = C_f,b p_con of eq 32 [Pa], where the surfaces slide (u_r > 0): a pure
     rolling contact has none (the operating point applies it only then; the creep of

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import tables as T
+from ..checks import check
 from ..errors import InputError
 
 
@@ -48,6 +49,8 @@ class Lubricant:
     eyring_stress: float | None = None
 
     def __post_init__(self):
+        if self.eyring_stress is not None:
+            check("Lubricant.eyring_stress", self.eyring_stress, "number")
         if self.eyring_stress is not None and not (np.isfinite(self.eyring_stress)
                                                    and self.eyring_stress > 0):
             raise InputError(f"Lubricant.eyring_stress must be positive [Pa] or None, got "
@@ -55,6 +58,9 @@ class Lubricant:
         if self.piezoviscosity not in ("roelands", "barus"):
             raise InputError("Lubricant.piezoviscosity must be 'roelands' or 'barus', got "
                              f"{self.piezoviscosity!r}")
+        for name in ("viscosity", "density", "roelands_alpha", "roelands_p0", "dh_c1",
+                     "dh_c2"):
+            check(f"Lubricant.{name}", getattr(self, name), "number")
         for name in ("viscosity", "density", "roelands_p0", "dh_c1", "dh_c2"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):

@@ -32,7 +32,7 @@ import scipy.sparse as sp
 import skfem
 from skfem.helpers import dot, grad
 
-from ..checks import as_field, as_pair
+from ..checks import arguments, as_field, as_pair
 from ..errors import InputError, ReynoldsNotConverged
 from ..assembly import at_points, grid_stencil, unit_element
 from .cavitation import cavitation_model
@@ -81,6 +81,7 @@ def homogenised_poiseuille_form(u, v, w):
                   + w.a21 * du[0] * dv[1] + w.a22 * du[1] * dv[1])
 
 
+@arguments(speed="number")
 def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 0.0,
                    cavitation_pressure: float = 0.0, method: str = "fe", tol: float = 1e-10,
                    max_iter: int = 200, complementarity: str = "switch",

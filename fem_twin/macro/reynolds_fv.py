@@ -14,7 +14,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ..checks import arguments
 
+
+@arguments(g="field", spacing="pair")
 def fvm_poiseuille(g, spacing, A=None) -> sp.csr_matrix:
     """Operator of ``-div(g A grad p)`` times the cell area, non-periodic grid.
 

@@ -24,6 +24,7 @@ import scipy.sparse as sp
 import skfem
 from skfem.helpers import dot, grad
 
+from ..checks import arguments
 from ..errors import InputError
 from ..io.mesh import GridMesh, grid_mesh
 from ..assembly import FixedPattern, element_entries, periodic_unknowns, unit_element
@@ -86,6 +87,7 @@ class CellSolver:
     :mod:`fem_twin.linalg`).
     """
 
+    @arguments(shape="shape", spacing="pair")
     def __init__(self, shape, spacing, *, pinned: int = 0, backend: str | None = None):
         self.shape = (int(shape[0]), int(shape[1]))
         self.spacing = tuple(float(s) for s in np.broadcast_to(np.asarray(spacing, float), (2,)))

@@ -30,6 +30,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..assembly import FixedPattern, periodic_unknowns
+from ..checks import arguments
 from ..errors import InputError
 from ..linalg import SPDSolver
 from .cell import CellSolution
@@ -58,6 +59,7 @@ class CellSolverFV:
     ``backend``: the sparse direct solver (see :mod:`fem_twin.linalg`).
     """
 
+    @arguments(shape="shape", spacing="pair")
     def __init__(self, shape, spacing, *, pinned: int = 0, face: str = "bilinear",
                  backend: str | None = None):
         if face not in FACE_RULES:

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
+from ..checks import arguments
 from ..errors import InputError
 from ..io.atomic import atomic_path
 from ..io.table import write_csv
@@ -69,12 +70,16 @@ class FlowFactors:
     meta: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        n = np.asarray(self.h0).shape
+        n = np.shape(self.h0)
         expect = {"h0": n, "h_m": n, "p_con": n, "A": n + (2, 2), "b": n + (2,),
                   "C": n + (2, 2), "d": n + (2,), "friction_factor": n,
                   "pressure_friction": n + (2,), "contact_fraction": n}
         for name, shape in expect.items():
-            v = np.asarray(getattr(self, name), dtype=float)
+            try:
+                v = np.asarray(getattr(self, name), dtype=float)
+            except (TypeError, ValueError):
+                raise InputError(f"FlowFactors.{name}: expected numbers, got "
+                                 f"{type(getattr(self, name)).__name__}") from None
             if v.shape != shape:
                 raise InputError(f"FlowFactors.{name} has shape {v.shape}, expected {shape}")
             if not np.all(np.isfinite(v)):
@@ -289,6 +294,7 @@ class LocalFactors:
     contact_fraction: np.ndarray | None
 
 
+@arguments(factors=[FlowFactors])
 def average(factors) -> FlowFactors:
     """Arithmetic mean over patches at the same ``h0`` (the paper's test average, Fig 4-5).
 

@@ -61,8 +61,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..checks import plausible
+from ..checks import arguments, plausible
 from ..errors import InputError
+from .flow_factors import FlowFactors
 
 #: the slide-to-roll ratio of the paper's cell: the pin at rest, the disk sliding over it
 SLIDING = 2.0
@@ -73,6 +74,7 @@ def slide_to_roll_of(factors) -> float:
     return float(factors.meta.get("slide_to_roll", SLIDING))
 
 
+@arguments(factors=FlowFactors, slide_to_roll="number")
 def at_slide_to_roll(factors, slide_to_roll: float):
     """``factors`` (a :class:`~fem_twin.micro.FlowFactors` at its own SRR, 2 unless its
     ``meta["slide_to_roll"]`` says otherwise) carried to ``slide_to_roll`` = u_r / u_m by

@@ -54,7 +54,7 @@ import numpy as np
 from ..contact import contact_rate
 from ..contact import solve as contact_solve
 from ..contact.levelling import TABLE4
-from ..checks import check_choices, plausible, setting
+from ..checks import arguments, check_choices, plausible, setting
 from ..errors import InputError
 from .cell_fv import CellSolverFV
 from .flow_factors import FlowFactors
@@ -156,6 +156,7 @@ class SlidingPass:
     couette: bool = True
 
 
+@arguments(z_low="field", z_up="field", spacing="pair", settings=CellSettings)
 def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | None = None,
                  offset: float = 0.0) -> SlidingPass:
     """The moving surface shifts by ``s = L_r1 / N_t`` per step (``+s`` for the disk, ``-s``

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..checks import arguments
+from ..errors import InputError, MissingFile
 from ..io.figure import save_figure
 from ..io.table import write_csv
 from ..macro.friction import BOUNDARY_FRICTION
@@ -33,11 +34,13 @@ UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
          "cf_max": ("1", "highest C_f of the single-patch sweeps")}
 
 
+@arguments(viscosity="numbers", speed="numbers", diameter="number", load="number")
 def hersey_number(viscosity, speed, diameter: float, load: float):
     """H = mu_0 U D / F_N,imp of eq 46 [-] (SI inputs)."""
     return np.asarray(viscosity) * np.asarray(speed) * diameter / load
 
 
+@arguments(cf="numbers", cf_ref="numbers", boundary="number")
 def friction_deviation(cf, cf_ref, boundary: float = BOUNDARY_FRICTION):
     """C_f,dev = (C_f - C_f,ref) / C_f,b of eq 35 [-]."""
     return (np.asarray(cf) - np.asarray(cf_ref)) / boundary
@@ -127,6 +130,7 @@ def joined(curves) -> StribeckCurve:
                    coarse_friction_coefficient=coarse)
 
 
+@arguments(path="path", curves=[StribeckCurve])
 def write_stribeck_csv(path, curves, band=None) -> Path:
     """All curves into one CSV (:data:`HEADERS`, SI units), atomically; ``cf_err``, the
     estimated discretisation error of C_f, when a curve has it; ``band``: optional
@@ -145,9 +149,12 @@ def write_stribeck_csv(path, curves, band=None) -> Path:
     return write_csv(path, columns)
 
 
+@arguments(path="path")
 def read_stribeck_csv(path) -> list[StribeckCurve]:
     """Curves written by :func:`write_stribeck_csv` (or with the unit-less headers of
     fem_twin 0.1), one per viscosity."""
+    if not Path(path).is_file():
+        raise MissingFile(f"{path}: no such Stribeck CSV (fem-twin run writes stribeck.csv)")
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
     if rows and set(HEADERS.values()) <= set(rows[0]):
@@ -166,6 +173,7 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
     return out
 
 
+@arguments(curves=[StribeckCurve], path="path")
 def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None,
                   boundary: float = BOUNDARY_FRICTION, bands=None, measured=None,
                   diameter: float = 8e-3, load: float = 150.0,
@@ -224,10 +232,14 @@ class MeasuredCurve:
     high: np.ndarray | None = None
 
 
+@arguments(path="path")
 def read_measured_csv(path, unit: str = "m/s") -> MeasuredCurve:
     """CSV with a header: ``speed`` [m/s, or rpm with ``unit="rpm"``, converted by the
     caller] and ``friction_coefficient`` (or ``cf``), and optionally ``cf_min``/``cf_max``
     (the scatter band of a test set)."""
+    if not Path(path).is_file():
+        raise MissingFile(f"{path}: no such measured curve (a CSV with speed and "
+                          "friction_coefficient)")
     try:
         with open(path, newline="", encoding="utf-8-sig") as f:
             rows = list(csv.DictReader(f))
@@ -266,6 +278,7 @@ def read_measured_csv(path, unit: str = "m/s") -> MeasuredCurve:
     return MeasuredCurve(speed, cf, low if band else None, high if band else None)
 
 
+@arguments(curve=StribeckCurve, measured=MeasuredCurve, boundary="number")
 def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve,
                             boundary: float = BOUNDARY_FRICTION):
     """C_f,dev (eq 35) of the simulated curve against the measured one, at the measured

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from ..checks import arguments
 from ..errors import InputError
 from ..io.checkpoint import input_key, load_or_none
 from ..io.mesh import write_pvd
@@ -59,6 +60,7 @@ def point_speed(path) -> float:
 
 
 @one_thread
+@arguments(gap="field", spacing="pair", factors=FlowFactors, speeds="numbers", load="number", lubricant=Lubricant)
 def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    lubricant: Lubricant, diameter: float = 8e-3, face=None,
                    settings: MacroSettings = MacroSettings(), checkpoint=None, fields=None,

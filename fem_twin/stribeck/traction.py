@@ -16,12 +16,14 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from ..checks import arguments
 from ..errors import InputError
 from ..io.checkpoint import load_or_none
 from ..io.figure import save_figure
 from ..io.table import write_csv
 from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
 from ..macro.estimate import friction_error
+from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from .sweep import point_file, sweep_key
 
@@ -60,6 +62,7 @@ class TractionCurve:
 
 
 @one_thread
+@arguments(gap="field", spacing="pair", factors=FlowFactors, entrainment="number", load="number", lubricant=Lubricant)
 def traction_sweep(gap, spacing, factors, slide_to_roll=DEFAULT_RATIOS, *, entrainment: float,
                    load: float, lubricant: Lubricant, face=None,
                    settings: MacroSettings = MacroSettings(), checkpoint=None,

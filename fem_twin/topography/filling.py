@@ -6,6 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..checks import arguments
 from ..errors import InputError
 from .core import Topography
 
@@ -14,6 +15,7 @@ from .core import Topography
 MIN_VALID = 0.01
 
 
+@arguments(topo=Topography)
 def fill_defects(topo: Topography) -> Topography:
     """Fill invalid pixels with the solution of the Laplace equation.
 

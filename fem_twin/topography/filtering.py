@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.ndimage as ndi
 
+from ..checks import arguments
 from ..errors import InputError
 from .core import Topography
 
@@ -12,6 +13,7 @@ from .core import Topography
 FWHM_PER_SIGMA = 2.0 * np.sqrt(2.0 * np.log(2.0))
 
 
+@arguments(topo=Topography, lower="number", upper="number")
 def clip_heights(topo: Topography, lower: float = -20e-6, upper: float = 20e-6) -> Topography:
     """Limit heights to ``[lower, upper]`` [m] (paper: height range limited to 20 um)."""
     if not lower < upper:
@@ -20,6 +22,7 @@ def clip_heights(topo: Topography, lower: float = -20e-6, upper: float = 20e-6) 
                              meta=topo.with_history(f"clip[{lower:.3g}, {upper:.3g}] m"))
 
 
+@arguments(topo=Topography, fwhm_px="number")
 def gaussian_filter(topo: Topography, fwhm_px: float) -> Topography:
     """Smooth with a Gaussian whose full width at half maximum is ``fwhm_px`` pixels.
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import arguments
 from ..errors import InputError
 from .core import Topography
 
@@ -12,6 +13,7 @@ from .core import Topography
 _TURNS = {"+x1": 0, "+x2": 1, "-x1": 2, "-x2": 3}
 
 
+@arguments(topo=Topography, shape="shape", start="pair")
 def extract_patch(topo: Topography, shape=(256, 256), start=(0, 0)) -> Topography:
     """Cut a ``shape = (ny, nx)`` sub-grid starting at pixel ``start = (row, col)``.
 
@@ -27,6 +29,7 @@ def extract_patch(topo: Topography, shape=(256, 256), start=(0, 0)) -> Topograph
                              meta=topo.with_history(f"patch({ny}x{nx} at {r0},{c0})"))
 
 
+@arguments(topo=Topography)
 def align_sliding(topo: Topography, direction: str = "+x1") -> Topography:
     """Rotate the map so that the measured axis ``direction`` becomes x1 (sliding velocity).
 
@@ -54,6 +57,7 @@ def _rotate(a: np.ndarray, k: int) -> np.ndarray:
     return a.T[:, ::-1]   # k == 3: new x1 = -old x2, new x2 = old x1
 
 
+@arguments(disk=Topography)
 def flip_disk(disk: Topography) -> Topography:
     """Turn the measured disk face-down over the pin by rotating it 180 deg about x1.
 
@@ -70,6 +74,7 @@ def flip_disk(disk: Topography) -> Topography:
                              meta=disk.with_history("flip_disk(about x1)"))
 
 
+@arguments(topo=Topography, face="field")
 def pin_centre(topo: Topography, face: np.ndarray) -> tuple[float, float]:
     """Centroid (x1, x2) [m] of the pin face pixels ``face`` (boolean array)."""
     x1, x2 = topo.coordinates()
@@ -78,6 +83,7 @@ def pin_centre(topo: Topography, face: np.ndarray) -> tuple[float, float]:
     return float(x1[face].mean()), float(x2[face].mean())
 
 
+@arguments(topo=Topography, centre="pair")
 def centre_on(topo: Topography, centre) -> Topography:
     """Shift coordinates so that ``centre`` (x1, x2) [m] becomes the origin."""
     origin = (topo.origin[0] - centre[0], topo.origin[1] - centre[1])
@@ -85,6 +91,7 @@ def centre_on(topo: Topography, centre) -> Topography:
                              meta=topo.with_history(f"centre_on({centre[0]:.4g}, {centre[1]:.4g})"))
 
 
+@arguments(topo=Topography, truncation="number", holder_height="number")
 def mount_pin(topo: Topography, truncation: float = -20e-6, holder_height: float = -1e-3,
               radius: float | None = None) -> Topography:
     """Put the pin face in its holder: everything off the face is the holder at -1 mm.
@@ -105,6 +112,7 @@ def mount_pin(topo: Topography, truncation: float = -20e-6, holder_height: float
                                  f"mount_pin(truncation={truncation:.3g} m, holder={holder_height:.3g} m)"))
 
 
+@arguments(topo=Topography, holder_height="number")
 def pin_face(topo: Topography, holder_height: float = -1e-3) -> np.ndarray:
     """Boolean mask of the pin face of a mounted pin (pixels above the holder)."""
     return topo.heights > holder_height

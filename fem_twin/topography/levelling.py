@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import arguments
 from ..errors import InputError
 from .core import Topography
 
 
+@arguments(topo=Topography)
 def mean_plane(topo: Topography, mask: np.ndarray | None = None) -> np.ndarray:
     """Least-squares plane ``(a, b1, b2)`` with ``z ~ a + b1 x1 + b2 x2`` over valid pixels.
 
@@ -25,6 +27,7 @@ def mean_plane(topo: Topography, mask: np.ndarray | None = None) -> np.ndarray:
     return np.array([a - b1 * c1 - b2 * c2, b1, b2])
 
 
+@arguments(topo=Topography)
 def level(topo: Topography, mask: np.ndarray | None = None) -> Topography:
     """Subtract the mean plane fitted where ``mask`` is True (all valid pixels by default).
 
@@ -38,6 +41,7 @@ def level(topo: Topography, mask: np.ndarray | None = None) -> Topography:
                              meta=topo.with_history(f"level(mean plane over {what})"))
 
 
+@arguments(topo=Topography)
 def zero_mean(topo: Topography, mask: np.ndarray | None = None) -> Topography:
     """Shift heights so that their mean over ``mask`` (valid pixels by default) is zero."""
     sel = _selection(topo, mask)
@@ -45,6 +49,7 @@ def zero_mean(topo: Topography, mask: np.ndarray | None = None) -> Topography:
                              meta=topo.with_history("zero_mean"))
 
 
+@arguments(topo=Topography, radius="number", centre="pair")
 def radial_mask(topo: Topography, radius: float, centre=(0.0, 0.0)) -> np.ndarray:
     """True for pixels within ``radius`` [m] of ``centre`` (x1, x2) [m]."""
     x1, x2 = topo.coordinates()

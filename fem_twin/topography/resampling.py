@@ -5,12 +5,14 @@ from __future__ import annotations
 import numpy as np
 import scipy.ndimage as ndi
 
+from ..checks import arguments
 from ..errors import InputError
 from .core import Topography
 
 _ORDER = {"nearest": 0, "linear": 1, "cubic": 3}
 
 
+@arguments(topo=Topography, shape="shape")
 def resample(topo: Topography, shape: tuple[int, int], method: str = "linear") -> Topography:
     """Interpolate onto a ``shape = (ny, nx)`` grid spanning the same first and last pixels.
 
@@ -35,6 +37,7 @@ def resample(topo: Topography, shape: tuple[int, int], method: str = "linear") -
                              meta=topo.with_history(f"resample({ny}x{nx}, {method})"))
 
 
+@arguments(topo=Topography, factor="number")
 def refine(topo: Topography, factor: int, method: str = "linear") -> Topography:
     """Insert ``factor - 1`` points between neighbours: ``n -> factor (n - 1) + 1`` pixels."""
     if int(factor) != factor or factor < 1:
@@ -43,6 +46,7 @@ def refine(topo: Topography, factor: int, method: str = "linear") -> Topography:
     return resample(topo, (factor * (ny - 1) + 1, factor * (nx - 1) + 1), method)
 
 
+@arguments(topo=Topography, shape="shape")
 def resample_cell(topo: Topography, shape: tuple[int, int]) -> Topography:
     """Periodic roughness cell onto ``shape = (ny, nx)`` pixels over the same period.
 
