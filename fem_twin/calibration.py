@@ -60,6 +60,9 @@ def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
     """``{label: (case, patch index or None, speeds [m/s] or None for the case's)}`` of a
     study and the reference label."""
     g = case.macro_geometry
+    if values and study not in ("filter", "resolution"):
+        raise InputError(f"--values: the {study} study takes none (its variants are the "
+                         "case's own); --values goes with the filter and resolution studies")
     if case.tribometer.ball:
         raise InputError(f"the {study} study runs on pin-on-disk cases (the paper's 3.2); a "
                          "ball-on-disk case's sweeps need its slide-to-roll ratio, which the "

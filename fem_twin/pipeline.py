@@ -19,6 +19,8 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 
+import numpy as np
+
 from .case import Case
 from .errors import InputError, RunLocked
 from .io.atomic import atomic_path
@@ -43,9 +45,14 @@ def run(case: Case, outdir, *, progress: bool = True, estimated_s: float | None 
     outdir = out.root
     if outdir.exists() and not outdir.is_dir():
         raise InputError(f"{outdir} is a file: give a folder for the results (-o)")
+    sw = case.sweep
     for path in case.measured:                 # [validation] curves: checked before any work
         if path is not None:
-            read_measured_csv(path)
+            speed = read_measured_csv(path).speed
+            if not np.any((speed >= sw.speed_min) & (speed <= sw.speed_max)):
+                raise InputError(f"[validation] {path}: its speeds ({speed.min():.3g} to "
+                                 f"{speed.max():.3g} m/s) lie outside the case's sweep "
+                                 f"({sw.speed_min:g} to {sw.speed_max:g} m/s)")
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     summary = {"case": case.name, "provenance": provenance(case), "stages": {},

@@ -1079,6 +1079,17 @@ def test_outputs_and_study_values_are_checked_before_any_work(tmp_path, capsys):
     ball = (ROOT / "examples" / "ball_on_disk.toml").read_text().replace(
         "../meshes/", str(ROOT / "meshes") + "/")
     (tmp_path / "ball.toml").write_text(ball)
+    assert main(["calibrate", str(case), "--study", "patches", "--values", "3", "-o",
+                 str(tmp_path / "c"), "--no-progress"]) == 2
+    assert "takes none" in capsys.readouterr().err
+    text = case.read_text()                  # a measured curve beside the sweep's speeds
+    far = tmp_path / "far.csv"
+    far.write_text("speed,friction_coefficient\n10,0.01\n20,0.02\n")
+    (tmp_path / "v.toml").write_text(text + f'\n[validation]\nmeasured = ["{far}"]\n')
+    assert main(["run", str(tmp_path / "v.toml"), "-o", str(tmp_path / "v"),
+                 "--no-progress"]) == 2
+    assert "outside the case's sweep" in capsys.readouterr().err
+    assert not (tmp_path / "v" / "geometry").exists()
     for study in ("pins", "patches"):
         assert main(["calibrate", str(tmp_path / "ball.toml"), "--study", study, "-o",
                      str(tmp_path / "b"), "--no-progress"]) == 2

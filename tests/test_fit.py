@@ -160,3 +160,18 @@ def test_a_curve_no_parameters_fit_is_refused_naming_its_residual(twin, factors)
                                                               "temperature"],
                      start_temperatures=[24.0])
     assert out["fit"]["warnings"] == [] and out["temperature_1"]["value"] > 26
+
+
+def test_a_parameter_the_points_do_not_see_is_refused(twin):
+    """Issue 64 item 2: measured points only where the film carries the load (no contact,
+    so C_f does not depend on C_f,b) gave the starting value back with a zero-width 95 %
+    interval; the fit now refuses, naming the parameter."""
+    sim, cf = twin
+    curve = sim[0.066]
+    full_film = curve.speed[curve.boundary_friction == 0][:4]
+    assert full_film.size == 4
+    measured = MeasuredCurve(full_film, np.interp(np.log(full_film), np.log(curve.speed[::-1]),
+                                                  curve.friction_coefficient[::-1]))
+    model = FitModel((curve,), CFB, 150.0, LAW)
+    with pytest.raises(InputError, match="do not constrain boundary_friction"):
+        fit_curves(model, [measured], ["boundary_friction"], start_temperatures=None)

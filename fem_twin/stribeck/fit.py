@@ -211,6 +211,13 @@ def _sigma(m: MeasuredCurve):
 def _summary(model, measured, names, sol, weighted, unpack) -> dict:
     n, p = sol.fun.size, sol.x.size
     dof = n - p
+    size = np.linalg.norm(sol.jac, axis=0)
+    blind = [name for name, s in zip(names, size) if not s > 1e-9 * max(size.max(), 1e-300)]
+    if blind or dof < 1:
+        raise InputError(f"the measured points do not constrain {', '.join(blind) or 'the fit'}"
+                         f" ({n} residuals for {p} unknowns): they lie where C_f does not "
+                         "depend on it (C_f,b in full film), or are too few; measure the "
+                         "speeds where it acts")
     cov = _covariance(sol.jac, sol.fun, weighted)
     half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
     out = {name: {"value": float(v), "low": float(v - h), "high": float(v + h)}
