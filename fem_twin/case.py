@@ -9,6 +9,7 @@ from dataclasses import MISSING, dataclass, field, fields
 from pathlib import Path
 
 from .checks import QUANTITIES, memory_shortfall
+from .cost import estimated_seconds
 from .errors import InputError
 from .sections import (SECTIONS, Geometry, LubricantSpec, MacroSpec, Materials, MicroSpec,
                        RunSpec, SweepSpec, Tribometer)
@@ -20,36 +21,8 @@ class CaseError(InputError):
 
 
 #: local worker processes a case may ask for per core (``[run] workers``): more only add
-#: memory and switching (issue 64: 10000 started about 4600 processes on 2 cores)
+#: memory and switching
 WORKERS_PER_CORE = 4
-
-
-#: a warm Stribeck point of a pin at 128^2 [s], its growth with the pixels, and the cost of
-#: a main-curve point with its C_f error estimate in plain points: fitted to the bundled
-#: case and the paper case (2026-11-26, 13:20-13:45, the probe of :mod:`fem_twin.speed`
-#: at 0.17-0.19 s: sweeps, band and results 54 s and 282 s)
-POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 1.38, 0.7, 1.28
-#: a ball's warm point at 73^2 (Newton coupling) [s] and its growth with the grid's side
-#: (the bundled ball case, the same hour: 30 points in 70 s on 2 cores)
-BALL_POINT_SECONDS, BALL_POINT_GROWTH = 3.9, 2.4
-#: a band point in main-curve points, by ``[run] band_grid``: the band's sweeps converge to
-#: 1e-4 and carry no error estimate, and "coarse" runs them on the coarsened grid (bundled
-#: case, 2026-11-25: 0.157 s on the coarse grid, 0.59 s on the full one, against 1.28 s a
-#: main point with its error estimate)
-BAND_POINT_COST = {"coarse": 0.14, "full": 0.54}
-#: a band point on a grid coarsened once more, against one on the grid before ("coarsest"
-#: on grids from 256^2; the paper case, 2026-11-26: a 32-speed sweep 6.0 s at 64^2 against
-#: 18.4 s at 128^2)
-BAND_LEVEL_COST = 0.33
-#: micro stage cost per cell pixel, time step and separation on one core [s] (the cell
-#: problems, the periodic contact and the coarsened cell of the error estimate: 3.5e-6 on
-#: the bundled case (54.5 s) and 3.6e-6 on the paper case (420 s), the same hour)
-MICRO_SECONDS = 3.5e-6
-#: separations an adaptive h0 sample solves per patch pair, for the time estimate:
-#: ``a + k / sqrt(h0_tol)`` (at most the candidates), fitted to the paper case's six patch
-#: pairs at 256^2 x 32 (2026-11-25: 30.5, 27, 22.3 and 18.8 a pair at h0_tol = 0.01, 0.02,
-#: 0.03 and 0.05; 2026-11-26: 16.5 at 0.05, 12.0 at 0.1; the bundled case solves all its 16)
-ADAPTIVE_H0 = (5.5, 2.7)
 
 
 @dataclass(frozen=True)
@@ -72,41 +45,8 @@ class Case:
 
     def estimated_seconds(self, cores: int = 2) -> float:
         """Rough wall time of ``fem-twin run`` on ``cores`` cores of the calibration
-        machine [s] (``fem-twin run`` scales it to this machine now by
-        :func:`fem_twin.speed.slowdown`), from the costs measured there:
-        ``MICRO_SECONDS`` per cell pixel, time step and separation of the micro stage on
-        one core (adaptive h0 solves ``ADAPTIVE_H0`` of the candidates); a warm Stribeck
-        point of a pin ``POINT_SECONDS`` at 128^2 growing as N^``POINT_GROWTH`` (pixels),
-        ``ESTIMATE_COST`` times that on the main curves (their C_f error estimates), one
-        sweep per viscosity and, with ``[run] patch_band``, one more per patch (a point at
-        ``BAND_POINT_COST`` by ``[run] band_grid``, ``BAND_LEVEL_COST`` for each further
-        coarsening); a ball's point ``BALL_POINT_SECONDS``
-        at 73^2.  Measured against it (2026-11-26, 13:20-13:45, tests/test_cli.py): the
-        bundled case 114 s (estimated 108 s), 173 s with its band on the full grid, the
-        paper case with its band at 128^2 709 s at ``h0_tol = 0.05`` and 605 s at 0.1, the
-        ball case 102 s; the paper case with its band at 64^2 (the default), 484 s at 16:00
-        with the probe at 0.87x (estimated 522 s on the calibration machine)."""
-        patches = len(self.geometry.patches)
-        h0 = self.micro.h0_count
-        if self.micro.h0_tol:
-            a, k = ADAPTIVE_H0
-            h0 = min(h0, a + k / math.sqrt(self.micro.h0_tol))
-        pixels = self.micro.resolution[0] * self.micro.resolution[1]
-        micro = MICRO_SECONDS * pixels * self.micro.steps * h0 * patches / max(cores, 1)
-        if self.tribometer.ball:         # Newton coupling
-            point = BALL_POINT_SECONDS * (self.macro.grid / 73) ** BALL_POINT_GROWTH
-            estimate = 1.0
-        else:
-            res = self.macro_geometry.resolution or (256, 256)
-            point = POINT_SECONDS * ((res[0] * res[1]) / 128 ** 2) ** POINT_GROWTH
-            estimate = ESTIMATE_COST
-        n_mu = len(self.lubricant.viscosities)
-        points = self.sweep.count * (1 + 0.5 * self.sweep.refine)   # refinement: ~+50 %
-        band = patches if self.run.patch_band and patches > 1 else 0
-        band *= self._band_point_cost()
-        sweeps = n_mu * (1 + (patches if band else 0))
-        macro = point * points * n_mu * (estimate + band) / max(1, min(cores, sweeps))
-        return micro + macro
+        machine [s] (:func:`fem_twin.cost.estimated_seconds`)."""
+        return estimated_seconds(self, cores)
 
     def band_coarsening(self, shape) -> int:
         """Coarsenings by two of the band's grid below a macro grid of ``shape``
@@ -116,15 +56,6 @@ class Case:
         from .macro.nested import nested_levels
         return {"full": 0, "coarse": 1}.get(self.run.band_grid,
                                             max(1, nested_levels(shape)))
-
-    def _band_point_cost(self) -> float:
-        """A band point in main-curve points, by ``[run] band_grid`` and the macro grid
-        (``BAND_LEVEL_COST`` for each coarsening beyond the first)."""
-        if self.run.band_grid != "coarsest":
-            return BAND_POINT_COST[self.run.band_grid]
-        shape = ((self.macro.grid,) * 2 if self.tribometer.ball
-                 else self.macro_geometry.resolution or (256, 256))
-        return BAND_POINT_COST["coarse"] * BAND_LEVEL_COST ** (self.band_coarsening(shape) - 1)
 
 
 def load_case(path) -> Case:

@@ -60,8 +60,9 @@ def plausible(name: str, value, quantity: str):
     return value
 
 
-#: peak memory a grid point takes in one process [B]: a macro node (the 2048^2 scale point,
-#: 7.44 GiB) and a cell pixel (PARDISO, 256^2 to 1024^2: 2.6-3.1 kB), measured 2026-11-28
+#: peak memory a grid point takes in one process [B]: a macro node (the 2048^2 point of
+#: ``benchmarks/run.py scale``) and a cell pixel (PARDISO, 256^2 to 1024^2; both in
+#: benchmarks/README.md)
 BYTES_PER_POINT = {"macro": 1.9e3, "cell": 3.2e3}
 
 
@@ -81,9 +82,7 @@ def memory_shortfall(points: int, grid: str, processes: int = 1) -> str | None:
 def number(name: str, value, quantity: str) -> float:
     """``value`` as one plausible number of ``quantity`` (:func:`plausible`), or
     :class:`InputError` naming ``name``: an array where a number goes is refused."""
-    if np.ndim(value) != 0 if _numeric(value) else True:
-        raise InputError(f"{name}: expected one number in {QUANTITIES[quantity][2]}, got "
-                         f"{value!r}"[:200])
+    check(name, value, "number")
     return float(plausible(name, value, quantity))
 
 

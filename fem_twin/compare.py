@@ -94,17 +94,7 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     out.root.mkdir(parents=True, exist_ok=True)
     reconstruct_geometry(case, out, progress)
     level_pins(case, out, progress)
-    factors = {}
-    with executor_for(case.run.workers, case.run.scheduler) as executor:
-        for method in ("fe", "fvm"):
-            sub = out.sub(method)
-            sub.root.mkdir(exist_ok=True)
-            for link, target in ((sub.geometry, out.geometry), (sub.levelling, out.levelling)):
-                if not link.exists():
-                    link.symlink_to(target.resolve(), target_is_directory=True)
-            c = replace(case, micro=replace(case.micro, method=method, h0_tol=0.0))
-            homogenise_patches(c, sub, executor, progress)
-            factors[method] = FlowFactors.load(sub.flow_factors)
+    factors = _both_factors(case, out, progress)
     reference = reference_factors(case, out.root, factors["fe"].h0, executor=None,
                                   progress=progress)
     against = {m: discrepancy(factors[m], reference) for m in ("fe", "fvm")}
@@ -147,6 +137,23 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     with atomic_path(out.compare) as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     return summary
+
+
+def _both_factors(case: Case, out: RunLayout, progress: bool) -> dict:
+    """``{method: FlowFactors}`` of the case by FE and by FVM at every h0 candidate, each in
+    ``out/<method>`` beside links to the shared geometry and levelling."""
+    factors = {}
+    with executor_for(case.run.workers, case.run.scheduler) as executor:
+        for method in ("fe", "fvm"):
+            sub = out.sub(method)
+            sub.root.mkdir(exist_ok=True)
+            for link, target in ((sub.geometry, out.geometry), (sub.levelling, out.levelling)):
+                if not link.exists():
+                    link.symlink_to(target.resolve(), target_is_directory=True)
+            c = replace(case, micro=replace(case.micro, method=method, h0_tol=0.0))
+            homogenise_patches(c, sub, executor, progress)
+            factors[method] = FlowFactors.load(sub.flow_factors)
+    return factors
 
 
 def _plot(path, ffd, curves, dev):

@@ -52,9 +52,8 @@ def worker_heap() -> None:
     fresh zeroed pages: the micro stage of one patch pair ran 2x slower in a Dask worker
     (33.7 s against 17.0 s without that setting, contact 2.8x).  32 MB, glibc's own largest
     threshold, keeps the 1997^2 grids (31.9 MB a field) on the heap and maps the 2048^2 ones
-    (33.5 MB), which a heap would hold beyond their use: a 2048^2 point of
-    ``benchmarks/run.py scale`` peaked at 8.04 GiB with 64 MB, 7.63 GiB with 32 MB
-    (7.60 GiB without the setting; 2026-11-27).  Called by the worker tasks (also when they
+    (33.5 MB), which a heap would hold beyond their use (a 2048^2 point's peak with 64 MB,
+    32 MB and none: benchmarks/README.md).  Called by the worker tasks (also when they
     run in the calling process), once per process; a no-op without glibc."""
     global _HEAP_SET
     if _HEAP_SET or not sys.platform.startswith("linux"):
@@ -106,9 +105,9 @@ def stop_pool(pool: ProcessPoolExecutor, failed: bool = False) -> None:
 
 #: Dask settings for processes that compute: no statistical profiler (it samples every
 #: task's stack every 10 ms), event-loop ticks, system and memory monitors at 1-5 s instead
-#: of 20-500 ms, no GIL monitor.  Measured on 2 cores (32 cell tasks of the bundled case,
-#: 2026-11-25): a task's wall time exceeds its thread's CPU time by 7-10 % in a default
-#: worker, 2 % with these, 0.5 % in a process-pool worker.  A LocalCluster of
+#: of 20-500 ms, no GIL monitor: a task's wall time exceeds its thread's CPU time by
+#: 7-10 % in a default worker, 2 % with these, 0.5 % in a process-pool worker (32 cell
+#: tasks of the bundled case on 2 cores; docs: Performance).  A LocalCluster of
 #: ``[run] scheduler = "local"`` runs with them; ``DASK_ENVIRONMENT`` sets them for
 #: ``dask worker`` (docs: Performance).
 DASK_CONFIG = {"distributed.worker.profile.enabled": False,

@@ -1,42 +1,23 @@
 """The discretisation error of an operating point's friction coefficient C_f (eq 34).
 
-Both scales contribute, and each part is a change of C_f [-]:
+Each part is a change of C_f [-] (docs/accuracy.md, "The error bar on every friction
+coefficient", has the measurements behind each choice):
 
 ``"macro"``
-    the point solved again on the macro grid coarsened by two (every other node; the face
-    mask likewise), warm-started from the converged state:
-    ``|C_f(h) - C_f(2h)| / (2^p - 1)`` with ``p = MACRO_ORDER``.  The Couette flux and the
-    Poiseuille term are second order (:mod:`.couette`), so with ``p = 1.5`` the estimate is
-    1 to 3 times the error wherever the observed order lies between 1.5 and 2.6.
+    the point on the macro grid coarsened by two, warm from the converged state:
+    ``|C_f(h) - C_f(2h)| / (2^p - 1)`` with ``p = MACRO_ORDER``.
 ``"time"``, ``"grid"``, ``"h0"``
-    the flow factors' own error estimates carried into C_f: the point solved with each
-    variant of the factors (:meth:`FlowFactors.variants`: every other instant, the
-    coarsened cell's difference added, every other separation), on a coarser grid and
-    warm from the point there, minus that point.  The sensitivity of C_f to the factors
-    needs no fine grid (the coarse grid changes C_f itself by a few tenths of a per cent of
-    C_f,b): the grid coarsened by two, and on grids of more than twice
-    ``MICRO_PARTS_SIDE`` a side the coarsest nested level with at least that many
-    nodes a side (:func:`micro_parts_level`).  The ``"h0"`` variant's interpolation error
-    is that of twice the spacing, ``H0_SPACING_RATIO`` times the error of the computed
-    sample.
-
+    the flow factors' own estimates carried into C_f: the point solved with each variant
+    of the factors (:meth:`FlowFactors.variants`) on the level :func:`micro_parts_level`
+    gives, minus the point there; ``"h0"`` over ``H0_SPACING_RATIO``.
 ``"film"``
-    the friction re-evaluated on the point's own fields with the friction factor of half
-    and of twice the boundary film (:mod:`fem_twin.micro.estimate`), the larger change:
-    the sensitivity to the film friction's cut-off at the contact edges, a model part; no
-    solve, as the Reynolds equation does not read the friction factors.
+    the point's own fields re-evaluated with the friction factor of half and of twice the
+    boundary film, the larger change (a model part; no solve).
 
-``"total"`` is the sum of the parts' magnitudes: their root sum of squares (independent
-errors of unknown sign), tried on 2026-11-26, fell to 0.62-0.87 of the truth on the
-paper-grade patch pair in heavy contact, where the parts' errors add with one sign
-(``benchmarks/README.md``). ``"signed"`` keeps each part with its sign as an estimate of
-``C_f - C_f,converged`` (macro: ``(C_f(2h) - C_f(h)) / (2^p - 1)``; the others: the
-variant's change, which is the error of the run's own factors where they converge at first
-order), kept for studies of how the parts combine; the total does not use it, as the signs
-are reliable only in the asymptotic range. A part that could not be estimated is NaN, left
-out of the total and named in ``"missing"`` (factors computed without their error
-estimate), with the reason in ``"failed"`` when its solve did not converge. Smooth factors
-have no micro parts (0).
+``"total"`` sums the parts' magnitudes (a root sum of squares fell below the truth where
+the parts' errors add with one sign); ``"signed"`` keeps each part's sign for studies.  A
+part that could not be estimated is NaN, left out of the total and named in
+``"missing"``, with the reason in ``"failed"``.  Smooth factors have no micro parts (0).
 """
 
 from __future__ import annotations

@@ -39,7 +39,7 @@ from . import newton
 from .fixed_point import Concentrated, solve_fixed_point
 from .lubricant import Lubricant
 from .problem import macro_problem
-from .reynolds import OPEN_GAP
+from .reynolds import check_closed
 from .result import MixedResult, mixed_result, on_grid
 from .settings import MacroSettings
 
@@ -104,9 +104,7 @@ def seeded_point(gap, spacing, factors: FlowFactors, *, load: float, speed: floa
     if np.abs(h_g).max() > MAX_GAP:
         raise InputError(f"gap [m] spans {h_g.min():.3g} to {h_g.max():.3g} m: implausible for a "
                          f"pin or a ball (at most {MAX_GAP:g} m either way); give it in metres")
-    if not np.any(h_g[1:-1, 1:-1] < OPEN_GAP):
-        raise InputError(f"the gap is open everywhere inside the grid (above {OPEN_GAP:g} m, "
-                         "the oil bath): nothing carries load; give the gap in metres")
+    check_closed(h_g)
     load = number("load [N]", load, "load")
     if entrainment is None or speed != 0:                # 0 with u_m: pure rolling
         speed = number("speed [m/s]", speed, "speed")

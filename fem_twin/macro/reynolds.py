@@ -81,6 +81,34 @@ def homogenised_poiseuille_form(u, v, w):
                   + w.a21 * du[0] * dv[1] + w.a22 * du[1] * dv[1])
 
 
+def check_closed(gap: np.ndarray) -> None:
+    """Refuse a gap [m] open (above :data:`OPEN_GAP`, the oil bath) at every interior node:
+    nothing would carry load, most likely a gap not in metres."""
+    if not np.any(gap[1:-1, 1:-1] <= OPEN_GAP):
+        raise InputError(f"the gap is open everywhere inside the grid (above {OPEN_GAP:g} m, "
+                         "the oil bath): nothing carries load; give the gap in metres")
+
+
+def _inputs(gap, spacing, viscosity, method, couette):
+    """:func:`solve_reynolds`'s checked inputs: ``(h, dx, lubricant or None, mu_0)``."""
+    h = as_field("gap [m]", gap, 3)
+    if h.min() <= 0:
+        raise InputError("gap must be positive everywhere [m]")
+    check_closed(h)
+    lubricant = viscosity if isinstance(viscosity, Lubricant) else None
+    mu0 = lubricant.viscosity if lubricant is not None else viscosity
+    if not mu0 > 0:
+        raise InputError(f"viscosity must be positive [Pa s], got {viscosity}")
+    if method not in ("fe", "fvm"):
+        raise InputError(f"method must be 'fe' or 'fvm', got {method!r}")
+    if couette not in SCHEMES:
+        raise InputError(f"couette must be one of {SCHEMES}, got {couette!r}")
+    dx = as_pair("spacing [m]", spacing)
+    if not all(np.isfinite(dx)) or min(dx) <= 0:
+        raise InputError(f"spacing must be positive and finite [m], got {dx}")
+    return h, dx, lubricant, mu0
+
+
 @arguments(speed="number")
 def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 0.0,
                    cavitation_pressure: float = 0.0, method: str = "fe", tol: float = 1e-10,
@@ -104,27 +132,11 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     couette : ``"central"`` (second order) or ``"upwind"`` (the paper's first order), the
         Couette flux of :mod:`fem_twin.macro.couette`
     """
-    h = as_field("gap [m]", gap, 3)
-    if h.min() <= 0:
-        raise InputError("gap must be positive everywhere [m]")
-    lubricant = viscosity if isinstance(viscosity, Lubricant) else None
-    mu0 = lubricant.viscosity if lubricant is not None else viscosity
-    if not mu0 > 0:
-        raise InputError(f"viscosity must be positive [Pa s], got {viscosity}")
+    h, dx, lubricant, mu0 = _inputs(gap, spacing, viscosity, method, couette)
     if ambient_pressure < cavitation_pressure:
         raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
-    if method not in ("fe", "fvm"):
-        raise InputError(f"method must be 'fe' or 'fvm', got {method!r}")
-    if couette not in SCHEMES:
-        raise InputError(f"couette must be one of {SCHEMES}, got {couette!r}")
-    dx = as_pair("spacing [m]", spacing)
-    if not all(np.isfinite(dx)) or min(dx) <= 0:
-        raise InputError(f"spacing must be positive and finite [m], got {dx}")
     boundary = h > OPEN_GAP
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
-    if boundary.all():
-        raise InputError(f"the gap is open everywhere inside the grid (above {OPEN_GAP:g} m, "
-                         "the oil bath): nothing carries load; give the gap in metres")
     scale = 12 * mu0 * max(abs(speed), 1e-30) / 2 * float(np.mean(dx)) / np.mean(h) ** 2
     model = cavitation_model(complementarity)
     assemble = fe_poiseuille if method == "fe" else fvm_poiseuille

@@ -1,35 +1,23 @@
 """A-posteriori estimates of the discretisation errors of flow factors (eqs 11-16).
 
-Time: the result over ``N_t`` instants is compared with the pass of ``N_t / 2`` instants,
-every other one.  With the exact squeeze term that is the same run's moments (no extra
-solve): the time average is the trapezoidal rule of a periodic function, whose error falls
-at least as fast as the roughness spectrum at the wavelength ``L_r1 / N_t``.  With the
-paper's backward difference the even instants are solved again with the difference over
-the doubled step (+50 % cell solves), since its error is the same at every instant and
-sampling alone would not see it.  ``|f_N - f_{N/2}|`` estimates the error of ``f_N`` when
-it falls at first order in ``1 / N_t`` and bounds it when faster.
+Time: the result over ``N_t`` instants against the pass of every other instant (the same
+run's moments with the exact squeeze term, the trapezoidal rule of a periodic function;
+the paper's backward difference solves the even instants again over the doubled step).
+``|f_N - f_{N/2}|`` estimates the error of ``f_N`` at first order and bounds it when faster.
 
-Grid: the same problem on the cell coarsened by two (every other pixel, exact for a
-periodic cell) at every separation, with half the instants (the same pixels per step),
-against the pass of as many instants of the run itself (about an eighth of the run's
-cost).  Coarsening a measured patch also drops its shortest wavelengths, and the flow factors then change at first order in the pixel size (measured on
-the bundled patches), so ``|f_h - f_{2h}|`` estimates the error of ``f_h``; where they
-converge at second order (a smooth or fully resolved surface) it is 3x the error.
+Grid: the cell coarsened by two (every other pixel) with half the instants, against the
+pass of as many instants of the run (about an eighth of its cost).  Coarsening a measured
+patch drops its shortest wavelengths and the factors change at first order in the pixel
+size, so ``|f_h - f_{2h}|`` estimates the error of ``f_h``.
 
-Each estimate is normwise per quantity: the largest difference over the separations
-relative to the largest magnitude over the range (``max |f - g| / max |f|``), so a factor
-that vanishes at one end of the range (``A`` at percolation, ``p_con`` out of contact,
-``d`` without roughness) is not judged by its relative error where it is negligible.
+Each estimate is normwise per quantity (``max |f - g| / max |f|`` over the separations),
+so a factor that vanishes at one end of the range is not judged where it is negligible.
 
-What the macro scale needs is the effect of these errors on the friction coefficient: the
-estimate also keeps, per kind, the factors with that error added (:func:`variants`), which
-the macro scale solves again (:mod:`fem_twin.macro.estimate`): ``"time"`` the factors over
-every other instant, ``"grid"`` the factors plus the difference to the coarsened cell,
-``"h0"`` the factors at every other computed separation (read by the interpolant between),
-``"film_thin"`` and ``"film_thick"`` the friction factor with half and twice the boundary
-film (the film friction's cut-off at contact edges, a model sensitivity rather than a
-discretisation error, estimate kind ``"film"``; it moves only the friction, so the macro
-scale re-evaluates the friction instead of solving again).
+For the macro scale (:mod:`fem_twin.macro.estimate`) the estimate keeps, per kind, the
+factors with that error added (:func:`variants`): ``"time"`` every other instant,
+``"grid"`` plus the coarsened cell's difference, ``"h0"`` every other separation, and
+``"film_thin"``/``"film_thick"`` the friction factor at half and twice the boundary film
+(kind ``"film"``, a model sensitivity; docs/accuracy.md).
 """
 
 from __future__ import annotations

@@ -50,21 +50,9 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
         is ``h0 + disk - pin + deformation``.
     h0 : rigid-body separations [m] (default: 100 values geometrically in [0.1, 1] um).
     settings : :class:`~fem_twin.micro.CellSettings`, everything of the cell problems the
-        result depends on (default: ``CellSettings()``); ``**shortcuts``, any of its fields
-        by keyword, replace its values: ``steps`` (N_t, paper 32; ``n_steps`` is its
-        historical keyword), ``e_reduced`` and
-        ``hardness`` [Pa] (Table 4), ``method`` (``"fe"`` or the paper's ``"fvm"``),
-        ``moving`` (``"both"``, the default: the disk at ``+U/2`` and the pin at ``-U/2``,
-        the mean-speed frame without eq 8's Couette term; ``"upper"``: the disk slides at
-        ``+U`` over the pin at rest, the paper's frame; ``"lower"``: the same seen from the
-        disk; :mod:`fem_twin.micro.sliding`), ``slide_to_roll`` (both surfaces moving, the pin at
-        ``u_m (1 - SRR/2)``: :mod:`fem_twin.micro.rolling`), ``time_derivative`` (``"exact"``: the squeeze term of
-        eq 8 at every instant, no time-step error, :func:`.sliding.sliding_squeeze`;
-        ``"backward"``: the paper's implicit Euler), ``first_step`` (``"backward"`` only),
-        ``gap_floor`` [m], ``contact_tol``, ``rate_tol``, ``time_tol`` (adaptive instants,
-        exact scheme: at each h0 the midpoints are added while A11, b1 or d1 change by more than
-        this relative tolerance from every other instant to all, up to one pixel per step;
-        ``meta["steps_used"]`` per h0; 0 or None: off, as in the case file).
+        result depends on (default: ``CellSettings()``), each field documented there
+        (frame, squeeze term, slide-to-roll ratio, boundary film, adaptive instants, ...);
+        ``**shortcuts``: any of its fields by keyword (``n_steps``: ``steps``).
     workers : processes for the h0 values (1: in this process); ``executor``: any
         ``concurrent.futures``-style executor instead (e.g. ``dask.distributed``'s), with
         ``workers`` the processes serving it.  The h0 values go out as ``4 workers`` tasks
@@ -81,9 +69,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
         interpolant in log h0 misses the factors at the skipped candidates by less than
         this relative tolerance (its bound: ``meta["error_estimate"]["h0"]``).  0 or None
         (off, as in the case file): every ``h0``.
-    friction : the friction law the factors serve (``[macro] friction``): with ``"paper"``
-        the adaptive separations watch eq 31's factors alone, as before the friction
-        factors s_C and C_F existed, which the factors still carry.
+    friction : ``[macro] friction``: with ``"paper"`` the adaptive separations watch eq 31's
+        factors alone (the paper's sample), not the friction factor s_C.
     """
     settings = _settings(settings, shortcuts)
     h0_tol = h0_tol or None                                  # 0 means off, as in the case

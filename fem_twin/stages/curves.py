@@ -188,9 +188,8 @@ def _summary(case: Case, out: RunLayout, curves, band) -> dict:
 def _range_check(common: dict, tasks) -> dict:
     """:func:`~fem_twin.stribeck.accuracy.range_summary` over the points of the sweeps
     ``tasks`` (the main curves' and the band's, whose single patches reach lower
-    separations), each share read from its checkpoint's meta (``LOAD_BELOW``: the 252
-    points of the bundled case took 1.3 s to load whole; a checkpoint of before
-    2026-11-27 is)."""
+    separations), each share read from its checkpoint's meta (``LOAD_BELOW``; a checkpoint
+    without it is loaded whole)."""
     h0_min = common["factors"].h0[0]
 
     def shares():

@@ -103,9 +103,9 @@ def _patch_geometry(case: Case, out: RunLayout, i: int) -> tuple[dict, list[str]
 
 
 #: pins on finer grids are levelled on every k-th pixel, at most this many a side, and
-#: tilted by the result (:func:`levelled_pin`): the tilt of sample pin 1 moved by 1.4e-7
-#: and 5e-8 rad from 500 to 999 px (under 1 nm over the face), where levelling took 40 s
-#: against 3.6 s (1997 px: about 7 min a pin; 2026-11-27)
+#: tilted by the result (:func:`levelled_pin`): the tilt of sample pin 1 moves by under
+#: 1 nm over the face from 500 to 999 px, where levelling every pixel takes about 11x the time
+#: (docs/model.md, "Levelling fine grids on the measured points")
 LEVELLING_GRID = 512
 
 
@@ -136,9 +136,8 @@ def prepare_pins(runs, progress: bool = True, executor=None) -> None:
     """The pins of several runs ``[(case, out)]`` (the variants of a calibration study)
     prepared (:func:`reconstruct_geometry`, pins only) and levelled (:func:`level_pins`),
     each step one set of jobs over all runs on the workers of ``executor``, the finest
-    grids first: prepared one run at a time, a run's third pin kept one of two workers
-    idle (the resolution study's sweeps began after 114 s, now after 75 s, the variants'
-    pins beside the micro stage; 2026-11-27)."""
+    grids first, so that no run's last pin keeps a worker idle (the variants' pins run
+    beside the micro stage)."""
     runs = sorted((r for r in runs if not r[0].tribometer.ball),
                   key=lambda r: -np.prod(r[0].macro_geometry.resolution or (0, 0)))
     for case, out in runs:

@@ -13,10 +13,9 @@ from ..stribeck.curve import joined
 from ..stribeck.sweep import point_files, point_key, sweep_key
 from ..threads import worker_heap
 
-#: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH: the resolution
-#: study (2026-11-27, two points at a time) 9.5 s a point at 500^2, 7.4 min at 1997^2
-#: (N^1.39); the largest-first schedule then starts the 1997^2 points before the 500^2
-#: sweep (by nodes alone it did not, and the study's sweeps took about 2 min longer)
+#: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH (the resolution
+#: study's points grow as N^1.39 from 500^2 to 1997^2, benchmarks/README.md), so that the
+#: largest-first schedule starts the finest grids' points first
 COST_GROWTH = 1.35
 
 
@@ -55,9 +54,8 @@ def chains(tasks, workers: int) -> list:
     share of the total over ``workers`` is cut into chains of about equal length, each
     costing at most half such a share (one point at least), so that a largest-first
     schedule keeps every worker busy to the end.  A chain's first point starts cold (from
-    the coarsest nested level): on the resolution study's 999^2 grid, five such points took
-    419 s against 438 s for the warm sweep of the same five speeds beside them (2026-11-27,
-    C_f the same to 2e-6).  A sweep that writes fields stays whole (one VTU per speed,
+    the coarsest nested level), about as fast as a warm one on fine grids and with the same
+    C_f to 2e-6 (benchmarks/README.md).  A sweep that writes fields stays whole (one VTU per speed,
     numbered along the sweep, and one PVD)."""
     share = sum(map(_cost, (kw for kw, _ in tasks))) / max(workers, 1)
     out = []
