@@ -48,8 +48,12 @@ class Tribometer:
     load: float = setting(T.LOAD, "imposed normal load F_N,imp (Table 6)", "load")
     pin_diameter: float = setting(8e-3, "pin diameter D of the Hersey number (eq 46)",
                                   "pin_diameter")
-    sliding_radius: float = setting(30e-3, "radius of the sliding track (recorded; speeds "
-                                    "are given in m/s)", "length")
+    sliding_radius: float = setting(30e-3, "radius of the pin's track on the disk (its "
+                                    "centre's; the sweep's speeds are the sliding speeds there)",
+                                    "length")
+    kinematics: str = setting("rotating", "the disk's motion under the face: turning about "
+                              "its axis (u = omega x r over the face), or sliding uniformly "
+                              "along x1 (the paper)", choices=("rotating", "uniform"))
     boundary_friction: float = setting(
         T.BOUNDARY_FRICTION, "C_f,b of eq 32 (the paper's 1/(3 sqrt 3)); also the scale of "
         "C_f,dev (eq 35)", "friction")
@@ -61,11 +65,19 @@ class Tribometer:
     ball_radius: float = setting(12.5e-3, "radius of a ball-on-disk's ball", "length")
     slide_to_roll: float = setting(0.5, "slide-to-roll ratio u_r / u_m of a ball, in [0, 2] "
                                    "(0: pure rolling; 2: a stationary ball)", "slide_to_roll")
-    track_radius: float = setting(20e-3, "radius of a ball's track (recorded)", "length")
+    track_radius: float = setting(20e-3, "radius of a ball's track on the disk (its "
+                                  "contact's centre's)", "length")
 
     @property
     def ball(self) -> bool:
         return self.kind == "ball-on-disk"
+
+    @property
+    def disk_radius(self) -> float | None:
+        """The track radius of the macro grid's centre [m]; None: uniform sliding."""
+        if self.kinematics == "uniform":
+            return None
+        return self.track_radius if self.ball else self.sliding_radius
 
 
 @dataclass(frozen=True)

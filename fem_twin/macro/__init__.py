@@ -2,10 +2,12 @@
 contact pressure and load balance (eqs 17-34)."""
 
 from .friction import BOUNDARY_FRICTION, boundary_shear, hydrodynamic_shear
+from .kinematics import disk_velocity
 from .lubricant import Lubricant
 from .mixed import MacroSettings, MixedNotConverged, MixedResult, solve_mixed
 from .reynolds import ReynoldsNotConverged, ReynoldsResult, solve_reynolds
 
-__all__ = ["BOUNDARY_FRICTION", "boundary_shear", "hydrodynamic_shear", "Lubricant",
+__all__ = ["BOUNDARY_FRICTION", "boundary_shear", "hydrodynamic_shear", "disk_velocity",
+           "Lubricant",
            "MacroSettings", "MixedNotConverged", "MixedResult", "solve_mixed",
            "ReynoldsNotConverged", "ReynoldsResult", "solve_reynolds"]

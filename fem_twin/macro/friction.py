@@ -15,6 +15,7 @@ import numpy as np
 
 from ..checks import arguments
 from .. import tables as T
+from .kinematics import rotate_tensor, rotations
 
 #: Boundary friction coefficient C_f,b of eq 32 (Bowden and Tabor, pure shearing).
 BOUNDARY_FRICTION = T.BOUNDARY_FRICTION
@@ -25,9 +26,11 @@ LAWS = ("pin", "paper")
 @arguments(pressure="field", mean_gap="field", spacing="pair", speed="number")
 def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing,
                        speed, *, entrainment=None, eyring_stress=None, law: str = "pin",
-                       ambient_pressure: float = 0.0, face=None) -> np.ndarray:
+                       ambient_pressure: float = 0.0, face=None,
+                       velocity=None) -> np.ndarray:
     """The film's tangential traction on the pin along +x1 [Pa], the disk sliding at
-    ``speed`` u_r along +x1 (``entrainment`` u_m, default u_r / 2: the pin at rest).
+    ``speed`` u_r along +x1 (``entrainment`` u_m, default u_r / 2: the pin at rest), or
+    at ``speed`` times ``velocity`` (ny, nx, 2), a rotating disk's (:mod:`.kinematics`).
 
     ``"pin"``: ``(mu u_r / h_m) s_C (1 - theta) - (h_m/2) (2 e1 - b) . grad p
     - (p - p_amb) dh_m/dx1``, the last term the film pressure on the slope of the pin's
@@ -36,21 +39,29 @@ def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, sp
     with ``d`` at the slide-to-roll ratio.  ``shear``: the
     :class:`~fem_twin.micro.LocalFactors` at the point's h0; gradients by central
     differences; ``eyring_stress`` tau_0 [Pa]: the Couette part becomes
-    ``tau_0 asinh(tau / tau_0)`` (Eyring).
+    ``tau_0 asinh(tau / tau_0)`` (Eyring) along the sliding.  On a rotating disk the
+    cell-frame factors turn with the sliding (``C``, ``d``; ``2 e1 - b`` completed
+    isotropically commutes with the turn) and the traction is its x1 component.
     """
     p = np.asarray(pressure, float)
     dp2, dp1 = np.gradient(p, spacing[1], spacing[0])
+    c, s, v = (1.0, 0.0, 1.0) if velocity is None else rotations(velocity)
+    across = 0.0
     if law == "paper":
         u_m = speed / 2 if entrainment is None else entrainment
-        poiseuille = -mean_gap / 2 * (shear.C[..., 0, 0] * dp1 + shear.C[..., 0, 1] * dp2)
-        couette = viscosity / mean_gap * (-6 * u_m * shear.d[..., 0] + speed)
+        C = shear.C if velocity is None else rotate_tensor(shear.C, c, s)
+        poiseuille = -mean_gap / 2 * (C[..., 0, 0] * dp1 + C[..., 0, 1] * dp2)
+        couette = viscosity / mean_gap * (-6 * u_m * shear.d[..., 0] + speed) * v
+        if velocity is not None:
+            across = viscosity / mean_gap * (-6 * u_m * shear.d[..., 1]) * v * s
     else:
         f = shear.pressure_friction
         poiseuille = -mean_gap / 2 * (f[..., 0] * dp1 + f[..., 1] * dp2)
-        couette = viscosity / mean_gap * (speed * shear.friction_factor)
+        couette = viscosity / mean_gap * (speed * shear.friction_factor) * v
     couette = couette * (1 - cavity_fraction)
     if eyring_stress is not None:
         couette = eyring_stress * np.arcsinh(couette / eyring_stress)
+    couette = couette * c - across * (1 - cavity_fraction)
     if law == "paper":
         return poiseuille + couette
     return poiseuille + couette - (p - ambient_pressure) * face_slope(mean_gap, face, spacing[0])

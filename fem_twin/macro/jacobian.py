@@ -24,6 +24,7 @@ from ..ordering import subgrid_order
 from .cavitation import cavitation_model
 from .contact_load import contact_load
 from .evaluation import NewtonEvaluation
+from .kinematics import rotate_tensor, rotate_vector, rotations
 from .problem import MAX_COEFFICIENT_PRESSURE, Problem
 
 
@@ -76,6 +77,9 @@ def jacobian(P: Problem, ev: NewtonEvaluation) -> dict:
     dlnrho = lub.density_log_slope(p_coef) * unclipped
     dlnmu = lub.viscosity_log_slope(p_coef) * unclipped
     d = P.factors.slopes(ev.h0)
+    if P.velocity is not None:                          # into the grid frame, as loc's
+        c, s, _ = rotations(P.velocity)
+        d["A"], d["b"] = rotate_tensor(d["A"], c, s), rotate_vector(d["b"], c, s)
     free = ~ev.touching
     g, q, loc, p = ev.g, ev.q, ev.loc, ev.p.ravel()
     Kg = _probe(P, lambda c: (c, loc.A), p)

@@ -37,6 +37,7 @@ from ..micro.rolling import at_slide_to_roll
 from ..threads import one_thread
 from . import newton
 from .fixed_point import Concentrated, solve_fixed_point
+from .kinematics import disk_velocity
 from .lubricant import Lubricant
 from .problem import macro_problem
 from .reynolds import check_closed
@@ -121,7 +122,8 @@ def seeded_point(gap, spacing, factors: FlowFactors, *, load: float, speed: floa
                                          lubricant, face, settings)
     if initial is not None:
         initial = on_grid(initial, h_g.shape, dx)
-    P = macro_problem(h_g, dx, factors, lubricant, settings, speed, u_m)
+    velocity = disk_velocity(face, dx, settings.track_radius)
+    P = macro_problem(h_g, dx, factors, lubricant, settings, speed, u_m, velocity)
     if settings.coupling == "newton" or (settings.coupling == "auto" and initial is not None
                                          and initial.meta.get("coupling") == "newton"):
         return _solve_newton(P, load, face, initial, progress, t0), None

@@ -16,6 +16,7 @@ import scipy.fft as fft
 
 from ..contact.elastic import elastic_operator
 from .contact_load import nodal_contact_pressure
+from .kinematics import in_grid_frame
 from .reynolds import OPEN_GAP, fe_poiseuille, trapezoid_weights
 from .reynolds_fv import fvm_poiseuille
 
@@ -43,6 +44,7 @@ class Problem:
     interior: np.ndarray       # flat indices of the interior nodes
     speed: float               # sliding speed u_r [m/s]
     entrainment: float         # mean (entrainment) speed u_m [m/s]
+    velocity: np.ndarray | None = None  # the disk's velocity / u_r (ny, nx, 2); None: e1
 
     @property
     def shape(self):
@@ -60,9 +62,12 @@ class Problem:
         separation ``h0`` [m]: ``(loc, mu, rho, g, q)`` with ``loc`` the flow factors at
         ``h0`` (its ``p_con`` by ``settings.contact_quadrature``, :mod:`.contact_load`; without
         the shear factors, which :func:`.result.mixed_result` evaluates once),
-        ``g = rho h_m^3 / (12 mu)`` [m^3/(Pa s)] and ``q = rho h_m u_m`` [m^2/s]."""
+        ``g = rho h_m^3 / (12 mu)`` [m^3/(Pa s)] and ``q = rho h_m u_m`` [m^2/s], with
+        ``loc``'s tensors in the grid frame and ``u_m`` the local speed on a rotating
+        disk (:mod:`.kinematics`)."""
         rule = self.settings.contact_quadrature
-        loc = self.factors.at(h0, friction=False, contact=rule == "nodal")
+        loc = in_grid_frame(self.factors.at(h0, friction=False, contact=rule == "nodal"),
+                            self.velocity)
         if rule != "nodal":
             loc = replace(loc, p_con=nodal_contact_pressure(self.factors, h0, rule))
         p_coef = np.minimum(p, MAX_COEFFICIENT_PRESSURE)
@@ -70,6 +75,8 @@ class Problem:
         rho = self.lubricant.density_ratio(p_coef)
         g = rho * loc.h_m ** 3 / (12 * mu)
         q = rho * loc.h_m * self.entrainment
+        if self.velocity is not None:
+            q = q * np.hypot(self.velocity[..., 0], self.velocity[..., 1])
         return loc, mu, rho, g, q
 
     def kernel(self):
@@ -89,12 +96,12 @@ class Problem:
 
 
 def macro_problem(gap, spacing, factors, lubricant, settings, speed: float,
-                  entrainment: float) -> Problem:
+                  entrainment: float, velocity=None) -> Problem:
     """The :class:`Problem` of a validated gap (ny, nx) [m] and spacing (dx1, dx2) [m]:
     Dirichlet nodes (ambient pressure) on the grid's edge and wherever the rigid gap opens
     beyond ``OPEN_GAP`` (around the pin face: the oil bath over the holder), the
     non-periodic FFT half-space of eqs 20-22 and the Poiseuille operator of
-    ``settings.method``."""
+    ``settings.method``; ``velocity``: the disk's (:func:`.kinematics.disk_velocity`)."""
     gap = np.asarray(gap, float)
     dx = tuple(float(v) for v in spacing)
     boundary = gap > OPEN_GAP
@@ -103,7 +110,7 @@ def macro_problem(gap, spacing, factors, lubricant, settings, speed: float,
                    partial(_poiseuille, POISEUILLE[settings.method], dx),
                    elastic_operator(gap.shape, dx, settings.e_reduced),
                    trapezoid_weights(gap.shape, dx), np.flatnonzero(~boundary.ravel()),
-                   float(speed), float(entrainment))
+                   float(speed), float(entrainment), velocity)
 
 
 def _poiseuille(assemble, dx, g, A):

@@ -11,6 +11,7 @@ import numpy as np
 from ..io.atomic import atomic_path
 from ..micro.rolling import at_slide_to_roll
 from .friction import boundary_shear, hydrodynamic_shear
+from .kinematics import disk_velocity, rotations
 
 #: the grid fields of an operating point and their SI units: declared once, for the
 #: checkpoints, VTU files and ``fields.nc`` (:func:`fem_twin.results.fields_dataset`)
@@ -114,7 +115,8 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
     loc = ev.loc
     p_hd = ev.p + s.cavitation_pressure
     tau_hd, tau_con = pin_friction(p_hd, ev.theta, ev.mu, ev.h0, loc.h_m, ev.p_con, dx,
-                                   P.factors, s, lubricant, speed, P.entrainment, face)
+                                   P.factors, s, lubricant, speed, P.entrainment, face,
+                                   P.velocity)
     cell = dx[0] * dx[1]
     F_hd = float(tau_hd[face].sum() * cell)
     F_con = float(tau_con[face].sum() * cell)
@@ -136,16 +138,20 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
 
 
 def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubricant, speed,
-                 entrainment, face=None):
-    """The film's and the contacts' tangential tractions on the pin [Pa] (eqs 31-32, or the
-    force on the pin: ``settings.friction``, :func:`.friction.hydrodynamic_shear`) of a
-    converged state, with ``factors`` at its slide-to-roll ratio, on the pin ``face``."""
+                 entrainment, face=None, velocity=None):
+    """The film's and the contacts' tangential tractions on the pin along x1 [Pa] (eqs
+    31-32, or the force on the pin: ``settings.friction``,
+    :func:`.friction.hydrodynamic_shear`) of a converged state, with ``factors`` at its
+    slide-to-roll ratio, on the pin ``face``, the disk moving at ``velocity``
+    (:func:`.kinematics.disk_velocity`; None: along x1)."""
     shear = factors.at(h0)              # the shear factors (the iterations read none)
     tau_hd = hydrodynamic_shear(p_hd, h_m, theta, mu, shear, dx, speed,
                                 entrainment=entrainment, eyring_stress=lubricant.eyring_stress,
                                 law=settings.friction, face=face,
-                                ambient_pressure=settings.ambient_pressure)
+                                ambient_pressure=settings.ambient_pressure, velocity=velocity)
     tau_con = boundary_shear(p_con, settings.boundary_friction) * (speed > 0)  # 0: no sliding
+    if velocity is not None:
+        tau_con = tau_con * rotations(velocity)[0]          # along the sliding, x1 part
     return tau_hd, tau_con
 
 
@@ -159,7 +165,9 @@ def friction_with(result: MixedResult, factors, settings, lubricant) -> float:
     tau_hd, tau_con = pin_friction(result.pressure, result.cavity_fraction, result.viscosity,
                                    result.h0, result.mean_gap, result.contact_pressure,
                                    result.spacing, moved, settings, lubricant, result.speed,
-                                   result.meta.get("entrainment"), result.face)
+                                   result.meta.get("entrainment"), result.face,
+                                   disk_velocity(result.face, result.spacing,
+                                                 settings.track_radius))
     cell = result.spacing[0] * result.spacing[1]
     return float((tau_hd + tau_con)[result.face].sum() * cell / result.normal_load)
 

@@ -113,7 +113,7 @@ def _inputs(gap, spacing, viscosity, method, couette):
 def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 0.0,
                    cavitation_pressure: float = 0.0, method: str = "fe", tol: float = 1e-10,
                    max_iter: int = 200, complementarity: str = "switch",
-                   couette: str = "central") -> ReynoldsResult:
+                   couette: str = "central", velocity=None) -> ReynoldsResult:
     """Smooth rigid-gap Reynolds with JFO cavitation, one surface sliding at ``speed``.
 
     Parameters
@@ -131,8 +131,15 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
         Fischer-Burmeister-Newton-Schur, :mod:`fem_twin.fvm.fbns`; slower, same solution)
     couette : ``"central"`` (second order) or ``"upwind"`` (the paper's first order), the
         Couette flux of :mod:`fem_twin.macro.couette`
+    velocity : (ny, nx, 2) the sliding surface's velocity over ``speed`` [-] (a rotating
+        disk's, :func:`~fem_twin.macro.kinematics.disk_velocity`); None: +x1
     """
     h, dx, lubricant, mu0 = _inputs(gap, spacing, viscosity, method, couette)
+    if velocity is not None:
+        velocity = np.asarray(velocity, float)
+        if velocity.shape != h.shape + (2,) or not np.all(np.isfinite(velocity)):
+            raise InputError(f"velocity must be finite, shaped like the gap plus (2,): "
+                             f"{h.shape + (2,)}, got {velocity.shape}")
     if ambient_pressure < cavitation_pressure:
         raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
     boundary = h > OPEN_GAP
@@ -144,7 +151,9 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     for _ in range(max_iter if lubricant is not None else 1):
         g = rho * h ** 3 / (12 * mu)
         q1 = rho * h * speed / 2
-        B = couette_matrix(q1, np.zeros_like(q1), dx, couette)
+        q2 = np.zeros_like(q1) if velocity is None else q1 * velocity[..., 1]
+        q1 = q1 if velocity is None else q1 * velocity[..., 0]
+        B = couette_matrix(q1, q2, dx, couette)
         phi, its, history = model.solve(assemble(g, dx), B, boundary,
                                         ambient_pressure - cavitation_pressure, scale,
                                         phi0=phi, tol=tol, max_iter=max_iter)

@@ -27,6 +27,10 @@ class MacroSettings:
     e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", unit="Pa", section="materials")
     boundary_friction: float = setting(BOUNDARY_FRICTION, "C_f,b of eq 32", unit="-",
                                        section="tribometer")
+    track_radius: float | None = setting(
+        None, "the disk's axis at this distance from the face's centre: the disk's velocity "
+        "field over the face (fem_twin.macro.kinematics); none: uniform sliding along x1",
+        "length", section="tribometer")
     friction: str = setting("pin", "friction law: the force on the pin (wall shear and "
                             "the film pressure on the asperity flanks and the face's slope), "
                             "or the paper's eq 31 (the pin's wall shear)", choices=LAWS)

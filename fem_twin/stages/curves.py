@@ -41,6 +41,7 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
     own = {f.name: getattr(case.macro, f.name) for f in fields(MacroSettings)}
     settings = MacroSettings(**{**own, "e_reduced": case.materials.e_reduced,
                                 "boundary_friction": case.tribometer.boundary_friction,
+                                "track_radius": case.tribometer.disk_radius,
                                 **({"method": method} if method else {})})
     if case.tribometer.ball:
         settings = replace(settings, cavitation_pressure=settings.ambient_pressure)
