@@ -182,3 +182,24 @@ def test_a_far_axis_is_uniform_sliding(factors):
           for R in (None, 0.3, 3.0)]
     assert 5 < (cf[1] - cf[0]) / (cf[2] - cf[0]) < 20
     assert abs(cf[2] / cf[0] - 1) < 1e-3
+
+
+def test_the_case_turns_the_disk_at_its_track_radius(tmp_path):
+    """``[tribometer] kinematics``: the pin turns at ``sliding_radius`` (default), a ball at
+    ``track_radius``; ``"uniform"`` is the paper's sliding; anything else is refused."""
+    from fem_twin.case import CaseError, load_case
+    from fem_twin.stages.curves import macro_settings
+    root = Path(__file__).resolve().parents[1] / "examples"
+    assert macro_settings(load_case(root / "pin_on_disk.toml")).track_radius == 30e-3
+    assert macro_settings(load_case(root / "ball_on_disk.toml")).track_radius == 20e-3
+    text = (root / "pin_on_disk.toml").read_text().replace("../meshes/", str(root.parent / "meshes") + "/")
+    for value, expect in (('"uniform"', None), ('"spinning"', "kinematics")):
+        (tmp_path / "case.toml").write_text(text.replace('kinematics = "rotating"', f"kinematics = {value}"))
+        if expect is None:
+            assert macro_settings(load_case(tmp_path / "case.toml")).track_radius is None
+        else:
+            with pytest.raises(CaseError, match=expect):
+                load_case(tmp_path / "case.toml")
+    (tmp_path / "radius.toml").write_text(text.replace("[macro]", "[macro]\ntrack_radius = 0.03", 1))
+    with pytest.raises(CaseError, match="set by"):
+        load_case(tmp_path / "radius.toml")
