@@ -639,11 +639,13 @@ def test_a_point_that_does_not_converge_in_a_worker_reports_its_history(tmp_path
 
 def test_boundary_friction_is_set_from_the_case(tmp_path):
     """Issue 18 item 3: C_f,b of eq 32 from [tribometer] boundary_friction: the boundary
-    friction force is C_f,b times the load carried by p_con (eqs 32-33), at every speed."""
+    friction force is C_f,b times the load carried by p_con (eqs 32-33), at every speed, on
+    the paper's uniformly sliding disk (turning, it is the x1 part: test_kinematics)."""
     text = small_case(tmp_path).read_text()
     assert "boundary_friction = 0.1924500897" in text
     (tmp_path / "cfb.toml").write_text(text.replace("boundary_friction = 0.1924500897",
-                                                    "boundary_friction = 0.12"))
+                                                    "boundary_friction = 0.12").replace(
+        'kinematics = "rotating"', 'kinematics = "uniform"'))
     out = tmp_path / "o"
     assert main(["run", str(tmp_path / "cfb.toml"), "-o", str(out), "--no-progress"]) == 0
     rows = list(csv.DictReader(open(out / "stribeck.csv")))

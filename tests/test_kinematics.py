@@ -16,7 +16,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from fem_twin.macro import Lubricant, MacroSettings, solve_mixed, solve_reynolds
+from fem_twin.macro import BOUNDARY_FRICTION, Lubricant, MacroSettings, solve_mixed, solve_reynolds
 from fem_twin.macro.couette import couette_matrix
 from fem_twin.macro.friction import face_slope
 from fem_twin.macro.kinematics import disk_velocity, in_grid_frame, rotations
@@ -182,6 +182,20 @@ def test_a_far_axis_is_uniform_sliding(factors):
           for R in (None, 0.3, 3.0)]
     assert 5 < (cf[1] - cf[0]) / (cf[2] - cf[0]) < 20
     assert abs(cf[2] / cf[0] - 1) < 1e-3
+
+
+def test_the_boundary_shear_acts_along_the_local_sliding(factors):
+    """On the turning disk the contacts' shear C_f,b p_con acts along the local sliding, and
+    the load cell reads its x1 part: C_f,b times p_con cos(phi) over the face, less than
+    C_f,b times the contact load by at most 1 - cos 7.6 degrees (0.9 %)."""
+    gap, dx, face = macro_case(32)
+    res = solve_mixed(gap, dx, factors, load=150.0, speed=0.01, face=face,
+                      lubricant=Lubricant(0.066), settings=MacroSettings(track_radius=30e-3))
+    c = rotations(disk_velocity(face, dx, 30e-3))[0]
+    along = BOUNDARY_FRICTION * (res.contact_pressure * c)[face].sum() * dx[0] * dx[1]
+    whole = BOUNDARY_FRICTION * res.contact_pressure[face].sum() * dx[0] * dx[1]
+    assert res.boundary_friction == pytest.approx(along, rel=1e-12)
+    assert 0.991 * whole < along < whole
 
 
 def test_the_case_turns_the_disk_at_its_track_radius(tmp_path):
