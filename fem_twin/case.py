@@ -11,6 +11,7 @@ from pathlib import Path
 from .checks import QUANTITIES, memory_shortfall
 from .cost import estimated_seconds
 from .errors import InputError
+from .macro.thermal import ThermalSettings
 from .sections import (SECTIONS, Geometry, LubricantSpec, MacroSpec, Materials, MicroSpec,
                        RunSpec, SweepSpec, Tribometer)
 from .topography.prepare import MacroOptions
@@ -37,6 +38,7 @@ class Case:
     materials: Materials = field(default_factory=Materials)
     micro: MicroSpec = field(default_factory=MicroSpec)
     macro: MacroSpec = field(default_factory=MacroSpec)
+    thermal: ThermalSettings = field(default_factory=ThermalSettings)
     sweep: SweepSpec = field(default_factory=SweepSpec)
     run: RunSpec = field(default_factory=RunSpec)
     measured: tuple[Path | None, ...] = ()   # [validation] measured curves per viscosity
@@ -87,6 +89,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     micro = _micro(data, where)
     macro = _macro(data, where, tribometer, geometry)
     sweep = _sweep(data, where)
+    thermal = _thermal(data, where, lubricant)
     run = _section(data, "run", RunSpec, where)
     if run.workers < 0:
         raise CaseError(f"{where} [run] workers: a number of processes >= 0 (0: all cores), "
@@ -111,7 +114,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     return Case(name=str(data.get("name", source.stem if source else "case")),
                 geometry=geometry, macro_geometry=macro_geometry, tribometer=tribometer,
                 lubricant=lubricant, materials=materials, micro=micro, macro=macro,
-                sweep=sweep, run=run, measured=measured, source=source, defaulted=defaulted)
+                thermal=thermal, sweep=sweep, run=run, measured=measured, source=source, defaulted=defaulted)
 
 
 #: the keys a pin case has no use for, with what sets them (refused, not ignored)
@@ -235,6 +238,16 @@ def _macro(data, where, tribometer, geometry) -> MacroSpec:
                                        and 1 <= macro.pin <= len(geometry.pins)):
         raise CaseError(f"{where} [macro] pin: 'average' or a pin number 1..{len(geometry.pins)}")
     return macro
+
+
+def _thermal(data, where, lubricant) -> ThermalSettings:
+    """[thermal]: the flash model needs the oil's viscosity at two temperatures."""
+    thermal = _section(data, "thermal", ThermalSettings, where)
+    if thermal.model != "none" and len(set(lubricant.temperatures)) < 2:
+        raise CaseError(f"{where} [thermal] model = \"{thermal.model}\": the film's viscosity "
+                        "at its temperature needs [lubricant] viscosities at two temperatures "
+                        "(the Walther law); give them, or set [thermal] model = \"none\"")
+    return thermal
 
 
 def _sweep(data, where) -> SweepSpec:

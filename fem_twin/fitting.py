@@ -18,7 +18,7 @@ from .io.layout import RunLayout
 from .io.table import write_csv
 from .macro.viscosity import WaltherLaw
 from .micro import FlowFactors
-from .stages.curves import macro_settings
+from .stages.curves import contact_thermal, macro_settings
 from .stages.sweeps import run_sweeps
 from .stages.geometry import hersey_length, macro_geometry
 from .stages.provenance import stage_keys
@@ -109,6 +109,7 @@ def share_curves(case: Case, out: RunLayout, curve, progress: bool = True,
     common = dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
                   speeds=np.sort(curve.speed)[::-1], diameter=hersey_length(case), face=face,
                   settings=macro_settings(case), checkpoint=out.fit_points,
+                  thermal=contact_thermal(case),
                   factors_key=stage_keys(case)["micro"])
     lub = case.lubricant.lubricants()[0]
     todo = sorted(s for s in shares if not np.isclose(s, tr.load_share, rtol=1e-9))

@@ -12,6 +12,7 @@ from pathlib import Path
 from . import tables as T
 from .checks import setting
 from .macro.settings import MacroSettings
+from .macro.thermal import ThermalSettings
 from .micro.sliding import CellSettings
 from .topography.prepare import MacroOptions
 
@@ -212,4 +213,5 @@ class RunSpec:
 #: (``[validation]`` has one key, ``measured``; ``name`` is top-level)
 SECTIONS = {"geometry": Geometry, "preprocessing": MacroOptions, "tribometer": Tribometer,
             "lubricant": LubricantSpec, "materials": Materials, "micro": MicroSpec,
-            "macro": MacroSpec, "sweep": SweepSpec, "run": RunSpec}
+            "macro": MacroSpec, "thermal": ThermalSettings, "sweep": SweepSpec,
+            "run": RunSpec}

@@ -141,6 +141,11 @@ class RunLayout:
         """The Stribeck plot against ``x`` (``"speed"`` or ``"hersey"``)."""
         return self.root / f"stribeck_{x}.png"
 
+    @property
+    def temperature_png(self) -> Path:
+        """A thermal run's contact temperatures against speed."""
+        return self.root / "contact_temperature.png"
+
     def fields_png(self, viscosity: float) -> Path:
         return self.root / f"fields_mu{viscosity:g}.png"
 

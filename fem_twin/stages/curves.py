@@ -18,8 +18,11 @@ from ..macro import MacroSettings, MixedResult
 from ..macro.nested import coarsened
 from ..macro.figures import plot_point_files
 from ..macro.point_contact import film_against_hamrock_dowson
+from ..macro.thermal import ContactThermal
+from ..macro.viscosity import WaltherLaw
 from ..micro import FlowFactors
 from ..stribeck import plot_stribeck, read_measured_csv, write_stribeck_csv
+from ..stribeck.curve import plot_temperatures
 from ..stribeck.accuracy import error_summary, range_summary
 from ..stribeck.analysis import (defect_corrected, hersey_collapse, patch_band,
                                  transition_speeds)
@@ -48,6 +51,17 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
     return settings
 
 
+def contact_thermal(case: Case) -> ContactThermal | None:
+    """The run's thermal model (``[thermal]``, the Walther law of ``[lubricant]``, C_f,b),
+    or None for the isothermal twin (``model = "none"``)."""
+    if case.thermal.model == "none":
+        return None
+    lb = case.lubricant
+    return ContactThermal(case.thermal, WaltherLaw.through(lb.temperatures, lb.viscosities,
+                                                           lb.density),
+                          case.tribometer.boundary_friction)
+
+
 def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = True,
                     writers: Writers | None = None) -> dict:
     """One Stribeck sweep per viscosity (in parallel on ``executor``), refined where the
@@ -64,6 +78,7 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     common = dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
                   speeds=case.sweep.speeds, load=face_load(case), diameter=hersey_length(case),
                   face=face, **ball, settings=macro_settings(case), checkpoint=out.points,
+                  thermal=contact_thermal(case),
                   fields=out.fields, origin=origin, factors_key=stage_keys(case)["micro"])
     curves, speeds = refined_curves(case, common, executor, progress)
     tasks = [(dict(common, speeds=speeds, error_estimate=True), lub)
@@ -179,6 +194,11 @@ def _summary(case: Case, out: RunLayout, curves, band) -> dict:
         "files": [p.name for p in (out.stribeck_csv, out.stribeck_png("speed"),
                                    out.stribeck_png("hersey"), out.results, out.fields_nc,
                                    out.fields, *(out.fields_png(c.viscosity) for c in curves))]}
+    if curves[0].contact_temperature is not None:
+        summary["files"].append(out.temperature_png.name)
+        for entry, c in zip(summary["curves"], curves):
+            entry["contact_temperature_C_range"] = [float(np.min(c.contact_temperature)),
+                                                    float(np.max(c.contact_temperature))]
     if band is not None:
         summary["patch_band_max_width"] = float(max(np.max(hi - lo) for lo, hi in band))
     summary["cf_error"] = error_summary(curves, case.tribometer.boundary_friction,
@@ -271,6 +291,9 @@ def plot_curves(case: Case, curves, band, out: RunLayout,
                      load=tr.load, speed_label=("entrainment speed $u_m$ [m/s], SRR "
                                                 f"{tr.slide_to_roll:g}" if tr.ball else
                                                 "sliding speed $U$ [m/s]"))
+    if curves[0].contact_temperature is not None:
+        writers.write(plot_temperatures, curves, out.temperature_png,
+                      labels=curve_labels(case, curves))
 
 
 def sweep_points(folder: Path, tasks) -> dict:

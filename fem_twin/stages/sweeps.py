@@ -84,4 +84,4 @@ def task_key(kwargs: dict, lubricant) -> str:
     """Checkpoint key of one sweep task (:func:`~fem_twin.stribeck.sweep.point_file`)."""
     return sweep_key(kwargs["gap"], kwargs["spacing"], kwargs["factors_key"], kwargs["load"],
                      lubricant, kwargs["settings"], kwargs["face"],
-                     kwargs.get("slide_to_roll"))
+                     kwargs.get("slide_to_roll"), kwargs.get("thermal"))

@@ -20,6 +20,12 @@ COLUMNS = ("speed", "hersey", "friction_coefficient", "viscosity", "hydrodynamic
 HEADERS = dict(zip(COLUMNS, ("speed_m_s", "hersey", "friction_coefficient", "viscosity_Pa_s",
                              "hydrodynamic_friction_N", "boundary_friction_N",
                              "contact_load_fraction", "h_d_m", "iterations")))
+#: a thermal run's temperatures per point [C] (:mod:`fem_twin.macro.thermal`): their CSV
+#: header and ``results.nc`` long name
+TEMPERATURES = {"contact_temperature": ("contact_temperature_C", "the film's temperature: oil, "
+                                        "bulk rise and the face's flash temperature"),
+                "asperity_temperature": ("asperity_temperature_C", "an asperity contact's "
+                                         "temperature: the film's and its flash")}
 #: the unit and meaning of each variable over (viscosity, speed) in ``results.nc``
 #: (:func:`fem_twin.results.stribeck_dataset`; speed and viscosity are its coordinates)
 UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
@@ -59,7 +65,8 @@ class StribeckCurve:
     sweep estimated them (None otherwise); coarse_friction_coefficient: C_f of the same
     points on the macro grid coarsened by two, four, ..., as ``(levels, points)`` (the
     nested solves' coarse points, finest first; NaN where none was solved), when the sweep
-    kept them.
+    kept them; contact_temperature and asperity_temperature [C]: a thermal run's
+    (:data:`TEMPERATURES`; None when isothermal).
     """
 
     speed: np.ndarray
@@ -74,6 +81,8 @@ class StribeckCurve:
     friction_error: np.ndarray | None = None
     friction_error_parts: dict | None = None
     coarse_friction_coefficient: np.ndarray | None = None
+    contact_temperature: np.ndarray | None = None
+    asperity_temperature: np.ndarray | None = None
 
     def with_load_share(self, share: float) -> "StribeckCurve":
         """This curve, swept at ``share`` F_N,imp on the pin face, referred to the imposed
@@ -113,7 +122,8 @@ def joined(curves) -> StribeckCurve:
     if any(c.viscosity != first.viscosity for c in curves):
         raise InputError("joined: the pieces of a curve share one viscosity")
     arrays = {name: np.concatenate([getattr(c, name) for c in curves])
-              for name in COLUMNS if name != "viscosity"}
+              for name in (*COLUMNS, *TEMPERATURES) if name != "viscosity"
+              and getattr(first, name) is not None}
     error = None if first.friction_error is None else np.concatenate(
         [c.friction_error for c in curves])
     parts = None if first.friction_error_parts is None else {
@@ -143,6 +153,11 @@ def write_stribeck_csv(path, curves, band=None) -> Path:
         columns["cf_err"] = np.concatenate([np.full(c.speed.shape, np.nan)
                                             if c.friction_error is None else c.friction_error
                                             for c in curves])
+    for name, (header, _) in TEMPERATURES.items():
+        if any(getattr(c, name) is not None for c in curves):
+            columns[header] = np.concatenate([np.full(c.speed.shape, np.nan)
+                                              if getattr(c, name) is None else getattr(c, name)
+                                              for c in curves])
     if band is not None:
         columns["cf_min"] = np.concatenate([np.asarray(b[0], float) for b in band])
         columns["cf_max"] = np.concatenate([np.asarray(b[1], float) for b in band])
@@ -217,6 +232,26 @@ def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None
                   "Hersey number $H = \\mu_0 U D / F_N$ [-] (eq 46)")
     ax.set_ylabel("friction coefficient $C_f$ [-]")
     ax.legend(fontsize="small", loc="upper right")
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    return save_figure(fig, path, dpi=120)
+
+
+def plot_temperatures(curves, path, *, labels=None,
+                      speed_label: str = "sliding speed $U$ [m/s]") -> Path:
+    """A thermal run's temperatures [C] against speed, log x: the film's
+    (``contact_temperature``, solid) and an asperity contact's (dashed), per curve."""
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for i, c in enumerate(curves):
+        label = labels[i] if labels else f"$\\mu_0$ = {c.viscosity:g} Pa s"
+        line, = ax.plot(c.speed, c.contact_temperature, "o-", ms=3, label=f"film, {label}")
+        ax.plot(c.speed, c.asperity_temperature, "--", color=line.get_color(),
+                label="asperity contacts" if i == 0 else None)
+    ax.set_xscale("log")
+    ax.set_xlabel(speed_label)
+    ax.set_ylabel("contact temperature [°C]")
+    ax.legend(fontsize="small")
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     return save_figure(fig, path, dpi=120)

@@ -17,6 +17,7 @@ from ..io.mesh import write_pvd
 from ..macro import Lubricant, MacroSettings, MixedResult
 from ..macro.estimate import PARTS, friction_error
 from ..macro.nested import coarsened, corrected, solve_nested
+from ..macro.thermal import thermal_point
 from ..micro.flow_factors import FlowFactors
 from ..threads import one_thread
 from .curve import StribeckCurve, hersey_number
@@ -68,7 +69,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    factors_key: str | None = None,
                    slide_to_roll: float | None = None,
                    error_estimate: bool = False, keep_level: int = 0,
-                   guide: str | None = None) -> StribeckCurve:
+                   guide: str | None = None, thermal=None) -> StribeckCurve:
     """C_f over ``speeds`` [m/s] at one viscosity (paper 3.2: from 2 m/s down to 0.01 m/s).
 
     Each point warm-starts from the previous one (give speeds from fast to slow: the
@@ -94,6 +95,9 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     factors' difference (bundled case, its 12 band sweeps at 64^2: 3163 Newton steps
     against 4379, C_f the same to 6e-5 C_f,b).  Where a guide point is missing the point
     starts from the previous one.
+    ``thermal``: a :class:`~fem_twin.macro.thermal.ContactThermal`; each point is then
+    solved at the film temperature its own heat gives it (the curve's
+    ``contact_temperature`` and ``asperity_temperature``; None: isothermal at mu_0).
     """
     speeds = np.asarray(speeds, float)
     if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
@@ -102,7 +106,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         raise InputError(f"slide_to_roll must be in (0, 2], got {slide_to_roll}")
     gap = np.asarray(gap, float)
     key = sweep_key(gap, spacing, factors if factors_key is None else factors_key, load,
-                    lubricant, settings, face, slide_to_roll)
+                    lubricant, settings, face, slide_to_roll, thermal)
     folder = Path(checkpoint) if checkpoint is not None else None
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
@@ -111,7 +115,7 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         fields.mkdir(parents=True, exist_ok=True)
     kept = None if not (keep_level and folder) else level_key(
         keep_level, gap, spacing, factors if factors_key is None else factors_key, load,
-        lubricant, settings, face, slide_to_roll)
+        lubricant, settings, face, slide_to_roll, thermal)
     guided = _Guide(folder, guide)
     # each point's numbers; its fields go to disk at once (a 2048^2 point holds 0.5 GB)
     records, entries, previous = [], [], ()
@@ -121,11 +125,9 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         res = None if path is None else load_or_none(path, MixedResult.load)
         coarser = []                        # the point on each coarsening of the grid
         if res is None:
-            sliding = dict(speed=float(speed)) if slide_to_roll is None else dict(
-                speed=float(slide_to_roll * speed), entrainment=float(speed))
-            res, *coarser = solve_nested(gap, spacing, factors, load=load, **sliding,
-                                         lubricant=lubricant, face=face, settings=settings,
-                                         previous=guided.start(speeds, i, previous))
+            res, *coarser = _solve_point(
+                gap, spacing, factors, load, float(speed), slide_to_roll, lubricant, face,
+                settings, guided.start(speeds, i, previous), thermal)
             res = replace(res, meta={**res.meta,
                                      LOAD_BELOW: res.contact_load_below(factors.h0[0])})
             if coarser:
@@ -141,7 +143,8 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         if error_estimate and "error_estimate" not in res.meta:
             t0 = time.perf_counter()
             estimate = friction_error(res, gap, spacing, factors, load=load,
-                                      lubricant=lubricant, face=face, settings=settings,
+                                      lubricant=film_lubricant(res, lubricant), face=face,
+                                      settings=settings,
                                       entrainment=res.meta.get("entrainment"),
                                       levels=coarser)
             res = replace(res, meta={**res.meta, "error_estimate": estimate,
@@ -158,8 +161,10 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     get = lambda name: np.array([r[name] for r in records])  # noqa: E731
     errors = ({part: np.array([r["error_estimate"][part] for r in records])
                for part in (*PARTS, "total")} if error_estimate else None)
+    temperature = ({k: get(k) for k in ("contact_temperature", "asperity_temperature")}
+                   if thermal is not None else {})
     return StribeckCurve(
-        speed=speeds.copy(),
+        speed=speeds.copy(), **temperature,
         hersey=hersey_number(lubricant.viscosity, speeds, diameter, load),
         friction_coefficient=get("friction_coefficient"), viscosity=lubricant.viscosity,
         hydrodynamic_friction=get("hydrodynamic_friction"),
@@ -205,13 +210,45 @@ class _Guide:
 
 
 def level_key(level: int, gap, spacing, factors, load, lubricant, settings, face,
-              slide_to_roll=None) -> str:
+              slide_to_roll=None, thermal=None) -> str:
     """The sweep key (:func:`sweep_key`) of these inputs on the grid coarsened ``level``
     times (:func:`~fem_twin.macro.nested.coarsened`): where ``keep_level`` checkpoints a
     sweep's nested solves."""
     for _ in range(level):
         gap, spacing, face = coarsened(gap, spacing, face)
-    return sweep_key(gap, spacing, factors, load, lubricant, settings, face, slide_to_roll)
+    return sweep_key(gap, spacing, factors, load, lubricant, settings, face, slide_to_roll,
+                     thermal)
+
+
+def _solve_point(gap, spacing, factors, load, speed, slide_to_roll, lubricant, face,
+                 settings, previous, thermal):
+    """The levels ``(result, *coarser)`` of :func:`solve_nested` at the sweep ``speed``
+    (sliding, or entrainment at ``slide_to_roll``), warm from ``previous``; with a
+    ``thermal`` model at the film temperature of its own heat (the record in the result's
+    ``meta["thermal"]``)."""
+    sliding = dict(speed=speed) if slide_to_roll is None else dict(
+        speed=slide_to_roll * speed, entrainment=speed)
+
+    def solve(lub, start):
+        return solve_nested(gap, spacing, factors, load=load, **sliding, lubricant=lub,
+                            face=face, settings=settings, previous=start or previous)
+
+    if thermal is None:
+        return solve(lubricant, None)
+    u_m = sliding.get("entrainment", speed / 2)
+    surfaces = (u_m - sliding["speed"] / 2, u_m + sliding["speed"] / 2)
+    levels, film, record = thermal_point(solve, lubricant, thermal, factors, surfaces)
+    res = levels[0]
+    record["viscosity_Pa_s"] = film.viscosity
+    return (replace(res, meta={**res.meta, "thermal": record}), *levels[1:])
+
+
+def film_lubricant(res: MixedResult, lubricant):
+    """The lubricant a point's film had: ``lubricant`` at the point's film viscosity when a
+    thermal model set it (``meta["thermal"]``), else ``lubricant``."""
+    record = res.meta.get("thermal")
+    return lubricant if record is None else replace(lubricant,
+                                                    viscosity=record["viscosity_Pa_s"])
 
 
 def _record(res: MixedResult) -> dict:
@@ -219,7 +256,9 @@ def _record(res: MixedResult) -> dict:
     return {**{name: getattr(res, name) for name in (
         "friction_coefficient", "hydrodynamic_friction", "boundary_friction", "contact_load",
         "h_d", "iterations")}, COARSE_CF: np.atleast_1d(res.meta.get(COARSE_CF, np.nan)),
-        "error_estimate": res.meta.get("error_estimate")}
+        "error_estimate": res.meta.get("error_estimate"),
+        "contact_temperature": res.meta.get("thermal", {}).get("film_C", np.nan),
+        "asperity_temperature": res.meta.get("thermal", {}).get("asperity_C", np.nan)}
 
 
 def _levels(rows) -> np.ndarray:
@@ -232,7 +271,7 @@ def _levels(rows) -> np.ndarray:
 
 
 def sweep_key(gap, spacing, factors, load, lubricant, settings, face,
-              slide_to_roll=None) -> str:
+              slide_to_roll=None, thermal=None) -> str:
     """Key of a sweep's checkpoints (``point_KEY_*.npz``): a hash of all its inputs, with
     ``factors`` a :class:`FlowFactors` or a key string of their inputs."""
     flow = ((factors.h0, factors.h_m, factors.p_con, factors.A, factors.b, factors.C,
@@ -241,5 +280,8 @@ def sweep_key(gap, spacing, factors, load, lubricant, settings, face,
     inputs = [load, lubricant.__dict__, settings.__dict__]
     if slide_to_roll is not None:
         inputs.append(slide_to_roll)
+    if thermal is not None:
+        inputs.append([thermal.settings.__dict__, thermal.law.__dict__,
+                       thermal.boundary_friction])
     return input_key(np.asarray(gap, float), np.asarray(spacing, float), *flow,
                      None if face is None else np.asarray(face, bool), inputs, length=12)

@@ -1,0 +1,226 @@
+"""The contact's temperature from its own frictional heat (beyond the paper).
+
+The frictional power ``Q = F_T U`` [W] enters pin and disk through the face as the surface
+flux ``q = tau U`` (the point's traction times the local sliding speed, scaled to Q).  Three
+temperature rises add to the oil's (docs/thermal.md has the model and its checks):
+
+* **bulk**, ``R_b Q``: the rig's lumped thermal resistance ``R_b`` [K/W] (pin, holder,
+  disk, bath), a parameter to fit;
+* **face flash**, Blok's partition of ``q`` between the pin, a stationary half-space, and
+  the disk, a half-space moving at ``U`` under the face (Jaeger 1942; Carslaw and Jaeger
+  1959, 10.7): the share that makes the two face-mean temperatures equal;
+* **asperity flash**, the same for one contact spot of radius ``a`` carrying the boundary
+  shear's flux ``C_f,b p_spot U`` (Archard 1959), reported, not fed back (C_f,b is a
+  constant of the model).
+
+The film sees the oil temperature plus bulk and face flash; its viscosity follows the
+Walther law of the case's viscosities (:mod:`.viscosity`).  Each operating point is
+iterated to that temperature (:func:`thermal_point`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from functools import lru_cache
+
+import numpy as np
+import scipy.fft as fft
+
+from ..checks import setting
+from ..contact.elastic import love_rectangle
+from ..errors import InputError, SolverError
+
+#: sub-samples a side of a cell for the moving part of the kernel (it varies over 2 kappa / U)
+SUBSAMPLES = 8
+
+
+class ThermalNotConverged(SolverError):
+    """The temperature of an operating point did not settle; ``history``: |dT| [K] per
+    iteration."""
+
+    def __init__(self, message, history=()):
+        super().__init__(message)
+        self.history = tuple(history)
+
+    def __reduce__(self):
+        return (type(self), (self.args[0], self.history))
+
+
+@dataclass(frozen=True)
+class ThermalSettings:
+    """``[thermal]``: the contact's temperature model (SI units; steel on steel defaults)."""
+
+    model: str = setting("flash", "the film's temperature from its own heat: bulk rise plus "
+                         "the face's flash temperature; none: isothermal at the oil's "
+                         "temperature (the paper)", choices=("flash", "none"))
+    bulk_resistance: float = setting(1.0, "the rig's thermal resistance R_b from the contact "
+                                     "to the oil bath (a parameter to fit)", unit="K/W")
+    conductivity: float = setting(46.0, "thermal conductivity k of pin and disk (steel)",
+                                  unit="W/(m K)")
+    diffusivity: float = setting(1.2e-5, "thermal diffusivity kappa of pin and disk (steel)",
+                                 unit="m^2/s")
+    spot_radius: float = setting(5e-6, "radius a of an asperity contact for its flash "
+                                 "temperature (a parameter to fit; reported only)", unit="m")
+    tol: float = setting(0.01, "the film temperature's iteration stops when it moves by "
+                         "less", unit="K")
+    max_iter: int = setting(30, "iterations before the temperature gives up", unit="-")
+    grid: int = setting(64, "nodes a side of the face's heat-flux grid at most", unit="-")
+
+    def __post_init__(self):
+        if self.model not in ("flash", "none"):
+            raise InputError(f"model must be 'flash' or 'none', got {self.model!r}")
+        bad = [k for k in ("bulk_resistance", "conductivity", "diffusivity", "spot_radius",
+                           "tol") if not (np.isfinite(getattr(self, k)) and getattr(self, k) >= 0)]
+        if bad or self.conductivity <= 0 or self.diffusivity <= 0 or self.tol <= 0:
+            raise InputError(f"{', '.join(bad) or 'conductivity, diffusivity, tol'}: "
+                             "must be positive (bulk_resistance and spot_radius may be 0)")
+        if int(self.max_iter) != self.max_iter or self.max_iter < 1 or self.grid < 8:
+            raise InputError("max_iter must be a positive integer and grid >= 8")
+
+
+def surface_temperature(flux, spacing, speed: float, conductivity: float,
+                        diffusivity: float) -> np.ndarray:
+    """The surface temperature rise [K] of a half-space under the surface heat ``flux``
+    (ny, nx) [W/m^2] on a grid of pitch ``spacing`` [m], the body moving at ``speed``
+    [m/s] along +x1 under the flux (0: at rest).  Linear convolution (zero padding, FFT)
+    with the moving point source's kernel ``exp(-U (R - dx1) / (2 kappa)) / (2 pi k R)``
+    averaged over each pixel: its 1/R part exactly (Love's integral), the rest by
+    :data:`SUBSAMPLES`^2 points."""
+    q = np.asarray(flux, float)
+    ny, nx = q.shape
+    k_hat = _kernel_hat((ny, nx), tuple(float(v) for v in spacing), float(speed),
+                        float(diffusivity))
+    theta = fft.irfft2(fft.rfft2(q, s=(2 * ny, 2 * nx)) * k_hat, s=(2 * ny, 2 * nx))
+    return theta[:ny, :nx] / conductivity
+
+
+@lru_cache(maxsize=64)
+def _kernel_hat(shape, spacing, speed, diffusivity):
+    """FFT of the pixel-averaged kernel times the pixel area, for k = 1, on the padded grid."""
+    ny, nx = shape
+    dx1, dx2 = spacing
+    off1 = np.r_[0:nx, -nx:0] * dx1                  # wrapped offsets of the padded grid
+    off2 = np.r_[0:ny, -ny:0] * dx2
+    # 1/R over the source pixel (love_rectangle with E' = 2/pi is the plain integral)
+    kernel = love_rectangle(off1[None, :], off2[:, None], dx1 / 2, dx2 / 2, 2 / np.pi)
+    if speed:
+        s = (np.arange(SUBSAMPLES) + 0.5) / SUBSAMPLES - 0.5
+        moving = np.zeros_like(kernel)
+        for a in s * dx1:
+            for b in s * dx2:
+                d1, d2 = off1[None, :] - a, off2[:, None] - b
+                r = np.hypot(d1, d2)
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    term = np.expm1(-speed * (r - d1) / (2 * diffusivity)) / r
+                moving += np.where(r > 0, term, 0.0)
+        kernel = kernel + moving * (dx1 * dx2 / SUBSAMPLES ** 2)
+    return fft.rfft2(kernel / (2 * np.pi))
+
+
+def face_flash(flux, face, spacing, speeds, settings: ThermalSettings) -> tuple:
+    """``(theta, pin_share)``: the face-mean flash temperature [K] of the heat ``flux``
+    [W/m^2] over the ``face`` (bool grid), shared between the pin (or ball) and the disk
+    whose surfaces pass the contact at ``speeds`` = (pin, disk) [m/s] so that both face
+    means agree (Blok), and the pin's share of the heat."""
+    q, f, dx = _coarse(np.where(face, flux, 0.0), face, spacing, settings.grid)
+    pin, disk = (surface_temperature(q, dx, abs(u), settings.conductivity,
+                                     settings.diffusivity)[f].mean() for u in speeds)
+    if pin + disk <= 0:
+        return 0.0, 0.5
+    return float(pin * disk / (pin + disk)), float(disk / (pin + disk))
+
+
+def spot_flash(flux: float, speeds, settings: ThermalSettings, n: int = 24) -> float:
+    """The mean flash temperature [K] of a circular asperity contact of radius
+    ``settings.spot_radius`` carrying ``flux`` [W/m^2], shared as in :func:`face_flash`."""
+    a = settings.spot_radius
+    if a == 0 or flux <= 0:
+        return 0.0
+    x = (np.arange(n) - (n - 1) / 2) * (2 * a / n)
+    disc = np.hypot(x[None, :], x[:, None]) <= a
+    return face_flash(np.where(disc, flux, 0.0), disc, (2 * a / n, 2 * a / n), speeds,
+                      replace(settings, grid=n))[0]
+
+
+def _coarse(flux, face, spacing, most: int):
+    """The flux (summed, as power) and face (any node) on blocks of k x k nodes, k the
+    smallest that leaves at most ``most`` a side."""
+    k = int(np.ceil(max(flux.shape) / most))
+    if k <= 1:
+        return flux, np.asarray(face, bool), tuple(spacing)
+    ny, nx = (-(-n // k) * k for n in flux.shape)
+    pad = lambda a: np.pad(a, ((0, ny - a.shape[0]), (0, nx - a.shape[1])))  # noqa: E731
+    blocks = lambda a: pad(a).reshape(ny // k, k, nx // k, k)  # noqa: E731
+    return (blocks(flux).mean(axis=(1, 3)), blocks(np.asarray(face, bool)).any(axis=(1, 3)),
+            (k * spacing[0], k * spacing[1]))
+
+
+
+@dataclass(frozen=True)
+class ContactThermal:
+    """A run's thermal model: its ``settings``, the oil's viscosity-temperature ``law``
+    (:class:`~.viscosity.WaltherLaw`; a curve's oil is at the temperature where the law
+    gives the curve's mu_0) and C_f,b (eq 32), which sets the asperity spots' flux."""
+
+    settings: ThermalSettings
+    law: object
+    boundary_friction: float
+
+    def heat(self, result, factors, speeds) -> dict:
+        """The heat of a converged point ``result``: ``power`` F_T U [W], the face's
+        ``flash`` [K] and the pin's share ``pin_share`` of the heat, and an asperity spot's
+        ``spot_flash`` [K]; ``factors`` the point's flow factors (contact fraction),
+        ``speeds`` (pin, disk) of :func:`face_flash`."""
+        power = max(float(result.friction_force * result.speed), 0.0)
+        face = np.asarray(result.face, bool)
+        flux = np.where(face, np.maximum(result.shear_stress, 0.0), 0.0)
+        total = flux.sum() * result.spacing[0] * result.spacing[1]
+        flux = flux * (power / total) if total > 0 else flux
+        flash, share = face_flash(flux, face, result.spacing, speeds, self.settings)
+        fraction = factors.at(result.h0).contact_fraction[face].sum()
+        spot = (self.boundary_friction * result.contact_pressure[face].sum() / fraction
+                * abs(result.speed) if fraction > 0 else 0.0)
+        return {"power": power, "flash": flash, "pin_share": share,
+                "spot_flash": spot_flash(spot, speeds, self.settings)}
+
+
+def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds) -> tuple:
+    """An operating point at the film temperature its own heat gives it.
+
+    ``solve(lubricant, previous)`` returns the point's levels ``(result, *coarser)`` with
+    the film's ``lubricant``, warm from ``previous`` (None first).  The film temperature
+    ``T = T_oil + R_b Q + theta_face`` is iterated by secant steps on ``T - g(T)`` until it
+    moves by less than ``settings.tol``; returns ``(levels, lubricant, record)`` with the
+    record's temperatures [C] (``oil``, ``film``, ``asperity``), rises [K], power [W] and
+    iterations, or raises :class:`ThermalNotConverged` with the history."""
+    s, law = thermal.settings, thermal.law
+    oil = float(law.temperature(lubricant.viscosity))
+    T, previous, history, pairs = oil, None, [], []
+    for _ in range(s.max_iter):
+        film = replace(lubricant, viscosity=float(law.viscosity(T)))
+        levels = solve(film, previous)
+        heat = thermal.heat(levels[0], factors, speeds)
+        target = oil + s.bulk_resistance * heat["power"] + heat["flash"]
+        history.append(abs(target - T))
+        if history[-1] < s.tol:
+            record = {"oil_C": oil, "film_C": T, "asperity_C": T + heat["spot_flash"],
+                      "bulk_rise_K": s.bulk_resistance * heat["power"],
+                      "face_flash_K": heat["flash"], "spot_flash_K": heat["spot_flash"],
+                      "power_W": heat["power"], "pin_share": heat["pin_share"],
+                      "iterations": len(history)}
+            return levels, film, record
+        pairs.append((T, target - T))
+        T, previous = _next_temperature(pairs), levels
+    raise ThermalNotConverged(f"the film temperature did not settle within {s.tol:g} K in "
+                              f"{s.max_iter} iterations (last change {history[-1]:.3g} K)",
+                              history)
+
+
+def _next_temperature(pairs) -> float:
+    """The secant root of ``r(T) = g(T) - T`` through the last two ``(T, r)`` pairs, or the
+    plain step ``T + r`` first and where the secant is flat."""
+    T, r = pairs[-1]
+    if len(pairs) < 2:
+        return T + r
+    T0, r0 = pairs[-2]
+    return T + r if r == r0 else T - r * (T - T0) / (r - r0)
