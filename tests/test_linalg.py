@@ -169,10 +169,11 @@ def test_anderson_mixing_is_gmres_on_a_linear_map():
 
 
 def test_pardiso_runs_the_threads_fem_twin_threads_allows():
-    """FEM_TWIN_THREADS=2 when MKL first loads: MKL's OpenMP layer and two PARDISO threads
-    on a matrix of THREADED_UNKNOWNS or more (a lone large point; more CPU time than wall
-    time), one thread below, the same factors to round-off as the default sequential layer
-    (one process each: the layer is chosen at load)."""
+    """FEM_TWIN_THREADS=2 when MKL first loads: MKL's OpenMP layer with two threads for a
+    matrix of THREADED_UNKNOWNS or more (a lone large point), the same factors to round-off
+    as the default sequential layer with one (one process each: the layer is chosen at
+    load).  The threads are read from MKL, not timed: CPU over wall time depends on the
+    machine's load."""
     if _mkl_rt() is None:
         pytest.skip("MKL not installed")
     import json
@@ -182,7 +183,7 @@ def test_pardiso_runs_the_threads_fem_twin_threads_allows():
 
     from fem_twin.linalg import THREADED_UNKNOWNS
     script = (
-        "import json, time, numpy as np, sys\n"
+        "import json, numpy as np, sys\n"
         "sys.path.insert(0, 'tests')\n"
         "from test_linalg import diffusion\n"
         "from fem_twin.linalg import SPDSolver\n"
@@ -191,13 +192,12 @@ def test_pardiso_runs_the_threads_fem_twin_threads_allows():
         f"for n in (200, {int(np.sqrt(THREADED_UNKNOWNS)) + 2}):\n"
         "    K = diffusion(n, seed=1)\n"
         "    s = SPDSolver(K.indptr, K.indices, 'pardiso').factor(K.data)\n"
-        "    w, c = time.perf_counter(), time.process_time()\n"
-        "    for _ in range(3): s.factor(K.data)\n"
-        "    w, c = time.perf_counter() - w, time.process_time() - c\n"
+        "    s.factor(K.data)\n"
         "    x = s.solve(np.ones(K.shape[0]))\n"
-        "    out[n] = {'x': x[:50].tolist(), 'cpu_over_wall': c / w}\n"
-        "layer = [i.get('threading_layer') for i in threadpool_info() if i['internal_api'] == 'mkl']\n"
-        "print(json.dumps({'runs': list(out.values()), 'layer': layer}))\n")
+        "    out[n] = {'x': x[:50].tolist()}\n"
+        "mkl = [i for i in threadpool_info() if i['internal_api'] == 'mkl']\n"
+        "print(json.dumps({'runs': list(out.values()), 'layer': [i.get('threading_layer') "
+        "for i in mkl], 'threads': [i['num_threads'] for i in mkl]}))\n")
     out = {}
     for threads in ("1", "2"):
         env = {k: v for k, v in os.environ.items() if not k.startswith("MKL_")}
@@ -207,9 +207,8 @@ def test_pardiso_runs_the_threads_fem_twin_threads_allows():
                              check=True)
         out[threads] = json.loads(run.stdout.splitlines()[-1])
     assert out["1"]["layer"] == ["sequential"] and out["2"]["layer"] == ["intel"]
+    assert out["2"]["threads"] == [2]
     (small1, large1), (small2, large2) = out["1"]["runs"], out["2"]["runs"]
-    assert max(small1["cpu_over_wall"], large1["cpu_over_wall"], small2["cpu_over_wall"]) \
-        < 1.1 < large2["cpu_over_wall"]
     for one, two in ((small1, small2), (large1, large2)):
         assert np.allclose(one["x"], two["x"], rtol=1e-10, atol=0)
 
