@@ -28,6 +28,7 @@ QUANTITIES = {
     "pin_diameter": (1e-4, 0.1, "m (8 mm is 8e-3)"),
     "friction": (1e-3, 1.0, "(a friction coefficient)"),
     "load_share": (0.05, 1.0, "a fraction of the imposed load, in (0, 1]"),
+    "thermal_resistance": (0.0, 100.0, "K/W (a rig's contact to its oil bath: about 1)"),
     "slide_to_roll": (-2.0, 2.0, "u_r / u_m in [-2, 2] (50 % is 0.5; 0: pure rolling; 2: "
                       "the pin or ball at rest)"),
     "viscosity": (1e-5, 10.0, "Pa s (66 mPa s is 0.066)"),

@@ -11,6 +11,7 @@ from pathlib import Path
 from . import cli_runs as runs
 from . import cli_stages as stages
 from .errors import NotConverged, RunLocked, SchedulerUnreachable
+from .stribeck.fit import PARAMETERS
 
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
@@ -153,17 +154,16 @@ def _add_case_commands(sub):
     cb = _case_command(sub, "calibrate", "calibration study of a case (paper 3.2): C_f,dev "
                                          "of variants against a reference curve",
                        "calibration", runs.calibrate)
-    ft = sub.add_parser("fit", help="fit C_f,b, the oil temperature and the load share of a "
-                                    "case to measured Stribeck curves (runs or resumes the "
-                                    "case first)")
+    ft = sub.add_parser("fit", help="fit C_f,b, the oil temperature, the load share and the "
+                                    "rig's thermal resistance of a case to measured Stribeck "
+                                    "curves (runs or resumes the case first)")
     ft.add_argument("case", type=Path, help="case file")
     ft.add_argument("measured", type=Path, nargs="+",
                     help="measured CSV per viscosity of the case (speed [m/s], "
                          "friction_coefficient, optional cf_min/cf_max)")
     ft.add_argument("-o", "--output", type=Path, default=Path("out"), help="output folder")
     ft.add_argument("--params", default="boundary_friction,temperature",
-                    help="comma-separated case keys to fit: boundary_friction, temperature, "
-                         "load_share")
+                    help="comma-separated case keys to fit: " + ", ".join(PARAMETERS))
     ft.add_argument("--predict", type=float, nargs="+", default=[], metavar="T",
                     help="oil temperatures [C] of predicted curves with their 95 %% band "
                          "(OUT/prediction_TC.csv)")

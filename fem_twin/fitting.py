@@ -24,8 +24,8 @@ from .stages.geometry import hersey_length, macro_geometry
 from .stages.provenance import stage_keys
 from .stribeck import read_measured_csv
 from .stribeck.curve import read_stribeck_csv
-from .stribeck.fit import (LOAD_SHARES, FitModel, check_parameters, fit_curves, plot_fit,
-                           predict)
+from .stribeck.fit import (LOAD_SHARES, RESISTANCES, FitModel, check_parameters, fit_curves,
+                           plot_fit, predict)
 from .threads import executor_for
 
 
@@ -56,6 +56,9 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
                          "temperatures in [lubricant] (the Walther law of ASTM D341)")
     if "load_share" in params and case.tribometer.ball:
         raise InputError("load_share is a pin face's share of the load; a ball carries it all")
+    if "bulk_resistance" in params and case.thermal.model == "none":
+        raise InputError("bulk_resistance is the thermal twin's: set [thermal] model = "
+                         "\"flash\" to fit it")
     _check_coverage(case, paths, curves_measured, params)
     law = (WaltherLaw.through(lb.temperatures, lb.viscosities, lb.density)
            if len(set(lb.temperatures)) > 1 else None)
@@ -66,8 +69,11 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     simulated = read_stribeck_csv(out.stribeck_csv)[:len(paths)]
     shares = (share_curves(case, out, simulated[0], progress) if "load_share" in params
               else ())
+    resistances = (resistance_curves(case, out, simulated, progress)
+                   if "bulk_resistance" in params else ())
     model = FitModel(tuple(simulated), case.tribometer.boundary_friction, case.tribometer.load,
-                     law, case.tribometer.load_share, shares)
+                     law, case.tribometer.load_share, shares, case.thermal.bulk_resistance,
+                     resistances)
     nominal = list(lb.temperatures[:len(paths)])
     result = fit_curves(model, curves_measured, params, verbose=progress,
                         start_temperatures=nominal if "temperature" in params else None)
@@ -119,6 +125,29 @@ def share_curves(case: Case, out: RunLayout, curve, progress: bool = True,
     return tuple(sorted([*zip(todo, swept), (tr.load_share, curve)], key=lambda p: p[0]))
 
 
+def resistance_curves(case: Case, out: RunLayout, curves, progress: bool = True,
+                      resistances=RESISTANCES) -> tuple:
+    """Per curve, ``((R_b, StribeckCurve), ...)``: each of ``curves`` (the case's K-th
+    viscosity) swept at the rig's thermal ``resistances`` [K/W] over its speeds (the
+    case's own R_b is the curve), checkpointed in ``OUT/fit/checkpoints``."""
+    gap, spacing, face, _ = macro_geometry(case, out)
+    common = dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
+                  diameter=hersey_length(case), face=face, settings=macro_settings(case),
+                  load=case.tribometer.load * case.tribometer.load_share,
+                  checkpoint=out.fit_points, factors_key=stage_keys(case)["micro"])
+    own, thermal = case.thermal.bulk_resistance, contact_thermal(case)
+    todo = sorted(r for r in resistances if not np.isclose(r, own, rtol=1e-9, atol=1e-12))
+    tasks = [(dict(common, speeds=np.sort(c.speed)[::-1], thermal=replace(
+        thermal, settings=replace(thermal.settings, bulk_resistance=r))), lub)
+        for c, lub in zip(curves, case.lubricant.lubricants()) for r in todo]
+    with executor_for(case.run.workers, case.run.scheduler) as executor:
+        swept = run_sweeps(tasks, executor, progress, desc="thermal-resistance points")
+    swept = [s.with_load_share(case.tribometer.load_share) for s in swept]
+    return tuple(tuple(sorted([*zip(todo, swept[k * len(todo):(k + 1) * len(todo)]),
+                               (own, c)], key=lambda p: p[0]))
+                 for k, c in enumerate(curves))
+
+
 def apply_fit(case: Case, result: dict) -> Case:
     """``case`` with the fitted parameters of ``result`` (a ``fit.json``): C_f,b, the load
     share, and viscosities from the fit's Walther law at the case's temperatures plus the
@@ -127,12 +156,14 @@ def apply_fit(case: Case, result: dict) -> Case:
     get = lambda name, default: result.get(name, {}).get("value", default)  # noqa: E731
     tr = replace(tr, boundary_friction=get("boundary_friction", tr.boundary_friction),
                  load_share=get("load_share", tr.load_share))
+    thermal = replace(case.thermal, bulk_resistance=get("bulk_resistance",
+                                                        case.thermal.bulk_resistance))
     offset = temperature_offset(result)
     if offset is not None:
         law = WaltherLaw(**result["case"]["law"])
         lb = replace(lb, viscosities=tuple(float(law.viscosity(t + offset))
                                            for t in lb.temperatures))
-    return replace(case, tribometer=tr, lubricant=lb)
+    return replace(case, tribometer=tr, lubricant=lb, thermal=thermal)
 
 
 def temperature_offset(result: dict) -> float | None:
@@ -150,12 +181,13 @@ def read_fit(path) -> dict:
     try:
         result = json.loads(Path(path).read_text())
         result["fit"]["parameters"], result["case"]["temperatures"]
-        values = {k: float(result[k]["value"]) for k in ("boundary_friction", "load_share")
-                  if k in result}
+        values = {k: float(result[k]["value"]) for k in ("boundary_friction", "load_share",
+                                                         "bulk_resistance") if k in result}
         offset = temperature_offset(result)
     except (OSError, ValueError, KeyError, TypeError) as err:
         raise InputError(f"{path}: not a fit.json of fem-twin fit ({err})") from err
-    quantity = {"boundary_friction": "friction", "load_share": "load_share"}
+    quantity = {"boundary_friction": "friction", "load_share": "load_share",
+                "bulk_resistance": "thermal_resistance"}
     for name, value in values.items():          # the case parser's ranges
         plausible(f"{path} {name}", value, quantity[name])
     if offset is not None and not -100.0 <= offset <= 100.0:
@@ -168,8 +200,9 @@ def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=Non
                  **options) -> dict:
     """Run ``case`` with the parameters fitted in ``fit_path`` (:func:`apply_fit`): at
     another load or oil temperature than the fit's; ``OUT/prediction.csv`` gives each
-    curve with the 95 % band of the fitted parameters' covariance (a fitted load share
-    by two more sweeps at its interval's ends) and the curve's C_f error estimate.
+    curve with the 95 % band of the fitted parameters' covariance (a fitted load share or
+    thermal resistance by more sweeps at its interval's ends) and the curve's C_f error
+    estimate.
     Returns the run's summary with ``"prediction"``; ``options`` go to ``run``
     (:func:`fem_twin.pipeline.run`)."""
     result = read_fit(fit_path)
@@ -187,7 +220,13 @@ def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=Non
         ends = {min(max(result["load_share"][e], lo), hi) for e in ("low", "high")}
         shares = share_curves(fitted, out, curves[0], progress, shares=ends)
         shares = shares if len(shares) > 1 else ()      # a zero-width interval
-    model = FitModel(tuple(curves), tr.boundary_friction, tr.load, law, tr.load_share, shares)
+    resistances = ()
+    if "bulk_resistance" in result:
+        ends = {max(result["bulk_resistance"][e], 0.0) for e in ("low", "high")}
+        resistances = resistance_curves(fitted, out, curves, progress, resistances=ends)
+        resistances = resistances if len(resistances[0]) > 1 else ()
+    model = FitModel(tuple(curves), tr.boundary_friction, tr.load, law, tr.load_share, shares,
+                     fitted.thermal.bulk_resistance, resistances)
     offset = temperature_offset(result)
     rows = [predict(model, result, c.speed, None if offset is None else t,
                     result["case"]["temperatures"], curve=k)

@@ -54,7 +54,8 @@ class ThermalSettings:
                          "the face's flash temperature; none: isothermal at the oil's "
                          "temperature (the paper)", choices=("flash", "none"))
     bulk_resistance: float = setting(1.0, "the rig's thermal resistance R_b from the contact "
-                                     "to the oil bath (a parameter to fit)", unit="K/W")
+                                     "to the oil bath (a parameter to fit)",
+                                     "thermal_resistance")
     conductivity: float = setting(46.0, "thermal conductivity k of pin and disk (steel)",
                                   unit="W/(m K)")
     diffusivity: float = setting(1.2e-5, "thermal diffusivity kappa of pin and disk (steel)",

@@ -20,6 +20,12 @@ Parameters, named by their case-file keys:
     once at each of :data:`LOAD_SHARES` (the micro stage is not run again) and C_f is
     interpolated between them (PCHIP in the share, at each speed), added to each curve as
     the change from its own share.
+``bulk_resistance``
+    the rig's thermal resistance R_b [K/W] of the thermal twin (``[thermal]``,
+    :mod:`fem_twin.macro.thermal`).  Its heating depends on speed and power, not on the
+    Hersey number alone, so every measured curve's viscosity is swept at each of
+    :data:`RESISTANCES` and C_f interpolated between them (PCHIP in R_b, per speed),
+    added as the change from the case's own R_b.
 
 Least squares on C_f,dev (eq 35) at the measured speeds (the simulated curve interpolated
 by PCHIP in log speed).  Weights: where the measured CSV gives ``cf_min``/``cf_max`` (the
@@ -34,7 +40,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import optimize, stats
 from scipy.interpolate import PchipInterpolator
 
 from ..errors import InputError, NotConverged
@@ -42,9 +47,11 @@ from ..macro.viscosity import WaltherLaw
 from .curve import MeasuredCurve, StribeckCurve
 
 #: the parameters :func:`fit_curves` can fit (case-file keys)
-PARAMETERS = ("boundary_friction", "temperature", "load_share")
+PARAMETERS = ("boundary_friction", "temperature", "load_share", "bulk_resistance")
 #: the face's shares of the imposed load swept for a ``load_share`` fit (its bounds)
 LOAD_SHARES = (0.5, 0.625, 0.75, 0.875, 1.0)
+#: the rig's thermal resistances [K/W] swept for a ``bulk_resistance`` fit (its bounds)
+RESISTANCES = (0.0, 1.0, 2.0, 4.0)
 #: a fitted contact temperature this far [K] from its curve's oil temperature is flagged
 TEMPERATURE_OFFSET = 15.0
 #: expected range of three normal samples in standard deviations (d2 of n = 3)
@@ -57,7 +64,9 @@ class FitModel:
     docstring).  ``curves``: a StribeckCurve per measured curve, swept at ``load_share`` of
     the imposed ``load`` [N]; ``law``: the lubricant's viscosity-temperature law (None
     without temperatures); ``share_curves``: ``((share, StribeckCurve), ...)`` swept at one
-    viscosity, ascending, that bracket ``load_share`` (empty: the share is not a parameter).
+    viscosity, ascending, that bracket ``load_share`` (empty: the share is not a parameter);
+    ``resistance_curves``: per curve, ``((R_b, StribeckCurve), ...)`` ascending around the
+    curves' own ``bulk_resistance`` [K/W] (empty: not a parameter).
     """
 
     curves: tuple
@@ -66,21 +75,29 @@ class FitModel:
     law: WaltherLaw | None
     load_share: float = 1.0
     share_curves: tuple = ()
+    bulk_resistance: float = 0.0
+    resistance_curves: tuple = ()
 
     def friction(self, k: int, speed, boundary_friction: float, viscosity: float,
-                 share: float | None = None):
-        """C_f of curve ``k`` at ``speed`` [m/s] for C_f,b, mu_0 [Pa s] and the face's
-        ``share`` of the load (None: the curves' own); and the mask of speeds whose Hersey
-        number lies inside the simulated range (ends held outside)."""
-        cf, inside = self._at(self.curves[k], speed, boundary_friction, viscosity)
-        if share is None or share == self.load_share or not self.share_curves:
-            return cf, inside
-        shares = [s for s, _ in self.share_curves]
-        values = [self._at(c, speed, boundary_friction, viscosity) for _, c in
-                  self.share_curves]
-        grid = PchipInterpolator(shares, np.stack([v[0] for v in values]), axis=0)
-        return cf + grid(share) - grid(self.load_share), inside & np.all(
-            [v[1] for v in values], axis=0)
+                 share: float | None = None, resistance: float | None = None):
+        """C_f of curve ``k`` at ``speed`` [m/s] for C_f,b, mu_0 [Pa s], the face's
+        ``share`` of the load and the rig's thermal ``resistance`` [K/W] (None: the curves'
+        own); and the mask of speeds whose Hersey number lies inside the simulated range
+        (ends held outside)."""
+        at = lambda c: self._at(c, speed, boundary_friction, viscosity)  # noqa: E731
+        cf, inside = at(self.curves[k])
+        for value, own, swept in ((share, self.load_share, self.share_curves),
+                                  (resistance, self.bulk_resistance,
+                                   self.resistance_curves[k] if self.resistance_curves
+                                   else ())):
+            if value is None or value == own or not swept:
+                continue
+            values = [at(c) for _, c in swept]
+            grid = PchipInterpolator([s for s, _ in swept], np.stack([v[0] for v in values]),
+                                     axis=0)
+            cf = cf + grid(value) - grid(own)
+            inside = inside & np.all([v[1] for v in values], axis=0)
+        return cf, inside
 
     def _at(self, c: StribeckCurve, speed, boundary_friction: float, viscosity: float):
         order = np.argsort(c.speed)
@@ -119,12 +136,15 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     if "load_share" in params and len(model.share_curves) < 2:
         raise InputError("fitting the load share needs sweeps at two or more load shares "
                          "(FitModel.share_curves)")
+    if "bulk_resistance" in params and len(model.resistance_curves) != len(model.curves):
+        raise InputError("fitting the thermal resistance needs every curve swept at two or "
+                         "more resistances (FitModel.resistance_curves)")
     names, x0, lower, upper = _unknowns(model, params, len(measured), start_temperatures)
     sigma = [_sigma(m) for m in measured]
     weighted = all(s is not None for s in sigma)
 
     def unpack(x):
-        """C_f,b, the viscosity [Pa s] of each curve and the face's load share."""
+        """C_f,b, the viscosity [Pa s] of each curve, the face's load share and R_b."""
         v = dict(zip(names, x))
         cfb = v.get("boundary_friction", model.boundary_friction)
         temps = [v.get(f"temperature_{k + 1}") for k in range(len(measured))]
@@ -133,13 +153,13 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
                    else [float(model.law.viscosity(t)) for t in start_temperatures])
         else:
             mus = [float(model.law.viscosity(t)) for t in temps]
-        return cfb, mus, v.get("load_share")
+        return cfb, mus, v.get("load_share"), v.get("bulk_resistance")
 
     def residuals(x):
-        cfb, mus, share = unpack(x)
+        cfb, mus, share, resistance = unpack(x)
         out = []
         for k, m in enumerate(measured):
-            cf, _ = model.friction(k, m.speed, cfb, mus[k], share)
+            cf, _ = model.friction(k, m.speed, cfb, mus[k], share, resistance)
             r = (cf - m.friction_coefficient) / model.boundary_friction
             out.append(r / (sigma[k] / model.boundary_friction) if weighted else r)
         return np.concatenate(out)
@@ -147,6 +167,7 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     n = sum(m.speed.size for m in measured)
     if n <= x0.size:
         raise InputError(f"{n} measured points cannot fit {x0.size} parameters")
+    from scipy import optimize              # imported here: the CLI reads PARAMETERS
     sol = optimize.least_squares(residuals, x0, bounds=(lower, upper), x_scale="jac",
                                  verbose=2 if verbose else 0)
     if not sol.success:
@@ -168,6 +189,9 @@ def _unknowns(model, params, n_curves, start_temperatures):
     if "load_share" in params:
         lo, hi = model.share_curves[0][0], model.share_curves[-1][0]
         rows.append(("load_share", min(max(model.load_share, lo), hi), lo, hi))
+    if "bulk_resistance" in params:
+        lo, hi = model.resistance_curves[0][0][0], model.resistance_curves[0][-1][0]
+        rows.append(("bulk_resistance", min(max(model.bulk_resistance, lo), hi), lo, hi))
     names, x0, lower, upper = zip(*rows)
     return list(names), np.array(x0, float), list(lower), list(upper)
 
@@ -189,10 +213,12 @@ def check_misfit(result: dict, names, x, lower, upper) -> None:
     where = (f"rms C_f,dev {f['rms_cf_dev']:.1%} of C_f,b, largest {worst[3]:+.1%} at "
              f"{worst[2]:.3g} m/s on curve {worst[1]}")
     pinned = [n for n, v, lo, hi in zip(names, x, lower, upper)
-              if n != "load_share" and min(v - lo, hi - v) <= 1e-6 * (hi - lo)]
+              if n not in ("load_share", "bulk_resistance")
+              and min(v - lo, hi - v) <= 1e-6 * (hi - lo)]
     if f["weights"] == "equal":
         bad = f["rms_cf_dev"] > MISFIT_RMS
     else:
+        from scipy import stats
         bad = stats.chi2.sf(f["chi2"], f["degrees_of_freedom"]) < MISFIT_P
     if pinned or bad:
         raise InputError(f"no parameter set fits the measured curve(s): {where}"
@@ -219,10 +245,11 @@ def _summary(model, measured, names, sol, weighted, unpack) -> dict:
                          "depend on it (C_f,b in full film), or are too few; measure the "
                          "speeds where it acts")
     cov = _covariance(sol.jac, sol.fun, weighted)
+    from scipy import stats
     half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
     out = {name: {"value": float(v), "low": float(v - h), "high": float(v + h)}
            for name, v, h in zip(names, sol.x, half)}
-    cfb, mus, share = unpack(sol.x)
+    cfb, mus, share, resistance = unpack(sol.x)
     for k in range(len(measured)):
         t = out.get(f"temperature_{k + 1}")
         if t is not None:                       # viscosity falls as temperature rises
@@ -231,7 +258,7 @@ def _summary(model, measured, names, sol, weighted, unpack) -> dict:
                                          "high": float(mu[2])}
     rows, outside = [], 0
     for k, m in enumerate(measured):
-        cf, inside = model.friction(k, m.speed, cfb, mus[k], share)
+        cf, inside = model.friction(k, m.speed, cfb, mus[k], share, resistance)
         outside += int((~inside).sum())
         rows.append({"curve": k + 1, "speed_m_s": m.speed.tolist(),
                      "measured_cf": m.friction_coefficient.tolist(), "fitted_cf": cf.tolist(),
@@ -277,7 +304,8 @@ def predict(model: FitModel, result: dict, speeds, temperature: float | None,
     curve of the nearest viscosity, or ``curve``, is rescaled (Hersey); without ``curve``
     the band adds the spread of all the simulated curves so rescaled (the Hersey collapse's
     own error, when there are two or more); it adds their C_f error estimates
-    (``cf_err``).  A fitted load share moves C_f along ``model.share_curves``."""
+    (``cf_err``).  A fitted load share and thermal resistance move C_f along
+    ``model.share_curves`` and ``model.resistance_curves``."""
     names = result["fit"]["parameters"]
     x = np.array([result[n]["value"] for n in names])
     cov = np.asarray(result["fit"]["covariance"])
@@ -292,7 +320,7 @@ def predict(model: FitModel, result: dict, speeds, temperature: float | None,
         if k is None:
             k = int(np.argmin([abs(np.log(c.viscosity / mu)) for c in model.curves]))
         return model.friction(k, speeds, v.get("boundary_friction", model.boundary_friction),
-                              mu, v.get("load_share"))
+                              mu, v.get("load_share"), v.get("bulk_resistance"))
 
     value, inside = cf(x)
     discretisation = _error_at(model, speeds) + (_collapse_error(model, cf, x)
