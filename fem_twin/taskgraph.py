@@ -8,9 +8,9 @@ A run's independent work is a graph of tasks, each timed as it ran:
   pass for the grid-error estimate at the chosen h0;
 * the macro scale, after every patch: one sweep per viscosity over the case's speeds (a
   chain of warm-started points: one task, the sum of its points' solve, nested coarse solve
-  and error-estimate seconds), the refinement's added speeds of each (after all first
-  passes), and the patch band's sweeps (after the refinement: they start from the main
-  points' nested solves on their grid).
+  and error-estimate seconds, and a thermal run's earlier iterations), the refinement's
+  added speeds of each (after all first passes), and the patch band's sweeps (after the
+  refinement: they start from the main points' nested solves on their grid).
 
 The rounds are replayed from the checkpoints (the sampler is deterministic), so the graph
 of any finished run can be read back.  :func:`makespan` schedules the graph greedily on
@@ -116,7 +116,7 @@ def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task
             continue
         speed = meta.get("entrainment") if case.tribometer.ball else scalars["speed"]
         seconds = sum(meta.get(k, 0.0) for k in ("seconds", "seconds_coarse",
-                                                   "seconds_estimate"))
+                                                   "seconds_estimate", "seconds_thermal"))
         sweeps[point_key(path)].append((speed, seconds, "error_estimate" in meta))
     main = {k: v for k, v in sweeps.items() if any(e for _, _, e in v)}
     split = {}

@@ -237,10 +237,13 @@ def _solve_point(gap, spacing, factors, load, speed, slide_to_roll, lubricant, f
         return solve(lubricant, None)
     u_m = sliding.get("entrainment", speed / 2)
     surfaces = (u_m - sliding["speed"] / 2, u_m + sliding["speed"] / 2)
+    start = time.perf_counter()
     levels, film, record = thermal_point(solve, lubricant, thermal, factors, surfaces)
-    res = levels[0]
     record["viscosity_Pa_s"] = film.viscosity
-    return (replace(res, meta={**res.meta, "thermal": record}), *levels[1:])
+    last = sum(level.meta["seconds"] for level in levels)     # the final iteration's solves
+    return (replace(levels[0], meta={**levels[0].meta, "thermal": record,
+                                     "seconds_thermal": time.perf_counter() - start - last}),
+            *levels[1:])
 
 
 def film_lubricant(res: MixedResult, lubricant):
