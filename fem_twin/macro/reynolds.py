@@ -135,11 +135,7 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
         disk's, :func:`~fem_twin.macro.kinematics.disk_velocity`); None: +x1
     """
     h, dx, lubricant, mu0 = _inputs(gap, spacing, viscosity, method, couette)
-    if velocity is not None:
-        velocity = np.asarray(velocity, float)
-        if velocity.shape != h.shape + (2,) or not np.all(np.isfinite(velocity)):
-            raise InputError(f"velocity must be finite, shaped like the gap plus (2,): "
-                             f"{h.shape + (2,)}, got {velocity.shape}")
+    velocity = _velocity(velocity, h.shape)
     if ambient_pressure < cavitation_pressure:
         raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
     boundary = h > OPEN_GAP
@@ -173,6 +169,17 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     p_hd = p + cavitation_pressure
     load = float(np.sum(trapezoid_weights(h.shape, dx) * (p_hd - ambient_pressure)))
     return ReynoldsResult(p_hd, theta, load, its, tuple(history))
+
+
+def _velocity(velocity, shape):
+    """A velocity field checked against the gap's ``shape`` (None stays None)."""
+    if velocity is None:
+        return None
+    velocity = np.asarray(velocity, float)
+    if velocity.shape != tuple(shape) + (2,) or not np.all(np.isfinite(velocity)):
+        raise InputError(f"velocity must be finite, shaped like the gap plus (2,): "
+                         f"{tuple(shape) + (2,)}, got {velocity.shape}")
+    return velocity
 
 
 def trapezoid_weights(shape, dx) -> np.ndarray:

@@ -264,12 +264,15 @@ def curve_labels(case: Case, curves) -> list[str]:
 
 def ehl_film(case: Case, points) -> dict:
     """The film of a ball-on-disk sweep's fastest point (first viscosity) beside the
-    Hamrock-Dowson films of the smooth ball at the same u_m: the full-film end of the curve."""
+    Hamrock-Dowson films of the smooth ball at the same u_m and the film's viscosity (the
+    oil's, or a thermal run's at the film temperature): the full-film end of the curve."""
     mu = case.lubricant.viscosities[0]
     u_m = max(u for m, u in points if m == mu)
+    point = points[mu, u_m]
+    film_mu = point.meta.get("thermal", {}).get("viscosity_Pa_s", mu)
     _, _, x1, x2 = ball_contact(case).grid(case.macro.grid)
-    film = film_against_hamrock_dowson(replace(ball_contact(case), viscosity=mu,
-                                               entrainment=u_m), points[mu, u_m], x1, x2)
+    film = film_against_hamrock_dowson(replace(ball_contact(case), viscosity=film_mu,
+                                               entrainment=u_m), point, x1, x2)
     log.info("EHL film at u_m = %g m/s: h_c %.4g m, h_min %.4g m; Hamrock-Dowson %.4g m, "
              "%.4g m", u_m, film["h_c_m"], film["h_min_m"], film["hamrock_dowson_h_c_m"],
              film["hamrock_dowson_h_min_m"])

@@ -70,34 +70,19 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
                    slide_to_roll: float | None = None,
                    error_estimate: bool = False, keep_level: int = 0,
                    guide: str | None = None, thermal=None) -> StribeckCurve:
-    """C_f over ``speeds`` [m/s] at one viscosity (paper 3.2: from 2 m/s down to 0.01 m/s).
+    """C_f over ``speeds`` [m/s] at one viscosity (paper 3.2: from 2 m/s down to 0.01 m/s),
+    each point warm from the previous one (give speeds fast to slow).
 
-    Each point warm-starts from the previous one (give speeds from fast to slow: the
-    hydrodynamic film is the easy start).  ``checkpoint``: folder that keeps every
-    finished point (``MixedResult`` npz, keyed by a hash of all inputs); a rerun loads
-    them instead of recomputing.  ``fields``: folder for one VTU per speed and a PVD.
-    ``factors_key``: a key of the inputs the flow factors were computed from (the pipeline's
-    micro-stage key); the checkpoints then depend on it instead of the factors' bits, so
-    recomputing a lost micro checkpoint (same numbers to ~1e-10) keeps the points.
-    ``slide_to_roll``: a rolling-sliding contact (a ball on a disk): ``speeds`` are then the
-    entrainment speeds u_m and each point slides at ``u_r = slide_to_roll * u_m``.
-    ``error_estimate``: estimate each point's discretisation error of C_f
-    (:func:`fem_twin.macro.estimate.friction_error`, kept in the point's ``meta`` and
-    checkpoint): the curve's ``friction_error`` and ``friction_error_parts``.
-    ``keep_level``: also checkpoint each point's nested solve on the grid coarsened that
-    many times (:func:`~fem_twin.macro.nested.solve_nested`'s level), under the key of a
-    sweep of these factors on that grid (:func:`level_key`); the patch band starts from it.
-    ``guide``: the key of such a sweep on this grid, in ``checkpoint``, with other flow
-    factors (the patch band: the average factors).  Each point then starts from the guide's
-    point at its speed, moved by this sweep's offset from the guide at the previous speed,
-    ``x(U) = x_g(U) + x(U_prev) - x_g(U_prev)`` (the first point: ``x_g(U)``), instead of
-    from ``x(U_prev)`` alone: the guide carries the speed change, the previous point the
-    factors' difference (bundled case, its 12 band sweeps at 64^2: 3163 Newton steps
-    against 4379, C_f the same to 6e-5 C_f,b).  Where a guide point is missing the point
-    starts from the previous one.
-    ``thermal``: a :class:`~fem_twin.macro.thermal.ContactThermal`; each point is then
-    solved at the film temperature its own heat gives it (the curve's
-    ``contact_temperature`` and ``asperity_temperature``; None: isothermal at mu_0).
+    ``checkpoint``: folder keeping every finished point, keyed by a hash of all inputs (a
+    rerun loads them; ``factors_key``: a key of the factors' inputs to hash instead of
+    their bits).  ``fields``: a VTU per speed and a PVD there.  ``slide_to_roll``: a ball
+    on a disk, ``speeds`` the entrainment speeds.  ``error_estimate``: each point's C_f
+    error (:func:`fem_twin.macro.estimate.friction_error`).  ``keep_level``: also keep
+    each point's nested solve that many coarsenings down (:func:`level_key`), which a
+    ``guide`` sweep (the patch band) starts from: ``x(U) = x_g(U) + x(U_prev) -
+    x_g(U_prev)`` (:class:`_Guide`).  ``thermal``: a
+    :class:`~fem_twin.macro.thermal.ContactThermal`, each point at the film temperature of
+    its own heat.
     """
     speeds = np.asarray(speeds, float)
     if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
@@ -105,17 +90,14 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
     if slide_to_roll is not None and not (0 < slide_to_roll <= 2):
         raise InputError(f"slide_to_roll must be in (0, 2], got {slide_to_roll}")
     gap = np.asarray(gap, float)
-    key = sweep_key(gap, spacing, factors if factors_key is None else factors_key, load,
-                    lubricant, settings, face, slide_to_roll, thermal)
-    folder = Path(checkpoint) if checkpoint is not None else None
-    if folder is not None:
-        folder.mkdir(parents=True, exist_ok=True)
-    if fields is not None:
-        fields = Path(fields)
-        fields.mkdir(parents=True, exist_ok=True)
-    kept = None if not (keep_level and folder) else level_key(
-        keep_level, gap, spacing, factors if factors_key is None else factors_key, load,
-        lubricant, settings, face, slide_to_roll, thermal)
+    inputs = (gap, spacing, factors if factors_key is None else factors_key, load, lubricant,
+              settings, face, slide_to_roll, thermal)
+    key = sweep_key(*inputs)
+    folder = None if checkpoint is None else _folder(checkpoint)
+    fields = None if fields is None else _folder(fields)
+    kept = level_key(keep_level, *inputs) if keep_level and folder else None
+    point = _Point(gap, spacing, factors, load, slide_to_roll, lubricant, face, settings,
+                   thermal)
     guided = _Guide(folder, guide)
     # each point's numbers; its fields go to disk at once (a 2048^2 point holds 0.5 GB)
     records, entries, previous = [], [], ()
@@ -125,32 +107,10 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         res = None if path is None else load_or_none(path, MixedResult.load)
         coarser = []                        # the point on each coarsening of the grid
         if res is None:
-            res, *coarser = _solve_point(
-                gap, spacing, factors, load, float(speed), slide_to_roll, lubricant, face,
-                settings, guided.start(speeds, i, previous), thermal)
-            res = replace(res, meta={**res.meta,
-                                     LOAD_BELOW: res.contact_load_below(factors.h0[0])})
-            if coarser:
-                res = replace(res, meta={**res.meta,
-                                         COARSE_CF: [c.friction_coefficient for c in coarser],
-                                         "seconds_coarse": coarser[0].meta["seconds"]})
-            if path is not None:
-                res.save(path)
-            if kept and len(coarser) >= keep_level:
-                level = coarser[keep_level - 1]
-                replace(level, meta={**level.meta, LEVEL_OF: key}).save(
-                    point_file(folder, kept, speed))
+            res, *coarser = point.solve(float(speed), guided.start(speeds, i, previous), path,
+                                        (folder, kept, keep_level, key))
         if error_estimate and "error_estimate" not in res.meta:
-            t0 = time.perf_counter()
-            estimate = friction_error(res, gap, spacing, factors, load=load,
-                                      lubricant=film_lubricant(res, lubricant), face=face,
-                                      settings=settings,
-                                      entrainment=res.meta.get("entrainment"),
-                                      levels=coarser)
-            res = replace(res, meta={**res.meta, "error_estimate": estimate,
-                                     "seconds_estimate": time.perf_counter() - t0})
-            if path is not None:
-                res.save(path)
+            res = point.estimated(res, coarser, path)
         if fields is not None:
             vtu = res.write_vtu(fields / f"mu{lubricant.viscosity:g}_{i:03d}.vtu", origin)
             entries.append((float(res.speed), vtu))            # ParaView time = U [m/s]
@@ -158,15 +118,71 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
         previous = (res, *coarser)
     if fields is not None:
         write_pvd(fields / f"stribeck_mu{lubricant.viscosity:g}.pvd", entries)
+    return _curve(records, speeds, lubricant.viscosity, diameter, load, error_estimate,
+                  thermal is not None)
+
+
+def _folder(path) -> Path:
+    folder = Path(path)
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
+class _Point:
+    """One sweep point's solve (:func:`_solve_point`), with what the sweep keeps of it, and
+    its C_f error estimate."""
+
+    def __init__(self, gap, spacing, factors, load, slide_to_roll, lubricant, face,
+                 settings, thermal):
+        self.gap, self.spacing, self.factors, self.load = gap, spacing, factors, load
+        self.slide_to_roll, self.lubricant, self.face = slide_to_roll, lubricant, face
+        self.settings, self.thermal = settings, thermal
+
+    def solve(self, speed, start, path, keep) -> tuple:
+        """The levels of the point at ``speed`` warm from ``start``, checkpointed at
+        ``path`` with its coarse C_f, and its level ``keep = (folder, key, level,
+        sweep key)`` kept for a guided sweep."""
+        res, *coarser = _solve_point(self.gap, self.spacing, self.factors, self.load, speed,
+                                     self.slide_to_roll, self.lubricant, self.face,
+                                     self.settings, start, self.thermal)
+        meta = {LOAD_BELOW: res.contact_load_below(self.factors.h0[0])}
+        if coarser:
+            meta.update({COARSE_CF: [c.friction_coefficient for c in coarser],
+                         "seconds_coarse": coarser[0].meta["seconds"]})
+        res = replace(res, meta={**res.meta, **meta})
+        if path is not None:
+            res.save(path)
+        folder, kept, level, key = keep
+        if kept and len(coarser) >= level:
+            replace(coarser[level - 1], meta={**coarser[level - 1].meta, LEVEL_OF: key}).save(
+                point_file(folder, kept, speed))
+        return (res, *coarser)
+
+    def estimated(self, res, coarser, path):
+        """``res`` with its C_f error estimate in ``meta`` (saved at ``path``)."""
+        t0 = time.perf_counter()
+        estimate = friction_error(res, self.gap, self.spacing, self.factors, load=self.load,
+                                  lubricant=film_lubricant(res, self.lubricant),
+                                  face=self.face, settings=self.settings,
+                                  entrainment=res.meta.get("entrainment"), levels=coarser)
+        res = replace(res, meta={**res.meta, "error_estimate": estimate,
+                                 "seconds_estimate": time.perf_counter() - t0})
+        if path is not None:
+            res.save(path)
+        return res
+
+
+def _curve(records, speeds, viscosity, diameter, load, error_estimate, thermal):
+    """The :class:`StribeckCurve` of a sweep's point ``records`` (:func:`_record`)."""
     get = lambda name: np.array([r[name] for r in records])  # noqa: E731
     errors = ({part: np.array([r["error_estimate"][part] for r in records])
                for part in (*PARTS, "total")} if error_estimate else None)
     temperature = ({k: get(k) for k in ("contact_temperature", "asperity_temperature")}
-                   if thermal is not None else {})
+                   if thermal else {})
     return StribeckCurve(
         speed=speeds.copy(), **temperature,
-        hersey=hersey_number(lubricant.viscosity, speeds, diameter, load),
-        friction_coefficient=get("friction_coefficient"), viscosity=lubricant.viscosity,
+        hersey=hersey_number(viscosity, speeds, diameter, load),
+        friction_coefficient=get("friction_coefficient"), viscosity=viscosity,
         hydrodynamic_friction=get("hydrodynamic_friction"),
         boundary_friction=get("boundary_friction"),
         contact_load_fraction=get("contact_load") / load, h_d=get("h_d"),
@@ -178,7 +194,11 @@ def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
 
 class _Guide:
     """The starts of a guided sweep (``stribeck_sweep``'s ``guide``), reading the guide's
-    checkpoints in ``folder`` under the key ``guide`` (None: no guide)."""
+    checkpoints in ``folder`` under the key ``guide`` (None: no guide).  The guide, a sweep
+    with other flow factors (the patch band's: the average factors), carries the speed
+    change and the previous point the factors' difference (the bundled case's 12 band
+    sweeps at 64^2: 3163 Newton steps against 4379, C_f the same to 6e-5 C_f,b); where a
+    guide point is missing the point starts from the previous one."""
 
     def __init__(self, folder, guide: str | None):
         self.folder, self.guide = folder, guide
