@@ -103,12 +103,13 @@ FRICTION_LAWS = {"pin": "the force on the pin: wall shear and the film pressure 
 
 
 def stribeck_section(out: RunLayout, friction: str | None = None) -> str:
-    pngs = [out.stribeck_png("speed"), out.stribeck_png("hersey")]
+    pngs = [out.stribeck_png("speed"), out.stribeck_png("hersey"), out.temperature_png]
     law = FRICTION_LAWS.get(friction, "eq 31") if friction else "eq 31"
     text = ("Friction coefficient (eq 34) of the patch-average flow factors, the friction "
             f"being {law}, with the estimated "
             "discretisation error of each point as error bars; the shaded band spans the "
-            "single-patch curves (Figure 13), squares are measured curves.")
+            "single-patch curves (Figure 13), squares are measured curves; a thermal run "
+            "adds the film's and the asperity contacts' temperatures.")
     body = figure_section("Stribeck curves (Figure 14)", pngs, text)
     fields, val = out.fields_pngs(), out.validation_pngs()
     return (body + figure_section("Traction curves (fem-twin traction)", [out.traction_png],
@@ -192,6 +193,8 @@ def caption(png: Path) -> str:
              "stribeck_hersey": "C_f versus Hersey number (eq 46)",
              "flow_factors": "flow factors versus h0", "pin_centre_lines": "pin centre lines",
              "traction": "C_f versus the slide-to-roll ratio",
+             "contact_temperature": "the film's and the asperity contacts' temperatures "
+                                    "versus sliding speed",
              "cf_dev": f"C_f,dev of the {png.parent.name} study"}
     if stem in fixed:
         return fixed[stem]
