@@ -169,11 +169,11 @@ def test_anderson_mixing_is_gmres_on_a_linear_map():
 
 
 def test_pardiso_runs_the_threads_fem_twin_threads_allows():
-    """FEM_TWIN_THREADS=2 when MKL first loads: MKL's OpenMP layer with two threads for a
-    matrix of THREADED_UNKNOWNS or more (a lone large point), the same factors to round-off
-    as the default sequential layer with one (one process each: the layer is chosen at
-    load).  The threads are read from MKL, not timed: CPU over wall time depends on the
-    machine's load."""
+    """FEM_TWIN_THREADS=2 when MKL first loads: MKL's OpenMP layer, and PARDISO called with
+    two threads on a matrix of THREADED_UNKNOWNS or more (a lone large point), one below,
+    the same factors to round-off as the default sequential layer (one process each: the
+    layer is chosen at load).  The threads are those the solver asks MKL for, not timed:
+    CPU over wall time depends on the machine's load."""
     if _mkl_rt() is None:
         pytest.skip("MKL not installed")
     import json
@@ -186,18 +186,25 @@ def test_pardiso_runs_the_threads_fem_twin_threads_allows():
         "import json, numpy as np, sys\n"
         "sys.path.insert(0, 'tests')\n"
         "from test_linalg import diffusion\n"
-        "from fem_twin.linalg import SPDSolver\n"
+        "from fem_twin.linalg import SPDSolver, _mkl_rt\n"
+        "lib, asked = _mkl_rt(), []\n"
+        "setter = lib.MKL_Set_Num_Threads_Local\n"
+        "def spy(n):\n"
+        "    asked.append(n.value)\n"
+        "    return setter(n)\n"
+        "lib.MKL_Set_Num_Threads_Local = spy\n"
         "from threadpoolctl import threadpool_info\n"
         "out = {}\n"
         f"for n in (200, {int(np.sqrt(THREADED_UNKNOWNS)) + 2}):\n"
         "    K = diffusion(n, seed=1)\n"
         "    s = SPDSolver(K.indptr, K.indices, 'pardiso').factor(K.data)\n"
+        "    del asked[:]\n"
         "    s.factor(K.data)\n"
         "    x = s.solve(np.ones(K.shape[0]))\n"
-        "    out[n] = {'x': x[:50].tolist()}\n"
+        "    out[n] = {'x': x[:50].tolist(), 'threads': max(asked)}\n"
         "mkl = [i for i in threadpool_info() if i['internal_api'] == 'mkl']\n"
         "print(json.dumps({'runs': list(out.values()), 'layer': [i.get('threading_layer') "
-        "for i in mkl], 'threads': [i['num_threads'] for i in mkl]}))\n")
+        "for i in mkl]}))\n")
     out = {}
     for threads in ("1", "2"):
         env = {k: v for k, v in os.environ.items() if not k.startswith("MKL_")}
@@ -207,8 +214,9 @@ def test_pardiso_runs_the_threads_fem_twin_threads_allows():
                              check=True)
         out[threads] = json.loads(run.stdout.splitlines()[-1])
     assert out["1"]["layer"] == ["sequential"] and out["2"]["layer"] == ["intel"]
-    assert out["2"]["threads"] == [2]
     (small1, large1), (small2, large2) = out["1"]["runs"], out["2"]["runs"]
+    assert (small1["threads"], large1["threads"], small2["threads"], large2["threads"]) == (
+        1, 1, 1, 2)
     for one, two in ((small1, small2), (large1, large2)):
         assert np.allclose(one["x"], two["x"], rtol=1e-10, atol=0)
 
