@@ -9,18 +9,16 @@ the same pattern; the factorisation is 85 % of the roughness-scale time.  Two ba
 ``"pardiso"``
     MKL PARDISO, sparse Cholesky (matrix type 2) through ``ctypes``: the METIS ordering and
     symbolic analysis run once per pattern (phase 11), each new matrix only repeats the
-    numeric factorisation (phase 22), by the two-level algorithm (``iparm[23] = 1``: the
-    cell Cholesky in 0.60-0.78x the time from 64^2 to 256^2, the macro Newton LU in
-    0.77-0.92x, sequential MKL 2026.2, 2026-11-26).  About 3x faster than SuperLU on a
+    numeric factorisation (phase 22), by the two-level algorithm (``iparm[23] = 1``,
+    faster on both the cells and the macro Newton LU).  About 3x faster than SuperLU on a
     256^2 cell (``benchmarks/run.py micro``).  Needs ``libmkl_rt`` from the ``mkl`` wheel, which
     ``pip install "fem-twin[pardiso]"`` installs; MKL is under the Intel Simplified Software
     License, so it stays an optional extra, not a core dependency.  MKL runs sequentially
     (``MKL_THREADING_LAYER=SEQUENTIAL``): parallel speed comes from processes.  A process
     that allows more threads when it first loads MKL (``FEM_TWIN_THREADS=N``, for a lone
     large point such as the 2048^2 grids of the resolution study) gets MKL's OpenMP layer
-    and N PARDISO threads on matrices of ``THREADED_UNKNOWNS`` or more: a 1024^2 Newton LU
-    factorised in 0.62x the time on 2 threads (1.46 against 2.37 s, solves 0.52x;
-    sequential and one OpenMP thread take the same).
+    and N PARDISO threads on matrices of ``THREADED_UNKNOWNS`` or more (a 1024^2 Newton LU
+    in 0.62x the time on 2 threads).
     Its idle threads sleep at once (``KMP_BLOCKTIME=0``): spinning for the default 200 ms
     after each call, they took a core from the numpy work between the solves (the 512^2
     cold point of ``benchmarks/run.py scale`` 20.4 against 17.9 s).
@@ -49,11 +47,8 @@ from .threads import thread_limit
 
 BACKENDS = ("superlu", "pardiso")
 #: PARDISO uses the threads ``FEM_TWIN_THREADS`` allows only on matrices of at least this
-#: many unknowns.  Measured on the macro Newton LU (2026-11-27, 2 threads against one, AMD
-#: EPYC): the 64^2 level of a cold nested point took 3.4 s against 1.7 s (68 coupling
-#: iterations of small solves, each waking the sleeping threads), the 256^2 level (53k
-#: unknowns) 3.1 against 2.7 s, the 512^2 one (214k) 7.5 against 8.6 s; a 1024^2
-#: factorisation 0.65x (0.96 against 1.46 s, 859k unknowns)
+#: many unknowns: below, waking the sleeping threads for each small solve costs more than
+#: they bring (benchmarks/README.md, "linalg")
 THREADED_UNKNOWNS = 1 << 17
 
 
@@ -100,9 +95,8 @@ class SPDSolver:
     PARDISO matrix type 11 with pivot perturbation, whose count after ``factor`` is
     ``perturbed``: a caller that needs an exact step checks it).  ``single=True`` (PARDISO
     only): the factors in single precision, half the memory (667k unknowns of the 3x3
-    stencil: 0.97 against 1.28 GiB), not always faster (2026-11-26, one Xeon: 1.2-1.5x
-    slower to 256^2, level at 512^2; 2026-11-27, AMD EPYC: the macro Newton LU in
-    0.60-0.82x the time from 13k to 859k unknowns); ``solve`` is then
+    stencil: 0.97 against 1.28 GiB), not always faster (it depends on the processor);
+    ``solve`` is then
     accurate to about 1e-5 relative and the caller refines.  ``order`` (PARDISO only): the
     unknowns in the order of elimination, a fill-reducing order the caller knows better
     than METIS (a grid's nested dissection, :mod:`fem_twin.ordering`); None: METIS.
@@ -182,9 +176,8 @@ class SPDSolver:
             return self._lu.solve(rhs)
         if self._a is None:
             raise SolverError("factor() a matrix before solve()")
-        # one column per call: PARDISO's block solve of 3 columns took 1.6-1.8x as long as
-        # three single ones on 64^2-128^2 cells, the same from 256^2 on (2026-11-26, MKL
-        # 2026.2, sequential)
+        # one column per call: PARDISO's block solve of 3 columns is slower than three single
+        # ones on small cells, the same on large ones
         b = np.asfortranarray(rhs.reshape(self.n, -1), dtype=self.dtype)
         x = np.column_stack([self._pardiso(33, b[:, [j]]) for j in range(b.shape[1])])
         return x.reshape(rhs.shape).astype(float, copy=False)

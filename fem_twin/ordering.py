@@ -11,10 +11,8 @@ import numpy as np
 
 from .errors import SolverError
 
-#: the pieces a sub-grid's order (:func:`subgrid_order`) stops bisecting at: PARDISO's LU
-#: of the macro Newton matrices (3x3 stencil, 2026-11-27, one thread) in the order of
-#: leaf 2 against leaf 4: 9.29 against 9.67 s at 2048^2, the same (1.76 s) at 1024^2;
-#: SuperLU the same at 256^2 and 512^2
+#: the pieces a sub-grid's order (:func:`subgrid_order`) stops bisecting at (2 is as fast
+#: as 4 or faster for both solvers; benchmarks/README.md, "ordering")
 SUBGRID_LEAF = 2
 #: the deepest bisection whose base-3 keys fit in 64 bits (sides up to about 2^19 pixels)
 MAX_DEPTH = 39
@@ -103,9 +101,7 @@ def subgrid_order(shape, position, leaf: int = SUBGRID_LEAF) -> np.ndarray:
     """The unknowns of a subset of the pixels of a non-periodic ``(ny, nx)`` grid in the
     order of :func:`nested_dissection` (the subset's unknown numbers; ``position``: each
     pixel's number, flat, -1 outside the subset).  For a pin face inside its grid, PARDISO
-    factorises the macro Newton matrices in this order in 0.67x METIS's time at 2048^2
-    (9.3 against 13.8 s; fill 425M against 483M), 0.86x at 1024^2 (1.76 against 2.05 s),
-    the same to 512^2, and its analysis takes a quarter of the time (one thread,
-    2026-11-27)."""
+    factorises the macro Newton matrices in this order faster than in METIS's on large grids
+    (0.67x at 2048^2), with less fill and a quarter of the analysis time."""
     order = np.asarray(position)[nested_dissection(shape, leaf)]
     return order[order >= 0]

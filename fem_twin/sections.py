@@ -192,18 +192,16 @@ class RunSpec:
                                     unit="address")
     patch_band: bool = setting(True, "one more sweep per patch: the roughness scatter band "
                                "(Figure 13)", unit="true or false")
-    # "coarsest" from the paper case (2026-11-26, 6 patches, 32 speeds, against the band
-    # swept at 256^2): a patch's C_f within 0.45 % C_f,b at 64^2 and 0.14 % at 128^2 on a
-    # band 45.9 % C_f,b wide; a 32-speed sweep 6.0 s at 64^2 against 18.4 s at 128^2
+    # "coarsest": a patch's C_f within 0.45 % C_f,b of the band swept on the full grid,
+    # on a band about 46 % C_f,b wide, at a third of the time (benchmarks/README.md)
     band_grid: str = setting("coarsest", "the band's macro grid, C_f corrected by the "
                              "average curve's relative change to the full grid: \"coarsest\" (the "
                              "main sweeps' coarsest nested grid, 48-95 px a side: 64^2 from "
                              '128^2 to 1024^2), "coarse" (every other node) or "full"',
                              unit="coarsest, coarse or full",
                              choices=("coarsest", "coarse", "full"))
-    # 1e-3 from the bundled case (2026-11-27, its 12 band sweeps at 64^2): the patches' C_f
-    # within 0.038 % C_f,b of 1e-4, 8x below the band's own error against the band swept
-    # on the full grid (0.31 %), in 0.79x the Newton steps
+    # 1e-3: the patches' C_f within 0.04 % C_f,b of 1e-4, far below the band's own grid
+    # error, in fewer Newton steps (benchmarks/README.md)
     band_tol: float = setting(1e-3, "coupling tolerance of the band's sweeps ([macro] tol "
                               "for the main curves, which carry the error estimates)",
                               unit="-")

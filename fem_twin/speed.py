@@ -2,14 +2,12 @@
 estimates were measured on (:meth:`fem_twin.case.Case.estimated_seconds`).
 
 Costs measured on one machine say little about another (a laptop, SuperLU instead of
-PARDISO), and the project's own 2-core machine ran the same work up to 1.9x slower from
-one hour to the next (2026-11-25).  Before a run, :func:`slowdown` times a miniature of
-the micro stage (a 64^2 roughness patch pair, two separations, four instants: periodic
-contact and the three cell problems, with the sparse backend the run will use) and divides
-by its time at the calibration.  It sees the machine for about a second: on the shared
-2-core machine of 2026-11-26 eight probes within a minute read 0.18-0.29 s, so there the
-estimate carries that scatter (the bundled case: 1.13x the measured time with the probe,
-0.71x without; the paper case at ``h0_tol = 0.1``: 1.49x with it, 1.0x without).
+PARDISO), and a shared machine runs the same work up to about 2x slower from one hour to
+the next.  Before a run, :func:`slowdown` times a miniature of the micro stage (a 64^2
+roughness patch pair, two separations, four instants: periodic contact and the three cell
+problems, with the sparse backend the run will use) and divides by its time at the
+calibration.  It sees the machine for about a second, so the estimate carries the scatter
+of the machine's speed within a minute (benchmarks/README.md, "speed").
 """
 
 from __future__ import annotations
@@ -25,7 +23,7 @@ from .threads import one_thread
 from .topography.synthetic import self_affine
 
 #: the miniature's time on the calibration machine, the hour the estimate's costs were
-#: measured (2026-11-26 13:36-13:45: 0.169-0.186 s, best of five, PARDISO) [s]
+#: measured (best of five, PARDISO) [s]
 REFERENCE_SECONDS = 0.18
 #: timed repeats of the miniature (the best counts: the machine's speed, not a hiccup)
 REPEATS = 5

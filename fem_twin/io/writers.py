@@ -1,10 +1,8 @@
 """A run's output files written on its worker processes, beside the main process's work:
 the figures, ``results.nc`` and ``fields.nc``.
 
-Measured (bundled case, 2026-11-26): the run's five figures took 9 s of its 123 in the main
-process while both workers waited (matplotlib's layout and text are pure Python, so they
-gain from processes, not threads); the NetCDF files then took 5.7 s of the last 7 s after
-the last Stribeck point.
+Written in the main process, the figures kept the workers waiting (matplotlib's layout and
+text are pure Python, so they gain from processes, not threads; benchmarks/README.md).
 """
 
 from __future__ import annotations

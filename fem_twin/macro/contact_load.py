@@ -6,8 +6,8 @@ factors' ``p_con(h0)`` (eq 11) into the load balance (eq 28), the elastic deform
 patches: a factor of about 3 per 40 nm), while across one pixel of a crowned pin face ``h0``
 changes by as much (60 nm at 128^2 over 8 mm).  Read at the nodes, as the paper does
 (``"nodal"``), the contact pressure misjudges the load the pixels around a node carry: on
-the bundled pin at 128^2 it overstated the contact load of the film it was given by 3-8 %,
-and by 9-22 % on the grid coarsened by two (mixed regime, 2026-11-25).
+the bundled pin at 128^2 it overstates the contact load of the film it is given by 3-8 %,
+and by 9-22 % on the grid coarsened by two (mixed regime; docs/accuracy.md).
 
 ``"gauss"`` (the default) takes the Galerkin load of the contact pressure over the Q1 film,
 lumped onto the nodes:

@@ -45,11 +45,9 @@ MACRO_ORDER = 1.5
 H0_SPACING_RATIO = 4.0
 #: the parts of an estimate, in the order of the CSV and NetCDF outputs
 PARTS = ("macro", "time", "grid", "h0", "film")
-#: the fewest nodes a side of the grid the micro parts are solved on.  Measured on the
-#: bundled case's factors and sample pin 1 at 1024^2 (2026-11-27; docs/accuracy.md): the
-#: sum of the parts on the 256^2 level within 3.3 % of the 512^2 one at 0.03, 0.05 and
-#: 0.1 m/s (the parts are 1.2-26 times their own true changes), in 4.0-6.1 s against
-#: 29-40 s
+#: the fewest nodes a side of the grid the micro parts are solved on: there their sum is
+#: within a few per cent of the next finer level's at a seventh of the time
+#: (docs/accuracy.md)
 MICRO_PARTS_SIDE = 192
 
 

@@ -54,10 +54,8 @@ RETRIES = 12
 #: Anderson iterations without halving the residual before its history is restarted
 STAGNATION = 25
 #: the inner Reynolds solves stop after ``MacroSettings.inner_steps`` Newton steps while the
-#: coupling residual exceeds this multiple of ``tol`` (``benchmarks/run.py newton``, 8 speeds
-#: at 256^2: 2.0x faster than exact inner solves with one step, C_f within 3e-8 C_f,b).
-#: 100 at tol 1e-6; 10 at tol 1e-4 (2026-11-25: 6 warm speeds at 256^2 in 18.3 s against
-#: 19.2 s with 100, a cold 1024^2 point 131.9 s against 142.7 s, C_f within 3e-7 C_f,b)
+#: coupling residual exceeds this multiple of ``tol``: about twice as fast as exact inner
+#: solves, C_f the same to 3e-7 C_f,b (benchmarks/README.md, "fixed_point")
 INEXACT = 10.0
 #: the last Anderson differences of a coarser grid's solve that seed a finer one's
 #: (:class:`Secants`; sample pin 1 at 0.03 m/s, cold nested points: the 512^2 grid 10
@@ -66,15 +64,10 @@ INEXACT = 10.0
 SEED_PAIRS = 4
 #: the first Reynolds solve of a coupling stops at the first Newton step that switches at
 #: most this fraction of the nodes its first step switched (``settle`` of
-#: :func:`.switch.solve_complementarity`), instead of solving to convergence: from a
-#: coarser grid's film the steps switch 3407, 1646, 327, 34, then 1-4 nodes five times
-#: (the cold 1024^2 point of ``benchmarks/run.py scale``), and that tail took 14 of the
-#: fine level's 62 s.  Measured on that benchmark's points (2026-11-27, one thread): 0.01
-#: stops after the 34 (warm: after 6 of 4090) and gave 0.82x and 0.86x the cold and warm
-#: 2048^2 points (384 against 468 s, 288 against 334 s; 7 and 6 coupling iterations
-#: against 7 and 5; C_f within 3e-10), with 0.1 the warm 2048^2 point took 14 iterations
-#: and 1.35x the time (it stops with hundreds of nodes still to switch); stopping after
-#: one step (a plain inexact first solve) took 15 coupling iterations against 10 at 512^2
+#: :func:`.switch.solve_complementarity`), instead of solving to convergence: from a coarser
+#: grid's film the last steps switch a handful of nodes each and cost a fifth of the fine
+#: level; 0.01 saves it without more coupling iterations (benchmarks/README.md,
+#: "fixed_point")
 SETTLE = 0.01
 
 
@@ -299,9 +292,8 @@ def elastic_ratio(ev, op, s) -> float:
     have no film and are left out: one such node under pressure made the ratio 25-252 on
     the 63^2 coarse start of sample pin 1 at 500, 999 and 1997 px (0.003 and 0.03 m/s),
     whose levels then all took the Newton coupling, and a 1997^2 point ran out of 24 GB.
-    Measured without them (2026-11-27): smooth balls 11-241 for M = 10-300, L = 5 and 20
-    (M = 1000: 2.2, it falls back to the Newton coupling when the fixed point fails); the
-    sample pin at 128^2 to 2048^2 and 0.003-1 m/s 0.22-13.3."""
+    Without them smooth balls give 11-241 and the sample pin 0.22-13.3
+    (benchmarks/README.md, "fixed_point")."""
     p_gauge = ev.p + s.cavitation_pressure - s.ambient_pressure
     film = ev.h0[(p_gauge > 0) & (ev.h0 > 2 * s.gap_floor)]
     if not film.size:

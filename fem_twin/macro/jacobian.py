@@ -211,10 +211,9 @@ class Preconditioner:
 def _grid_lu(A, shape, nodes):
     """SuperLU of the sparse ``A`` whose unknowns are the grid ``shape``'s flat ``nodes``,
     eliminated in the grid's nested-dissection order (:func:`~fem_twin.ordering.subgrid_order`)
-    with diagonal pivots preferred; ``solve(rhs)`` in ``A``'s numbering.  Against SuperLU's
-    own COLAMD order: a Newton point of the smooth ball at 385^2 in 0.84x the time, peak
-    memory 0.70x (2026-11-28).  PARDISO's LU as :class:`~fem_twin.linalg.SPDSolver` runs it
-    (no matching, no scaling) missed these matrices by O(1): not used."""
+    with diagonal pivots preferred (faster and leaner than SuperLU's own COLAMD order);
+    ``solve(rhs)`` in ``A``'s numbering.  PARDISO's LU as :class:`~fem_twin.linalg.SPDSolver`
+    runs it (no matching, no scaling) misses these matrices by O(1): not used."""
     position = np.full(int(np.prod(shape)), -1)
     position[nodes] = np.arange(nodes.size)
     order = subgrid_order(shape, position)

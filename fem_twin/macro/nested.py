@@ -100,10 +100,8 @@ def _film_from(coarse: MixedResult, start: MixedResult) -> MixedResult:
     """``start`` with the film pressure and cavity fraction of the ``coarse`` solution,
     interpolated: where film and cavity meet.  Moved by the coarse change instead, the
     previous point's free boundary lies farther from the new one than the coarse solution's
-    does (the warm 2048^2 point of ``benchmarks/run.py scale``: its first Reynolds solve
-    switched 12143 nodes, then 5678 ... 101 in 8 factorisations, against 6971 ... 44 in 4
-    from the coarse film; the point 0.89x the time on two threads, 0.86x on one,
-    2026-11-27)."""
+    does: its first Reynolds solve switches about twice the nodes in twice the
+    factorisations (benchmarks/README.md, "macro/nested")."""
     shape, spacing = start.pressure.shape, start.spacing
     return replace(start, pressure=resampled(coarse.pressure, coarse.spacing, shape, spacing),
                    cavity_fraction=np.clip(resampled(coarse.cavity_fraction, coarse.spacing,

@@ -55,19 +55,16 @@ class MacroSettings:
     gains: tuple = setting(T.MACRO_GAINS, "K_P, K_I, K_D of the PID on h_d, eq 29 (pid "
                            "coupling)", unit="-")
     anderson_depth: int = setting(8, "iterates the Anderson acceleration keeps", unit="-")
-    # 0.5 from measured iterations (2026-11-26, sample pin, 16 speeds at 256^2: 138 fine
-    # iterations against 156 undamped, C_f within 1e-5 C_f,b; 1024^2 point: 10 against 14
-    # cold; bundled case, 2 same-run pairs: sweeps 0.77x, 386 against 418 iterations, C_f
-    # within 3.3e-5 C_f,b)
+    # 0.5: fewer coupling iterations than undamped, C_f the same to 3.3e-5 C_f,b
+    # (benchmarks/README.md, "macro/settings")
     anderson_damping: float = setting(0.5, "damping beta of the Anderson step (1: undamped)",
                                       unit="-")
     inner_steps: int = setting(1, "Newton steps per Reynolds solve while far from the fixed "
                                "point (0: every solve to convergence)", unit="-")
     p_ref: float = setting(100e6, "pressure scale of the residuals and of theta", unit="Pa")
     h_ref: float = setting(1e-6, "length scale of the residuals", unit="m")
-    # 1e-4 from measured convergence (2026-11-25, docs/accuracy.md): C_f within 2.1e-5
-    # C_f,b of 1e-6 on the paper case's 64 points, against C_f error estimates of 1e-4 to
-    # 1e-2 C_f,b; 34 % fewer coupling iterations
+    # 1e-4: C_f within 2.1e-5 C_f,b of 1e-6, far below the points' error estimates
+    # (docs/accuracy.md)
     tol: float = setting(1e-4, "convergence tolerance of the coupling (scaled residuals)",
                          unit="-")
     max_iter: int = setting(300, "iterations of the coupling before it gives up", unit="-")

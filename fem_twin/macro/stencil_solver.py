@@ -2,46 +2,20 @@
 
 The Newton matrix ``J = K diag(pos) + B diag(dtheta)`` of the interior lives on a pattern
 fixed per grid: PARDISO's symbolic factorisation is computed once per grid, in the grid's
-nested-dissection order (:func:`fem_twin.ordering.subgrid_order`: 0.67x METIS's
-factorisation time at 2048^2, 0.86x at 1024^2), and where each entry of ``K`` and ``B``
-lands in that pattern once per sparsity pattern of theirs, so a step costs one numeric
-factorisation and a solve (the kept maps made a bundled-case sweep 12 % faster).  On grids
-of more than ``SINGLE_UNKNOWNS`` unknowns the factors are single precision, refined with
-the residual in double precision (one refinement step reaches ``STEP_RTOL`` on the
-equilibrated matrix; half the factors' memory:
-2.06 GiB at 2048^2).  Single precision factorises the same Newton matrices in 0.82x the
-time at 13k unknowns, 0.75x at 53k, 0.67x at 214k and 0.60x at 859k (PARDISO, one thread,
-AMD EPYC, 2026-11-27); below ``SINGLE_UNKNOWNS`` the refinement's extra solve and product
-cost about what that saves, and double precision needs no refinement.  The products
-``J x`` of the refinement are taken from ``K`` and ``B`` themselves:
-``J``'s entries are built once per factorisation, and no double-precision copy of them is
-kept.
-
-The factors of a step are kept for the next steps of the same inner solve (``K`` and
-``B`` do not change within it, only which nodes are film and which cavity).  A step whose
-matrix differs from the factorised one ``J_0`` in the ``m`` columns of the nodes switched
-since is solved with those factors updated by the Woodbury identity (Hager 1989,
-"Updating the inverse of a matrix", SIAM Review 31): ``J = J_0 + U V^T``, ``V^T x`` the
-switched entries of ``x``, ``W = J_0^-1 U`` (one solve per switched column, kept per node
-for the later steps), and ``J^-1 = J_0^-1 - W (I + V^T W)^-1 V^T J_0^-1``, applied as the
-preconditioner of the same refinement in double precision as a new factorisation's.  A
-step tries it when one solve per newly switched column plus two refinement passes take
-at most :meth:`_Grid.budget` solves (about half a factorisation; else it factorises
-anew).  It replaced GMRES with the kept factors, which lost its Krylov space at every
-refinement pass and had to find the switched columns again: on the cold 2048^2 point of
-``benchmarks/run.py scale`` 3 of the last exact solve's 5 GMRES attempts failed their
-budget of 14 solves (4 switched nodes: GMRES passes of 6, 3 and 3 solves, the true
-residual 0.36 after the first pass at GMRES's estimate of 1e-4), where the update
-solved the same step to 1.5e-11 in 4 + 3 solves (2026-11-27).  The factors are freed when
-the inner solve ends (``step.release()``).  A step is returned only when it solves ``J x =
-rhs`` to ``STEP_RTOL``.
-
-Tried and dropped (2026-11-25, bundled case, 12 speeds at 128^2): the last factorisation
-as a GMRES preconditioner for the next step.  The matrices move too much between coupling
-iterations (nodes switching between film and cavity, ``h^3`` near contact): 214 of 444
-attempts did not converge in 30 iterations, and the sweep took 27.6 s against 20.2 s.
+nested-dissection order (:func:`fem_twin.ordering.subgrid_order`), and where each entry of
+``K`` and ``B`` lands in that pattern once per sparsity pattern of theirs, so a step costs
+one numeric factorisation and a solve.  On grids of more than ``SINGLE_UNKNOWNS`` unknowns
+the factors are single precision, refined with the residual in double precision (one step
+reaches ``STEP_RTOL``; half the factors' memory), the products ``J x`` taken from ``K`` and
+``B`` themselves.  The factors of a step serve the next steps of the same inner solve: a
+matrix that differs in the ``m`` columns of the nodes switched since is solved with them
+updated by the Woodbury identity (Hager 1989, SIAM Review 31), ``J^-1 = J_0^-1 - W (I +
+V^T W)^-1 V^T J_0^-1`` with ``W = J_0^-1 U``, as the refinement's preconditioner, when
+that takes at most :meth:`_Grid.budget` solves (else it factorises anew).  A step is
+returned only when it solves ``J x = rhs`` to ``STEP_RTOL``; the factors are freed when
+the inner solve ends (``step.release()``).  The measurements behind these choices, and
+what was tried and dropped, are in ``benchmarks/README.md`` ("stencil_solver").
 """
-
 from __future__ import annotations
 
 import hashlib
@@ -68,14 +42,11 @@ SINGLE_MAX = 1e30
 REUSE_SOLVES = 16
 #: ... which is at most half a factorisation's time: a step takes one solve per node newly
 #: switched, plus about two refinement passes.  A factorisation costs about
-#: ``1.44 n^0.2`` solves of the grid's ``n`` unknowns (PARDISO, one thread, 2026-11-27:
-#: 16.7 at 214k unknowns, 22 at 859k; 20-40 at 3.4M), a rule of the size rather than of
-#: measured times so that a run repeats to the last bit
+#: ``1.44 n^0.2`` solves of the grid's ``n`` unknowns (PARDISO, one thread), a rule of the
+#: size rather than of measured times so that a run repeats to the last bit
 REUSE_SHARE = 0.5 * 1.44
-#: grids of more unknowns factorise in single precision (from about 181^2 nodes; the cold
-#: and warm points of ``benchmarks/run.py scale`` against 2^20, twice each, 2026-11-27:
-#: 0.87-0.94x and 0.85-0.90x at 256^2, 0.86-0.89x and 0.84-0.87x at 512^2, 0.78-0.79x and
-#: 0.73-0.75x at 1024^2, peak memory 0.83x there, C_f the same to 1e-13)
+#: grids of more unknowns factorise in single precision (from about 181^2 nodes: faster
+#: from there on, C_f the same to 1e-13)
 SINGLE_UNKNOWNS = 1 << 15
 #: grids whose patterns and PARDISO analyses are kept (a sweep with error estimates
 #: alternates between the grid and its coarsening) ...

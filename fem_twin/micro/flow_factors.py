@@ -29,9 +29,9 @@ from .estimate import combine
 ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "friction_factor", "pressure_friction",
           "contact_fraction")
 #: p_con is interpolated as ``log(p_con + P_CON_FLOOR max p_con)``: it falls by a factor of
-#: about 3 per 40 nm of h0, and linearly between samples 1.17 apart (16 over a decade) the
-#: bundled case's C_f was up to 0.13 % C_f,b off a 46-separation run, in log 0.019 %
-#: (2026-11-25); the floor keeps the log finite where the surfaces separate (p_con = 0)
+#: about 3 per 40 nm of h0, so its logarithm interpolates seven times closer than p_con
+#: itself (benchmarks/README.md); the floor keeps the log finite where the surfaces
+#: separate (p_con = 0)
 P_CON_FLOOR = 1e-6
 #: what the friction needs beyond the Reynolds equation (eqs 31-32, the force on the pin)
 SHEAR = ("C", "d", "friction_factor", "pressure_friction", "contact_fraction")

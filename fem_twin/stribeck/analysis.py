@@ -22,12 +22,9 @@ def defect_corrected(patch_curves, fine, coarse) -> list:
     h by the average curve's relative grid change: ``C_f,i(h) ~ C_f,i(H) C_f(h) / C_f(H)``
     (``fine`` and ``coarse`` are the average-factor curves per lubricant on the two grids,
     at the patch curves' speeds).  Relative, because the patches' grid errors scale with
-    their C_f: against the band swept on the full grid the largest error was 0.45 %
-    C_f,b (paper case, 64^2 against 256^2), 0.14 % (128^2) and 0.31 % (bundled case, 64^2
-    against 128^2), where adding the average's change ``C_f(h) - C_f(H)`` left 0.80 %,
-    0.21 % and 0.60 %, and no correction 0.49 %, 0.13 % and 0.42 % (2026-11-26,
-    docs/accuracy.md).  Only C_f is corrected: the band (:func:`patch_band`) reads nothing
-    else."""
+    their C_f: against the band swept on the full grid it leaves about half the error of
+    adding the average's change ``C_f(h) - C_f(H)`` (docs/accuracy.md).  Only C_f is
+    corrected: the band (:func:`patch_band`) reads nothing else."""
     out = []
     for per_mu in patch_curves:
         out.append([replace(c, friction_coefficient=c.friction_coefficient

@@ -23,7 +23,7 @@ from ..threads import one_thread
 from .curve import StribeckCurve, hersey_number
 
 #: a point's ``meta`` entry for C_f on the grids coarsened by two, four, ... (its nested
-#: coarse solves, finest first; a float in checkpoints of before 2026-11-26: by two only)
+#: coarse solves, finest first; a float in older checkpoints: by two only)
 COARSE_CF = "coarse_friction_coefficient"
 #: the ``meta`` entry of a nested level kept as a checkpoint (``keep_level``): the key of
 #: the sweep whose point solved it (its time is that point's)
