@@ -1,41 +1,23 @@
 """The Couette term of eq 17, ``div(q (1 - theta))``, on the dual cells of the node grid.
 
 Every face between two neighbouring nodes ``a -> b`` carries the liquid flux
-
-    width * q_f * s_up,       s = 1 - theta,
-
-out of ``a``'s dual cell into ``b``'s, so mass is conserved face by face whatever the
-scheme.  The liquid fraction ``s`` is always taken from the upstream node (the sign of
-the face's ``q`` decides): in a cavity the equation is pure transport of ``s h`` with no
-pressure diffusion, and only an upwind ``s`` keeps theta in [0, 1] and monotone.  The
-schemes differ in the face value ``q_f`` of the Couette coefficient ``q = rho h_m u_m b``:
+``width * q_f * s_up`` (``s = 1 - theta``) out of ``a``'s dual cell into ``b``'s, so mass is
+conserved face by face whatever the scheme.  The liquid fraction is always the upstream
+node's (the sign of the face's ``q`` decides): in a cavity the equation is pure transport of
+``s h``, and only an upwind ``s`` keeps theta in [0, 1] and monotone.  The schemes differ in
+the face value ``q_f`` of the Couette coefficient ``q = rho h_m u_m b``:
 
 ``"central"`` (default)
-    ``q_f = (q_a + q_b) / 2``, the face-centred coefficient of Ausas, Jai and Buscaglia
-    (J. Tribol. 131, 2009, 031702) with the upwind saturation of Elrod and Adams.  In full
-    film (``s = 1``) the flux is the second-order central one, so the wedge term of eq 17
-    is second order; in a cavity ``q_f s_up`` is constant along the flow exactly as
-    ``q s`` is.  Measured (``tests/test_reynolds.py``, ``tests/test_couette.py``):
-    Swift-Stieber cylinder load -0.93, -0.24, -0.063 % at 100, 200, 400 cells (order 1.9);
-    a pocketed pad with inlet suction, rupture and reformation -0.12 % at 161 nodes
-    against the exact solution (upwind: -17 %); the bundled sample pin's C_f at 0.03 m/s
-    0.09004, 0.08905, 0.08880 on 128, 255, 509 px (order 1.97; upwind 0.49); the Mourier
-    EHL ball's central film 207.7 nm at 97^2 against 210 nm measured (upwind 228.4 nm).
-    On very coarse grids of heavily loaded balls (< 60 nodes per side) it underestimates
-    the film more than upwind overestimates it (docs/accuracy.md).  A van Albada-limited
-    upwind reconstruction of ``q_f`` was measured too and is not offered: it equals the
-    central scheme in EHL and falls to first order where a pocket's wall meets the land
-    (it upwinds at every kink of ``q``, right at the rupture).
+    ``q_f = (q_a + q_b) / 2`` (Ausas, Jai and Buscaglia, J. Tribol. 131, 2009, 031702, with
+    Elrod and Adams' upwind saturation): second order in full film, ``q_f s_up`` constant
+    along the flow in a cavity (docs/accuracy.md: Swift-Stieber, a pocketed pad, EHL).
 ``"upwind"``
-    ``q_f = q_up``: the paper's first-order upwind flux (reproduces the paper), whose
-    error in full film is a numerical diffusion ``|q| dx / 2``.
+    ``q_f = q_up``: the paper's first-order flux, a numerical diffusion ``|q| dx / 2``.
 
-Written as face matrices, per direction ``k``: ``outflow = D_k ((J_k q_k) * (U_k s))``
-with ``D`` the signed face widths, ``J`` the face coefficient and ``U`` the upwind pick,
-so the Newton coupling gets both derivatives (:meth:`Couette.matrix` for ``s``,
-:meth:`Couette.q_derivatives` for ``q``).
+As face matrices, per direction ``k``: ``outflow = D_k ((J_k q_k) * (U_k s))`` with ``D`` the
+signed face widths, ``J`` the face coefficient and ``U`` the upwind pick, so the Newton
+coupling gets both derivatives (:meth:`Couette.matrix`, :meth:`Couette.q_derivatives`).
 """
-
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -1,49 +1,21 @@
 """One sliding pass of a roughness cell at one separation: contact, squeeze term and the
 three cell problems at each instant, and their time average (paper eqs 8-16).
 
-Kinematics.  The pin is at rest and the disk moves at ``U = 2 u_m``.  One pass of the disk
-over the period ``L_r1`` takes ``T_r = L_r1 / U``; in ``N_t`` instants the disk patch shifts
-by ``s = L_r1 / N_t`` each.  The gap is ``h = h0 + z_up(x1 - U t, x2) - z_low + w`` with the
-contact deformation ``w``, so the time term of eq 8 is, exactly,
+The pin is at rest and the disk moves at ``U = 2 u_m``: one pass over the period ``L_r1``
+in ``N_t`` instants, the disk patch shifted by ``L_r1 / N_t`` each.  The gap is ``h = h0 +
+z_up(x1 - U t, x2) - z_low + w`` with the contact deformation ``w``, so the time term of
+eq 8 is exactly ``tau = (1 / u_m) dh/dt = -2 d z_up / dx1 + (1 / u_m) dw/dt``, free of u_m;
+``time_derivative="exact"`` (default) evaluates it at every instant (``dw/dt`` from the
+contact problem's tangent), leaving only the trapezoidal rule of a periodic time average.
+The paper's implicit Euler (``"backward"``) is first order in ``1 / N_t``.
 
-    tau = (1 / u_m) dh/dt = -2 d z_up / dx1 + (1 / u_m) dw/dt,
-
-free of u_m.  The default ``time_derivative="exact"`` evaluates it at every instant (the
-deformation rate from the tangent of the contact problem), so only the quadrature of the
-time average over the ``N_t`` instants remains: the trapezoidal rule of a periodic function.
-The paper's implicit Euler ``2 (h^n - h^(n-1)) / s`` (``time_derivative="backward"``) is
-first order in ``1 / N_t`` and kept to reproduce the paper.  (The paper's
-``dt = L_r1 / (N_t u_m)`` with a shift of ``L_r1 / N_t`` would be a disk moving at ``u_m``,
-i.e. half the squeeze term.)
-
-Frame identities (tested).  ``moving="lower"`` computes the same physics in the disk's frame:
-the pin slides at ``-U`` and ``u_m -> -u_m``, and ``tau = -2 d(-z_low)/dx1 + ...``.  In that
-frame the right-hand side of eq 8 is ``dh/dx1 + tau' = -(dh/dx1 + tau)`` (the sum is
-``2 d h/dx1 - 2 d(h_rigid + w)/dx1 = 0``), so ``chi_1' = -chi_1`` and
-
-    A' = A,  C' = C,  h_m' = h_m,  p_con' = p_con  (eqs 9, 10 do not see the motion),
-    b' = 2 e1 - b  (from eq 14: <h (1 + h^2 d chi_1/dx1)> / h_m = 2 e1 - b),
-    d' = -d        (eq 16 is linear in chi_1).
-
-The same holds for a rough surface moving over a smooth one against the same surface at
-rest under the smooth one.  Without contact the FVM satisfies these identities to
-round-off (its Couette flux difference is the central difference used for ``tau``), the FE
-to its second-order spatial error; with contact, to the discretisation of the contact edge.
-
-The mean-speed frame (``moving="both"``, the default).  Half-way between the two, the disk
-moves at ``+U/2`` and the pin at ``-U/2``: the mean speed is zero, so eq 8 has no Couette
-term and its right-hand side is the squeeze term alone, ``tau = -d z_up/dx1 - d z_low/dx1 +
-(2/U) dw/dt``.  The factors of the pin's frame follow exactly (:mod:`.rolling`: the frame
-change adds ``u_m h e1`` to the flux), and the identities above hold to round-off for
-either method, with or without contact.  In the pin's frame the discrete Couette term and
-the discrete squeeze term cancel only up to the grid error, and at the edge of a contact
-spot (the squeeze set to zero on the gap floor, the Couette difference not) they leave a
-spurious pressure that the continuum does not have: the pure rolling cell of the same
-discretisation, whose exact ``chi_1`` is zero, gives ``d1`` = 0.08 (FE) and 0.27 (FVM) on
-a 64^2 random pair at 0.1 um, 14 % of the pixels in contact.  Without it ``d1`` converges
-several times faster, and FE and FVM agree (module ``rolling``'s table).
+Frames (``moving``): the disk's frame (``"lower"``) gives ``A' = A``, ``C' = C``, ``b' =
+2 e1 - b``, ``d' = -d`` (tested); the mean-speed frame (``"both"``, the default: the disk
+at ``+U/2``, the pin at ``-U/2``) has no Couette term in eq 8, so the spurious pressure the
+pin's frame leaves at contact edges (its Couette and squeeze terms cancel only to the grid
+error) does not arise; its factors are the pin frame's exactly (:mod:`.rolling`).
+docs/rolling_sliding.md has the measurements.
 """
-
 from __future__ import annotations
 
 import time
