@@ -1010,6 +1010,35 @@ def test_fit_a_case_to_measured_curves(tmp_path, capsys):
                  str(files[0])]) == 2                                  # not a fit.json
 
 
+def test_fit_the_rigs_thermal_resistance(tmp_path, capsys):
+    """Issue 61 item 3: fem-twin fit --params boundary_friction,bulk_resistance sweeps each
+    curve at the other RESISTANCES (checkpointed in OUT/fit) and recovers the case's own
+    R_b = 1 K/W and C_f,b = 0.15 from the thermal run's own curves; the isothermal twin
+    refuses the parameter before any work."""
+    case = small_case(tmp_path)
+    out = tmp_path / "o"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    cfb = 1 / (3 * 3 ** 0.5)
+    files = []
+    for c in read_stribeck_csv(out / "stribeck.csv"):
+        cf = (c.hydrodynamic_friction + 0.15 / cfb * c.boundary_friction) / 150.0
+        path = tmp_path / f"m{c.viscosity:g}.csv"
+        path.write_text("speed,friction_coefficient\n" + "".join(
+            f"{float(u)!r},{float(f)!r}\n" for u, f in zip(c.speed, cf)))
+        files.append(str(path))
+    params = "boundary_friction,bulk_resistance"
+    assert main(["fit", str(case), *files, "-o", str(out), "--no-progress", "--params",
+                 params]) == 0
+    fit = json.loads((out / "fit.json").read_text())
+    assert fit["bulk_resistance"]["value"] == pytest.approx(1.0, abs=0.05)
+    assert fit["boundary_friction"]["value"] == pytest.approx(0.15, rel=2e-3)
+    assert "bulk_resistance" in capsys.readouterr().out
+    iso = tmp_path / "iso.toml"
+    iso.write_text(case.read_text().replace('model = "flash"', 'model = "none"'))
+    assert main(["fit", str(iso), *files, "-o", str(tmp_path / "x"), "--params", params]) == 2
+    assert not (tmp_path / "x").exists()
+
+
 def test_fit_validate_and_from_fit_refuse_what_they_cannot_use(tmp_path, capsys):
     """Issue 64 items 1-2: checked against the case before any work, exit 2 and one line:
     a fit whose measured speeds lie outside the case's sweep (it returned the starting
