@@ -11,7 +11,9 @@ from pathlib import Path
 from . import cli_runs as runs
 from . import cli_stages as stages
 from .errors import NotConverged, RunLocked, SchedulerUnreachable
+from .sections import LubricantSpec, MicroSpec, Tribometer
 from .stribeck.fit import PARAMETERS
+from .topography.prepare import MacroOptions
 
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
@@ -246,9 +248,11 @@ def _add_homogenise(sub):
     hr.add_argument("pin", type=Path, help="pin patch (fem-twin topography prepare-patch)")
     hr.add_argument("disk", type=Path, help="disk patch flipped over the pin (--upper)")
     hr.add_argument("-o", "--output", type=Path, required=True, help="output folder")
-    hr.add_argument("--h0", type=float, nargs=3, default=(1e-7, 1e-6, 100),
+    micro = MicroSpec()                                   # [micro]: the paper's h0
+    hr.add_argument("--h0", type=float, nargs=3,
+                    default=(micro.h0_min, micro.h0_max, micro.h0_count),
                     metavar=("MIN", "MAX", "N"), help="geometric h0 range [m] and count "
-                    "(default: 1e-7 1e-6 100, the paper's)")
+                    "(default: %(default)s, the paper's)")
     from .micro import CellSettings
     _settings_options(hr, CellSettings, stages.CELL_OPTIONS)
     hr.add_argument("--h0-tol", type=float,
@@ -280,10 +284,14 @@ def _add_macro(sub):
                                               "(default: flat)")
     mp.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     mp.add_argument("--speed", type=float, required=True, help="sliding speed U [m/s]")
-    mp.add_argument("--viscosity", type=float, default=0.066, help="mu_0 [Pa s]")
-    mp.add_argument("--load", type=float, default=150.0, help="imposed normal load [N]")
-    mp.add_argument("--diameter", type=float, default=8e-3,
-                    help="pin diameter D of the Hersey number, eq 46 [m]")
+    tribometer = Tribometer()                             # [tribometer], [lubricant]
+    mp.add_argument("--viscosity", type=float, default=LubricantSpec().viscosities[0],
+                    help="mu_0 [Pa s] (default: %(default)s)")
+    mp.add_argument("--load", type=float, default=tribometer.load,
+                    help="imposed normal load [N] (default: %(default)s)")
+    mp.add_argument("--diameter", type=float, default=tribometer.pin_diameter,
+                    help="pin diameter D of the Hersey number, eq 46 [m] (default: "
+                         "%(default)s)")
     from .macro import MacroSettings
     _settings_options(mp, MacroSettings, stages.MACRO_OPTIONS)
     mp.set_defaults(func=stages.macro_point)
@@ -303,6 +311,8 @@ def _settings_options(parser, cls, names, flags=None) -> None:
                   + " (default: %(default)s)")
         if d["choices"]:
             kw["choices"] = d["choices"]
+        elif isinstance(f.default, tuple):
+            kw.update(nargs=len(f.default), type=type(f.default[0]))
         else:
             kw["type"] = type(f.default) if f.default is not None else float
         parser.add_argument((flags or {}).get(name, "--" + name.replace("_", "-")), **kw)
@@ -343,8 +353,9 @@ def _step_options(name, s):
         s.add_argument("--radius", type=float, help="fit only within this radius [m]")
         s.add_argument("--centre", type=float, nargs=2, default=(0.0, 0.0), metavar=("X1", "X2"))
     elif name == "clip":
-        s.add_argument("--lower", type=float, default=-20e-6)
-        s.add_argument("--upper", type=float, default=20e-6)
+        clip = MacroOptions().clip                        # [preprocessing] clip
+        s.add_argument("--lower", type=float, default=-clip, help="[m] (default: %(default)s)")
+        s.add_argument("--upper", type=float, default=clip, help="[m] (default: %(default)s)")
     elif name == "filter":
         s.add_argument("--fwhm", type=float, required=True, help="FWHM in pixels")
     elif name in ("resample", "patch", "prepare-patch"):
@@ -361,12 +372,11 @@ def _step_options(name, s):
     elif name == "align":
         s.add_argument("--direction", choices=("+x1", "-x1", "+x2", "-x2"), required=True)
     elif name == "mount":
-        s.add_argument("--truncation", type=float, default=-20e-6)
-        s.add_argument("--holder", type=float, default=-1e-3)
+        _settings_options(s, MacroOptions, ("truncation", "holder_height"),
+                          {"holder_height": "--holder"})
     elif name in ("prepare-pin", "prepare-disk"):
-        s.add_argument("--fwhm", type=float, default=9.0)
-        s.add_argument("--resolution", type=int, nargs=2, default=(256, 256))
-        s.add_argument("--clip", type=float, default=20e-6)
+        _settings_options(s, MacroOptions, ("fwhm_px", "resolution", "clip"),
+                          {"fwhm_px": "--fwhm"})
 
 
 if __name__ == "__main__":  # pragma: no cover

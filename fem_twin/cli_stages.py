@@ -53,9 +53,10 @@ def topography(args):
     elif step == "flip":
         out = tp.flip_disk(topo)
     elif step == "mount":
-        out = tp.mount_pin(topo, args.truncation, args.holder)
+        out = tp.mount_pin(topo, args.truncation, args.holder_height)
     elif step in ("prepare-pin", "prepare-disk"):
-        opts = MacroOptions(fwhm_px=args.fwhm, resolution=tuple(args.resolution), clip=args.clip)
+        opts = MacroOptions(fwhm_px=args.fwhm_px, resolution=tuple(args.resolution),
+                            clip=args.clip)
         out = (prepare_pin if step == "prepare-pin" else prepare_disk)(topo, opts)
     else:  # prepare-patch
         out = prepare_patch(topo, args.shape, args.start, upper=args.upper)
