@@ -63,9 +63,11 @@ def variant(case, n, quick, patches=None):
     sweep = replace(case.sweep, **(dict(count=5, speed_min=0.01, refine=0) if quick else {}))
     macro_geometry = replace(case.macro_geometry, resolution=(48, 48) if quick else (128, 128))
     lubricant = replace(case.lubricant, viscosities=(0.066,), temperatures=(24.0,))
+    thermal = replace(case.thermal, model="none")   # one viscosity: no viscosity-temperature law
     return replace(case, name=case.name + ("_real" if patches else "_synthetic"),
                    geometry=geometry, micro=micro, sweep=sweep, lubricant=lubricant,
-                   macro_geometry=macro_geometry, run=replace(case.run, patch_band=False))
+                   thermal=thermal, macro_geometry=macro_geometry,
+                   run=replace(case.run, patch_band=False))
 
 
 def turning_speed(curve, level):

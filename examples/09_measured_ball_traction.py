@@ -90,6 +90,8 @@ h0_min = 2e-8
 h0_max = 1e-6
 h0_count = {8 if quick else 16}
 steps = {4 if quick else 16}
+[thermal]
+model = "none"     # one oil temperature: the isothermal twin, as fem-twin traction runs
 [macro]
 coupling = "auto"
 grid = {33 if quick else 73}
