@@ -2,7 +2,8 @@
 
     python benchmarks/run.py [GROUP ...]      # topography contact micro macro stribeck ...
                                               # (micro-full: ~15 min, estimate: ~40 min,
-                                              #  estimate-paper: ~100 min, scale: ~10 min;
+                                              #  estimate-paper: ~100 min, scale: ~10 min,
+                                              #  cores: the bundled case on 1, 2, all workers;
                                               #  only when named)
 """
 
@@ -597,18 +598,19 @@ def bench_estimate(case_file="pin_on_disk.toml", viscosity=0.066):
     return t_base, rows
 
 
+from cores import bench_cores  # noqa: E402
 from scale import bench_scale  # noqa: E402
 
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
           "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "paper": bench_paper, "stribeck": bench_stribeck,
-          "estimate": bench_estimate, "scale": bench_scale,
+          "estimate": bench_estimate, "scale": bench_scale, "cores": bench_cores,
           "estimate-paper": lambda: bench_estimate("paper.toml"),
           "micro-full": lambda: bench_micro(full=True)}
 
 
 def main(argv):
     groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "estimate-paper",
-                                                        "scale")]
+                                                        "scale", "cores")]
     for name in groups:
         base, rows = GROUPS[name]()
         print(f"\n## {name}")

@@ -1,40 +1,25 @@
 """Fitting the twin's unknowns to measured Stribeck curves, with 95 % intervals.
 
-Parameters, named by their case-file keys:
+Parameters, by their case-file keys; none re-runs the micro stage:
 
 ``boundary_friction``
-    C_f,b of eq 32.  The friction force is ``F_hd + C_f,b F_con`` (eqs 31-34) and the
-    contact force does not depend on C_f,b, so a simulated curve's two force parts give C_f
-    at any C_f,b without a new solve.
+    C_f,b of eq 32: C_f = (F_hd + C_f,b F_con) / F_N from a simulated curve's force parts.
 ``temperature``
-    one effective oil temperature per measured curve [C], through the lubricant's
-    Walther law (:class:`~fem_twin.macro.viscosity.WaltherLaw`, fixed by the case's
-    viscosities and temperatures).  By the Hersey collapse (eq 46; 0.1 % C_f,b between the
-    bundled case's two viscosities) the simulated curve at ``mu_S`` gives the curve at
-    ``mu`` at the speeds ``U mu / mu_S``: the micro and macro stages are not run again.
+    one oil temperature per curve [C] through the case's Walther law; the simulated curve
+    at ``mu_S`` gives the one at ``mu`` at the speeds ``U mu / mu_S`` (the Hersey collapse,
+    eq 46: 0.1 % C_f,b isothermal, about 1 % with the thermal twin's heating).
 ``load_share``
-    the share of the imposed load the pin face carries (``[tribometer] load_share``, in
-    [0.5, 1] here; the rest goes elsewhere, e.g. an edge of the holder or the load path's
-    friction), C_f still referred to the imposed load.  The load does not collapse with
-    the Hersey number in mixed lubrication, so the macro stage sweeps the first viscosity
-    once at each of :data:`LOAD_SHARES` (the micro stage is not run again) and C_f is
-    interpolated between them (PCHIP in the share, at each speed), added to each curve as
-    the change from its own share.
+    the pin face's share of the imposed load: the first viscosity swept at
+    :data:`LOAD_SHARES`, C_f interpolated (PCHIP in the share, per speed).
 ``bulk_resistance``
-    the rig's thermal resistance R_b [K/W] of the thermal twin (``[thermal]``,
-    :mod:`fem_twin.macro.thermal`).  Its heating depends on speed and power, not on the
-    Hersey number alone, so every measured curve's viscosity is swept at each of
-    :data:`RESISTANCES` and C_f interpolated between them (PCHIP in R_b, per speed),
-    added as the change from the case's own R_b.
+    the thermal twin's R_b [K/W]: every curve swept at :data:`RESISTANCES`, C_f
+    interpolated (PCHIP in R_b, per speed).
 
-Least squares on C_f,dev (eq 35) at the measured speeds (the simulated curve interpolated
-by PCHIP in log speed).  Weights: where the measured CSV gives ``cf_min``/``cf_max`` (the
-scatter of a set of tests), ``sigma = (cf_max - cf_min) / 1.693``, the expected range of
-three normal samples in standard deviations; otherwise equal weights and the variance from
-the residuals.  Intervals: ``t_{0.975, n - p}`` times the square root of the diagonal of
-``(J^T W J)^-1`` (scaled by the residual variance without a band).
+Least squares on C_f,dev (eq 35) at the measured speeds (PCHIP in log speed).  Weights:
+``sigma = (cf_max - cf_min) / 1.693`` where the measured CSV gives its scatter, else equal
+weights with the HC3 covariance (:func:`_covariance`); intervals ``t_{0.975, n - p}`` times
+its diagonal's root.
 """
-
 from __future__ import annotations
 
 from dataclasses import dataclass

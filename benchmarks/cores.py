@@ -1,0 +1,58 @@
+"""The ``cores`` group: the bundled case end to end on 1, 2 and all workers.
+
+Each run is a fresh ``fem-twin run`` of ``examples/pin_on_disk.toml`` with ``[run] workers``
+set, in its own process and folder.  Printed per run: the wall time, the run's own
+estimate, and from its task graph (``summary.json``, :mod:`fem_twin.taskgraph`) the CPU
+time, the critical path and the wall times it predicts on 16 and 64 workers.  The
+baseline is the one-worker run.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _case(folder: Path, workers: int) -> Path:
+    """The bundled case with absolute paths and ``workers`` processes."""
+    text = (ROOT / "examples" / "pin_on_disk.toml").read_text()
+    text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
+    text = text.replace("workers = 0 ", f"workers = {workers} ", 1)
+    path = folder / f"case_{workers}.toml"
+    path.write_text(text)
+    return path
+
+
+def _run(folder: Path, workers: int) -> tuple[float, dict]:
+    """Wall time [s] of one run and its summary."""
+    out = folder / f"out_{workers}"
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "fem_twin.cli", "run", str(_case(folder, workers)),
+                    "-o", str(out), "--no-progress", "--yes"], check=True,
+                   capture_output=True, text=True)
+    return time.perf_counter() - start, json.loads((out / "summary.json").read_text())
+
+
+def bench_cores():
+    """The bundled case on 1, 2 and all workers (see the module docstring)."""
+    counts = sorted({1, 2, os.cpu_count() or 1})
+    rows, base = [], None
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in counts:
+            wall, summary = _run(Path(tmp), n)
+            graph = summary["task_graph"]
+            base = wall if base is None else base
+            rows.append((f"bundled case, {n} worker{'s' if n > 1 else ''}", wall,
+                         f"estimate {summary['estimated_s']:.0f} s; task graph "
+                         f"{graph['cpu_s']:.0f} CPU s, critical path "
+                         f"{graph['critical_path_s']:.0f} s, predicts "
+                         f"{graph['wall_s']['16']:.0f} s on 16 workers and "
+                         f"{graph['wall_s']['64']:.0f} s on 64"))
+    return base, rows
