@@ -185,18 +185,20 @@ class ContactThermal:
                 "spot_flash": spot_flash(spot, speeds, self.settings)}
 
 
-def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds) -> tuple:
+def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
+                  start: float | None = None) -> tuple:
     """An operating point at the film temperature its own heat gives it.
 
     ``solve(lubricant, previous)`` returns the point's levels ``(result, *coarser)`` with
     the film's ``lubricant``, warm from ``previous`` (None first).  The film temperature
-    ``T = T_oil + R_b Q + theta_face`` is iterated by secant steps on ``T - g(T)`` until it
-    moves by less than ``settings.tol``; returns ``(levels, lubricant, record)`` with the
+    ``T = T_oil + R_b Q + theta_face`` is iterated by secant steps on ``T - g(T)``, from
+    ``start`` [C] (a neighbouring point's; None: the oil's), until it moves by less than
+    ``settings.tol``; returns ``(levels, lubricant, record)`` with the
     record's temperatures [C] (``oil``, ``film``, ``asperity``), rises [K], power [W] and
     iterations, or raises :class:`ThermalNotConverged` with the history."""
     s, law = thermal.settings, thermal.law
     oil = float(law.temperature(lubricant.viscosity))
-    T, previous, history, pairs = oil, None, [], []
+    T, previous, history, pairs = oil if start is None else float(start), None, [], []
     for _ in range(s.max_iter):
         film = replace(lubricant, viscosity=float(law.viscosity(T)))
         levels = solve(film, previous)
