@@ -35,8 +35,8 @@ SUBSAMPLES = 8
 
 
 class ThermalNotConverged(SolverError):
-    """The temperature of an operating point did not settle; ``history``: |dT| [K] per
-    iteration."""
+    """The temperature of an operating point did not settle; ``history``: the film
+    temperature's change ``abs(dT)`` [K] per iteration."""
 
     def __init__(self, message, history=()):
         super().__init__(message)
@@ -85,8 +85,8 @@ def surface_temperature(flux, spacing, speed: float, conductivity: float,
     (ny, nx) [W/m^2] on a grid of pitch ``spacing`` [m], the body moving at ``speed``
     [m/s] along +x1 under the flux (0: at rest).  Linear convolution (zero padding, FFT)
     with the moving point source's kernel ``exp(-U (R - dx1) / (2 kappa)) / (2 pi k R)``
-    averaged over each pixel: its 1/R part exactly (Love's integral), the rest by
-    :data:`SUBSAMPLES`^2 points."""
+    averaged over each pixel: its 1/R part exactly (Love's integral), the rest on a grid
+    of sub-samples (:data:`SUBSAMPLES` a side)."""
     q = np.asarray(flux, float)
     ny, nx = q.shape
     k_hat = _kernel_hat((ny, nx), tuple(float(v) for v in spacing), float(speed),
