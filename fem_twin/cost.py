@@ -23,7 +23,7 @@ BAND_POINT_COST = {"coarse": 0.14, "full": 0.54}
 BAND_LEVEL_COST = 0.33
 #: the Stribeck stage of the thermal twin (``[thermal] model = "flash"``) against the
 #: isothermal one: each point iterates its film temperature (2-5 warm solves)
-THERMAL_COST = 1.65
+THERMAL_COST = 1.5
 #: micro stage cost per cell pixel, time step and separation on one core [s] (the cell
 #: problems, the periodic contact and the coarsened cell of the error estimate)
 MICRO_SECONDS = 3.5e-6
