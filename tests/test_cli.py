@@ -960,6 +960,20 @@ def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     assert [duration(s) for s in (85, 250, 1529)] == ["85 s", "4.2 min", "25 min"]
 
 
+def measured_from_run(out, folder, speeds):
+    """'Measured' CSVs made of a run's own curves at C_f,b = 0.15 (their force parts), at
+    the ``speeds`` slice of each curve; their paths."""
+    cfb = 1 / (3 * 3 ** 0.5)
+    files = []
+    for c in read_stribeck_csv(out / "stribeck.csv"):
+        cf = (c.hydrodynamic_friction + 0.15 / cfb * c.boundary_friction) / 150.0
+        path = folder / f"m{c.viscosity:g}.csv"
+        path.write_text("speed,friction_coefficient\n" + "".join(
+            f"{float(u)!r},{float(f)!r}\n" for u, f in zip(c.speed[speeds], cf[speeds])))
+        files.append(str(path))
+    return files
+
+
 def test_fit_a_case_to_measured_curves(tmp_path, capsys):
     """Issue 29: fem-twin fit CASE measured.csv -o OUT --params ... --predict T: the
     'measured' curves are the run's own at C_f,b = 0.15 (its two viscosities, 24 and 50 C in
@@ -970,13 +984,7 @@ def test_fit_a_case_to_measured_curves(tmp_path, capsys):
     out = tmp_path / "o"
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
     cfb = 1 / (3 * 3 ** 0.5)
-    files = []
-    for c in read_stribeck_csv(out / "stribeck.csv"):
-        cf = (c.hydrodynamic_friction + 0.15 / cfb * c.boundary_friction) / 150.0
-        path = tmp_path / f"m{c.viscosity:g}.csv"
-        path.write_text("speed,friction_coefficient\n" + "".join(
-            f"{float(u)!r},{float(f)!r}\n" for u, f in zip(c.speed[1:-1], cf[1:-1])))
-        files.append(str(path))
+    files = measured_from_run(out, tmp_path, slice(1, -1))
     assert main(["fit", str(case), *files, "-o", str(out), "--no-progress", "--predict", "37",
                  "--params", "boundary_friction,temperature,load_share"]) == 0
     fit = json.loads((out / "fit.json").read_text())
@@ -1018,14 +1026,7 @@ def test_fit_the_rigs_thermal_resistance(tmp_path, capsys):
     case = small_case(tmp_path)
     out = tmp_path / "o"
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
-    cfb = 1 / (3 * 3 ** 0.5)
-    files = []
-    for c in read_stribeck_csv(out / "stribeck.csv"):
-        cf = (c.hydrodynamic_friction + 0.15 / cfb * c.boundary_friction) / 150.0
-        path = tmp_path / f"m{c.viscosity:g}.csv"
-        path.write_text("speed,friction_coefficient\n" + "".join(
-            f"{float(u)!r},{float(f)!r}\n" for u, f in zip(c.speed, cf)))
-        files.append(str(path))
+    files = measured_from_run(out, tmp_path, slice(None))
     params = "boundary_friction,bulk_resistance"
     assert main(["fit", str(case), *files, "-o", str(out), "--no-progress", "--params",
                  params]) == 0
