@@ -111,12 +111,7 @@ def share_curves(case: Case, out: RunLayout, curve, progress: bool = True,
     its load over the speeds of ``curve`` (the case's own share is ``curve``), checkpointed
     in ``OUT/fit/checkpoints``; the micro stage's flow factors are reused."""
     tr = case.tribometer
-    gap, spacing, face, _ = macro_geometry(case, out)
-    common = dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
-                  speeds=np.sort(curve.speed)[::-1], diameter=hersey_length(case), face=face,
-                  settings=macro_settings(case), checkpoint=out.fit_points,
-                  thermal=contact_thermal(case),
-                  factors_key=stage_keys(case)["micro"])
+    common = dict(_fit_sweep(case, out), speeds=np.sort(curve.speed)[::-1])
     lub = case.lubricant.lubricants()[0]
     todo = sorted(s for s in shares if not np.isclose(s, tr.load_share, rtol=1e-9))
     with executor_for(case.run.workers, case.run.scheduler) as executor:
@@ -130,12 +125,8 @@ def resistance_curves(case: Case, out: RunLayout, curves, progress: bool = True,
     """Per curve, ``((R_b, StribeckCurve), ...)``: each of ``curves`` (the case's K-th
     viscosity) swept at the rig's thermal ``resistances`` [K/W] over its speeds (the
     case's own R_b is the curve), checkpointed in ``OUT/fit/checkpoints``."""
-    gap, spacing, face, _ = macro_geometry(case, out)
-    common = dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
-                  diameter=hersey_length(case), face=face, settings=macro_settings(case),
-                  load=case.tribometer.load * case.tribometer.load_share,
-                  checkpoint=out.fit_points, factors_key=stage_keys(case)["micro"])
-    own, thermal = case.thermal.bulk_resistance, contact_thermal(case)
+    common = dict(_fit_sweep(case, out), load=case.tribometer.load * case.tribometer.load_share)
+    own, thermal = case.thermal.bulk_resistance, common["thermal"]
     todo = sorted(r for r in resistances if not np.isclose(r, own, rtol=1e-9, atol=1e-12))
     tasks = [(dict(common, speeds=np.sort(c.speed)[::-1], thermal=replace(
         thermal, settings=replace(thermal.settings, bulk_resistance=r))), lub)
@@ -146,6 +137,16 @@ def resistance_curves(case: Case, out: RunLayout, curves, progress: bool = True,
     return tuple(tuple(sorted([*zip(todo, swept[k * len(todo):(k + 1) * len(todo)]),
                                (own, c)], key=lambda p: p[0]))
                  for k, c in enumerate(curves))
+
+
+def _fit_sweep(case: Case, out: RunLayout) -> dict:
+    """What the fit's extra sweeps share with the case's run: its macro geometry, flow
+    factors, settings and thermal model, checkpointed in ``OUT/fit/checkpoints``."""
+    gap, spacing, face, _ = macro_geometry(case, out)
+    return dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
+                diameter=hersey_length(case), face=face, settings=macro_settings(case),
+                checkpoint=out.fit_points, thermal=contact_thermal(case),
+                factors_key=stage_keys(case)["micro"])
 
 
 def apply_fit(case: Case, result: dict) -> Case:

@@ -1,31 +1,16 @@
 """Direct solves of symmetric positive-definite systems that share one sparsity pattern.
 
-The cell problems (eqs 8-10) factorise a new operator at every h0 and time step, always on
-the same pattern; the factorisation is 85 % of the roughness-scale time.  Two backends:
-
-``"superlu"``
-    scipy's SuperLU without pivoting (the matrix is SPD), in the fill-reducing order the
-    caller numbered the unknowns in (``permc_spec="NATURAL"``).  Always available.
-``"pardiso"``
-    MKL PARDISO, sparse Cholesky (matrix type 2) through ``ctypes``: the METIS ordering and
-    symbolic analysis run once per pattern (phase 11), each new matrix only repeats the
-    numeric factorisation (phase 22), by the two-level algorithm (``iparm[23] = 1``,
-    faster on both the cells and the macro Newton LU).  About 3x faster than SuperLU on a
-    256^2 cell (``benchmarks/run.py micro``).  Needs ``libmkl_rt`` from the ``mkl`` wheel, which
-    ``pip install "fem-twin[pardiso]"`` installs; MKL is under the Intel Simplified Software
-    License, so it stays an optional extra, not a core dependency.  MKL runs sequentially
-    (``MKL_THREADING_LAYER=SEQUENTIAL``): parallel speed comes from processes.  A process
-    that allows more threads when it first loads MKL (``FEM_TWIN_THREADS=N``, for a lone
-    large point such as the 2048^2 grids of the resolution study) gets MKL's OpenMP layer
-    and N PARDISO threads on matrices of ``THREADED_UNKNOWNS`` or more (a 1024^2 Newton LU
-    in 0.62x the time on 2 threads).
-    Its idle threads sleep at once (``KMP_BLOCKTIME=0``): spinning for the default 200 ms
-    after each call, they took a core from the numpy work between the solves (the 512^2
-    cold point of ``benchmarks/run.py scale`` 20.4 against 17.9 s).
-
-``backend=None`` takes the environment variable ``FEM_TWIN_SPARSE`` (``auto``, ``superlu``
-or ``pardiso``); ``auto`` (the default) is PARDISO when ``libmkl_rt`` loads, else SuperLU.
-The two agree to round-off (about 1e-11 relative, tested).
+The cell problems (eqs 8-10) factorise a new operator at every h0 and time step on one
+pattern; the factorisation is 85 % of the roughness-scale time.  Backends:
+``"superlu"`` (scipy's, no pivoting, in the caller's fill-reducing order; always there)
+and ``"pardiso"`` (MKL PARDISO's Cholesky through ``ctypes``: METIS and the symbolic
+analysis once per pattern, then numeric factorisations by the two-level algorithm; about
+3x faster on a 256^2 cell; ``pip install "fem-twin[pardiso]"``, an optional extra under
+the Intel Simplified Software License).  MKL runs sequentially: parallel speed comes from
+processes; ``FEM_TWIN_THREADS=N`` before MKL loads gives N PARDISO threads on matrices of
+``THREADED_UNKNOWNS`` or more, idle threads sleeping at once (``KMP_BLOCKTIME=0``).
+``backend=None`` reads ``FEM_TWIN_SPARSE`` (``auto``: PARDISO when ``libmkl_rt`` loads,
+else SuperLU); the two agree to about 1e-11 (tested).  Measurements: benchmarks/README.md.
 """
 
 from __future__ import annotations

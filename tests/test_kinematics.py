@@ -163,10 +163,10 @@ def test_the_cell_frame_turns_into_the_grid():
     loc = LocalFactors(h0=np.ones((3, 4)), h_m=np.ones((3, 4)), p_con=None,
                        A=np.broadcast_to(2 * np.eye(2), (3, 4, 2, 2)), b=np.tile([1.0, 0.0], (3, 4, 1)),
                        C=A, d=None, friction_factor=None, pressure_friction=None, contact_fraction=None)
-    moved = in_grid_frame(loc, v)
+    moved = in_grid_frame(loc, rotations(v))
     c, s, _ = rotations(v)
     assert np.allclose(moved.A, 2 * np.eye(2)) and np.allclose(moved.b, np.stack([c, s], -1))
-    back = in_grid_frame(moved, v * [1, -1])
+    back = in_grid_frame(moved, rotations(v * [1, -1]))
     assert np.allclose(back.C, A, atol=1e-14)
     assert in_grid_frame(loc, None) is loc
 

@@ -66,6 +66,46 @@ def tilt_pin(pin: Topography, tilt, holder_height: float = -1e-3) -> Topography:
     return pin.with_heights(np.where(face, tilted, holder_height))
 
 
+def _pid(evaluate, tilt, gains, tol, max_iter):
+    """The paper's incremental PID on the torque residuals (eqs 5-6, angles in degrees):
+    the last tilt [rad] and ``evaluate``'s ``(tilted, contact, residuals)`` there."""
+    kp, ki, kd = gains
+    state = evaluate(tilt)
+    r = state[2]
+    integral, r_prev = np.zeros(2), r.copy()
+    for _ in range(max_iter):
+        if np.max(np.abs(r)) < tol:
+            break
+        integral += r
+        tilt = np.deg2rad((kp * r + ki * integral + kd * (r - r_prev)) * 360.0)
+        r_prev = r
+        state = evaluate(tilt)
+        r = state[2]
+    return tilt, state
+
+
+def _broyden(evaluate, tilt, tol, max_iter, pin, holder_height, history):
+    """Broyden's method on the torque residuals from the finite-difference Jacobian:
+    the last tilt [rad] and ``evaluate``'s ``(tilted, contact, residuals)`` there."""
+    state = evaluate(tilt)
+    r = state[2]
+    jac = _initial_jacobian(evaluate, tilt, r, pin, holder_height)
+    for _ in range(max_iter):
+        if np.max(np.abs(r)) < tol:
+            break
+        try:
+            step = -np.linalg.solve(jac, r)
+        except np.linalg.LinAlgError:
+            raise ContactNotConverged(
+                "pin levelling: a tilt does not change the contact torques (singular "
+                "Jacobian); is the pin face cropped by the edge of the map, or the map "
+                "not square about the pin?", _residuals(history)) from None
+        state = evaluate(tilt + step)
+        jac += np.outer(state[2] - r - jac @ step, step) / (step @ step)   # Broyden update
+        tilt, r = tilt + step, state[2]
+    return tilt, state
+
+
 @arguments(pin=Topography, disk=Topography, load="number")
 def level_pin(pin: Topography, disk: Topography | None = None, *, load: float = TABLE4["load"],
               e_reduced: float = TABLE4["e_reduced"], hardness: float = TABLE4["hardness"],
@@ -97,32 +137,11 @@ def level_pin(pin: Topography, disk: Topography | None = None, *, load: float = 
         return tilted, res, r
 
     tilt = np.zeros(2) if method == "pid" else mean_plane_tilt(pin, upper, holder_height)
-    tilted, res, r = evaluate(tilt)
     if method == "pid":
-        kp, ki, kd = gains
-        integral, r_prev = np.zeros(2), r.copy()
-        for _ in range(max_iter):
-            if np.max(np.abs(r)) < tol:
-                break
-            integral += r
-            tilt = np.deg2rad((kp * r + ki * integral + kd * (r - r_prev)) * 360.0)
-            r_prev = r
-            tilted, res, r = evaluate(tilt)
+        tilt, (tilted, res, r) = _pid(evaluate, tilt, gains, tol, max_iter)
     else:
-        jac = _initial_jacobian(evaluate, tilt, r, pin, holder_height)
-        for _ in range(max_iter):
-            if np.max(np.abs(r)) < tol:
-                break
-            try:
-                step = -np.linalg.solve(jac, r)
-            except np.linalg.LinAlgError:
-                raise ContactNotConverged(
-                    "pin levelling: a tilt does not change the contact torques (singular "
-                    "Jacobian); is the pin face cropped by the edge of the map, or the map "
-                    "not square about the pin?", _residuals(history)) from None
-            tilted, res, r_new = evaluate(tilt + step)
-            jac += np.outer(r_new - r - jac @ step, step) / (step @ step)   # Broyden update
-            tilt, r = tilt + step, r_new
+        tilt, (tilted, res, r) = _broyden(evaluate, tilt, tol, max_iter, pin, holder_height,
+                                          history)
     if np.max(np.abs(r)) >= tol:
         raise ContactNotConverged(f"pin levelling ({method}) did not reach torque residuals "
                                   f"below {tol}", _residuals(history))

@@ -54,33 +54,18 @@ class ContactResult:
 def solve(shape, spacing, e_reduced, *, load=None, separation=None, hardness=np.inf,
           periodic=False, p_min=0.0, gap_floor=1e-9, initial_pressure=None, tol=1e-10,
           max_iter=2000) -> ContactResult:
-    """Dry contact of a rigid-body ``shape`` [m] against an elastic half-space.
+    """Dry contact of a rigid-body ``shape`` [m] (ny, nx; x1 along the columns) against an
+    elastic half-space of E' ``e_reduced`` [Pa] (eq 22) on a grid of ``spacing`` [m].
 
-    Parameters
-    ----------
-    shape : (ny, nx) array
-        Undeformed gap geometry [m] up to the rigid-body separation, x1 along columns.
-    spacing : (dx1, dx2) [m]
-    e_reduced : E' of eq 22 [Pa]
-    load : imposed normal load [N]; or
-    separation : imposed rigid-body separation h0 [m] (exactly one of the two).
-    hardness : pressure cap H [Pa] (paper: 6.99e9); ``inf`` for purely elastic.
-    periodic : periodic (roughness cell) or non-periodic (zero-padded) elasticity.
-    p_min : pressure floor [Pa] (default 0).
-    gap_floor : truncation of the reported deformed gap [m] (paper: 1 nm).
-    initial_pressure : warm start [Pa].
-    tol : relative pressure change at convergence.
-
-    The gap is ``separation + shape + K p``; contact where it closes.  KKT: ``p = p_min``
-    where the gap is open, gap 0 where ``p_min < p < H``, gap <= 0 where ``p = H``.
-
-    Under an imposed load, Polonsky-Keer's load-constrained CG, with the cap too (the load
-    kept by scaling the points below it); should that not converge or miss the load, the
-    separation is found by a bracketed root search (Brent) on the load of warm-started
-    separation-controlled solves.  The gap is carried from the step's K t; the points the
-    bounds move add a single-precision pair, so an iteration costs one or two single-
-    precision FFT pairs (an exact double pair every ``_REFRESH`` iterations) against the
-    two double pairs of the textbook method, and works on the loaded points only.
+    Exactly one of ``load`` [N] and ``separation`` h0 [m]; ``hardness`` H caps the pressure
+    [Pa] (inf: elastic), ``p_min`` floors it [Pa]; ``periodic``: a roughness cell; the
+    deformed gap reported floored at ``gap_floor`` [m]; ``initial_pressure`` warm-starts;
+    converged at a relative pressure change ``tol``.  The gap is ``separation + shape + K p``
+    with KKT: ``p = p_min`` where it is open, 0 where ``p_min < p < H``, <= 0 at ``p = H``.
+    Under a load: Polonsky-Keer's load-constrained CG with the cap, else (no convergence or
+    a missed load) a bracketed root search (Brent) on the load of separation-controlled
+    solves.  An iteration costs one or two single-precision FFT pairs on the loaded points
+    (an exact double pair every ``_REFRESH``), against two double pairs in the textbook.
     """
     as_field("shape [m]", shape)
     plausible("spacing [m]", as_pair("spacing [m]", spacing), "pitch")
@@ -145,13 +130,10 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
         initial_pressure, tol, max_iter) -> ContactResult:
     """Polonsky-Keer CG (load) or its separation-controlled variant, pressure in [p_min, H].
 
-    Only the loaded points (``p > p_min``, a few per cent of a rough contact) carry the CG
-    vectors, as index sets into the grid; the dense grid is touched by the FFT pairs, the
-    gap update and one comparison for the points that ask to be loaded.  The gap without
-    the separation, ``G = shape + K p``, is carried from the step's ``K t`` and, where the
-    bounds or the load scaling moved points, the ``K c`` of their correction (both single
-    precision, about 1e-6 of the increment), and recomputed exactly every ``_REFRESH``
-    iterations."""
+    Only the loaded points (a few per cent of a rough contact) carry the CG vectors, as
+    index sets into the grid.  The gap ``G = shape + K p`` is carried from the step's ``K t``
+    and the ``K c`` of the bounds' corrections (single precision, about 1e-6 of the
+    increment) and recomputed exactly every ``_REFRESH`` iterations."""
     s = np.asarray(shape, dtype=float)
     dx1, dx2 = np.broadcast_to(np.asarray(spacing, float), (2,))
     area = dx1 * dx2
@@ -170,31 +152,13 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
     history, size_old = [], floor(loaded.size) + np.abs(p[loaded]).sum()
     for it in range(1, max_iter + 1):
         if G is None or fresh >= _REFRESH:
-            exact, fresh = s.ravel() + deform(p), 0
-            if G is not None:
-                jump = exact[t_at] - G[t_at]       # the carried gap's drift: past 1 % of the
-                if jump @ jump > 1e-4 * g_old:     # free-set gap, the CG restarts (the
-                    delta = 0.0                    # directions no longer conjugate)
-            G = exact
+            (G, delta), fresh = _exact_gap(s, p, deform, G, t_at, g_old, delta), 0
             loaded.sort()
         pl = p[loaded]
         fi = loaded[pl < hardness]                 # the free set
-        gf = G[fi]
-        if by_load and fi.size:
-            h0 = -gf.mean()
-        gf += h0
-        gg = float(gf @ gf)
-        tf = gf + delta * (gg / g_old) * t32[fi] if delta else gf   # t = m (g + beta t)
-        g_old = gg if gg > 0 else 1.0
-        t32[t_at] = 0.0
-        t32[fi] = tf
-        t_at, tf = fi, t32[fi].astype(float)       # the direction as transformed
-        kt = deform(t32, exact=False)
-        ktf = kt[fi].astype(float)
-        rt = float(ktf @ tf)                       # (K t - its free-set mean) . t under load
-        if by_load and fi.size:
-            rt -= ktf.mean() * tf.sum()
-        tau = float(gf @ tf) / rt if rt > 0 else 0.0
+        h0, g_old, tf, kt, tau = _direction(G, fi, h0, by_load, delta, g_old, t32, t_at,
+                                            deform)
+        t_at = fi
         wrong, low = _wrong_points(G, h0, is_loaded, loaded[pl >= hardness])
         cand = np.concatenate([loaded, low])       # every point whose pressure may change
         p_was = p[cand]
@@ -203,11 +167,8 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
         p[fi] = np.clip(pf, p_min, hardness, out=pf)
         _move_wrong(p, wrong, G, h0, tau, was_wrong, deform, c32, p_min, hardness)
         new = cand[p[cand] > p_min]
-        factor = 1.0
-        if by_load:
-            pl = p[new]
-            factor = _rescale(pl, load / area - p_min * (n - new.size), p_min, hardness)
-            p[new] = pl
+        factor = _load_kept(p, new, load / area - p_min * (n - new.size), p_min,
+                            hardness) if by_load else 1.0
         diff = p[cand] - p_was
         size_new = floor(new.size) + np.abs(p[new]).sum()
         change = np.abs(diff).sum() / max(size_new, size_old, 1e-14 * e_reduced * n)
@@ -225,6 +186,52 @@ def _cg(shape, spacing, e_reduced, *, load, separation, hardness, periodic, p_mi
                                   f"(tol {tol})", history)
     p = p.reshape(grid)
     return _result(s, op(p), p, h0, by_load, area, p_min, hardness, gap_floor, it, history)
+
+
+def _exact_gap(s, p, deform, G, t_at, g_old, delta):
+    """``(G, delta)``: the gap without the separation recomputed exactly, and the CG's
+    conjugation switched off (0) when the carried gap ``G`` had drifted past 1 % of the
+    free-set gap at the last direction's points ``t_at`` (the directions no longer
+    conjugate)."""
+    exact = s.ravel() + deform(p)
+    if G is not None:
+        jump = exact[t_at] - G[t_at]
+        if jump @ jump > 1e-4 * g_old:
+            delta = 0.0
+    return exact, delta
+
+
+def _load_kept(p, new, mean, p_min, hardness) -> float:
+    """Scale the loaded points ``new`` of ``p`` in place to the mean pressure ``mean`` they
+    must carry (:func:`_rescale`); the factor."""
+    pl = p[new]
+    factor = _rescale(pl, mean, p_min, hardness)
+    p[new] = pl
+    return factor
+
+
+def _direction(G, fi, h0, by_load, delta, g_old, t32, t_at, deform):
+    """One CG direction on the free set ``fi``: ``(h0, g_old, t, K t, tau)`` with the
+    separation (under load: the free set's mean gap), the squared gap for the next
+    conjugation, the direction as transformed (single precision, ``t32`` updated in place
+    and cleared at the previous direction's points ``t_at``), its deformation and the step."""
+    gf = G[fi]
+    if by_load and fi.size:
+        h0 = -gf.mean()
+    gf += h0
+    gg = float(gf @ gf)
+    tf = gf + delta * (gg / g_old) * t32[fi] if delta else gf   # t = m (g + beta t)
+    g_old = gg if gg > 0 else 1.0
+    t32[t_at] = 0.0
+    t32[fi] = tf
+    tf = t32[fi].astype(float)                     # the direction as transformed
+    kt = deform(t32, exact=False)
+    ktf = kt[fi].astype(float)
+    rt = float(ktf @ tf)                           # (K t - its free-set mean) . t under load
+    if by_load and fi.size:
+        rt -= ktf.mean() * tf.sum()
+    tau = float(gf @ tf) / rt if rt > 0 else 0.0
+    return h0, g_old, tf, kt, tau
 
 
 def _wrong_points(G, h0, is_loaded, plastic):

@@ -1,29 +1,20 @@
-"""Cavitation models of the homogenised Reynolds equation: the contract every coupling
-honours, and the registry that names them (``MacroSettings(complementarity=...)``,
-``solve_reynolds(..., complementarity=...)``).
+"""Cavitation models of the homogenised Reynolds equation: their contract and registry
+(``MacroSettings(complementarity=...)``, ``solve_reynolds(..., complementarity=...)``).
 
-JFO cavitation (eq 18) couples the film pressure ``p = p_hd - p_cav`` and the cavity
-fraction ``theta`` by ``p theta = 0``, ``p >= 0``, ``theta >= 0``.  A model carries them in
-one unknown per node, ``phi``, and provides:
+JFO cavitation (eq 18) couples ``p = p_hd - p_cav`` and the cavity fraction ``theta`` by
+``p theta = 0``, ``p >= 0``, ``theta >= 0``, carried in one unknown per node, ``phi``.  A
+model provides:
 
 ``solve(K, B, dirichlet, p_boundary, scale, *, phi0, tol, max_iter, inexact[, settle])``
-    the inner problem ``K p + B (1 - theta) = 0`` on the interior, Dirichlet nodes at
-    ``p = p_boundary``, ``theta = 0``; returns ``(phi, iterations, residual history)``
-    (the fixed-point couplings, ``solve_reynolds`` and the Newton coupling's cold start);
-    ``settle`` only where the class attribute ``settles`` is true (an active-set solver
-    that can stop once its active set has settled, :func:`.switch.solve_complementarity`);
-``split(phi, scale)``
-    ``(p, theta)`` of the unknown;
-``unknown(p, theta, scale)``
-    the unknown of a solved state (warm starts from a converged point);
+    ``K p + B (1 - theta) = 0`` on the interior (``p = p_boundary``, ``theta = 0`` at the
+    Dirichlet nodes): ``(phi, iterations, residual history)``; ``settle`` where the class's
+    ``settles`` is true (:func:`.switch.solve_complementarity`);
+``split(phi, scale)`` and ``unknown(p, theta, scale)``
+    ``(p, theta)`` of an unknown, and the unknown of a solved state (warm starts);
 ``derivatives(phi, scale)``
-    ``(dp/dphi, d(1 - theta)/dphi)``: the linearisation the monolithic Newton coupling
-    (:mod:`.newton`) puts into its Jacobian.
+    ``(dp/dphi, d(1 - theta)/dphi)`` for the Newton coupling's Jacobian (:mod:`.newton`).
 
-Adding a model: a class with these four methods here, an entry in :data:`MODELS`, and a
-test against an exact solution (``tests/test_reynolds.py`` has them: the pocket that
-carries no load, Swift-Stieber); ``MacroSettings`` and ``solve_reynolds`` accept its name
-from the registry, and every coupling uses it.
+Adding one: ARCHITECTURE.md, "Adding a cavitation model".
 """
 
 from __future__ import annotations

@@ -18,6 +18,7 @@ As face matrices, per direction ``k``: ``outflow = D_k ((J_k q_k) * (U_k s))`` w
 signed face widths, ``J`` the face coefficient and ``U`` the upwind pick, so the Newton
 coupling gets both derivatives (:meth:`Couette.matrix`, :meth:`Couette.q_derivatives`).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -1,34 +1,16 @@
 """The fixed-point couplings of the macro scale: ``"anderson"`` and the paper's ``"pid"``.
 
-Each iteration solves the Reynolds complementarity problem (eqs 17-18) at the coefficients
-of the previous pressure (lagged viscosity and density, warm-started), then updates the
+Each iteration solves the Reynolds complementarity problem (eqs 17-18) at the previous
+pressure's coefficients (lagged viscosity and density, warm-started), then updates the
 elastic deformation ``h_el`` (eqs 20-22), the contact pressure ``p_con`` (eqs 25-27) and the
-rigid-body separation ``h_d`` (eqs 28-30):
-
-``"anderson"``
-    the fixed point ``(h_el, h_d) -> (op(p_tot - p_amb), h_d + dF/k)`` with ``p_con``
-    taken at the current ``h0`` (no under-relaxation), accelerated by Anderson mixing
-    (Walker and Ni 2011).  ``k`` is a load-stiffness estimate (contact stiffness from the
-    slope of ``p_con(h0)`` plus ``2 F_hd / h``); Anderson mixing corrects it.  Its steps
-    are damped (``MacroSettings.anderson_damping``): the undamped first step from a
-    coarse-grid start thins the film near contact enough to move the pressure by 70 MPa.
-    A point started from a coarser grid's solution also starts from that solve's last
-    ``SEED_PAIRS`` Anderson differences, interpolated (:class:`Secants`): they carry the
-    slow, smooth modes (the load balance on ``h_d``, the elastic deformation's long
-    waves), which the fine grid then no longer iterates out alone.
-``"pid"``
-    the paper's scheme: ``p_con`` under-relaxed with ``alpha_pcon`` (eq 26), the
-    incremental PID controller of eq 29 on ``h_d``, and ``h_el`` under-relaxed (the
-    paper's EHL-FBNS solves the elastic coupling inside its Newton system; a plain
-    fixed point on ``h_el`` oscillates here, so it is relaxed with ``relaxation_elastic``).
-
-Converged when, between two iterations, the change of ``h_el`` / h_ref, the update of
-``p_con`` / p_ref (eq 27), the change of ``p`` / p_ref and the load residual (eq 30) are all
-below ``tol``.  While the residual is above ``INEXACT * tol`` the Reynolds solves are cut
-to ``MacroSettings.inner_steps`` Newton steps (inexact inner solves: the outer iteration
-corrects what they leave); convergence is only accepted after an exact one.  The first
-solve, from the start's film, runs until its active set has settled (``SETTLE``; for
-a cavitation model that settles, else to convergence).
+separation ``h_d`` (eqs 28-30).  ``"anderson"``: the fixed point ``(h_el, h_d) ->
+(op(p_tot - p_amb), h_d + dF/k)`` with ``p_con`` at the current ``h0``, ``k`` a load
+stiffness estimate, accelerated by damped Anderson mixing (Walker and Ni 2011), seeded
+from a coarser grid's last differences (:class:`Secants`).  ``"pid"``: the paper's
+under-relaxed ``p_con`` (eq 26), PID on ``h_d`` (eq 29) and under-relaxed ``h_el``.
+Converged when the changes of ``h_el``, ``p_con`` and ``p`` and the load residual (eq 30),
+scaled, are all below ``tol``; far from it the Reynolds solves are inexact (``INEXACT``,
+``SETTLE``), and convergence is accepted only after an exact one.
 """
 
 from __future__ import annotations

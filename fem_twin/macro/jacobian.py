@@ -24,7 +24,7 @@ from ..ordering import subgrid_order
 from .cavitation import cavitation_model
 from .contact_load import contact_load
 from .evaluation import NewtonEvaluation
-from .kinematics import rotate_tensor, rotate_vector, rotations
+from .kinematics import rotate_tensor, rotate_vector
 from .problem import MAX_COEFFICIENT_PRESSURE, Problem
 
 
@@ -77,8 +77,8 @@ def jacobian(P: Problem, ev: NewtonEvaluation) -> dict:
     dlnrho = lub.density_log_slope(p_coef) * unclipped
     dlnmu = lub.viscosity_log_slope(p_coef) * unclipped
     d = P.factors.slopes(ev.h0)
-    if P.velocity is not None:                          # into the grid frame, as loc's
-        c, s, _ = rotations(P.velocity)
+    if P.turn is not None:                              # into the grid frame, as loc's
+        c, s, _ = P.turn
         d["A"], d["b"] = rotate_tensor(d["A"], c, s), rotate_vector(d["b"], c, s)
     free = ~ev.touching
     g, q, loc, p = ev.g, ev.q, ev.loc, ev.p.ravel()

@@ -78,14 +78,15 @@ def rotate_tensor(T, c, s):
     return out
 
 
-def in_grid_frame(loc, v):
+def in_grid_frame(loc, turn):
     """The :class:`~fem_twin.micro.LocalFactors` ``loc`` (cell frame: sliding along x1)
-    rotated into the grid at each node's sliding direction ``v`` (None: unchanged).
+    rotated into the grid at each node's sliding direction, ``turn`` the
+    :func:`rotations` of the disk's velocity (None: unchanged).
     ``pressure_friction`` and the scalars stay (the Poiseuille friction weight, completed
     isotropically, commutes with rotations: docs/model.md)."""
-    if v is None:
+    if turn is None:
         return loc
-    c, s, _ = rotations(v)
+    c, s, _ = turn
     moved = {}
     for name, rotate in (("A", rotate_tensor), ("C", rotate_tensor), ("b", rotate_vector),
                          ("d", rotate_vector)):

@@ -9,14 +9,14 @@ pressure and a separation field.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from functools import partial
+from functools import cached_property, partial
 
 import numpy as np
 import scipy.fft as fft
 
 from ..contact.elastic import elastic_operator
 from .contact_load import nodal_contact_pressure
-from .kinematics import in_grid_frame
+from .kinematics import in_grid_frame, rotations
 from .reynolds import OPEN_GAP, fe_poiseuille, trapezoid_weights
 from .reynolds_fv import fvm_poiseuille
 
@@ -46,6 +46,12 @@ class Problem:
     entrainment: float         # mean (entrainment) speed u_m [m/s]
     velocity: np.ndarray | None = None  # the disk's velocity / u_r (ny, nx, 2); None: e1
 
+    @cached_property
+    def turn(self) -> tuple | None:
+        """``(cos phi, sin phi, |v|)`` of the disk's velocity at each node, computed once
+        (:func:`.kinematics.rotations`); None for uniform sliding."""
+        return None if self.velocity is None else rotations(self.velocity)
+
     @property
     def shape(self):
         return self.gap.shape
@@ -67,7 +73,7 @@ class Problem:
         disk (:mod:`.kinematics`)."""
         rule = self.settings.contact_quadrature
         loc = in_grid_frame(self.factors.at(h0, friction=False, contact=rule == "nodal"),
-                            self.velocity)
+                            self.turn)
         if rule != "nodal":
             loc = replace(loc, p_con=nodal_contact_pressure(self.factors, h0, rule))
         p_coef = np.minimum(p, MAX_COEFFICIENT_PRESSURE)
@@ -75,8 +81,8 @@ class Problem:
         rho = self.lubricant.density_ratio(p_coef)
         g = rho * loc.h_m ** 3 / (12 * mu)
         q = rho * loc.h_m * self.entrainment
-        if self.velocity is not None:
-            q = q * np.hypot(self.velocity[..., 0], self.velocity[..., 1])
+        if self.turn is not None:
+            q = q * self.turn[2]
         return loc, mu, rho, g, q
 
     def kernel(self):

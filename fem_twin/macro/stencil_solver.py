@@ -16,6 +16,7 @@ returned only when it solves ``J x = rhs`` to ``STEP_RTOL``; the factors are fre
 the inner solve ends (``step.release()``).  The measurements behind these choices, and
 what was tried and dropped, are in ``benchmarks/README.md`` ("stencil_solver").
 """
+
 from __future__ import annotations
 
 import hashlib

@@ -167,48 +167,55 @@ class ContactThermal:
     law: object
     boundary_friction: float
 
-    def heat(self, result, factors, speeds) -> dict:
+    def heat(self, result, speeds) -> dict:
         """The heat of a converged point ``result``: ``power`` F_T U [W], the face's
-        ``flash`` [K] and the pin's share ``pin_share`` of the heat, and an asperity spot's
-        ``spot_flash`` [K]; ``factors`` the point's flow factors (contact fraction),
-        ``speeds`` (pin, disk) of :func:`face_flash`."""
+        ``flash`` [K] and the pin's share ``pin_share`` of the heat; ``speeds`` (pin, disk)
+        of :func:`face_flash`."""
         power = max(float(result.friction_force * result.speed), 0.0)
         face = np.asarray(result.face, bool)
         flux = np.where(face, np.maximum(result.shear_stress, 0.0), 0.0)
         total = flux.sum() * result.spacing[0] * result.spacing[1]
         flux = flux * (power / total) if total > 0 else flux
         flash, share = face_flash(flux, face, result.spacing, speeds, self.settings)
+        return {"power": power, "flash": flash, "pin_share": share}
+
+    def spot(self, result, factors, speeds) -> float:
+        """An asperity spot's flash temperature [K] at the point ``result``: the boundary
+        shear's flux at the contacts' mean pressure (``factors``: the point's flow factors,
+        for the contact fraction)."""
+        face = np.asarray(result.face, bool)
         fraction = factors.at(result.h0).contact_fraction[face].sum()
-        spot = (self.boundary_friction * result.contact_pressure[face].sum() / fraction
+        flux = (self.boundary_friction * result.contact_pressure[face].sum() / fraction
                 * abs(result.speed) if fraction > 0 else 0.0)
-        return {"power": power, "flash": flash, "pin_share": share,
-                "spot_flash": spot_flash(spot, speeds, self.settings)}
+        return spot_flash(flux, speeds, self.settings)
 
 
 def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
-                  start: float | None = None) -> tuple:
+                  near: dict | None = None) -> tuple:
     """An operating point at the film temperature its own heat gives it.
 
     ``solve(lubricant, previous)`` returns the point's levels ``(result, *coarser)`` with
     the film's ``lubricant``, warm from ``previous`` (None first).  The film temperature
-    ``T = T_oil + R_b Q + theta_face`` is iterated by secant steps on ``T - g(T)``, from
-    ``start`` [C] (a neighbouring point's; None: the oil's), until it moves by less than
-    ``settings.tol``; returns ``(levels, lubricant, record)`` with the
+    ``T = T_oil + R_b Q + theta_face`` is iterated by secant steps on ``T - g(T)``, from the
+    film temperature of ``near`` (a neighbouring point's record on the same oil; else the
+    oil's), until it moves by less than ``settings.tol``; returns ``(levels, lubricant, record)`` with the
     record's temperatures [C] (``oil``, ``film``, ``asperity``), rises [K], power [W] and
     iterations, or raises :class:`ThermalNotConverged` with the history."""
     s, law = thermal.settings, thermal.law
     oil = float(law.temperature(lubricant.viscosity))
-    T, previous, history, pairs = oil if start is None else float(start), None, [], []
+    T = near["film_C"] if near and near["oil_C"] == oil else oil
+    previous, history, pairs = None, [], []
     for _ in range(s.max_iter):
         film = replace(lubricant, viscosity=float(law.viscosity(T)))
         levels = solve(film, previous)
-        heat = thermal.heat(levels[0], factors, speeds)
+        heat = thermal.heat(levels[0], speeds)
         target = oil + s.bulk_resistance * heat["power"] + heat["flash"]
         history.append(abs(target - T))
         if history[-1] < s.tol:
-            record = {"oil_C": oil, "film_C": T, "asperity_C": T + heat["spot_flash"],
+            spot = thermal.spot(levels[0], factors, speeds)     # reported: once, at the end
+            record = {"oil_C": oil, "film_C": T, "asperity_C": T + spot,
                       "bulk_rise_K": s.bulk_resistance * heat["power"],
-                      "face_flash_K": heat["flash"], "spot_flash_K": heat["spot_flash"],
+                      "face_flash_K": heat["flash"], "spot_flash_K": spot,
                       "power_W": heat["power"], "pin_share": heat["pin_share"],
                       "iterations": len(history)}
             return levels, film, record

@@ -39,38 +39,19 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
                checkpoint=None, progress: bool = False, patch_id=None,
                error_estimate: bool = True, h0_tol: float | None = None,
                friction: str = "pin", **shortcuts) -> FlowFactors:
-    """Flow factors of a roughness patch pair versus h0 (eqs 11-16).
+    """Flow factors of a roughness patch pair versus h0 [m] (eqs 11-16).
 
-    Parameters
-    ----------
-    pin, disk : Topography
-        Periodic roughness cells on the same grid, both with zero mean plane: ``pin`` the
-        lower surface, ``disk`` the upper one already flipped over the pin (as
-        :func:`fem_twin.topography.prepare.prepare_patch` with ``upper=True`` gives).  The gap
-        is ``h0 + disk - pin + deformation``.
-    h0 : rigid-body separations [m] (default: 100 values geometrically in [0.1, 1] um).
-    settings : :class:`~fem_twin.micro.CellSettings`, everything of the cell problems the
-        result depends on (default: ``CellSettings()``), each field documented there
-        (frame, squeeze term, slide-to-roll ratio, boundary film, adaptive instants, ...);
-        ``**shortcuts``: any of its fields by keyword (``n_steps``: ``steps``).
-    workers : processes for the h0 values (1: in this process); ``executor``: any
-        ``concurrent.futures``-style executor instead (e.g. ``dask.distributed``'s), with
-        ``workers`` the processes serving it.  The h0 values go out as ``4 workers`` tasks
-        (each warm-starts along its own h0 values), so a 64-worker cluster gets 100 tasks
-        of one h0 from the paper's 100 values; with ``h0_tol``, the new points of each round
-        of the adaptive sample go out so (5 to start with, then the bisected gaps).
-    checkpoint : folder that keeps one file per finished h0; a rerun resumes from it.
-    progress : show a progress bar (or a tqdm-like bar to advance, shared by several runs).
-    patch_id : recorded in the metadata.
-    error_estimate : estimate the time and grid errors (``meta["error_estimate"]``, see
-        :mod:`fem_twin.micro.estimate`; about ``3 / (4 len(h0))`` of the run's cost).
-    h0_tol : adaptive separations: ``h0`` is the dense candidate set and only the subset
-        :func:`fem_twin.micro.sampling.adaptive_separations` needs is solved, so that the
-        interpolant in log h0 misses the factors at the skipped candidates by less than
-        this relative tolerance (its bound: ``meta["error_estimate"]["h0"]``).  0 or None
-        (off, as in the case file): every ``h0``.
-    friction : ``[macro] friction``: with ``"paper"`` the adaptive separations watch eq 31's
-        factors alone (the paper's sample), not the friction factor s_C.
+    ``pin`` and ``disk``: periodic cells on one grid, zero mean plane, the disk flipped over
+    the pin (:func:`fem_twin.topography.prepare.prepare_patch`); the gap is ``h0 + disk -
+    pin + deformation``.  ``h0`` default: 100 values in [0.1, 1] um.  ``settings``: a
+    :class:`~fem_twin.micro.CellSettings`, or its fields as ``**shortcuts`` (``n_steps``:
+    ``steps``).  ``workers`` processes, or any ``executor`` (Dask's), take the h0 values as
+    ``4 workers`` warm-started tasks; ``checkpoint``: a folder keeping each finished h0 (a
+    rerun resumes); ``progress``: a bar, or a bar to share; ``patch_id``: for the metadata.
+    ``error_estimate``: the time and grid errors (:mod:`fem_twin.micro.estimate`).
+    ``h0_tol``: solve only the subset of ``h0`` the log-h0 interpolant needs to miss the
+    others by less than this fraction (:func:`fem_twin.micro.sampling.adaptive_separations`;
+    0 or None: every h0), watching eq 31's factors alone when ``friction`` is ``"paper"``.
     """
     settings = _settings(settings, shortcuts)
     h0_tol = h0_tol or None                                  # 0 means off, as in the case
@@ -88,15 +69,8 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
     bar = progress_bar(len(h0), progress, patch_id, h0_tol is not None) if own_bar else progress
     points = Separations(h0, args, workers, executor, bar)
     try:
-        if h0_tol is None:
-            chosen, bound = list(range(len(h0))), None
-        else:
-            chosen, bound = adaptive_separations(h0, points.factors, h0_tol,
-                                                 quantities=watched(friction))
-        moments = points.moments(chosen)
-        bar.update(len(h0) - len(chosen))             # the candidates interpolated
-        coarse = (coarse_moments(points, chosen, z_low, z_up, spacing, settings, checkpoint)
-                  if error_estimate else None)
+        chosen, bound, moments, coarse = _solve(points, h0, h0_tol, friction, bar, (
+            z_low, z_up, spacing, settings, checkpoint) if error_estimate else None)
     except BaseException:
         points.close(failed=True)
         raise
@@ -110,11 +84,32 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
             "steps_used": [int(m.get("n_steps", settings.steps)) for m in moments],
             "seconds": points.seconds()}
     factors = factors_from_moments(h0[chosen], moments, meta)
-    if not error_estimate:
-        return factors
+    return _estimated(factors, moments, coarse, settings, bound) if error_estimate else factors
+
+
+def _solve(points, h0, h0_tol, friction, bar, coarse_args):
+    """``(chosen, bound, moments, coarse)``: the indices of the h0 solved (all, or the
+    adaptive subset and its bound), their moments, and the coarsened cells' moments of
+    the grid estimate (``coarse_args``; None: no estimate)."""
+    if h0_tol is None:
+        chosen, bound = list(range(len(h0))), None
+    else:
+        chosen, bound = adaptive_separations(h0, points.factors, h0_tol,
+                                             quantities=watched(friction))
+    moments = points.moments(chosen)
+    bar.update(len(h0) - len(chosen))             # the candidates interpolated
+    coarse = (None if coarse_args is None
+              else coarse_moments(points, chosen, *coarse_args))
+    return chosen, bound, moments, coarse
+
+
+def _estimated(factors, moments, coarse, settings, bound):
+    """``factors`` with their error estimate and its variants in the metadata (the h0 part
+    the adaptive sample's ``bound`` when it has one)."""
     estimate = estimate_errors(factors, moments, coarse, settings)
     if bound is not None:
         estimate["h0"] = bound
+    meta = factors.meta
     keys = meta["checkpoint_keys"] + estimate.pop("checkpoint_keys", [])
     moved = estimate.pop("variants")
     return replace(factors, meta={**meta, "error_estimate": estimate, "checkpoint_keys": keys,

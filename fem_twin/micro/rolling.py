@@ -14,6 +14,7 @@ shear then vanishes in pure rolling, as the local shear ``mu u_r / h`` does.  Th
 cell solves in the mean-speed frame, where the pure rolling cell's discretisation error
 does not enter.  docs/rolling_sliding.md has the derivation and the measurements.
 """
+
 from __future__ import annotations
 
 from dataclasses import replace

@@ -16,6 +16,7 @@ pin's frame leaves at contact edges (its Couette and squeeze terms cancel only t
 error) does not arise; its factors are the pin frame's exactly (:mod:`.rolling`).
 docs/rolling_sliding.md has the measurements.
 """
+
 from __future__ import annotations
 
 import time

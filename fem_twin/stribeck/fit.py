@@ -20,6 +20,7 @@ Least squares on C_f,dev (eq 35) at the measured speeds (PCHIP in log speed).  W
 weights with the HC3 covariance (:func:`_covariance`); intervals ``t_{0.975, n - p}`` times
 its diagonal's root.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

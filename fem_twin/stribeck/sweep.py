@@ -258,10 +258,8 @@ def _solve_point(gap, spacing, factors, load, speed, slide_to_roll, lubricant, f
     u_m = sliding.get("entrainment", speed / 2)
     surfaces = (u_m - sliding["speed"] / 2, u_m + sliding["speed"] / 2)
     start = time.perf_counter()
-    near = previous[0].meta.get("thermal") if previous else None   # the neighbour's film
     levels, film, record = thermal_point(solve, lubricant, thermal, factors, surfaces,
-                                         near["film_C"] if near and near["oil_C"] == float(
-                                             thermal.law.temperature(lubricant.viscosity))
+                                         previous[0].meta.get("thermal") if previous
                                          else None)
     record["viscosity_Pa_s"] = film.viscosity
     last = sum(level.meta["seconds"] for level in levels)     # the final iteration's solves
