@@ -24,17 +24,9 @@ from fem_twin.topography.prepare import prepare_pin  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-SAMPLE = os.path.join(HERE, "..", "meshes", "sample")
-
-
-def best_of(fn, repeat=3):
-    """Minimum wall time of ``repeat`` calls [s] and the last result."""
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
+from common import SAMPLE, best_of, macro_factors, macro_gap  # noqa: E402
+from cores import bench_cores  # noqa: E402
+from scale import bench_scale  # noqa: E402
 
 
 def bench_topography():
@@ -271,7 +263,7 @@ def bench_micro(full=False):
     rows = [("baseline: skfem assemble + P^T K P, 256^2", base, "")]
     t, _ = best_of(lambda: cs.operator(a_q), 5)
     rows.append(("re-assembly from element tensors", t, ""))
-    from fem_twin.linalg import _mkl_rt, default_backend
+    from fem_twin.numerics.linalg import _mkl_rt, default_backend
     backends = ["superlu"] + (["pardiso"] if _mkl_rt() is not None else [])
     for name, make in (("FE", CellSolver), ("FVM", CellSolverFV)):
         for backend in backends:
@@ -301,26 +293,6 @@ def bench_micro(full=False):
     return base, rows
 
 
-def _macro_factors():
-    """Flow factors of sample patch 1 at 64^2, 30 h0 x 8 steps: the macro groups' input."""
-    from fem_twin.micro import homogenise
-    from fem_twin.topography.prepare import prepare_patch
-    low = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz"))),
-                           (64, 64))
-    up = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
-                                        upper=True), (64, 64))
-    return homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), n_steps=8)
-
-
-def _macro_gap(n):
-    """Gap, spacing and pin face of sample pin 1 on disk 1 at n^2."""
-    from fem_twin.topography.prepare import MacroOptions, prepare_disk
-    opts = MacroOptions(resolution=(n, n))
-    pin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
-    disk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
-    return disk.heights - pin.heights, pin.spacing, pin.heights > opts.holder_height / 2
-
-
 def bench_macro():
     """One operating point (150 N, 0.066 Pa s, 0.1 and 1 m/s), cold start, FE and FVM.
 
@@ -330,10 +302,10 @@ def bench_macro():
     """
     from fem_twin.macro import Lubricant, MacroSettings, solve_mixed
 
-    ff = _macro_factors()
+    ff = macro_factors()
     rows, base = [], None
     for n in (128, 256):
-        gap, spacing, face = _macro_gap(n)
+        gap, spacing, face = macro_gap(n)
         for speed in (1.0, 0.1):
             cf = {}
             for method in ("fvm", "fe"):
@@ -379,8 +351,8 @@ def bench_stribeck():
                         "--no-progress"], check=True, capture_output=True)
         wall = time.perf_counter() - t0
         sec = json.loads(open(os.path.join(tmp, "summary.json")).read())["seconds"]
-    ff = _macro_factors()
-    gap, spacing, face = _macro_gap(256)
+    ff = macro_factors()
+    gap, spacing, face = macro_gap(256)
     t0 = time.perf_counter()
     solve_mixed(gap, spacing, ff, load=150.0, speed=2.0, face=face,
                 lubricant=Lubricant(0.066))
@@ -405,18 +377,18 @@ def bench_newton():
     stencil pattern (analysis once per grid) with exact inner solves, and by the default
     (PARDISO, one Newton step per inner solve while the coupling is far from converged).
     Baseline: the previous method at 128^2.  Goal of the paper-grade issue: 2x at 256^2."""
-    from fem_twin.linalg import _mkl_rt
+    from fem_twin.numerics.linalg import _mkl_rt
     from fem_twin.macro import Lubricant, MacroSettings
     from fem_twin.stribeck import stribeck_sweep
 
-    ff = _macro_factors()
+    ff = macro_factors()
     backend = "pardiso" if _mkl_rt() is not None else "superlu"
     methods = {"previous (SuperLU, exact inner solves)": ("superlu", 0),
                f"{backend}, exact inner solves": (backend, 0),
                f"default ({backend}, inexact inner solves)": (backend, 1)}
     rows, base = [], None
     for n in (128, 256):
-        gap, spacing, face = _macro_gap(n)
+        gap, spacing, face = macro_gap(n)
         times, cf = [], []
         for name, (sparse, steps) in methods.items():
             os.environ["FEM_TWIN_SPARSE"] = sparse
@@ -460,9 +432,9 @@ def bench_paper():
     t0 = time.perf_counter()
     ad = homogenise(pin, disk, DEFAULT_H0, workers=cores, h0_tol=case.micro.h0_tol)
     t_pair = time.perf_counter() - t0
-    gap, spacing, face = _macro_gap(256)
+    gap, spacing, face = macro_gap(256)
     speeds = np.geomspace(2.0, 0.01, case.sweep.count)[6:14]
-    ff = _macro_factors()          # smooth factors (30 h0): 10 h0 kink p_con, the sweep stalls
+    ff = macro_factors()          # smooth factors (30 h0): 10 h0 kink p_con, the sweep stalls
     t0 = time.perf_counter()
     stribeck_sweep(gap, spacing, ff, speeds[:1], load=150.0, lubricant=Lubricant(0.066),
                    face=face)
@@ -528,9 +500,9 @@ def _refined(case, scale, steps, h0):
     candidates refined ``h0`` times (old candidates kept)."""
     from dataclasses import replace
 
-    res = tuple(scale * n for n in case.macro_geometry.resolution)
+    res = tuple(scale * n for n in case.preprocessing.resolution)
     cell = tuple(scale * n for n in case.micro.resolution)
-    return replace(case, macro_geometry=replace(case.macro_geometry, resolution=res),
+    return replace(case, preprocessing=replace(case.preprocessing, resolution=res),
                    micro=replace(case.micro, resolution=cell, steps=steps * case.micro.steps,
                                  h0_count=h0 * (case.micro.h0_count - 1) + 1))
 
@@ -584,7 +556,7 @@ def bench_estimate(case_file="pin_on_disk.toml", viscosity=0.066):
     t_base, base = _run_kept(case, f"{stem}_base")
     t_ref, ref = _run_kept(fine, f"{stem}_reference", reuse=True)
     cb = case.tribometer.boundary_friction
-    res, cell = fine.macro_geometry.resolution[0], fine.micro.resolution[0]
+    res, cell = fine.preprocessing.resolution[0], fine.micro.resolution[0]
     rows = [(f"baseline: {stem}, 1 patch, 1 viscosity", t_base, ""),
             (f"reference: {res}^2 / {cell}^2, {fine.micro.h0_count} h0, "
              f"{fine.micro.steps} steps", t_ref, "")]
@@ -597,9 +569,6 @@ def bench_estimate(case_file="pin_on_disk.toml", viscosity=0.066):
                      f"effectivity {err / actual:.2f} {'ok' if ok else 'OUTSIDE'}"))
     return t_base, rows
 
-
-from cores import bench_cores  # noqa: E402
-from scale import bench_scale  # noqa: E402
 
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
           "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "paper": bench_paper, "stribeck": bench_stribeck,

@@ -1,6 +1,6 @@
 """Benchmark group ``scale``: one cold and one warm macro point from 128^2 up (issue 28 item 3).
 
-Sample pin 1 on disk 1 prepared at n^2 (``run._macro_gap``) with the macro groups' flow
+Sample pin 1 on disk 1 prepared at n^2 (``common.macro_gap``) with the macro groups' flow
 factors (sample patch 1 at 64^2, 30 h0 x 8 steps), 150 N, 0.066 Pa s: a cold point at
 0.03 m/s (mixed lubrication, the coarse-to-fine start included) and a warm one at
 0.025 m/s from it, both as a sweep solves them (:func:`fem_twin.macro.nested.solve_nested`:
@@ -9,7 +9,7 @@ memory (maximum resident set) is its own.  ``FEM_TWIN_SCALE_MAX`` (default 1024)
 largest grid: 2048 takes 2.8 min for its cold point and 7.4 GiB on two threads (2026-11-28).
 A lone point has the machine to itself, so each grid's process gets as many PARDISO threads
 as the machine has cores (``FEM_TWIN_THREADS``, if set, wins; PARDISO uses them only on
-matrices of ``fem_twin.linalg.THREADED_UNKNOWNS`` or more).
+matrices of ``fem_twin.numerics.linalg.THREADED_UNKNOWNS`` or more).
 Baseline: the cold point at 128^2.  The growth exponent is ``log(t_n / t_(n/2)) / log 4``,
 in the number of nodes N.
 """
@@ -31,18 +31,18 @@ import numpy as np  # noqa: E402
 
 COLD, WARM = 0.03, 0.025          # [m/s]
 #: the environment before this process loads MKL, which sets its threading layer there
-#: (``fem_twin.linalg``): a child given more threads must choose its own layer, not
+#: (``fem_twin.numerics.linalg``): a child given more threads must choose its own layer, not
 #: inherit this process's sequential one
 _ENVIRONMENT = dict(os.environ)
 
 
 def bench_scale():
-    from run import _macro_factors
+    from common import macro_factors
     top = int(os.environ.get("FEM_TWIN_SCALE_MAX", "1024"))
     sizes = [n for n in (128, 256, 512, 1024, 2048) if n <= top]
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "factors.npz")
-        _macro_factors().save(path)
+        macro_factors().save(path)
         env = {**_ENVIRONMENT,
                "FEM_TWIN_THREADS": os.environ.get("FEM_TWIN_THREADS", str(os.cpu_count() or 1))}
         runs = [json.loads(subprocess.run(
@@ -63,13 +63,13 @@ def bench_scale():
 
 def _point(n: int, factors: str) -> dict:
     """One grid's cold and warm points (in a process of its own)."""
-    from run import _macro_gap
+    from common import macro_gap
 
     from fem_twin.macro import Lubricant
     from fem_twin.macro.nested import solve_nested
     from fem_twin.micro import FlowFactors
     ff = FlowFactors.load(factors)
-    gap, spacing, face = _macro_gap(n)
+    gap, spacing, face = macro_gap(n)
     common = dict(load=150.0, face=face, lubricant=Lubricant(0.066))
     t0 = time.perf_counter()
     cold = solve_nested(gap, spacing, ff, speed=COLD, **common)

@@ -31,7 +31,7 @@ HERE = Path(sys.argv[0]).resolve().parent
 
 def reduced(case):
     """The bundled case at smoke-test size."""
-    return replace(case, macro_geometry=replace(case.macro_geometry, resolution=(48, 48)),
+    return replace(case, preprocessing=replace(case.preprocessing, resolution=(48, 48)),
                    micro=replace(case.micro, resolution=(16, 16), h0_count=6, steps=4),
                    geometry=replace(case.geometry, patches=case.geometry.patches[:2]),
                    sweep=replace(case.sweep, count=4, speed_min=0.01, refine=0),

@@ -61,12 +61,12 @@ def variant(case, n, quick, patches=None):
     micro = replace(case.micro, resolution=(n, n), h0_max=2e-6,
                     **(dict(steps=4, h0_count=14) if quick else dict(h0_count=20)))
     sweep = replace(case.sweep, **(dict(count=5, speed_min=0.01, refine=0) if quick else {}))
-    macro_geometry = replace(case.macro_geometry, resolution=(48, 48) if quick else (128, 128))
+    preprocessing = replace(case.preprocessing, resolution=(48, 48) if quick else (128, 128))
     lubricant = replace(case.lubricant, viscosities=(0.066,), temperatures=(24.0,))
     thermal = replace(case.thermal, model="none")   # one viscosity: no viscosity-temperature law
     return replace(case, name=case.name + ("_real" if patches else "_synthetic"),
                    geometry=geometry, micro=micro, sweep=sweep, lubricant=lubricant,
-                   thermal=thermal, macro_geometry=macro_geometry,
+                   thermal=thermal, preprocessing=preprocessing,
                    run=replace(case.run, patch_band=False))
 
 

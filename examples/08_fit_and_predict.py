@@ -49,7 +49,7 @@ TRUE_CFB, HEATING = 0.15, 3.0          # the synthetic truth: C_f,b and the cont
 
 def reduced(case):
     """The bundled case at smoke-test size."""
-    return replace(case, macro_geometry=replace(case.macro_geometry, resolution=(48, 48)),
+    return replace(case, preprocessing=replace(case.preprocessing, resolution=(48, 48)),
                    micro=replace(case.micro, resolution=(16, 16), h0_count=6, steps=4),
                    geometry=replace(case.geometry, patches=case.geometry.patches[:2]),
                    sweep=replace(case.sweep, count=6, speed_max=1.0, speed_min=0.01,

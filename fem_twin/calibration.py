@@ -45,7 +45,7 @@ from .stages.sweeps import run_sweeps
 from .stages.factors import homogenise_patches
 from .stages.geometry import face_load, macro_geometry, prepare_pins, reconstruct_geometry
 from .stribeck import friction_deviation, plot_stribeck, write_stribeck_csv
-from .threads import executor_for
+from .numerics.threads import executor_for
 
 STUDIES = ("filter", "resolution", "disk", "pins", "patches")
 #: the paper's resolution study (3.2, Figure 10): macro grids [px] interpolated from its
@@ -59,7 +59,7 @@ FINE_SPEEDS = (0.1, 0.08, 0.06, 0.04, 0.02)
 def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
     """``{label: (case, patch index or None, speeds [m/s] or None for the case's)}`` of a
     study and the reference label."""
-    g = case.macro_geometry
+    g = case.preprocessing
     if values and study not in ("filter", "resolution"):
         raise InputError(f"--values: the {study} study takes none (its variants are the "
                          "case's own); --values goes with the filter and resolution studies")
@@ -71,7 +71,7 @@ def variants(case: Case, study: str, values=None) -> tuple[dict, str]:
         if values and not all(0 <= v <= 200 for v in values):
             raise InputError(f"--values {values}: filter widths FWHM in pixels, 0 to 200")
         values = values or [0, 3, 5, 7, 9, 11]
-        out = {f"fwhm {v:g} px": (replace(case, macro_geometry=replace(g, fwhm_px=float(v))),
+        out = {f"fwhm {v:g} px": (replace(case, preprocessing=replace(g, fwhm_px=float(v))),
                                   None, None) for v in values}
         ref = max(values, key=lambda v: (v == 11, v))
         return out, f"fwhm {ref:g} px"
@@ -119,7 +119,7 @@ def _resolutions(case: Case, values) -> tuple[dict, str]:
                 else None)
     ref = measured if measured in values else max(values)
     both = np.array(sorted({*case.sweep.speeds, *FINE_SPEEDS}, reverse=True))
-    out = {f"{v} px": (replace(case, macro_geometry=replace(case.macro_geometry,
+    out = {f"{v} px": (replace(case, preprocessing=replace(case.preprocessing,
                                                             resolution=(v, v))), None,
                        np.array(FINE_SPEEDS) if v > ref else both) for v in values}
     return out, f"{ref} px"

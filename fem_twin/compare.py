@@ -31,7 +31,7 @@ from .stages.curves import macro_settings
 from .stages.factors import homogenise_patches
 from .stages.geometry import face_load, level_pins, macro_geometry, reconstruct_geometry
 from .stribeck.sweep import point_files
-from .threads import executor_for
+from .numerics.threads import executor_for
 
 
 def flow_factor_differences(fe: FlowFactors, fvm: FlowFactors) -> dict:

@@ -26,7 +26,7 @@ from .stribeck import read_measured_csv
 from .stribeck.curve import read_stribeck_csv
 from .stribeck.fit import (LOAD_SHARES, RESISTANCES, FitModel, check_parameters, fit_curves,
                            plot_fit, predict)
-from .threads import executor_for
+from .numerics.threads import executor_for
 
 
 def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: bool = True,

@@ -31,7 +31,7 @@ from .stages.factors import homogenise_patches
 from .stages.geometry import level_pins, reconstruct_geometry
 from .stages.provenance import provenance, stage_keys
 from .stribeck import read_measured_csv
-from .threads import executor_for, one_thread
+from .numerics.threads import executor_for, one_thread
 
 log = logging.getLogger("fem_twin")
 

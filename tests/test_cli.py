@@ -357,7 +357,7 @@ def test_resolution_study_follows_the_papers_protocol(tmp_path, monkeypatch):
     fine = np.array(calibration.FINE_SPEEDS)
     for label, (variant, patch, speeds) in cases.items():
         n = int(label.split()[0])
-        assert variant.macro_geometry.resolution == (n, n) and patch is None
+        assert variant.preprocessing.resolution == (n, n) and patch is None
         assert np.array_equal(speeds, fine) == (n > 500)
         assert n > 500 or set(fine) | set(case.sweep.speeds) == set(speeds)
 
@@ -383,7 +383,7 @@ def test_a_studys_pins_are_prepared_together_as_one_at_a_time(tmp_path):
     from dataclasses import replace
     from fem_twin.stages.geometry import level_pins, prepare_pins, reconstruct_geometry
     case = load_case(small_case(tmp_path))
-    runs = [replace(case, macro_geometry=replace(case.macro_geometry, resolution=(n, n)))
+    runs = [replace(case, preprocessing=replace(case.preprocessing, resolution=(n, n)))
             for n in (24, 40)]
     together = [RunLayout(tmp_path / f"together_{i}") for i in range(2)]
     prepare_pins(list(zip(runs, together)), progress=False)
@@ -418,7 +418,7 @@ def test_sliding_direction_turns_the_roughness_patches_too(tmp_path):
     text = text.replace('sliding_direction = "+x1"', 'sliding_direction = "+x2"')
     (tmp_path / "turned.toml").write_text(text)
     other = load_case(tmp_path / "turned.toml")
-    assert other.macro_geometry.sliding_direction == "+x2"
+    assert other.preprocessing.sliding_direction == "+x2"
     runs = RunLayout(tmp_path / "a"), RunLayout(tmp_path / "b")
     for c, out in zip((case, other), runs):
         reconstruct_geometry(c, out, progress=False)
@@ -513,7 +513,7 @@ def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, 
     at more than seven times the bundled case stops with exit 2 unless --yes is given.
     Issue 64 item 0: the question does not depend on the machine's speed (the probe forced
     fast and slow), and the bundled case's figure it quotes is the estimate's."""
-    from fem_twin.cli_runs import BUNDLED_SECONDS, LONG_RUN_SECONDS
+    from fem_twin.cli.runs import BUNDLED_SECONDS, LONG_RUN_SECONDS
     monkeypatch.setenv("FEM_TWIN_SLOWDOWN", slowdown)
     bundled = load_case(ROOT / "examples" / "pin_on_disk.toml")
     assert bundled.estimated_seconds(2) == pytest.approx(BUNDLED_SECONDS, rel=0.02)
@@ -905,7 +905,7 @@ def test_inputs_that_failed_late_or_unhelpfully(tmp_path, capsys):
 def test_run_time_estimates_hold():
     """Issue 28 item 5: fem-twin run's estimate on the calibration machine lies within 30 %
     of the wall time measured there on 2 cores the same hour (2026-11-26, 13:20-13:45, the
-    probe of fem_twin.speed at 0.17-0.19 s): the bundled case 114 s with its band on the
+    probe of fem_twin.case.machine at 0.17-0.19 s): the bundled case 114 s with its band on the
     coarse grid and 173 s with it on the full grid, the paper case 605 s with its band at
     128^2 (band_grid = "coarse", at h0_tol = 0.1; 709 s at 0.05), the bundled ball-on-disk
     case 102 s; and the paper case with its band at 64^2 (the default "coarsest"), 484 s at
@@ -938,8 +938,8 @@ def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     twice as slow gets twice the estimate.  The probe is one thread's time of real work
     (0.05-3 s: 0.24 s on the calibration machine), and the printed durations read as a
     person would write them."""
-    import fem_twin.speed as speed
-    from fem_twin.cli_runs import _confirm_cost, duration
+    import fem_twin.case.machine as speed
+    from fem_twin.cli.runs import _confirm_cost, duration
     monkeypatch.delenv("FEM_TWIN_SLOWDOWN")                   # the probe itself
     t = speed.probe_seconds(repeats=1)
     assert 0.05 < t < 3.0

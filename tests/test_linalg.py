@@ -1,4 +1,4 @@
-"""Sparse SPD solves with a fixed pattern (fem_twin.linalg): SuperLU and MKL PARDISO."""
+"""Sparse SPD solves with a fixed pattern (fem_twin.numerics.linalg): SuperLU and MKL PARDISO."""
 
 import pickle
 
@@ -11,9 +11,9 @@ from hypothesis import strategies as st
 
 from fem_twin.fvm import CellSolverFV
 from fem_twin.errors import InputError
-from fem_twin.linalg import SPDSolver, _mkl_rt, default_backend
+from fem_twin.numerics.linalg import SPDSolver, _mkl_rt, default_backend
 from fem_twin.macro.stencil_solver import _stencil_pattern
-from fem_twin.ordering import nested_dissection, subgrid_order
+from fem_twin.numerics.ordering import nested_dissection, subgrid_order
 from fem_twin.micro import CellSolver
 
 BACKENDS = ["superlu", pytest.param("pardiso", marks=pytest.mark.skipif(
@@ -124,7 +124,7 @@ def test_one_thread_while_computing_and_restored_after(monkeypatch):
     raises it) and get their previous sizes back afterwards: importing changes nothing."""
     from threadpoolctl import threadpool_info, threadpool_limits
 
-    from fem_twin.threads import one_thread
+    from fem_twin.numerics.threads import one_thread
 
     inside = one_thread(lambda: {p["internal_api"]: p["num_threads"] for p in threadpool_info()})
     with threadpool_limits(limits=2):
@@ -144,7 +144,7 @@ def test_anderson_mixing_is_gmres_on_a_linear_map():
     the dimension n reaches the fixed point in at most n + 1 steps (GMRES equivalence),
     where the plain iteration needs hundreds, damped or not (the damped steps span the same
     Krylov space); depth 0 is the plain iteration."""
-    from fem_twin.anderson import Anderson
+    from fem_twin.numerics.anderson import Anderson
     rng = np.random.default_rng(5)
     n = 6
     Q = np.linalg.qr(rng.normal(size=(n, n)))[0]
@@ -181,12 +181,12 @@ def test_pardiso_runs_the_threads_fem_twin_threads_allows():
     import subprocess
     import sys
 
-    from fem_twin.linalg import THREADED_UNKNOWNS
+    from fem_twin.numerics.linalg import THREADED_UNKNOWNS
     script = (
         "import json, numpy as np, sys\n"
         "sys.path.insert(0, 'tests')\n"
         "from test_linalg import diffusion\n"
-        "from fem_twin.linalg import SPDSolver, _mkl_rt\n"
+        "from fem_twin.numerics.linalg import SPDSolver, _mkl_rt\n"
         "lib, asked = _mkl_rt(), []\n"
         "setter = lib.MKL_Set_Num_Threads_Local\n"
         "def spy(n):\n"
@@ -227,7 +227,7 @@ def test_anderson_seeded_with_the_pairs_of_a_related_map():
     mixes the slow modes out: with pairs spanning the space it lands on the fixed point at
     once, and with pairs of a perturbed map it still needs fewer steps than from nothing;
     pairs() gives the last differences oldest first."""
-    from fem_twin.anderson import Anderson
+    from fem_twin.numerics.anderson import Anderson
     rng = np.random.default_rng(7)
     n = 6
     Q = np.linalg.qr(rng.normal(size=(n, n)))[0]

@@ -246,7 +246,7 @@ def test_a_newton_step_reuses_the_factors_of_its_inner_solve(monkeypatch, scale)
     node's, as on the 2048^2 pin where GMRES with the kept factors failed such steps."""
     import scipy.sparse as sp
 
-    from fem_twin.linalg import SPDSolver, default_backend
+    from fem_twin.numerics.linalg import SPDSolver, default_backend
     from fem_twin.macro import stencil_solver as ss
     from fem_twin.macro.couette import couette_matrix
     from fem_twin.macro.reynolds import fe_poiseuille

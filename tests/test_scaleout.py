@@ -51,7 +51,7 @@ def test_a_local_cluster_computes_without_the_dask_profiler():
     way (threads.DASK_CONFIG: a default worker's profiler and ticks made a task's wall time
     7-10 % longer than its CPU time on 2 cores)."""
     pytest.importorskip("distributed")
-    from fem_twin.threads import DASK_CONFIG, DASK_ENVIRONMENT, executor_for
+    from fem_twin.numerics.threads import DASK_CONFIG, DASK_ENVIRONMENT, executor_for
 
     def settings():
         import os

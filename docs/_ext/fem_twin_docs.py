@@ -1,7 +1,7 @@
 """Sphinx extension: the reference pages generated from the code, so they cannot drift.
 
 ``reference/_generated/case_keys.md``: every case-file key from its one declaration
-(:func:`fem_twin.checks.setting` fields of :data:`fem_twin.sections.SECTIONS`);
+(:func:`fem_twin.checks.setting` fields of :data:`fem_twin.case.sections.SECTIONS`);
 ``reference/_generated/cli.md``: every command's ``--help`` from the CLI's parser.
 """
 
@@ -26,7 +26,7 @@ def _default(f) -> str:
 
 def case_keys() -> str:
     """One section per case-file table: its doc and a row per key."""
-    from fem_twin.sections import SECTIONS
+    from fem_twin.case.sections import SECTIONS
     from fem_twin.checks import describe
     lines = []
     for name, cls in SECTIONS.items():

@@ -31,7 +31,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import CORNERS, at_points, grid_stencil
+from ..numerics.assembly import CORNERS, at_points, grid_stencil
 from ..micro.flow_factors import REL_STEP
 
 #: the rules of ``MacroSettings.contact_quadrature``
@@ -49,7 +49,7 @@ BLOCK = 1 << 16
 class ContactLoad:
     """The ``"gauss"`` rule on one node grid ``shape`` (ny, nx): :meth:`pressure` and its
     derivative :meth:`derivative` (the Newton coupling's Jacobian).  Pixels are taken a
-    block of rows at a time, their corners by slicing (:data:`fem_twin.assembly.CORNERS`),
+    block of rows at a time, their corners by slicing (:data:`fem_twin.numerics.assembly.CORNERS`),
     so nothing is kept per pixel."""
 
     def __init__(self, shape, points: int = POINTS):

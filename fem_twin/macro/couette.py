@@ -27,7 +27,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import grid_stencil
+from ..numerics.assembly import grid_stencil
 from ..errors import InputError
 
 #: the Couette schemes (``MacroSettings.couette``, ``solve_reynolds(couette=...)``)
@@ -77,7 +77,7 @@ def couette(q1, q2, spacing, scheme: str = "central") -> Couette:
 def couette_matrix(q1, q2, spacing, scheme: str = "central") -> sp.csr_matrix:
     """``B`` with ``B @ (1 - theta)`` the net Couette outflow of each node's dual cell
     [m^3/s], :meth:`Couette.matrix` added face by face into the grid's 3 x 3 stencil
-    (:func:`fem_twin.assembly.grid_stencil`, the pattern of the Poiseuille matrix, zeros
+    (:func:`fem_twin.numerics.assembly.grid_stencil`, the pattern of the Poiseuille matrix, zeros
     where no face couples): no face matrices kept (which a grid would keep: 180 B a node),
     no sort of triplets, and one pattern for every coefficient and flow direction (the
     Newton steps map it into their matrix once per grid)."""

@@ -19,7 +19,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..anderson import Anderson
+from ..numerics.anderson import Anderson
 from ..errors import MixedNotConverged
 from .couette import couette_matrix
 from .cavitation import cavitation_model

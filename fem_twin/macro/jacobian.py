@@ -20,7 +20,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import SolverError
-from ..ordering import subgrid_order
+from ..numerics.ordering import subgrid_order
 from .cavitation import cavitation_model
 from .contact_load import contact_load
 from .evaluation import NewtonEvaluation
@@ -210,9 +210,9 @@ class Preconditioner:
 
 def _grid_lu(A, shape, nodes):
     """SuperLU of the sparse ``A`` whose unknowns are the grid ``shape``'s flat ``nodes``,
-    eliminated in the grid's nested-dissection order (:func:`~fem_twin.ordering.subgrid_order`)
+    eliminated in the grid's nested-dissection order (:func:`~fem_twin.numerics.ordering.subgrid_order`)
     with diagonal pivots preferred (faster and leaner than SuperLU's own COLAMD order);
-    ``solve(rhs)`` in ``A``'s numbering.  PARDISO's LU as :class:`~fem_twin.linalg.SPDSolver`
+    ``solve(rhs)`` in ``A``'s numbering.  PARDISO's LU as :class:`~fem_twin.numerics.linalg.SPDSolver`
     runs it (no matching, no scaling) misses these matrices by O(1): not used."""
     position = np.full(int(np.prod(shape)), -1)
     position[nodes] = np.arange(nodes.size)

@@ -34,7 +34,7 @@ from ..checks import as_field, as_pair, number, plausible
 from ..errors import InputError, MixedNotConverged
 from ..micro.flow_factors import FlowFactors
 from ..micro.rolling import at_slide_to_roll
-from ..threads import one_thread
+from ..numerics.threads import one_thread
 from . import newton
 from .fixed_point import Concentrated, solve_fixed_point
 from .kinematics import disk_velocity

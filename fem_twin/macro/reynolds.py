@@ -34,7 +34,7 @@ from skfem.helpers import dot, grad
 
 from ..checks import arguments, as_field, as_pair
 from ..errors import InputError, ReynoldsNotConverged
-from ..assembly import at_points, grid_stencil, unit_element
+from ..numerics.assembly import at_points, grid_stencil, unit_element
 from .cavitation import cavitation_model
 from .couette import SCHEMES, couette_matrix
 from .lubricant import Lubricant
@@ -215,7 +215,7 @@ class PoiseuilleAssembly:
     ``sum_q g_q A_kl,q T[q, k, l]`` with 16 x 16 reference tensors ``T`` that scikit-fem
     assembles once on a single element (unit coefficient at one quadrature point and one
     tensor entry).  A new matrix is then one matrix product per block of element rows,
-    added into the grid's 3 x 3 stencil (:class:`fem_twin.assembly.GridStencil`): about
+    added into the grid's 3 x 3 stencil (:class:`fem_twin.numerics.assembly.GridStencil`): about
     10x faster than ``BilinearForm.assemble`` with five interpolated coefficient fields
     (``benchmarks/run.py macro``), with nothing kept per element.
     """

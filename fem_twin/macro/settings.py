@@ -1,6 +1,6 @@
 """The macro solver's settings, one declaration each (:func:`fem_twin.checks.setting`):
 the case file's ``[macro]`` section is this dataclass (with the macro pin and a ball's grid,
-:class:`fem_twin.sections.MacroSpec`), its reference page is generated from it, and
+:class:`fem_twin.case.sections.MacroSpec`), its reference page is generated from it, and
 :func:`fem_twin.macro.solve_mixed` takes it.  Table 6 defaults, SI units."""
 
 from __future__ import annotations

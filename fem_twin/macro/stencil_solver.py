@@ -2,7 +2,7 @@
 
 The Newton matrix ``J = K diag(pos) + B diag(dtheta)`` of the interior lives on a pattern
 fixed per grid: PARDISO's symbolic factorisation is computed once per grid, in the grid's
-nested-dissection order (:func:`fem_twin.ordering.subgrid_order`), and where each entry of
+nested-dissection order (:func:`fem_twin.numerics.ordering.subgrid_order`), and where each entry of
 ``K`` and ``B`` lands in that pattern once per sparsity pattern of theirs, so a step costs
 one numeric factorisation and a solve.  On grids of more than ``SINGLE_UNKNOWNS`` unknowns
 the factors are single precision, refined with the residual in double precision (one step
@@ -25,9 +25,9 @@ from collections import OrderedDict
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import grid_stencil
-from ..linalg import SPDSolver, default_backend
-from ..ordering import subgrid_order
+from ..numerics.assembly import grid_stencil
+from ..numerics.linalg import SPDSolver, default_backend
+from ..numerics.ordering import subgrid_order
 
 #: relative residual ``|J x - rhs| / |rhs|`` a step must reach
 STEP_RTOL = 1e-8
@@ -134,7 +134,7 @@ class _Grid:
         of the CSR matrix ``M``, or None if ``M`` leaves the stencil.  Kept per sparsity
         pattern of ``M``, known by a digest of it (at 2048^2 a copy of the pattern would
         hold 40 B a node), or as the grid's own 3 x 3 stencil
-        (:func:`fem_twin.assembly.grid_stencil`, on which ``K`` and ``B`` are assembled:
+        (:func:`fem_twin.numerics.assembly.grid_stencil`, on which ``K`` and ``B`` are assembled:
         compared in 0.03 s at 2048^2, where the digest takes 0.13 s)."""
         stencil = grid_stencil(self.shape)
         own = (M.shape == (stencil.indptr.size - 1,) * 2

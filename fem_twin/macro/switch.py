@@ -15,7 +15,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import ReynoldsNotConverged
-from ..ordering import subgrid_order
+from ..numerics.ordering import subgrid_order
 from .stencil_solver import newton_solver
 
 

@@ -27,8 +27,8 @@ from skfem.helpers import dot, grad
 from ..checks import arguments
 from ..errors import InputError
 from ..io.mesh import GridMesh, grid_mesh
-from ..assembly import FixedPattern, element_entries, periodic_unknowns, unit_element
-from ..linalg import SPDSolver
+from ..numerics.assembly import FixedPattern, element_entries, periodic_unknowns, unit_element
+from ..numerics.linalg import SPDSolver
 
 
 @skfem.BilinearForm
@@ -84,7 +84,7 @@ class CellSolver:
     Everything that does not depend on the gap is built once: the mesh, the per-quadrature-
     point element tensors, the sparsity pattern with the pinned node removed, the scatter
     maps of the right-hand sides, and the symbolic factorisation (``backend``: see
-    :mod:`fem_twin.linalg`).
+    :mod:`fem_twin.numerics.linalg`).
     """
 
     @arguments(shape="shape", spacing="pair")

@@ -29,10 +29,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import FixedPattern, periodic_unknowns
+from ..numerics.assembly import FixedPattern, periodic_unknowns
 from ..checks import arguments
 from ..errors import InputError
-from ..linalg import SPDSolver
+from ..numerics.linalg import SPDSolver
 from .cell import CellSolution
 
 
@@ -56,7 +56,7 @@ FACE_RULES = {"bilinear": _bilinear_face,
 class CellSolverFV:
     """Periodic 5-point FVM cell problems on a ``(ny, nx)`` grid of pitch ``spacing`` [m].
 
-    ``backend``: the sparse direct solver (see :mod:`fem_twin.linalg`).
+    ``backend``: the sparse direct solver (see :mod:`fem_twin.numerics.linalg`).
     """
 
     @arguments(shape="shape", spacing="pair")

@@ -19,7 +19,7 @@ import numpy as np
 from .. import __version__
 from ..checks import plausible
 from ..errors import InputError
-from ..threads import one_thread
+from ..numerics.threads import one_thread
 from ..topography import Topography
 from ..topography.plausibility import check_patch
 from .estimate import QUANTITIES, discrepancy, variants, watched

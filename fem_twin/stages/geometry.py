@@ -23,7 +23,7 @@ from ..topography.filling import fill_defects
 from ..topography.plausibility import check_patch, check_pin
 from ..topography.sphere import cap_gap, fit_sphere
 from ..topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
-from ..threads import run_jobs
+from ..numerics.threads import run_jobs
 
 log = logging.getLogger("fem_twin")
 
@@ -55,7 +55,7 @@ def _surface(job) -> tuple[dict, list[str]]:
 
 def _pin_geometry(case: Case, out: RunLayout, i: int) -> tuple[dict, list[str]]:
     """Pin ``i`` and its disk (or a flat one) prepared for the macro scale."""
-    opts = case.macro_geometry
+    opts = case.preprocessing
     pin_out, disk_out = out.pin(i + 1), out.disk(i + 1)
     if not all(load_or_none(f, read_topography) for f in (pin_out, disk_out)):
         raw = read_topography(case.geometry.pins[i])
@@ -85,7 +85,7 @@ def _patch_geometry(case: Case, out: RunLayout, i: int) -> tuple[dict, list[str]
     warnings = []
     if not all(load_or_none(f, read_topography) for f in (low_out, up_out)):
         src_pin, src_disk = case.geometry.patches[i]
-        axis = case.macro_geometry.sliding_direction
+        axis = case.preprocessing.sliding_direction
         low = prepare_patch(read_topography(src_pin), case.geometry.patch_shape,
                             case.geometry.patch_start, sliding_direction=axis)
         up = prepare_patch(read_topography(src_disk), case.geometry.patch_shape,
@@ -139,7 +139,7 @@ def prepare_pins(runs, progress: bool = True, executor=None) -> None:
     grids first, so that no run's last pin keeps a worker idle (the variants' pins run
     beside the micro stage)."""
     runs = sorted((r for r in runs if not r[0].tribometer.ball),
-                  key=lambda r: -np.prod(r[0].macro_geometry.resolution or (0, 0)))
+                  key=lambda r: -np.prod(r[0].preprocessing.resolution or (0, 0)))
     for case, out in runs:
         out.geometry.mkdir(parents=True, exist_ok=True)
         out.levelling.mkdir(parents=True, exist_ok=True)
@@ -160,7 +160,7 @@ def _averaged(job) -> None:
     if n < 2 or load_or_none(path, read_topography) is not None:
         return
     levelled = [read_topography(out.levelled_pin(i + 1)) for i in range(n)]
-    g = case.macro_geometry
+    g = case.preprocessing
     write_topography(path, levelled_pin(
         average_pins(levelled, radius=g.level_radius, truncation=g.truncation,
                      holder_height=g.holder_height), read_topography(out.disk(1)), case))
@@ -184,7 +184,7 @@ def levelled_pin(pin, disk, case: Case):
     px give back the measured 500 px points) and tilted by the result: kept points keep
     their coordinates, where a resampling would move them (nearest pixels, by up to half a
     pixel: 1.6e-6 rad) or smear the 1 mm step to the holder into a ramp (linear)."""
-    holder = case.macro_geometry.holder_height
+    holder = case.preprocessing.holder_height
     k = -(-max(pin.shape) // LEVELLING_GRID)
     lev = level_pin(_every(pin, k), _every(disk, k), e_reduced=case.materials.e_reduced,
                     hardness=case.materials.hardness, holder_height=holder)
@@ -225,7 +225,7 @@ def macro_geometry(case: Case, out: RunLayout):
     pin = read_topography(macro_pin_file(case, out))
     k = macro_pin_number(case)
     disk = read_topography(out.disk(1 if k == "average" else k))
-    face = pin.heights > case.macro_geometry.holder_height / 2
+    face = pin.heights > case.preprocessing.holder_height / 2
     return disk.heights - pin.heights, pin.spacing, face, pin.origin
 
 

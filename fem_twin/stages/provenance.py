@@ -37,7 +37,7 @@ def stage_keys(case: Case) -> dict:
     g = case.geometry
     files = [(str(p), p.stat().st_mtime_ns, p.stat().st_size)
              for p in (*g.pins, *g.disks, *(q for pair in g.patches for q in pair))]
-    geometry = key(files, g, case.macro_geometry)
+    geometry = key(files, g, case.preprocessing)
     return {"geometry": geometry,
             "levelling": key(geometry, case.materials, case.macro.pin),
             "micro": key(geometry, case.micro, case.materials, case.macro.friction)}

@@ -11,7 +11,7 @@ from tqdm import tqdm
 from ..stribeck import stribeck_sweep
 from ..stribeck.curve import joined
 from ..stribeck.sweep import point_files, point_key, sweep_key
-from ..threads import worker_heap
+from ..numerics.threads import worker_heap
 
 #: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH (the resolution
 #: study's points grow as N^1.39 from 500^2 to 1997^2, benchmarks/README.md), so that the

@@ -10,7 +10,7 @@ from ..case import Case
 from ..io.layout import RunLayout
 from ..micro import FlowFactors
 from ..stribeck.traction import plot_traction, traction_sweep, write_traction_csv
-from ..threads import worker_heap
+from ..numerics.threads import worker_heap
 from .curves import curve_labels, macro_settings
 from .geometry import face_load, macro_geometry
 from .provenance import stage_keys

@@ -19,7 +19,7 @@ from ..macro.estimate import PARTS, friction_error
 from ..macro.nested import coarsened, corrected, solve_nested
 from ..macro.thermal import thermal_point
 from ..micro.flow_factors import FlowFactors
-from ..threads import one_thread
+from ..numerics.threads import one_thread
 from .curve import StribeckCurve, hersey_number
 
 #: a point's ``meta`` entry for C_f on the grids coarsened by two, four, ... (its nested

@@ -24,7 +24,7 @@ from ..io.table import write_csv
 from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
 from ..macro.estimate import friction_error
 from ..micro.flow_factors import FlowFactors
-from ..threads import one_thread
+from ..numerics.threads import one_thread
 from .sweep import point_file, sweep_key
 
 #: the CSV header of each column of ``traction.csv``: its name with the SI unit

@@ -1,6 +1,6 @@
 """The run-time cost model: a case's wall time on the calibration machine, before it runs.
 
-``fem-twin run`` prints it scaled to this machine by :func:`fem_twin.speed.slowdown` and
+``fem-twin run`` prints it scaled to this machine by :func:`fem_twin.case.machine.slowdown` and
 asks for ``--yes`` above seven times the bundled case's.  The constants were fitted to the
 bundled, paper and ball cases on the calibration machine (their measurements:
 ``benchmarks/README.md``, "The run-time cost model"); ``tests/test_cli.py`` holds the
@@ -50,7 +50,7 @@ def estimated_seconds(case, cores: int = 2) -> float:
         point = BALL_POINT_SECONDS * (case.macro.grid / 73) ** BALL_POINT_GROWTH
         estimate = 1.0
     else:
-        res = case.macro_geometry.resolution or (256, 256)
+        res = case.preprocessing.resolution or (256, 256)
         point = POINT_SECONDS * ((res[0] * res[1]) / 128 ** 2) ** POINT_GROWTH
         estimate = ESTIMATE_COST
     n_mu = len(case.lubricant.viscosities)
@@ -68,5 +68,5 @@ def _band_point_cost(case) -> float:
     if case.run.band_grid != "coarsest":
         return BAND_POINT_COST[case.run.band_grid]
     shape = ((case.macro.grid,) * 2 if case.tribometer.ball
-             else case.macro_geometry.resolution or (256, 256))
+             else case.preprocessing.resolution or (256, 256))
     return BAND_POINT_COST["coarse"] * BAND_LEVEL_COST ** (case.band_coarsening(shape) - 1)

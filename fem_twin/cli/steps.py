@@ -7,19 +7,19 @@ import json
 
 import numpy as np
 
-from .errors import InputError
-from .io.layout import RunLayout
+from ..errors import InputError
+from ..io.layout import RunLayout
 
 
 def read_input(args):
-    from .io.files import read_topography
+    from ..io.files import read_topography
     return read_topography(args.input, spacing=args.spacing, unit=args.unit)
 
 
 def topography(args):
-    from . import topography as tp
-    from .io.files import write_topography
-    from .topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
+    from .. import topography as tp
+    from ..io.files import write_topography
+    from ..topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
     topo = read_input(args)
     step = args.step
     if step == "info":
@@ -66,8 +66,8 @@ def topography(args):
 
 
 def contact_level(args):
-    from .contact.levelling import level_pin
-    from .io.files import read_topography, write_topography
+    from ..contact.levelling import level_pin
+    from ..io.files import read_topography, write_topography
     pin = read_topography(args.pin)
     disk = read_topography(args.disk) if args.disk else None
     res = level_pin(pin, disk, load=args.load, method=args.method)
@@ -79,8 +79,8 @@ def contact_level(args):
 
 
 def contact_average(args):
-    from .contact.levelling import average_pins, level_pin
-    from .io.files import read_topography, write_topography
+    from ..contact.levelling import average_pins, level_pin
+    from ..io.files import read_topography, write_topography
     res = level_pin(average_pins([read_topography(p) for p in args.pins]))
     write_topography(args.output, res.pin)
     print(json.dumps({"pins": len(args.pins), "tilt_rad": res.tilt,
@@ -98,9 +98,9 @@ MACRO_OPTIONS = ("method", "coupling", "couette", "complementarity", "inner_step
 def homogenise_run(args):
     import numpy as np
 
-    from .io.files import read_topography
-    from .micro import CellSettings, homogenise
-    from .micro.output import write_cell_fields
+    from ..io.files import read_topography
+    from ..micro import CellSettings, homogenise
+    from ..micro.output import write_cell_fields
     pin, disk = read_topography(args.pin), read_topography(args.disk)
     lo, hi, n = args.h0
     if int(n) != n or n < 1:
@@ -119,14 +119,14 @@ def homogenise_run(args):
 
 
 def homogenise_average(args):
-    from .micro import FlowFactors, average
+    from ..micro import FlowFactors, average
     factors = [FlowFactors.load(p) for p in args.inputs]
     _write_factors(args.output, average(factors), factors)
     return 0
 
 
 def _write_factors(folder, ff, patches=()):
-    from .micro.output import plot_flow_factors
+    from ..micro.output import plot_flow_factors
     out = RunLayout(folder)                  # the files of a run's flow factors, in folder
     ff.save(folder / out.flow_factors.name)
     ff.write_csv(out.flow_factors_csv)
@@ -145,10 +145,10 @@ def _write_factors(folder, ff, patches=()):
 
 
 def macro_point(args):
-    from .io.atomic import atomic_path
-    from .io.files import read_topography
-    from .macro import Lubricant, MacroSettings, solve_mixed
-    from .micro import FlowFactors
+    from ..io.atomic import atomic_path
+    from ..io.files import read_topography
+    from ..macro import Lubricant, MacroSettings, solve_mixed
+    from ..micro import FlowFactors
     pin = read_topography(args.pin)
     upper = read_topography(args.disk).heights if args.disk else 0.0 * pin.heights
     if np.shape(upper) != pin.shape:
@@ -171,8 +171,8 @@ def macro_point(args):
 
 
 def mesh(args):
-    from .io.files import read_topography
-    from .io.mesh import grid_mesh, write_vtu
+    from ..io.files import read_topography
+    from ..io.mesh import grid_mesh, write_vtu
     topo = read_topography(args.input, spacing=args.spacing)
     gm = grid_mesh(topo.shape, topo.spacing, topo.origin, periodic=args.periodic, kind=args.kind)
     fields = {"height": topo.heights, "valid": topo.valid.astype(float)}
@@ -182,7 +182,7 @@ def mesh(args):
 
 
 def sample(args):
-    from . import samples
+    from .. import samples
     for path in samples.generate(args.output):
         print(path)
     return 0

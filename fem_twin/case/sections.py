@@ -6,15 +6,16 @@ read these declarations; ``[preprocessing]`` is
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import tables as T
-from .checks import setting
-from .macro.settings import MacroSettings
-from .macro.thermal import ThermalSettings
-from .micro.sliding import CellSettings
-from .topography.prepare import MacroOptions
+from .. import tables as T
+from ..checks import setting
+from ..macro.settings import MacroSettings
+from ..macro.thermal import ThermalSettings
+from ..micro.sliding import CellSettings
+from ..topography.prepare import MacroOptions
+from .cost import estimated_seconds
 
 
 @dataclass(frozen=True)
@@ -104,7 +105,7 @@ class LubricantSpec:
 
     def lubricants(self) -> list:
         """One :class:`fem_twin.macro.Lubricant` per viscosity."""
-        from .macro.lubricant import Lubricant
+        from ..macro.lubricant import Lubricant
         return [Lubricant(mu, density=self.density, roelands_alpha=self.roelands_alpha,
                           roelands_p0=self.roelands_p0, dh_c1=self.dh_c1, dh_c2=self.dh_c2,
                           eyring_stress=self.eyring_stress or None)
@@ -125,7 +126,7 @@ class Materials:
     @property
     def e_reduced(self) -> float:
         """E' of eq 22 [Pa]."""
-        from .contact.elastic import reduced_modulus
+        from ..contact.elastic import reduced_modulus
         return reduced_modulus(self.e_pin, self.nu_pin, self.e_disk, self.nu_disk)
 
 
@@ -213,3 +214,37 @@ SECTIONS = {"geometry": Geometry, "preprocessing": MacroOptions, "tribometer": T
             "lubricant": LubricantSpec, "materials": Materials, "micro": MicroSpec,
             "macro": MacroSpec, "thermal": ThermalSettings, "sweep": SweepSpec,
             "run": RunSpec}
+
+
+@dataclass(frozen=True)
+class Case:
+    """A whole case: geometry sources, pre-processing, physics, scales, sweep, execution."""
+
+    name: str
+    geometry: Geometry
+    preprocessing: MacroOptions = field(default_factory=MacroOptions)
+    tribometer: Tribometer = field(default_factory=Tribometer)
+    lubricant: LubricantSpec = field(default_factory=LubricantSpec)
+    materials: Materials = field(default_factory=Materials)
+    micro: MicroSpec = field(default_factory=MicroSpec)
+    macro: MacroSpec = field(default_factory=MacroSpec)
+    thermal: ThermalSettings = field(default_factory=ThermalSettings)
+    sweep: SweepSpec = field(default_factory=SweepSpec)
+    run: RunSpec = field(default_factory=RunSpec)
+    measured: tuple[Path | None, ...] = ()   # [validation] measured curves per viscosity
+    source: Path | None = None
+    defaulted: tuple[str, ...] = ()          # sections absent from the file (defaults used)
+
+    def estimated_seconds(self, cores: int = 2) -> float:
+        """Rough wall time of ``fem-twin run`` on ``cores`` cores of the calibration
+        machine [s] (:func:`fem_twin.case.cost.estimated_seconds`)."""
+        return estimated_seconds(self, cores)
+
+    def band_coarsening(self, shape) -> int:
+        """Coarsenings by two of the band's grid below a macro grid of ``shape``
+        (``[run] band_grid``): none ("full"), one ("coarse"), or down to the main sweeps'
+        coarsest nested grid ("coarsest", at least one: 64^2 for the grids 128^2 to
+        1024^2)."""
+        from ..macro.nested import nested_levels
+        return {"full": 0, "coarse": 1}.get(self.run.band_grid,
+                                            max(1, nested_levels(shape)))

@@ -110,7 +110,7 @@ class GridStencil:
 def at_points(phi, field, r0: int, r1: int) -> np.ndarray:
     """A nodal ``field`` ``(..., ny, nx)`` interpolated with the corner weights ``phi``
     (4, npoints; corners :data:`CORNERS`) at the points of the pixels whose first node is in
-    rows ``r0 .. r1 - 1``: ``(npoints, ..., r1 - r0, nx - 1)``."""
+    rows ``r0`` to ``r1 - 1``: ``(npoints, ..., r1 - r0, nx - 1)``."""
     f = np.asarray(field, float)
     nx = f.shape[-1]
     corners = np.stack([f[..., r0 + a:r1 + a, b:nx - 1 + b] for a, b in CORNERS])

@@ -8,12 +8,12 @@ import os
 import sys
 from pathlib import Path
 
-from . import cli_runs as runs
-from . import cli_stages as stages
-from .errors import NotConverged, RunLocked, SchedulerUnreachable
-from .sections import LubricantSpec, MicroSpec, Tribometer
-from .stribeck.fit import PARAMETERS
-from .topography.prepare import MacroOptions
+from . import runs
+from . import steps
+from ..errors import NotConverged, RunLocked, SchedulerUnreachable
+from ..case.sections import LubricantSpec, MicroSpec, Tribometer
+from ..stribeck.fit import PARAMETERS
+from ..topography.prepare import MacroOptions
 
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
@@ -108,7 +108,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from . import __version__
+    from .. import __version__
     p = _Parser(
         prog="fem-twin",
         description="Digital twin of a pin-on-disk tribometer in mixed lubrication. "
@@ -209,9 +209,9 @@ def _add_run_commands(sub):
 def _add_topography(sub):
     """topography STEP: one pre-processing step per subcommand."""
     t = sub.add_parser("topography", help="read and pre-process measured topographies")
-    steps = t.add_subparsers(dest="step", required=True, metavar="STEP")
+    parsers = t.add_subparsers(dest="step", required=True, metavar="STEP")
     for name, text in _STEPS.items():
-        s = steps.add_parser(name, help=text, description=text)
+        s = parsers.add_parser(name, help=text, description=text)
         s.add_argument("input", type=Path)
         if name != "info":
             s.add_argument("output", type=Path)
@@ -219,7 +219,7 @@ def _add_topography(sub):
                        help="pixel pitch [m] for files that do not store it")
         s.add_argument("--unit", default="m", help="unit of plain ASCII/.npy files")
         _step_options(name, s)
-        s.set_defaults(func=stages.topography)
+        s.set_defaults(func=steps.topography)
 
 
 def _add_contact(sub):
@@ -232,11 +232,11 @@ def _add_contact(sub):
     lv.add_argument("--disk", type=Path, help="flipped disk on the same grid (default: flat)")
     lv.add_argument("--load", type=float, default=50.0, help="imposed load [N]")
     lv.add_argument("--method", choices=("broyden", "pid"), default="broyden")
-    lv.set_defaults(func=stages.contact_level)
+    lv.set_defaults(func=steps.contact_level)
     av = cs.add_parser("average", help="set average of levelled pins, then level it again")
     av.add_argument("pins", type=Path, nargs="+")
     av.add_argument("-o", "--output", type=Path, required=True)
-    av.set_defaults(func=stages.contact_average)
+    av.set_defaults(func=steps.contact_average)
 
 
 def _add_homogenise(sub):
@@ -253,8 +253,8 @@ def _add_homogenise(sub):
                     default=(micro.h0_min, micro.h0_max, micro.h0_count),
                     metavar=("MIN", "MAX", "N"), help="geometric h0 range [m] and count "
                     "(default: %(default)s, the paper's)")
-    from .micro import CellSettings
-    _settings_options(hr, CellSettings, stages.CELL_OPTIONS)
+    from ..micro import CellSettings
+    _settings_options(hr, CellSettings, steps.CELL_OPTIONS)
     hr.add_argument("--h0-tol", type=float,
                     help="adaptive h0: solve only the subset of the N values the log-h0 "
                          "interpolant needs to miss the others by less than this fraction "
@@ -264,11 +264,11 @@ def _add_homogenise(sub):
     hr.add_argument("--fields", type=float, nargs="*", default=(), metavar="H0",
                     help="also write the cell fields (VTU/PVD) at these h0 [m]")
     hr.add_argument("--no-progress", action="store_true", help="no progress bar")
-    hr.set_defaults(func=stages.homogenise_run)
+    hr.set_defaults(func=steps.homogenise_run)
     ha = hs.add_parser("average", help="average flow factors over patches (same h0 range)")
     ha.add_argument("inputs", type=Path, nargs="+", help="flow_factors.npz files")
     ha.add_argument("-o", "--output", type=Path, required=True, help="output folder")
-    ha.set_defaults(func=stages.homogenise_average)
+    ha.set_defaults(func=steps.homogenise_average)
 
 
 def _add_macro(sub):
@@ -292,9 +292,9 @@ def _add_macro(sub):
     mp.add_argument("--diameter", type=float, default=tribometer.pin_diameter,
                     help="pin diameter D of the Hersey number, eq 46 [m] (default: "
                          "%(default)s)")
-    from .macro import MacroSettings
-    _settings_options(mp, MacroSettings, stages.MACRO_OPTIONS)
-    mp.set_defaults(func=stages.macro_point)
+    from ..macro import MacroSettings
+    _settings_options(mp, MacroSettings, steps.MACRO_OPTIONS)
+    mp.set_defaults(func=steps.macro_point)
 
 
 def _settings_options(parser, cls, names, flags=None) -> None:
@@ -302,7 +302,7 @@ def _settings_options(parser, cls, names, flags=None) -> None:
     doc and unit of its one declaration (:func:`fem_twin.checks.setting`)."""
     from dataclasses import fields
 
-    from .checks import describe
+    from ..checks import describe
     declared = {f.name: f for f in fields(cls)}
     for name in names:
         f, d = declared[name], describe(declared[name])
@@ -326,7 +326,7 @@ def _add_utilities(sub):
     m.add_argument("--periodic", action="store_true", help="periodic mesh (roughness patch)")
     m.add_argument("--kind", choices=("quad", "tri"), default="quad")
     m.add_argument("--spacing", type=float, nargs="+", metavar="M")
-    m.set_defaults(func=stages.mesh)
+    m.set_defaults(func=steps.mesh)
 
     ex = sub.add_parser("example", help="write the bundled example case and its sample twin "
                                          "into a folder (works without the repository)")
@@ -334,7 +334,7 @@ def _add_utilities(sub):
     ex.set_defaults(func=runs.example)
     g = sub.add_parser("sample", help="regenerate the bundled sample twin (seeded)")
     g.add_argument("-o", "--output", type=Path, default=Path("meshes/sample"))
-    g.set_defaults(func=stages.sample)
+    g.set_defaults(func=steps.sample)
 
 
 def _case_command(sub, name, text, output, func):
@@ -378,6 +378,3 @@ def _step_options(name, s):
         _settings_options(s, MacroOptions, ("fwhm_px", "resolution", "clip"),
                           {"fwhm_px": "--fwhm"})
 
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

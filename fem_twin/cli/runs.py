@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .checks import number
-from .errors import InputError, MissingFile
-from .io.layout import RunLayout
+from ..checks import number
+from ..errors import InputError, MissingFile
+from ..io.layout import RunLayout
 
 
 #: the bundled case's estimate on 2 cores of the calibration machine [s]
@@ -27,9 +27,9 @@ LONG_RUN_SECONDS = LONG_RUN_RATIO * BUNDLED_SECONDS
 
 def _confirm_cost(case, yes: bool) -> float | None:
     """Say which sections take defaults and what the run will cost on this machine now
-    (:func:`fem_twin.speed.slowdown`); the estimate [s], or None (refused: a run
+    (:func:`fem_twin.case.machine.slowdown`); the estimate [s], or None (refused: a run
     estimated above :data:`LONG_RUN_RATIO` times the bundled case without ``--yes``)."""
-    from .speed import slowdown
+    from ..case.machine import slowdown
     if case.defaulted:
         print(f"fem-twin run: sections not in {case.source.name}, defaults used: " + ", ".join(
             f"[{s}]" for s in case.defaulted), file=sys.stderr)
@@ -62,15 +62,15 @@ def duration(seconds: float) -> str:
 
 
 def run(args):
-    from .case import load_case
-    from .pipeline import run
+    from ..case import load_case
+    from ..pipeline import run
     if not args.case.is_file():
         raise MissingFile(f"case file not found: {args.case} (give the case file as "
                                 "the first argument)")
     case = load_case(args.case)
     fitted = case
     if args.from_fit is not None:
-        from .fitting import apply_fit, read_fit, run_from_fit
+        from ..fitting import apply_fit, read_fit, run_from_fit
         fitted = apply_fit(case, read_fit(args.from_fit))        # checked before any work
     estimate = _confirm_cost(fitted, args.yes)
     if estimate is None:
@@ -89,10 +89,10 @@ def run(args):
 
 
 def traction(args):
-    from .case import load_case
-    from .checks import plausible
-    from .pipeline import traction
-    from .stribeck.traction import DEFAULT_RATIOS
+    from ..case import load_case
+    from ..checks import plausible
+    from ..pipeline import traction
+    from ..stribeck.traction import DEFAULT_RATIOS
     if not args.case.is_file():
         raise MissingFile(f"case file not found: {args.case}")
     case = load_case(args.case)
@@ -150,8 +150,8 @@ def _short_summary(summary: dict, out: Path) -> str:
 
 
 def fit(args):
-    from .case import load_case
-    from .fitting import fit_case
+    from ..case import load_case
+    from ..fitting import fit_case
     if not args.case.is_file():
         raise MissingFile(f"case file not found: {args.case}")
     case = load_case(args.case)
@@ -172,8 +172,8 @@ def fit(args):
 
 
 def calibrate(args):
-    from .calibration import calibrate
-    from .case import load_case
+    from ..calibration import calibrate
+    from ..case import load_case
     summary = calibrate(load_case(args.case), args.study, args.output, values=args.values,
                         progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
@@ -181,7 +181,7 @@ def calibrate(args):
 
 
 def html_report(args):
-    from .report import write_report
+    from ..report import write_report
     if args.output is not None and Path(args.output).is_dir():
         raise InputError(f"report -o {args.output} is a folder: give the page's file name "
                          "(e.g. report.html)")
@@ -193,11 +193,11 @@ def html_report(args):
 def validate(args):
     from dataclasses import replace
 
-    from .case import load_case
-    from .macro.friction import BOUNDARY_FRICTION
-    from .stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
-    from .io.table import write_csv
-    from .stribeck.curve import read_stribeck_csv
+    from ..case import load_case
+    from ..macro.friction import BOUNDARY_FRICTION
+    from ..stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
+    from ..io.table import write_csv
+    from ..stribeck.curve import read_stribeck_csv
     if args.radius is not None:
         number("--radius [m]", args.radius, "length")
     run = RunLayout(args.run)
@@ -254,7 +254,7 @@ def _run_case_file(run: Path):
 def example(args):
     from importlib.resources import files
 
-    from .samples import generate
+    from ..samples import generate
     args.folder.mkdir(parents=True, exist_ok=True)
     case = args.folder / "pin_on_disk.toml"
     case.write_text(files("fem_twin.cases").joinpath("pin_on_disk.toml").read_text())
@@ -265,8 +265,8 @@ def example(args):
 
 
 def compare(args):
-    from .case import load_case
-    from .compare import compare
+    from ..case import load_case
+    from ..compare import compare
     summary = compare(load_case(args.case), args.output, progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
     return 0

@@ -26,7 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .errors import InputError, MissingDependency, NotPositiveDefinite, SolverError
+from ..errors import InputError, MissingDependency, NotPositiveDefinite, SolverError
 from .ordering import is_permutation
 from .threads import thread_limit
 
@@ -84,7 +84,7 @@ class SPDSolver:
     ``solve`` is then
     accurate to about 1e-5 relative and the caller refines.  ``order`` (PARDISO only): the
     unknowns in the order of elimination, a fill-reducing order the caller knows better
-    than METIS (a grid's nested dissection, :mod:`fem_twin.ordering`); None: METIS.
+    than METIS (a grid's nested dissection, :mod:`fem_twin.numerics.ordering`); None: METIS.
     ``release()`` frees the factors and keeps the analysis.
     """
 

@@ -17,10 +17,10 @@ import time
 
 import numpy as np
 
-from .errors import InputError
-from .micro import homogenise
-from .threads import one_thread
-from .topography.synthetic import self_affine
+from ..errors import InputError
+from ..micro import homogenise
+from ..numerics.threads import one_thread
+from ..topography.synthetic import self_affine
 
 #: the miniature's time on the calibration machine, the hour the estimate's costs were
 #: measured (best of five, PARDISO) [s]

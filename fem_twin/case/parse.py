@@ -8,13 +8,12 @@ import tomllib
 from dataclasses import MISSING, dataclass, field, fields
 from pathlib import Path
 
-from .checks import QUANTITIES, memory_shortfall
-from .cost import estimated_seconds
-from .errors import InputError
-from .macro.thermal import ThermalSettings
-from .sections import (SECTIONS, Geometry, LubricantSpec, MacroSpec, Materials, MicroSpec,
-                       RunSpec, SweepSpec, Tribometer)
-from .topography.prepare import MacroOptions
+from ..checks import QUANTITIES, memory_shortfall
+from ..errors import InputError
+from ..macro.thermal import ThermalSettings
+from .sections import (SECTIONS, Case, Geometry, LubricantSpec, MacroSpec, Materials,
+                       MicroSpec, RunSpec, SweepSpec, Tribometer)
+from ..topography.prepare import MacroOptions
 
 
 class CaseError(InputError):
@@ -24,40 +23,6 @@ class CaseError(InputError):
 #: local worker processes a case may ask for per core (``[run] workers``): more only add
 #: memory and switching
 WORKERS_PER_CORE = 4
-
-
-@dataclass(frozen=True)
-class Case:
-    """A whole case: geometry sources, pre-processing, physics, scales, sweep, execution."""
-
-    name: str
-    geometry: Geometry
-    macro_geometry: MacroOptions = field(default_factory=MacroOptions)
-    tribometer: Tribometer = field(default_factory=Tribometer)
-    lubricant: LubricantSpec = field(default_factory=LubricantSpec)
-    materials: Materials = field(default_factory=Materials)
-    micro: MicroSpec = field(default_factory=MicroSpec)
-    macro: MacroSpec = field(default_factory=MacroSpec)
-    thermal: ThermalSettings = field(default_factory=ThermalSettings)
-    sweep: SweepSpec = field(default_factory=SweepSpec)
-    run: RunSpec = field(default_factory=RunSpec)
-    measured: tuple[Path | None, ...] = ()   # [validation] measured curves per viscosity
-    source: Path | None = None
-    defaulted: tuple[str, ...] = ()          # sections absent from the file (defaults used)
-
-    def estimated_seconds(self, cores: int = 2) -> float:
-        """Rough wall time of ``fem-twin run`` on ``cores`` cores of the calibration
-        machine [s] (:func:`fem_twin.cost.estimated_seconds`)."""
-        return estimated_seconds(self, cores)
-
-    def band_coarsening(self, shape) -> int:
-        """Coarsenings by two of the band's grid below a macro grid of ``shape``
-        (``[run] band_grid``): none ("full"), one ("coarse"), or down to the main sweeps'
-        coarsest nested grid ("coarsest", at least one: 64^2 for the grids 128^2 to
-        1024^2)."""
-        from .macro.nested import nested_levels
-        return {"full": 0, "coarse": 1}.get(self.run.band_grid,
-                                            max(1, nested_levels(shape)))
 
 
 def load_case(path) -> Case:
@@ -83,7 +48,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if geometry.ball is not None and "ball_radius" in data.get("tribometer", {}):
         raise CaseError(f"{where} [tribometer] ball_radius: the measured cap's fitted sphere "
                         "gives the radius ([geometry] ball); remove one of the two")
-    macro_geometry = _preprocessing(data, where)
+    preprocessing = _preprocessing(data, where)
     lubricant = _lubricant(data, where)
     materials = _section(data, "materials", Materials, where, positive=True)
     micro = _micro(data, where)
@@ -102,7 +67,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if not 0 < run.band_tol < 1:
         raise CaseError(f"{where} [run] band_tol: a coupling tolerance in (0, 1), got "
                         f"{run.band_tol}")
-    radius = macro_geometry.level_radius
+    radius = preprocessing.level_radius
     if not tribometer.ball and radius is not None and not 0 < radius <= tribometer.pin_diameter:
         raise CaseError(f"{where} [preprocessing] level_radius = {radius}: the mean-plane radius "
                         f"in metres, at most the pin diameter {tribometer.pin_diameter:g} m "
@@ -112,7 +77,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     measured = _measured(data.get("validation", {}), base, where, lubricant)
     defaulted = tuple(name for name in SECTIONS if name != "geometry" and name not in data)
     return Case(name=str(data.get("name", source.stem if source else "case")),
-                geometry=geometry, macro_geometry=macro_geometry, tribometer=tribometer,
+                geometry=geometry, preprocessing=preprocessing, tribometer=tribometer,
                 lubricant=lubricant, materials=materials, micro=micro, macro=macro,
                 thermal=thermal, sweep=sweep, run=run, measured=measured, source=source, defaulted=defaulted)
 

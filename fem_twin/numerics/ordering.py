@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import SolverError
+from ..errors import SolverError
 
 #: the pieces a sub-grid's order (:func:`subgrid_order`) stops bisecting at (2 is as fast
 #: as 4 or faster for both solvers; benchmarks/README.md, "ordering")
@@ -58,7 +58,7 @@ def _dissect(rows, cols, nx, out, leaf):
 
 
 def is_permutation(order, n: int) -> bool:
-    """Whether ``order`` holds each of ``0 .. n-1`` exactly once."""
+    """Whether ``order`` holds each of ``0`` to ``n - 1`` exactly once."""
     order = np.asarray(order)
     return order.size == n and bool(np.all(np.bincount(order, minlength=n) == 1))
 

@@ -20,7 +20,7 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 
-from .errors import InputError, SchedulerUnreachable
+from ..errors import InputError, SchedulerUnreachable
 
 
 def thread_limit() -> int:
