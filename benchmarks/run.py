@@ -341,7 +341,7 @@ def bench_stribeck():
     import tempfile
 
     from fem_twin.macro import Lubricant, solve_mixed
-    from fem_twin.stribeck import stribeck_sweep
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
 
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -361,8 +361,8 @@ def bench_stribeck():
     rows.append(("bundled case, fem-twin run (2 viscosities)", wall,
                  ", ".join(f"{k} {v:.0f} s" for k, v in sec.items())))
     t0 = time.perf_counter()
-    curve = stribeck_sweep(gap, spacing, ff, np.geomspace(2.0, 0.01, 25), load=150.0,
-                           lubricant=Lubricant(0.066), face=face)
+    curve = stribeck_sweep(SweepRequest(gap, spacing, ff, np.geomspace(2.0, 0.01, 25), load=150.0,
+                           lubricant=Lubricant(0.066), face=face))
     t = time.perf_counter() - t0
     rows.append(("paper-grade curve: 25 speeds at 256^2", t,
                  f"{int(curve.iterations.sum())} iterations, C_f {curve.friction_coefficient[0]:.4f}"
@@ -379,7 +379,7 @@ def bench_newton():
     Baseline: the previous method at 128^2.  Goal of the paper-grade issue: 2x at 256^2."""
     from fem_twin.numerics.linalg import _mkl_rt
     from fem_twin.macro import Lubricant, MacroSettings
-    from fem_twin.stribeck import stribeck_sweep
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
 
     ff = macro_factors()
     backend = "pardiso" if _mkl_rt() is not None else "superlu"
@@ -393,9 +393,9 @@ def bench_newton():
         for name, (sparse, steps) in methods.items():
             os.environ["FEM_TWIN_SPARSE"] = sparse
             t0 = time.perf_counter()
-            c = stribeck_sweep(gap, spacing, ff, np.geomspace(2.0, 0.01, 8), load=150.0,
+            c = stribeck_sweep(SweepRequest(gap, spacing, ff, np.geomspace(2.0, 0.01, 8), load=150.0,
                                lubricant=Lubricant(0.066), face=face,
-                               settings=MacroSettings(inner_steps=steps))
+                               settings=MacroSettings(inner_steps=steps)))
             times.append(time.perf_counter() - t0)
             cf.append(c.friction_coefficient)
             base = base or times[-1]
@@ -421,7 +421,7 @@ def bench_paper():
     from fem_twin.macro import Lubricant
     from fem_twin.macro.nested import coarsened, nested_levels
     from fem_twin.micro import DEFAULT_H0, homogenise
-    from fem_twin.stribeck import stribeck_sweep
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
 
     case = load_case(os.path.join(HERE, "..", "examples", "paper.toml"))
     cores, patches, n_mu = 2, len(case.geometry.patches), len(case.lubricant.viscosities)
@@ -436,20 +436,20 @@ def bench_paper():
     speeds = np.geomspace(2.0, 0.01, case.sweep.count)[6:14]
     ff = macro_factors()          # smooth factors (30 h0): 10 h0 kink p_con, the sweep stalls
     t0 = time.perf_counter()
-    stribeck_sweep(gap, spacing, ff, speeds[:1], load=150.0, lubricant=Lubricant(0.066),
-                   face=face)
+    stribeck_sweep(SweepRequest(gap, spacing, ff, speeds[:1], load=150.0, lubricant=Lubricant(0.066),
+                   face=face))
     cold = time.perf_counter() - t0
     t0 = time.perf_counter()
-    curve = stribeck_sweep(gap, spacing, ff, speeds, load=150.0, lubricant=Lubricant(0.066),
-                           face=face)
+    curve = stribeck_sweep(SweepRequest(gap, spacing, ff, speeds, load=150.0, lubricant=Lubricant(0.066),
+                           face=face))
     warm = (time.perf_counter() - t0 - cold) / (speeds.size - 1)
     band = []                                  # a point on each of the band's grids
     grid = (gap, spacing, face)
     for _ in range(nested_levels(gap.shape)):
         grid = coarsened(*grid)
         t0 = time.perf_counter()
-        stribeck_sweep(grid[0], grid[1], ff, speeds, load=150.0, lubricant=Lubricant(0.066),
-                       face=grid[2])
+        stribeck_sweep(SweepRequest(grid[0], grid[1], ff, speeds, load=150.0, lubricant=Lubricant(0.066),
+                       face=grid[2]))
         band.append((time.perf_counter() - t0) / speeds.size)
     coarse, coarsest = band[0], band[-1]
     dense = per_h0 * case.micro.h0_count * patches / cores

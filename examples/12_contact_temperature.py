@@ -28,7 +28,7 @@ from fem_twin.macro import Lubricant, MacroSettings
 from fem_twin.macro.thermal import ContactThermal, ThermalSettings, surface_temperature
 from fem_twin.macro.viscosity import WaltherLaw
 from fem_twin.micro import homogenise
-from fem_twin.stribeck import stribeck_sweep
+from fem_twin.stribeck import SweepRequest, stribeck_sweep
 from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 
@@ -61,10 +61,10 @@ def sample_pin(n, speeds, thermal):
     up = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"), upper=True),
                        (32, 32))
     factors = homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), n_steps=4)
-    return stribeck_sweep(disk.heights - pin.heights, pin.spacing, factors, speeds,
+    return stribeck_sweep(SweepRequest(disk.heights - pin.heights, pin.spacing, factors, speeds,
                           load=150.0, lubricant=Lubricant(0.066),
                           face=pin.heights > opts.holder_height / 2,
-                          settings=MacroSettings(track_radius=30e-3), thermal=thermal)
+                          settings=MacroSettings(track_radius=30e-3), thermal=thermal))
 
 
 def main(out="out/contact_temperature", quick=False):

@@ -40,10 +40,10 @@ from .io.figure import save_figure
 from .io.files import read_topography
 from .io.layout import RunLayout
 from .micro import FlowFactors
-from .stages.curves import macro_settings
+from .stages.requests import sweep_request
 from .stages.sweeps import run_sweeps
 from .stages.factors import homogenise_patches
-from .stages.geometry import face_load, macro_geometry, prepare_pins, reconstruct_geometry
+from .stages.geometry import prepare_pins, reconstruct_geometry
 from .stribeck import friction_deviation, plot_stribeck, write_stribeck_csv
 from .numerics.threads import executor_for
 
@@ -143,8 +143,7 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
             pins.result()
         tasks = [_sweep(variant, folder, out, patch, speeds)
                  for folder, (variant, patch, speeds) in zip(folders, cases.values())]
-        swept = run_sweeps([(kw, lub) for kw in tasks], executor, progress,
-                           desc="calibration points")
+        swept = run_sweeps(tasks, executor, progress, desc="calibration points")
     curves = {label: c.with_load_share(variant.tribometer.load_share)
               for (label, (variant, _, _)), c in zip(cases.items(), swept)}
     ref = curves[ref_label]
@@ -166,17 +165,15 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     return summary
 
 
-def _sweep(variant: Case, folder: RunLayout, out: RunLayout, patch, speeds) -> dict:
-    """The sweep task of one variant (:func:`~fem_twin.stages.sweeps.run_sweeps`) on its
-    levelled pins in ``folder`` (:func:`~fem_twin.stages.geometry.prepare_pins`), its
-    points in the study's checkpoints."""
-    gap, spacing, face, _ = macro_geometry(variant, folder)
+def _sweep(variant: Case, folder: RunLayout, out: RunLayout, patch, speeds):
+    """The sweep request of one variant (first viscosity) on its levelled pins in
+    ``folder`` (:func:`~fem_twin.stages.geometry.prepare_pins`), its points in the study's
+    checkpoints; isothermal, as the paper's studies."""
     path = out.patch_factors(patch)
-    return dict(gap=gap, spacing=spacing, factors=FlowFactors.load(path),
-                factors_key=input_key(np.frombuffer(path.read_bytes(), np.uint8)),
-                speeds=variant.sweep.speeds if speeds is None else speeds,
-                load=face_load(variant), diameter=variant.tribometer.pin_diameter, face=face,
-                settings=macro_settings(variant), checkpoint=out.points)
+    return sweep_request(variant, folder, factors=FlowFactors.load(path),
+                         factors_key=input_key(np.frombuffer(path.read_bytes(), np.uint8)),
+                         speeds=variant.sweep.speeds if speeds is None else speeds,
+                         thermal=None, checkpoint=out.points)
 
 
 def _at(curve, speeds):

@@ -27,9 +27,9 @@ from .micro import FlowFactors
 from .micro.flow_factors import ARRAYS
 from .micro.estimate import discrepancy, grid_separations
 from .stribeck import friction_deviation, stribeck_sweep
-from .stages.curves import macro_settings
+from .stages.requests import macro_settings, sweep_request
 from .stages.factors import homogenise_patches
-from .stages.geometry import face_load, level_pins, macro_geometry, reconstruct_geometry
+from .stages.geometry import level_pins, reconstruct_geometry
 from .stribeck.sweep import point_files
 from .numerics.threads import executor_for
 
@@ -99,18 +99,16 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
                                   progress=progress)
     against = {m: discrepancy(factors[m], reference) for m in ("fe", "fvm")}
     ffd = flow_factor_differences(factors["fe"], factors["fvm"])
-    gap, spacing, face, origin = macro_geometry(case, out)
-    lub = case.lubricant.lubricants()[0]
     curves, points = {}, {}
-    for method in ("fe", "fvm"):
-        ckpt = out.sub(method).points
-        curves[method] = stribeck_sweep(
-            gap, spacing, factors[method], case.sweep.speeds, load=face_load(case),
-            lubricant=lub, diameter=case.tribometer.pin_diameter, face=face,
-            settings=macro_settings(case, method),
-            checkpoint=ckpt, progress=progress).with_load_share(case.tribometer.load_share)
-        points[method] = sorted((MixedResult.load(p) for p in point_files(ckpt)),
+    for method in ("fe", "fvm"):                  # isothermal: the methods, not the heat
+        request = sweep_request(case, out, factors=factors[method], thermal=None,
+                                settings=macro_settings(case, method),
+                                checkpoint=out.sub(method).points)
+        curves[method] = stribeck_sweep(request, progress).with_load_share(
+            case.tribometer.load_share)
+        points[method] = sorted((MixedResult.load(p) for p in point_files(request.checkpoint)),
                                 key=lambda r: -r.speed)            # as the curve: fast first
+    lub = request.lubricant
     dev = friction_deviation(curves["fe"].friction_coefficient,
                              curves["fvm"].friction_coefficient)
     fields = [field_differences(a, b) for a, b in zip(points["fe"], points["fvm"])]

@@ -17,11 +17,8 @@ from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .io.table import write_csv
 from .macro.viscosity import WaltherLaw
-from .micro import FlowFactors
-from .stages.curves import contact_thermal, macro_settings
+from .stages.requests import per_viscosity, sweep_request
 from .stages.sweeps import run_sweeps
-from .stages.geometry import hersey_length, macro_geometry
-from .stages.provenance import stage_keys
 from .stribeck import read_measured_csv
 from .stribeck.curve import read_stribeck_csv
 from .stribeck.fit import (LOAD_SHARES, RESISTANCES, FitModel, check_parameters, fit_curves,
@@ -111,11 +108,10 @@ def share_curves(case: Case, out: RunLayout, curve, progress: bool = True,
     its load over the speeds of ``curve`` (the case's own share is ``curve``), checkpointed
     in ``OUT/fit/checkpoints``; the micro stage's flow factors are reused."""
     tr = case.tribometer
-    common = dict(_fit_sweep(case, out), speeds=np.sort(curve.speed)[::-1])
-    lub = case.lubricant.lubricants()[0]
+    request = _fit_sweep(case, out, speeds=np.sort(curve.speed)[::-1])
     todo = sorted(s for s in shares if not np.isclose(s, tr.load_share, rtol=1e-9))
     with executor_for(case.run.workers, case.run.scheduler) as executor:
-        swept = run_sweeps([(dict(common, load=tr.load * s), lub) for s in todo], executor,
+        swept = run_sweeps([replace(request, load=tr.load * s) for s in todo], executor,
                            progress, desc="load-share points")
     return tuple(sorted([*zip(todo, swept), (tr.load_share, curve)], key=lambda p: p[0]))
 
@@ -125,12 +121,12 @@ def resistance_curves(case: Case, out: RunLayout, curves, progress: bool = True,
     """Per curve, ``((R_b, StribeckCurve), ...)``: each of ``curves`` (the case's K-th
     viscosity) swept at the rig's thermal ``resistances`` [K/W] over its speeds (the
     case's own R_b is the curve), checkpointed in ``OUT/fit/checkpoints``."""
-    common = dict(_fit_sweep(case, out), load=case.tribometer.load * case.tribometer.load_share)
-    own, thermal = case.thermal.bulk_resistance, common["thermal"]
+    own = case.thermal.bulk_resistance
     todo = sorted(r for r in resistances if not np.isclose(r, own, rtol=1e-9, atol=1e-12))
-    tasks = [(dict(common, speeds=np.sort(c.speed)[::-1], thermal=replace(
-        thermal, settings=replace(thermal.settings, bulk_resistance=r))), lub)
-        for c, lub in zip(curves, case.lubricant.lubricants()) for r in todo]
+    tasks = [replace(request, speeds=np.sort(c.speed)[::-1], thermal=replace(
+        request.thermal, settings=replace(request.thermal.settings, bulk_resistance=r)))
+        for c, request in zip(curves, per_viscosity(case, _fit_sweep(case, out)))
+        for r in todo]
     with executor_for(case.run.workers, case.run.scheduler) as executor:
         swept = run_sweeps(tasks, executor, progress, desc="thermal-resistance points")
     swept = [s.with_load_share(case.tribometer.load_share) for s in swept]
@@ -139,14 +135,10 @@ def resistance_curves(case: Case, out: RunLayout, curves, progress: bool = True,
                  for k, c in enumerate(curves))
 
 
-def _fit_sweep(case: Case, out: RunLayout) -> dict:
-    """What the fit's extra sweeps share with the case's run: its macro geometry, flow
-    factors, settings and thermal model, checkpointed in ``OUT/fit/checkpoints``."""
-    gap, spacing, face, _ = macro_geometry(case, out)
-    return dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
-                diameter=hersey_length(case), face=face, settings=macro_settings(case),
-                checkpoint=out.fit_points, thermal=contact_thermal(case),
-                factors_key=stage_keys(case)["micro"])
+def _fit_sweep(case: Case, out: RunLayout, **changes):
+    """The case's sweep request (first viscosity) for the fit's extra sweeps, checkpointed
+    in ``OUT/fit/checkpoints``; ``changes`` as :func:`dataclasses.replace`'s."""
+    return sweep_request(case, out, checkpoint=out.fit_points, **changes)
 
 
 def apply_fit(case: Case, result: dict) -> Case:

@@ -627,9 +627,9 @@ def test_a_point_that_does_not_converge_in_a_worker_reports_its_history(tmp_path
     not survive pickling); now exit 3 with the residual history."""
     from dataclasses import replace
 
-    import fem_twin.stages.curves as curves
-    real = curves.macro_settings
-    monkeypatch.setattr(curves, "macro_settings",
+    import fem_twin.stages.requests as requests
+    real = requests.macro_settings
+    monkeypatch.setattr(requests, "macro_settings",
                         lambda case, method=None: replace(real(case, method), max_iter=2))
     case = small_case(tmp_path, workers=2)
     assert main(["run", str(case), "-o", str(tmp_path / "o"), "--no-progress"]) == 3

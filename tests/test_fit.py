@@ -13,7 +13,7 @@ import pytest
 from fem_twin.errors import InputError
 from fem_twin.macro import Lubricant, MacroSettings
 from fem_twin.macro.viscosity import WaltherLaw
-from fem_twin.stribeck import stribeck_sweep
+from fem_twin.stribeck import SweepRequest, stribeck_sweep
 from fem_twin.stribeck.curve import MeasuredCurve
 from fem_twin.macro.thermal import ContactThermal, ThermalSettings
 from fem_twin.stribeck.fit import LOAD_SHARES, RESISTANCES, FitModel, fit_curves, predict
@@ -37,10 +37,10 @@ def twin(factors):  # noqa: F811
     with C_f,b = 0.15 (C_f only)."""
     gap, dx, face = macro_case(32)
     common = dict(load=150.0, face=face, settings=MacroSettings())
-    sim = {mu: stribeck_sweep(gap, dx, factors, SIMULATED,
-                              lubricant=Lubricant(mu), **common) for mu in (0.066, 0.024)}
-    direct = {t: stribeck_sweep(gap, dx, factors, SPEEDS, lubricant=Lubricant(
-        float(LAW.viscosity(t))), **common) for t in (35.0, 45.0)}
+    sim = {mu: stribeck_sweep(SweepRequest(gap, dx, factors, SIMULATED,
+                              lubricant=Lubricant(mu), **common)) for mu in (0.066, 0.024)}
+    direct = {t: stribeck_sweep(SweepRequest(gap, dx, factors, SPEEDS, lubricant=Lubricant(
+        float(LAW.viscosity(t))), **common)) for t in (35.0, 45.0)}
     cf = {t: (r.hydrodynamic_friction + CFB_TRUE / CFB * r.boundary_friction) / 150
           for t, r in direct.items()}
     return sim, cf
@@ -100,10 +100,10 @@ def shares(twin, factors):  # noqa: F811
     sim, _ = twin
     gap, dx, face = macro_case(32)
     common = dict(face=face, settings=MacroSettings(), lubricant=Lubricant(0.066))
-    grid = tuple((s, stribeck_sweep(gap, dx, factors, sim[0.066].speed, load=150.0 * s,
-                                    **common) if s != 1.0 else sim[0.066])
+    grid = tuple((s, stribeck_sweep(SweepRequest(gap, dx, factors, sim[0.066].speed, load=150.0 * s,
+                                    **common)) if s != 1.0 else sim[0.066])
                  for s in LOAD_SHARES)
-    direct = stribeck_sweep(gap, dx, factors, SPEEDS, load=120.0, **common)
+    direct = stribeck_sweep(SweepRequest(gap, dx, factors, SPEEDS, load=120.0, **common))
     return grid, (direct.hydrodynamic_friction + CFB_TRUE / CFB * direct.boundary_friction) / 150
 
 
@@ -151,8 +151,8 @@ def test_a_curve_no_parameters_fit_is_refused_naming_its_residual(twin, factors)
         fit_curves(model, [rising], ["boundary_friction", "temperature"],
                    start_temperatures=[24.0])
     gap, dx, face = macro_case(32)
-    heavy = stribeck_sweep(gap, dx, factors, SPEEDS, load=600.0, face=face,
-                           settings=MacroSettings(), lubricant=Lubricant(0.066))
+    heavy = stribeck_sweep(SweepRequest(gap, dx, factors, SPEEDS, load=600.0, face=face,
+                           settings=MacroSettings(), lubricant=Lubricant(0.066)))
     cf600 = (heavy.hydrodynamic_friction + CFB_TRUE / CFB * heavy.boundary_friction) / 600
     banded = MeasuredCurve(SPEEDS, cf600, 0.98 * cf600, 1.02 * cf600)
     with pytest.raises(InputError, match="no parameter set fits"):
@@ -188,8 +188,8 @@ def resistances(factors):  # noqa: F811
 
     def sweep(mu, r, at=SPEEDS):
         thermal = ContactThermal(ThermalSettings(bulk_resistance=r), LAW, CFB)
-        return stribeck_sweep(gap, dx, factors, at, lubricant=Lubricant(mu), thermal=thermal,
-                              **common)
+        return stribeck_sweep(SweepRequest(gap, dx, factors, at, lubricant=Lubricant(mu), thermal=thermal,
+                              **common))
     grid = tuple(tuple((r, sweep(mu, r)) for r in RESISTANCES) for mu in (0.066, 0.024))
     direct = [sweep(mu, 1.5) for mu in (0.066, 0.024)]
     cf = [(r.hydrodynamic_friction + CFB_TRUE / CFB * r.boundary_friction) / 150 for r in direct]

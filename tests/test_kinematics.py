@@ -202,7 +202,7 @@ def test_the_case_turns_the_disk_at_its_track_radius(tmp_path):
     """``[tribometer] kinematics``: the pin turns at ``sliding_radius`` (default), a ball at
     ``track_radius``; ``"uniform"`` is the paper's sliding; anything else is refused."""
     from fem_twin.case import CaseError, load_case
-    from fem_twin.stages.curves import macro_settings
+    from fem_twin.stages.requests import macro_settings
     root = Path(__file__).resolve().parents[1] / "examples"
     assert macro_settings(load_case(root / "pin_on_disk.toml")).track_radius == 30e-3
     assert macro_settings(load_case(root / "ball_on_disk.toml")).track_radius == 20e-3

@@ -472,7 +472,7 @@ def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors)
     measured 24 against 42); its coarse point is the one the error estimate solves."""
     from fem_twin.macro.estimate import friction_error
     from fem_twin.macro.nested import coarsened, nested_levels, solve_nested
-    from fem_twin.stribeck import stribeck_sweep
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
     gap, dx, face = macro_case(112)
     kw = dict(load=150.0, lubricant=Lubricant(0.066), face=face,
               settings=MacroSettings(tol=TIGHT))
@@ -488,7 +488,7 @@ def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors)
                         **{**kw, "face": face2})
     assert abs(again.friction_coefficient - coarse.friction_coefficient) < 1e-6 * 0.19245
     # a sweep keeps each point's C_f on every nested grid: the patch band's average curve
-    curve = stribeck_sweep(gap, dx, factors, [0.05, 0.03], **kw)
+    curve = stribeck_sweep(SweepRequest(gap, dx, factors, [0.05, 0.03], **kw))
     assert curve.coarse_friction_coefficient.shape == (nested_levels(gap.shape), 2) == (1, 2)
     assert abs(curve.coarse_friction_coefficient[0, 1]
                - again.friction_coefficient) < 1e-6 * 0.19245
@@ -521,9 +521,9 @@ def test_nested_levels_each_start_from_the_next_coarser_change(factors, monkeypa
     plain = solve_mixed(gap, dx, factors, speed=0.03, initial=first[0], face=face, **kw)
     assert abs(warm[0].friction_coefficient - plain.friction_coefficient) < 1e-6 * 0.19245
     # a sweep keeps C_f on every level (the band's "coarsest" grid reads the last row)
-    from fem_twin.stribeck import stribeck_sweep
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
     assert nest.nested_levels(gap.shape) == 2
-    curve = stribeck_sweep(gap, dx, factors, [0.05, 0.03], face=face, **kw)
+    curve = stribeck_sweep(SweepRequest(gap, dx, factors, [0.05, 0.03], face=face, **kw))
     assert np.allclose(curve.coarse_friction_coefficient, [
         [r.friction_coefficient for r in (first[k], warm[k])] for k in (1, 2)], rtol=1e-9)
 
@@ -539,26 +539,26 @@ def test_the_patch_band_starts_from_the_main_points_nested_levels(tmp_path, fact
     from dataclasses import replace as moved
 
     from fem_twin.macro import nested
-    from fem_twin.stribeck import stribeck_sweep
-    from fem_twin.stribeck.sweep import level_key
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
     gap, dx, face = macro_case(96)
     speeds = [0.08, 0.04, 0.025, 0.018]
     kw = dict(load=150.0, lubricant=Lubricant(0.066), settings=MacroSettings(tol=TIGHT))
-    main = stribeck_sweep(gap, dx, factors, speeds, face=face, checkpoint=tmp_path,
-                          factors_key="average", keep_level=1, **kw)
-    guide = level_key(1, gap, dx, "average", 150.0, kw["lubricant"], kw["settings"], face)
+    main = stribeck_sweep(SweepRequest(gap, dx, factors, speeds, face=face, checkpoint=tmp_path,
+                          factors_key="average", keep_level=1, **kw))
+    guide = SweepRequest(gap, dx, factors, speeds, face=face, factors_key="average",
+                         **kw).level_key(1)
     gap2, dx2, face2 = nested.coarsened(gap, dx, face)
     calls = []
     monkeypatch.setattr("fem_twin.stribeck.sweep.solve_nested",
                         lambda *a, **k: calls.append(1) or nested.solve_nested(*a, **k))
-    coarse = stribeck_sweep(gap2, dx2, factors, speeds, face=face2, checkpoint=tmp_path,
-                            factors_key="average", **kw)
+    coarse = stribeck_sweep(SweepRequest(gap2, dx2, factors, speeds, face=face2, checkpoint=tmp_path,
+                            factors_key="average", **kw))
     assert not calls and np.array_equal(coarse.friction_coefficient,
                                         main.coarse_friction_coefficient[0])
     patch = moved(factors, p_con=1.3 * factors.p_con, A=0.9 * factors.A)
     band = dict(face=face2, checkpoint=tmp_path, factors_key="patch", **kw)
-    guided = stribeck_sweep(gap2, dx2, patch, speeds, guide=guide, **band)
-    plain = stribeck_sweep(gap2, dx2, patch, speeds, **{**band, "checkpoint": None})
+    guided = stribeck_sweep(SweepRequest(gap2, dx2, patch, speeds, guide=guide, **band))
+    plain = stribeck_sweep(SweepRequest(gap2, dx2, patch, speeds, **{**band, "checkpoint": None}))
     assert np.abs(guided.friction_coefficient
                   - plain.friction_coefficient).max() < 1e-6 * 0.19245
     assert guided.iterations.sum() < 0.9 * plain.iterations.sum()

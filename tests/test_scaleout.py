@@ -1,5 +1,6 @@
 """Scale-out: a small Stribeck sweep on a Dask LocalCluster equals the serial one."""
 
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -10,10 +11,22 @@ from fem_twin.io.files import read_topography
 from fem_twin.macro import Lubricant
 from fem_twin.micro import homogenise
 from fem_twin.stages.sweeps import run_sweeps
+from fem_twin.stribeck import SweepRequest
 from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 
 SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "sample"
+
+
+@dataclass(frozen=True, eq=False)
+class Scheduled:
+    """What the scheduler reads of a SweepRequest: its grid, speeds and outputs."""
+
+    gap: np.ndarray
+    speeds: np.ndarray
+    fields: str | None = None
+    factors_key: str | None = None
+    checkpoint: str | None = None
 
 
 def small_sweep():
@@ -33,7 +46,7 @@ def test_dask_local_cluster_gives_the_serial_numbers(tmp_path):
     distributed = pytest.importorskip("distributed")
     common = small_sweep()
     lubricants = [Lubricant(0.066), Lubricant(0.024)]
-    tasks = [(common, lub) for lub in lubricants]
+    tasks = [SweepRequest(**common, lubricant=lub) for lub in lubricants]
     serial = run_sweeps(tasks, None, progress=False)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
@@ -155,19 +168,19 @@ def test_the_largest_sweeps_are_submitted_first(monkeypatch):
     from concurrent.futures import Future
 
     import fem_twin.stages.sweeps as curves
-    monkeypatch.setattr(curves, "_sweep_task", lambda args: args[0]["gap"].shape[0])
+    monkeypatch.setattr(curves, "_sweep_task", lambda args: args[0].gap.shape[0])
 
     class Recording:
         order = []
 
         def submit(self, fn, args):
-            self.order.append(args[0]["gap"].shape[0])
+            self.order.append(args[0].gap.shape[0])
             done = Future()
             done.set_result(fn(args))
             return done
 
     pool = Recording()
-    tasks = [(dict(gap=np.zeros((n, n)), speeds=np.ones(k)), None)
+    tasks = [Scheduled(np.zeros((n, n)), np.ones(k))
              for n, k in ((128, 17), (999, 5), (1997, 5), (256, 17))]
     assert curves.run_sweeps(tasks, pool, progress=False) == [128, 999, 1997, 256]
     assert pool.order == [1997, 999, 256, 128]
@@ -185,8 +198,8 @@ def test_a_sweep_longer_than_a_workers_share_runs_as_chains(monkeypatch):
     from fem_twin.stribeck import StribeckCurve
 
     def sweep(args):
-        kw, speeds = args[0], np.asarray(args[0]["speeds"])
-        one = np.full(speeds.size, kw["gap"].shape[0], float)
+        speeds = args[0].speeds
+        one = np.full(speeds.size, args[0].gap.shape[0], float)
         return StribeckCurve(speeds, speeds, speeds / 10, 0.066, one, one, one, one, one,
                              friction_error=speeds / 100,
                              friction_error_parts={"macro": speeds / 100},
@@ -197,23 +210,22 @@ def test_a_sweep_longer_than_a_workers_share_runs_as_chains(monkeypatch):
         n_workers, order = 2, []
 
         def submit(self, fn, args):
-            self.order.append((args[0]["gap"].shape[0], len(args[0]["speeds"])))
+            self.order.append((args[0].gap.shape[0], args[0].speeds.size))
             done = Future()
             done.set_result(fn(args))
             return done
 
     speeds = {128: 17, 256: 17, 500: 17, 999: 5, 1997: 5}
-    tasks = [(dict(gap=np.zeros((n, n)), speeds=np.geomspace(2, 0.005, k)), None)
-             for n, k in speeds.items()]
+    tasks = [Scheduled(np.zeros((n, n)), np.geomspace(2, 0.005, k)) for n, k in speeds.items()]
     pool = Pool()
     out = curves.run_sweeps(tasks, pool, progress=False)
     assert pool.order == [(1997, 2), (1997, 1), (1997, 1), (1997, 1), (999, 5), (500, 17),
                           (256, 17), (128, 17)]
-    for (kw, _), c in zip(tasks, out):
-        assert np.array_equal(c.speed, kw["speeds"])
-        assert np.array_equal(c.friction_coefficient, kw["speeds"] / 10)
-        assert np.array_equal(c.friction_error_parts["macro"], kw["speeds"] / 100)
-        assert c.coarse_friction_coefficient.shape == (2, kw["speeds"].size)
-    fields = [(dict(kw, fields="somewhere"), lub) for kw, lub in tasks]
+    for task, c in zip(tasks, out):
+        assert np.array_equal(c.speed, task.speeds)
+        assert np.array_equal(c.friction_coefficient, task.speeds / 10)
+        assert np.array_equal(c.friction_error_parts["macro"], task.speeds / 100)
+        assert c.coarse_friction_coefficient.shape == (2, task.speeds.size)
+    fields = [replace(task, fields="somewhere") for task in tasks]
     assert len(curves.chains(fields, 2)) == len(tasks)
     assert len(curves.chains(tasks, 1)) == len(tasks)

@@ -6,13 +6,14 @@ read these declarations; ``[preprocessing]`` is
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 from .. import tables as T
 from ..checks import setting
 from ..macro.settings import MacroSettings
 from ..macro.thermal import ThermalSettings
+from ..micro.rolling import SLIDING
 from ..micro.sliding import CellSettings
 from ..topography.prepare import MacroOptions
 from .cost import estimated_seconds
@@ -208,6 +209,17 @@ class RunSpec:
                               unit="-")
 
 
+#: each setting a stage's settings take from another section (declared with
+#: ``setting(..., section=...)``): its section and how the case gives it.  The cells slide
+#: (the pin at rest, SRR 2) in every case: a ball's ratio reaches the flow factors by the
+#: frame change of :func:`fem_twin.micro.at_slide_to_roll` in ``solve_mixed``.
+FILLED = {"e_reduced": ("materials", lambda case: case.materials.e_reduced),
+          "hardness": ("materials", lambda case: case.materials.hardness),
+          "boundary_friction": ("tribometer", lambda case: case.tribometer.boundary_friction),
+          "track_radius": ("tribometer", lambda case: case.tribometer.disk_radius),
+          "slide_to_roll": ("tribometer", lambda case: SLIDING)}
+
+
 #: the case file's sections and the dataclass that declares each one's keys
 #: (``[validation]`` has one key, ``measured``; ``name`` is top-level)
 SECTIONS = {"geometry": Geometry, "preprocessing": MacroOptions, "tribometer": Tribometer,
@@ -234,6 +246,12 @@ class Case:
     measured: tuple[Path | None, ...] = ()   # [validation] measured curves per viscosity
     source: Path | None = None
     defaulted: tuple[str, ...] = ()          # sections absent from the file (defaults used)
+
+    def filled(self, settings):
+        """``settings`` (a stage's settings dataclass) with every field another section
+        sets taken from this case (:data:`FILLED`)."""
+        return replace(settings, **{f.name: FILLED[f.name][1](self) for f in fields(settings)
+                                    if f.metadata.get("section")})
 
     def estimated_seconds(self, cores: int = 2) -> float:
         """Rough wall time of ``fem-twin run`` on ``cores`` cores of the calibration

@@ -14,11 +14,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..checks import arguments
-from .. import tables as T
+from ..tables import BOUNDARY_FRICTION
 from .kinematics import rotate_tensor, rotations
 
 #: Boundary friction coefficient C_f,b of eq 32 (Bowden and Tabor, pure shearing).
-BOUNDARY_FRICTION = T.BOUNDARY_FRICTION
 #: the friction laws: the force on the pin, or the paper's eq 31
 LAWS = ("pin", "paper")
 

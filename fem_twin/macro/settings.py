@@ -13,7 +13,7 @@ from ..errors import InputError
 from .cavitation import MODELS, cavitation_model
 from .contact_load import RULES
 from .couette import SCHEMES
-from .friction import BOUNDARY_FRICTION, LAWS
+from .friction import LAWS
 
 
 @dataclass(frozen=True)
@@ -24,8 +24,9 @@ class MacroSettings:
                                       "edges of the pin (Table 6)", unit="Pa")
     cavitation_pressure: float = setting(T.CAVITATION_PRESSURE, "cavitation pressure p_cav "
                                          "(Table 6)", unit="Pa")
-    e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", unit="Pa", section="materials")
-    boundary_friction: float = setting(BOUNDARY_FRICTION, "C_f,b of eq 32", unit="-",
+    e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", "reduced_modulus",
+                               section="materials")
+    boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", unit="-",
                                        section="tribometer")
     track_radius: float | None = setting(
         None, "the disk's axis at this distance from the face's centre: the disk's velocity "

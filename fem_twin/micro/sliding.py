@@ -26,11 +26,12 @@ import numpy as np
 
 from ..contact import contact_rate
 from ..contact import solve as contact_solve
-from ..contact.levelling import TABLE4
+from .. import tables as T
 from ..checks import arguments, check_choices, plausible, setting
 from ..errors import InputError
 from .cell_fv import CellSolverFV
 from .flow_factors import FlowFactors
+from .rolling import SLIDING
 
 
 @dataclass(frozen=True)
@@ -40,9 +41,9 @@ class CellSettings:
     takes it whole (``settings=``) or field by field as keyword shortcuts."""
 
     steps: int = setting(32, "time steps N_t of one sliding pass (paper: 32)", unit="-")
-    e_reduced: float = setting(TABLE4["e_reduced"], "E' of eq 22", "reduced_modulus",
+    e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", "reduced_modulus",
                                section="materials")
-    hardness: float = setting(TABLE4["hardness"], "the cap on the contact pressure",
+    hardness: float = setting(T.HARDNESS, "the cap on the contact pressure",
                               "hardness", section="materials")
     gap_floor: float = setting(1e-9, "smallest film of the cell problems (a contact spot)",
                                unit="m")
@@ -54,7 +55,7 @@ class CellSettings:
                           "(the mean-speed frame, no Couette term in eq 8), the disk at +U "
                           "over the pin at rest (the paper), or the pin at -U (the disk's "
                           "frame)", choices=("both", "upper", "lower"))
-    slide_to_roll: float = setting(2.0, "SRR = u_r / u_m of the cell's kinematics: the pin or "
+    slide_to_roll: float = setting(SLIDING, "SRR = u_r / u_m of the cell's kinematics: the pin or "
                                    "ball at u_m (1 - SRR/2), the disk at u_m (1 + SRR/2) "
                                    "(2: the pin at rest; exact squeeze term only)",
                                    "slide_to_roll", section="tribometer")

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 import logging
-from dataclasses import fields, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,12 +14,9 @@ import numpy as np
 from ..case import Case
 from ..io.writers import Writers
 from ..io.layout import RunLayout
-from ..macro import MacroSettings, MixedResult
-from ..macro.nested import coarsened
+from ..macro import MixedResult
 from ..macro.figures import plot_point_files
 from ..macro.point_contact import film_against_hamrock_dowson
-from ..macro.thermal import ContactThermal
-from ..macro.viscosity import WaltherLaw
 from ..micro import FlowFactors
 from ..stribeck import plot_stribeck, read_measured_csv, write_stribeck_csv
 from ..stribeck.curve import plot_temperatures
@@ -28,38 +25,12 @@ from ..stribeck.analysis import (defect_corrected, hersey_collapse, patch_band,
                                  transition_speeds)
 from ..stribeck.sweep import LOAD_BELOW, point_files, point_key, point_meta, point_speed
 from ..stribeck.validation import validate_curves
-from .geometry import ball_contact, face_load, hersey_length, macro_geometry
-from .provenance import provenance, stage_keys
-from .sweeps import run_sweeps, task_key
+from .geometry import ball_contact, hersey_length
+from .provenance import provenance
+from .requests import per_viscosity, sweep_request
+from .sweeps import run_sweeps
 
 log = logging.getLogger("fem_twin")
-
-
-def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
-    """The macro solver settings of a case (``method`` overrides ``[macro] method``).
-
-    A ball's contact cavitates at the ambient pressure: the 0.2 bar between p_amb and p_cav
-    of Table 6 is nothing beside its GPa, and the thin pressurised layer it forces along
-    the sides of the outlet cavity makes the Newton coupling cycle between two states."""
-    own = {f.name: getattr(case.macro, f.name) for f in fields(MacroSettings)}
-    settings = MacroSettings(**{**own, "e_reduced": case.materials.e_reduced,
-                                "boundary_friction": case.tribometer.boundary_friction,
-                                "track_radius": case.tribometer.disk_radius,
-                                **({"method": method} if method else {})})
-    if case.tribometer.ball:
-        settings = replace(settings, cavitation_pressure=settings.ambient_pressure)
-    return settings
-
-
-def contact_thermal(case: Case) -> ContactThermal | None:
-    """The run's thermal model (``[thermal]``, the Walther law of ``[lubricant]``, C_f,b),
-    or None for the isothermal twin (``model = "none"``)."""
-    if case.thermal.model == "none":
-        return None
-    lb = case.lubricant
-    return ContactThermal(case.thermal, WaltherLaw.through(lb.temperatures, lb.viscosities,
-                                                           lb.density),
-                          case.tribometer.boundary_friction)
 
 
 def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = True,
@@ -72,36 +43,30 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     done, beside the band's sweeps."""
     own = writers is None
     writers = Writers(executor) if own else writers
-    gap, spacing, face, origin = macro_geometry(case, out)
     tr = case.tribometer
-    ball = dict(slide_to_roll=tr.slide_to_roll) if tr.ball else {}
-    common = dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
-                  speeds=case.sweep.speeds, load=face_load(case), diameter=hersey_length(case),
-                  face=face, **ball, settings=macro_settings(case), checkpoint=out.points,
-                  thermal=contact_thermal(case),
-                  fields=out.fields, origin=origin, factors_key=stage_keys(case)["micro"])
-    curves, speeds = refined_curves(case, common, executor, progress)
-    tasks = [(dict(common, speeds=speeds, error_estimate=True), lub)
-             for lub in case.lubricant.lubricants()]
-    _plot_fields(out, common["checkpoint"], tasks, writers)       # beside the band's sweeps
-    writers.write(write_run_fields, case, out, tasks, origin)
-    band_run = band_tasks(case, out, dict(common, speeds=speeds))
+    request = sweep_request(case, out)
+    curves, speeds = refined_curves(case, out, request, executor, progress)
+    request = replace(request, speeds=speeds)
+    tasks = per_viscosity(case, replace(request, error_estimate=True))
+    _plot_fields(out, tasks, writers)                             # beside the band's sweeps
+    writers.write(write_run_fields, case, out, tasks, request.origin)
+    band_run = band_tasks(case, out, request)
     patch_curves, patch_tasks = band_curves(
-        case, dict(common, speeds=speeds), curves, band_run,
+        case, request, curves, band_run,
         run_sweeps(band_run, executor, progress, desc="patch band points"), executor,
         progress)
     band = patch_band(patch_curves) if patch_curves else None
-    _prune_points(common["checkpoint"], tasks + patch_tasks)
+    _prune_points(out.points, tasks + patch_tasks)
     write_stribeck_csv(out.stribeck_csv, curves, band)
     summary = _summary(case, out, curves, band)
     writers.write(write_run_results, case, out, curves, patch_curves)
     plot_curves(case, curves, band, out, writers)
-    summary["h0_range"] = _range_check(common, tasks + patch_tasks)
+    summary["h0_range"] = _range_check(tasks + patch_tasks)
     _log_points(curves)
     if len(curves) > 1:
         summary["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, tr.boundary_friction)
     if tr.ball:
-        summary["ehl_film"] = ehl_film(case, sweep_points(common["checkpoint"], tasks))
+        summary["ehl_film"] = ehl_film(case, sweep_points(tasks))
     if any(case.measured):
         summary["validation"] = validate_curves(
             curves, case.measured, tr.boundary_friction, curve_labels(case, curves),
@@ -111,19 +76,20 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     return summary
 
 
-def refined_curves(case: Case, common: dict, executor=None, progress: bool = True):
-    """The main curves (with their C_f error estimates) over the case's speeds, then
-    ``[sweep] refine`` passes adding the midpoints where C_f jumps; ``(curves, speeds)``.
-    With the patch band on, each point also keeps its solve on the band's grid
-    (``keep_level``), which the band's sweeps start from."""
+def refined_curves(case: Case, out: RunLayout, request, executor=None,
+                   progress: bool = True):
+    """The main curves (with their C_f error estimates) of the sweep ``request`` over the
+    case's viscosities, then ``[sweep] refine`` passes adding the midpoints where C_f
+    jumps; ``(curves, speeds)``.  With the patch band on, each point also keeps its solve
+    on the band's grid (``keep_level``), which the band's sweeps start from."""
     tr, step = case.tribometer, case.sweep.refine_step * case.tribometer.boundary_friction
-    lubricants = case.lubricant.lubricants()
-    speeds = case.sweep.speeds
-    keep = case.band_coarsening(np.shape(common["gap"])) if case.run.patch_band else 0
+    speeds = request.speeds
+    keep = case.band_coarsening(request.gap.shape) if case.run.patch_band else 0
 
     def sweeps(final):                                    # the fields with the final pass
-        tasks = [(dict(common, speeds=speeds, error_estimate=True, keep_level=keep,
-                       fields=common["fields"] if final else None), lub) for lub in lubricants]
+        tasks = per_viscosity(case, replace(request, speeds=speeds, error_estimate=True,
+                                            keep_level=keep,
+                                            fields=out.fields if final else None))
         return [c.with_load_share(tr.load_share) for c in run_sweeps(tasks, executor, progress)]
 
     for level in range(case.sweep.refine + 1):
@@ -140,24 +106,21 @@ def refined_curves(case: Case, common: dict, executor=None, progress: bool = Tru
     return curves, speeds
 
 
-def band_tasks(case: Case, out: RunLayout, common: dict) -> list:
+def band_tasks(case: Case, out: RunLayout, request) -> list:
     """The sweep tasks of the scatter band (``[run] patch_band``): one per patch and
     viscosity, on the macro grid coarsened :meth:`~fem_twin.case.Case.band_coarsening`
     times, each guided by the average factors' points on that grid (the main sweeps'
     nested level, ``keep_level``; :func:`~fem_twin.stribeck.sweep.stribeck_sweep`), at the
     coupling tolerance ``[run] band_tol``."""
-    sweeps = band_sweeps(case, out, common) if case.run.patch_band else []
-    for _ in range(case.band_coarsening(np.shape(common["gap"])) if sweeps else 0):
-        gap, spacing, face = coarsened(sweeps[0]["gap"], sweeps[0]["spacing"],
-                                       sweeps[0]["face"])
-        sweeps = [dict(kw, gap=gap, spacing=spacing, face=face) for kw in sweeps]
-    band = replace(common["settings"], tol=case.run.band_tol)
-    return [(dict(kw, settings=band, guide=task_key(
-        dict(kw, factors_key=common["factors_key"]), lub)), lub)
-        for kw in sweeps for lub in case.lubricant.lubricants()]
+    sweeps = band_sweeps(case, out, request) if case.run.patch_band else []
+    level = case.band_coarsening(request.gap.shape)
+    band = replace(request.settings, tol=case.run.band_tol)
+    return [replace(task, settings=band, guide=replace(task, factors_key=request.factors_key,
+                                                       factors=request.factors).key)
+            for patch in sweeps for task in per_viscosity(case, patch.coarsened(level))]
 
 
-def band_curves(case: Case, common: dict, curves, tasks, swept, executor=None,
+def band_curves(case: Case, request, curves, tasks, swept, executor=None,
                 progress: bool = True):
     """The single-patch curves of the scatter band, one list per patch over the
     viscosities, from the curves ``swept`` of :func:`band_tasks`' ``tasks``, and the tasks
@@ -170,7 +133,7 @@ def band_curves(case: Case, common: dict, curves, tasks, swept, executor=None,
     n = len(case.lubricant.lubricants())
     swept = [c.with_load_share(case.tribometer.load_share) for c in swept]
     per_patch = [swept[i:i + n] for i in range(0, len(swept), n)]
-    level = case.band_coarsening(np.shape(common["gap"]))
+    level = case.band_coarsening(request.gap.shape)
     if not per_patch or level == 0:
         return per_patch, tasks
     coarse = [c.coarse_friction_coefficient for c in curves]
@@ -179,9 +142,7 @@ def band_curves(case: Case, common: dict, curves, tasks, swept, executor=None,
         return defect_corrected(per_patch, curves, [
             replace(c, friction_coefficient=cf[level - 1])
             for c, cf in zip(curves, coarse)]), tasks
-    kw = tasks[0][0]
-    average = [(dict(common, gap=kw["gap"], spacing=kw["spacing"], face=kw["face"],
-                     fields=None), lub) for lub in case.lubricant.lubricants()]
+    average = per_viscosity(case, request.coarsened(level))
     coarse = [c.with_load_share(case.tribometer.load_share)
               for c in run_sweeps(average, executor, progress, desc="patch band points")]
     return defect_corrected(per_patch, curves, coarse), tasks + average
@@ -206,37 +167,37 @@ def _summary(case: Case, out: RunLayout, curves, band) -> dict:
     return summary
 
 
-def _range_check(common: dict, tasks) -> dict:
+def _range_check(tasks) -> dict:
     """:func:`~fem_twin.stribeck.accuracy.range_summary` over the points of the sweeps
     ``tasks`` (the main curves' and the band's, whose single patches reach lower
     separations), each share read from its checkpoint's meta (``LOAD_BELOW``; a checkpoint
     without it is loaded whole)."""
-    h0_min = common["factors"].h0[0]
+    h0_min = tasks[0].factors.h0[0]
 
     def shares():
-        for kw, lub in tasks:
-            name = kw["factors_key"].rsplit("-", 1)[-1]
+        for task in tasks:
+            name = task.factors_key.rsplit("-", 1)[-1]
             factors = name if name.startswith("patch") else "average"
-            for path in point_files(common["checkpoint"], task_key(kw, lub)):
+            for path in point_files(task.checkpoint, task.key):
                 scalars, meta = point_meta(path)
                 share = meta.get(LOAD_BELOW)
                 if share is None:
                     share = MixedResult.load(path).contact_load_below(h0_min)
-                speed = scalars["speed"] if kw.get("slide_to_roll") is None else meta[
-                    "entrainment"]
-                yield share, (f"{factors} factors, mu_0 = {lub.viscosity:g} Pa s, "
+                speed = task.motion.sweep_speed(scalars["speed"], meta)
+                yield share, (f"{factors} factors, mu_0 = {task.lubricant.viscosity:g} Pa s, "
                               f"U = {speed:.3g} m/s")
     return range_summary(shares(), h0_min)
 
 
-def _plot_fields(out: RunLayout, folder: Path, tasks, writers: Writers) -> None:
+def _plot_fields(out: RunLayout, tasks, writers: Writers) -> None:
     """The fields of the fastest, a middle and the slowest point of each main sweep
-    ``tasks``, from their checkpoints in ``folder``."""
-    for kw, lub in tasks:
-        files = sorted(point_files(folder, task_key(kw, lub)), key=point_speed,
+    ``tasks``, from their checkpoints."""
+    for task in tasks:
+        files = sorted(point_files(task.checkpoint, task.key), key=point_speed,
                        reverse=True)                                     # fast to slow
         chosen = [files[i] for i in sorted({0, len(files) // 2, len(files) - 1})]
-        writers.write(plot_point_files, chosen, out.fields_png(lub.viscosity), lub.viscosity)
+        mu = task.lubricant.viscosity
+        writers.write(plot_point_files, chosen, out.fields_png(mu), mu)
 
 
 def _log_points(curves) -> None:
@@ -247,13 +208,13 @@ def _log_points(curves) -> None:
                      "%d iterations", c.viscosity, u, cf, share, it)
 
 
-def band_sweeps(case: Case, out: RunLayout, common: dict) -> list[dict]:
-    """Sweep arguments of every single patch's flow factors (the scatter band, Figure 13)."""
+def band_sweeps(case: Case, out: RunLayout, request) -> list:
+    """``request`` with every single patch's flow factors (the scatter band, Figure 13)."""
     n = len(case.geometry.patches)
     if n < 2:
         return []
-    return [dict(common, factors=FlowFactors.load(out.patch_factors(i + 1)),
-                 factors_key=f"{common['factors_key']}-patch{i + 1}", fields=None)
+    return [replace(request, factors=FlowFactors.load(out.patch_factors(i + 1)),
+                    factors_key=f"{request.factors_key}-patch{i + 1}", fields=None)
             for i in range(n)]
 
 
@@ -299,14 +260,13 @@ def plot_curves(case: Case, curves, band, out: RunLayout,
                       labels=curve_labels(case, curves))
 
 
-def sweep_points(folder: Path, tasks) -> dict:
+def sweep_points(tasks) -> dict:
     """{(viscosity, speed): MixedResult} of the checkpoints of the sweeps ``tasks``."""
     points = {}
-    for kw, lub in tasks:
-        for path in point_files(folder, task_key(kw, lub)):
+    for task in tasks:
+        for path in point_files(task.checkpoint, task.key):
             res = MixedResult.load(path)
-            speed = res.speed if kw.get("slide_to_roll") is None else res.meta["entrainment"]
-            points[lub.viscosity, speed] = res
+            points[task.lubricant.viscosity, task.motion.sweep_speed(res.speed, res.meta)] = res
     return points
 
 
@@ -327,7 +287,7 @@ def write_run_fields(case: Case, out: RunLayout, tasks, origin) -> None:
     from their checkpoints (written beside the band's sweeps: they need only the main
     curves)."""
     from ..results import fields_dataset, write_netcdf
-    write_netcdf(out.fields_nc, {None: fields_dataset(sweep_points(out.points, tasks),
+    write_netcdf(out.fields_nc, {None: fields_dataset(sweep_points(tasks),
                                                       origin)}, _attributes(case))
 
 
@@ -340,7 +300,7 @@ def _attributes(case: Case) -> dict:
 
 def _prune_points(folder: Path, tasks) -> None:
     """Remove the Stribeck checkpoints of no current sweep or guide (changed inputs)."""
-    keys = {task_key(kw, lub) for kw, lub in tasks} | {kw.get("guide") for kw, _ in tasks}
+    keys = {task.key for task in tasks} | {task.guide for task in tasks}
     stale = [p for p in point_files(folder) if point_key(p) not in keys]
     for p in stale:
         p.unlink()

@@ -89,8 +89,7 @@ def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> Flo
 
 
 def cell_settings(case: Case) -> CellSettings:
-    """The cell settings of a case: its ``[micro]`` settings with the materials' E' and
-    hardness."""
-    own = {f.name: getattr(case.micro, f.name) for f in fields(CellSettings)}
-    return CellSettings(**{**own, "e_reduced": case.materials.e_reduced,
-                           "hardness": case.materials.hardness})
+    """The cell settings of a case: its ``[micro]`` settings, the materials' E' and hardness
+    filled in (:meth:`~fem_twin.case.sections.Case.filled`)."""
+    return case.filled(CellSettings(**{f.name: getattr(case.micro, f.name)
+                                       for f in fields(CellSettings)}))

@@ -4,13 +4,14 @@ workers (local processes or Dask), largest first."""
 from __future__ import annotations
 
 from concurrent.futures import wait
+from dataclasses import replace
 
 import numpy as np
 from tqdm import tqdm
 
 from ..stribeck import stribeck_sweep
 from ..stribeck.curve import joined
-from ..stribeck.sweep import point_files, point_key, sweep_key
+from ..stribeck.sweep import point_files, point_key
 from ..numerics.threads import worker_heap
 
 #: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH (the resolution
@@ -20,8 +21,7 @@ COST_GROWTH = 1.35
 
 
 def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points"):
-    """Sweeps ``tasks`` [(sweep kwargs, lubricant)]: serial, or in process tasks on
-    ``executor``.
+    """The sweep requests ``tasks``: serial, or in process tasks on ``executor``.
 
     In parallel a sweep that costs more than a worker's even share (:func:`chains`) is cut
     into chains of consecutive speeds, each started cold, so that the resolution study's
@@ -31,14 +31,13 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     order of ``tasks``, each one's chains joined."""
     pieces = [] if executor is None else chains(tasks, getattr(executor, "n_workers", 1))
     if len(pieces) <= 1:
-        return [_sweep_task((dict(kw, progress=progress), lub)) for kw, lub in tasks]
+        return [_sweep_task((task, progress)) for task in tasks]
     order = sorted(range(len(pieces)), key=lambda j: -_cost(pieces[j][1]))
-    submitted = {j: executor.submit(_sweep_task, (dict(pieces[j][1], progress=False),
-                                                  tasks[pieces[j][0]][1])) for j in order}
+    submitted = {j: executor.submit(_sweep_task, (pieces[j][1], False)) for j in order}
     futures = [submitted[j] for j in range(len(pieces))]
-    total = sum(len(kw["speeds"]) for kw, _ in tasks)
-    keys = {task_key(kw, lub) for kw, lub in tasks if kw.get("factors_key")}
-    folder = tasks[0][0].get("checkpoint")
+    total = sum(task.speeds.size for task in tasks)
+    keys = {task.key for task in tasks if task.factors_key}
+    folder = tasks[0].checkpoint
     with tqdm(total=total, desc=desc, unit="point", disable=not progress) as bar:
         while wait(futures, timeout=0.5).not_done:            # the bar, twice a second
             if folder is not None and keys:                   # points finished so far
@@ -49,7 +48,7 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
 
 
 def chains(tasks, workers: int) -> list:
-    """``[(task, kwargs)]``: each sweep of ``tasks`` as chains of consecutive speeds, in
+    """``[(task, request)]``: each sweep of ``tasks`` as chains of consecutive speeds, in
     order.  A sweep that writes no fields and costs (:func:`_cost`) more than an even
     share of the total over ``workers`` is cut into chains of about equal length, each
     costing at most half such a share (one point at least), so that a largest-first
@@ -57,31 +56,23 @@ def chains(tasks, workers: int) -> list:
     the coarsest nested level), about as fast as a warm one on fine grids and with the same
     C_f to 2e-6 (benchmarks/README.md).  A sweep that writes fields stays whole (one VTU per speed,
     numbered along the sweep, and one PVD)."""
-    share = sum(map(_cost, (kw for kw, _ in tasks))) / max(workers, 1)
+    share = sum(map(_cost, tasks)) / max(workers, 1)
     out = []
-    for i, (kw, _) in enumerate(tasks):
-        n = len(kw["speeds"])
-        whole = workers <= 1 or kw.get("fields") is not None or _cost(kw) <= share
-        count = 1 if whole else min(n, int(np.ceil(2 * _cost(kw) / share)))
-        out += [(i, dict(kw, speeds=np.asarray(kw["speeds"])[part]))
+    for i, task in enumerate(tasks):
+        n = task.speeds.size
+        whole = workers <= 1 or task.fields is not None or _cost(task) <= share
+        count = 1 if whole else min(n, int(np.ceil(2 * _cost(task) / share)))
+        out += [(i, replace(task, speeds=task.speeds[part]))
                 for part in np.array_split(np.arange(n), count)]
     return out
 
 
-def _cost(kwargs) -> float:
+def _cost(request) -> float:
     """A sweep's cost: speeds times nodes to the power :data:`COST_GROWTH`."""
-    return float(np.size(kwargs["gap"])) ** COST_GROWTH * len(kwargs["speeds"])
+    return float(request.gap.size) ** COST_GROWTH * request.speeds.size
 
 
 def _sweep_task(args):
-    """One viscosity's sweep (a picklable unit of work for process pools and Dask)."""
+    """One sweep ``(request, progress)`` (a picklable unit of work for pools and Dask)."""
     worker_heap()
-    kwargs, lub = args
-    return stribeck_sweep(lubricant=lub, **kwargs)
-
-
-def task_key(kwargs: dict, lubricant) -> str:
-    """Checkpoint key of one sweep task (:func:`~fem_twin.stribeck.sweep.point_file`)."""
-    return sweep_key(kwargs["gap"], kwargs["spacing"], kwargs["factors_key"], kwargs["load"],
-                     lubricant, kwargs["settings"], kwargs["face"],
-                     kwargs.get("slide_to_roll"), kwargs.get("thermal"))
+    return stribeck_sweep(*args)

@@ -8,12 +8,10 @@ import logging
 
 from ..case import Case
 from ..io.layout import RunLayout
-from ..micro import FlowFactors
 from ..stribeck.traction import plot_traction, traction_sweep, write_traction_csv
 from ..numerics.threads import worker_heap
-from .curves import curve_labels, macro_settings
-from .geometry import face_load, macro_geometry
-from .provenance import stage_keys
+from .curves import curve_labels
+from .requests import per_viscosity, sweep_request
 
 log = logging.getLogger("fem_twin")
 
@@ -23,16 +21,16 @@ def traction_curves(case: Case, out: RunLayout, entrainment: float, ratios,
     """C_f versus SRR at ``entrainment`` [m/s] for every viscosity of the ball-on-disk
     ``case`` (its micro stage done in ``out``), in parallel on ``executor``; the stage's
     summary."""
-    gap, spacing, face, _ = macro_geometry(case, out)
-    common = dict(gap=gap, spacing=spacing, factors=FlowFactors.load(out.flow_factors),
-                  slide_to_roll=ratios, entrainment=entrainment, load=face_load(case),
-                  face=face, settings=macro_settings(case), checkpoint=out.traction_points,
-                  factors_key=stage_keys(case)["micro"])
-    tasks = [dict(common, lubricant=lub) for lub in case.lubricant.lubricants()]
+    # isothermal: a traction point's heat is not modelled ([thermal] is the Stribeck
+    # curves'); its checkpoints in OUT/traction
+    request = sweep_request(case, out, speeds=[entrainment], thermal=None,
+                            checkpoint=out.traction_points)
+    tasks = per_viscosity(case, request)
     if executor is None or len(tasks) == 1:
-        curves = [traction_sweep(**kw, progress=progress) for kw in tasks]
+        curves = [traction_sweep(task, ratios, progress) for task in tasks]
     else:
-        curves = [f.result() for f in [executor.submit(_task, kw) for kw in tasks]]
+        curves = [f.result() for f in [executor.submit(_task, (task, ratios))
+                                       for task in tasks]]
     write_traction_csv(out.traction_csv, curves)
     plot_traction(curves, out.traction_png, curve_labels(case, curves))
     for c in curves:
@@ -44,7 +42,8 @@ def traction_curves(case: Case, out: RunLayout, entrainment: float, ratios,
             "files": [str(out.traction_csv), str(out.traction_png)]}
 
 
-def _task(kwargs):
-    """One viscosity's traction sweep (a picklable unit of work for pools and Dask)."""
+def _task(args):
+    """One viscosity's traction sweep ``(request, ratios)`` (a picklable unit of work for
+    pools and Dask)."""
     worker_heap()
-    return traction_sweep(**kwargs)
+    return traction_sweep(*args)

@@ -10,17 +10,16 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from ..checks import arguments
-from ..errors import InputError
-from ..io.checkpoint import input_key, load_or_none
+from ..checks import check
+from ..io.checkpoint import load_or_none
 from ..io.mesh import write_pvd
-from ..macro import Lubricant, MacroSettings, MixedResult
+from ..macro import MixedResult
 from ..macro.estimate import PARTS, friction_error
-from ..macro.nested import coarsened, corrected, solve_nested
+from ..macro.nested import corrected, solve_nested
 from ..macro.thermal import thermal_point
-from ..micro.flow_factors import FlowFactors
 from ..numerics.threads import one_thread
 from .curve import StribeckCurve, hersey_number
+from .request import SweepRequest
 
 #: a point's ``meta`` entry for C_f on the grids coarsened by two, four, ... (its nested
 #: coarse solves, finest first; a float in older checkpoints: by two only)
@@ -61,65 +60,41 @@ def point_speed(path) -> float:
 
 
 @one_thread
-@arguments(gap="field", spacing="pair", factors=FlowFactors, speeds="numbers", load="number", lubricant=Lubricant)
-def stribeck_sweep(gap, spacing, factors: FlowFactors, speeds, *, load: float,
-                   lubricant: Lubricant, diameter: float = 8e-3, face=None,
-                   settings: MacroSettings = MacroSettings(), checkpoint=None, fields=None,
-                   origin=(0.0, 0.0), progress: bool = False,
-                   factors_key: str | None = None,
-                   slide_to_roll: float | None = None,
-                   error_estimate: bool = False, keep_level: int = 0,
-                   guide: str | None = None, thermal=None) -> StribeckCurve:
-    """C_f over ``speeds`` [m/s] at one viscosity (paper 3.2: from 2 m/s down to 0.01 m/s),
-    each point warm from the previous one (give speeds fast to slow).
-
-    ``checkpoint``: folder keeping every finished point, keyed by a hash of all inputs (a
-    rerun loads them; ``factors_key``: a key of the factors' inputs to hash instead of
-    their bits).  ``fields``: a VTU per speed and a PVD there.  ``slide_to_roll``: a ball
-    on a disk, ``speeds`` the entrainment speeds.  ``error_estimate``: each point's C_f
-    error (:func:`fem_twin.macro.estimate.friction_error`).  ``keep_level``: also keep
-    each point's nested solve that many coarsenings down (:func:`level_key`), which a
-    ``guide`` sweep (the patch band) starts from: ``x(U) = x_g(U) + x(U_prev) -
-    x_g(U_prev)`` (:class:`_Guide`).  ``thermal``: a
-    :class:`~fem_twin.macro.thermal.ContactThermal`, each point at the film temperature of
-    its own heat.
-    """
-    speeds = np.asarray(speeds, float)
-    if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
-        raise InputError("speeds must be a non-empty list of positive values [m/s]")
-    if slide_to_roll is not None and not (0 < slide_to_roll <= 2):
-        raise InputError(f"slide_to_roll must be in (0, 2], got {slide_to_roll}")
-    gap = np.asarray(gap, float)
-    inputs = (gap, spacing, factors if factors_key is None else factors_key, load, lubricant,
-              settings, face, slide_to_roll, thermal)
-    key = sweep_key(*inputs)
-    folder = None if checkpoint is None else _folder(checkpoint)
-    fields = None if fields is None else _folder(fields)
-    kept = level_key(keep_level, *inputs) if keep_level and folder else None
-    point = _Point(gap, spacing, factors, load, slide_to_roll, lubricant, face, settings,
-                   thermal)
-    guided = _Guide(folder, guide)
+def stribeck_sweep(request: SweepRequest, progress: bool = False) -> StribeckCurve:
+    """C_f over the ``request``'s speeds [m/s] at its viscosity (paper 3.2: from 2 m/s down
+    to 0.01 m/s), each point warm from the previous one (speeds fast to slow), or from its
+    guide's (:class:`_Guide`).  Every finished point is checkpointed under the request's
+    :attr:`~fem_twin.stribeck.request.SweepRequest.key`, so a rerun loads it; with
+    ``fields``, a VTU per speed and a PVD; with ``error_estimate``, each point's C_f error
+    (:func:`fem_twin.macro.estimate.friction_error`)."""
+    check("stribeck_sweep: request", request, SweepRequest)
+    r = request
+    key = r.key
+    folder = None if r.checkpoint is None else _folder(r.checkpoint)
+    fields = None if r.fields is None else _folder(r.fields)
+    kept = r.level_key(r.keep_level) if r.keep_level and folder else None
+    point, guided = _Point(r), _Guide(folder, r.guide)
     # each point's numbers; its fields go to disk at once (a 2048^2 point holds 0.5 GB)
     records, entries, previous = [], [], ()
-    for i, speed in enumerate(tqdm(speeds, desc=f"Stribeck mu0={lubricant.viscosity:g}",
+    mu = r.lubricant.viscosity
+    for i, speed in enumerate(tqdm(r.speeds, desc=f"Stribeck mu0={mu:g}",
                                    disable=not progress, unit="speed")):
         path = None if folder is None else point_file(folder, key, speed)
         res = None if path is None else load_or_none(path, MixedResult.load)
         coarser = []                        # the point on each coarsening of the grid
         if res is None:
-            res, *coarser = point.solve(float(speed), guided.start(speeds, i, previous), path,
-                                        (folder, kept, keep_level, key))
-        if error_estimate and "error_estimate" not in res.meta:
+            res, *coarser = point.solve(float(speed), guided.start(r.speeds, i, previous),
+                                        path, (folder, kept, r.keep_level, key))
+        if r.error_estimate and "error_estimate" not in res.meta:
             res = point.estimated(res, coarser, path)
         if fields is not None:
-            vtu = res.write_vtu(fields / f"mu{lubricant.viscosity:g}_{i:03d}.vtu", origin)
+            vtu = res.write_vtu(fields / f"mu{mu:g}_{i:03d}.vtu", r.origin)
             entries.append((float(res.speed), vtu))            # ParaView time = U [m/s]
         records.append(_record(res))
         previous = (res, *coarser)
     if fields is not None:
-        write_pvd(fields / f"stribeck_mu{lubricant.viscosity:g}.pvd", entries)
-    return _curve(records, speeds, lubricant.viscosity, diameter, load, error_estimate,
-                  thermal is not None)
+        write_pvd(fields / f"stribeck_mu{mu:g}.pvd", entries)
+    return _curve(records, r)
 
 
 def _folder(path) -> Path:
@@ -132,20 +107,15 @@ class _Point:
     """One sweep point's solve (:func:`_solve_point`), with what the sweep keeps of it, and
     its C_f error estimate."""
 
-    def __init__(self, gap, spacing, factors, load, slide_to_roll, lubricant, face,
-                 settings, thermal):
-        self.gap, self.spacing, self.factors, self.load = gap, spacing, factors, load
-        self.slide_to_roll, self.lubricant, self.face = slide_to_roll, lubricant, face
-        self.settings, self.thermal = settings, thermal
+    def __init__(self, request: SweepRequest):
+        self.request = request
 
     def solve(self, speed, start, path, keep) -> tuple:
         """The levels of the point at ``speed`` warm from ``start``, checkpointed at
         ``path`` with its coarse C_f, and its level ``keep = (folder, key, level,
         sweep key)`` kept for a guided sweep."""
-        res, *coarser = _solve_point(self.gap, self.spacing, self.factors, self.load, speed,
-                                     self.slide_to_roll, self.lubricant, self.face,
-                                     self.settings, start, self.thermal)
-        meta = {LOAD_BELOW: res.contact_load_below(self.factors.h0[0])}
+        res, *coarser = _solve_point(self.request, speed, start)
+        meta = {LOAD_BELOW: res.contact_load_below(self.request.factors.h0[0])}
         if coarser:
             meta.update({COARSE_CF: [c.friction_coefficient for c in coarser],
                          "seconds_coarse": coarser[0].meta["seconds"]})
@@ -160,11 +130,11 @@ class _Point:
 
     def estimated(self, res, coarser, path):
         """``res`` with its C_f error estimate in ``meta`` (saved at ``path``)."""
-        t0 = time.perf_counter()
-        estimate = friction_error(res, self.gap, self.spacing, self.factors, load=self.load,
-                                  lubricant=film_lubricant(res, self.lubricant),
-                                  face=self.face, settings=self.settings,
-                                  entrainment=res.meta.get("entrainment"), levels=coarser)
+        t0, r = time.perf_counter(), self.request
+        estimate = friction_error(res, r.gap, r.spacing, r.factors, load=r.load,
+                                  lubricant=film_lubricant(res, r.lubricant), face=r.face,
+                                  settings=r.settings, entrainment=res.meta.get("entrainment"),
+                                  levels=coarser)
         res = replace(res, meta={**res.meta, "error_estimate": estimate,
                                  "seconds_estimate": time.perf_counter() - t0})
         if path is not None:
@@ -172,17 +142,18 @@ class _Point:
         return res
 
 
-def _curve(records, speeds, viscosity, diameter, load, error_estimate, thermal):
+def _curve(records, request: SweepRequest) -> StribeckCurve:
     """The :class:`StribeckCurve` of a sweep's point ``records`` (:func:`_record`)."""
     get = lambda name: np.array([r[name] for r in records])  # noqa: E731
     errors = ({part: np.array([r["error_estimate"][part] for r in records])
-               for part in (*PARTS, "total")} if error_estimate else None)
+               for part in (*PARTS, "total")} if request.error_estimate else None)
     temperature = ({k: get(k) for k in ("contact_temperature", "asperity_temperature")}
-                   if thermal else {})
+                   if request.thermal is not None else {})
+    speeds, mu, load = request.speeds, request.lubricant.viscosity, request.load
     return StribeckCurve(
         speed=speeds.copy(), **temperature,
-        hersey=hersey_number(viscosity, speeds, diameter, load),
-        friction_coefficient=get("friction_coefficient"), viscosity=viscosity,
+        hersey=hersey_number(mu, speeds, request.hersey_length, load),
+        friction_coefficient=get("friction_coefficient"), viscosity=mu,
         hydrodynamic_friction=get("hydrodynamic_friction"),
         boundary_friction=get("boundary_friction"),
         contact_load_fraction=get("contact_load") / load, h_d=get("h_d"),
@@ -229,36 +200,25 @@ class _Guide:
         return self.read[speed]
 
 
-def level_key(level: int, gap, spacing, factors, load, lubricant, settings, face,
-              slide_to_roll=None, thermal=None) -> str:
-    """The sweep key (:func:`sweep_key`) of these inputs on the grid coarsened ``level``
-    times (:func:`~fem_twin.macro.nested.coarsened`): where ``keep_level`` checkpoints a
-    sweep's nested solves."""
-    for _ in range(level):
-        gap, spacing, face = coarsened(gap, spacing, face)
-    return sweep_key(gap, spacing, factors, load, lubricant, settings, face, slide_to_roll,
-                     thermal)
-
-
-def _solve_point(gap, spacing, factors, load, speed, slide_to_roll, lubricant, face,
-                 settings, previous, thermal):
+def _solve_point(request: SweepRequest, speed: float, previous):
     """The levels ``(result, *coarser)`` of :func:`solve_nested` at the sweep ``speed``
-    (sliding, or entrainment at ``slide_to_roll``), warm from ``previous``; with a
+    (sliding, or entrainment, by the request's motion), warm from ``previous``; with a
     ``thermal`` model at the film temperature of its own heat (the record in the result's
     ``meta["thermal"]``)."""
-    sliding = dict(speed=speed) if slide_to_roll is None else dict(
-        speed=slide_to_roll * speed, entrainment=speed)
+    r = request
+    sliding = r.motion.speeds(speed)
 
     def solve(lub, start):
-        return solve_nested(gap, spacing, factors, load=load, **sliding, lubricant=lub,
-                            face=face, settings=settings, previous=start or previous)
+        return solve_nested(r.gap, r.spacing, r.factors, load=r.load, **sliding,
+                            lubricant=lub, face=r.face, settings=r.settings,
+                            previous=start or previous)
 
-    if thermal is None:
-        return solve(lubricant, None)
+    if r.thermal is None:
+        return solve(r.lubricant, None)
     u_m = sliding.get("entrainment", speed / 2)
     surfaces = (u_m - sliding["speed"] / 2, u_m + sliding["speed"] / 2)
     start = time.perf_counter()
-    levels, film, record = thermal_point(solve, lubricant, thermal, factors, surfaces,
+    levels, film, record = thermal_point(solve, r.lubricant, r.thermal, r.factors, surfaces,
                                          previous[0].meta.get("thermal") if previous
                                          else None)
     record["viscosity_Pa_s"] = film.viscosity
@@ -293,20 +253,3 @@ def _levels(rows) -> np.ndarray:
     for j, r in enumerate(rows):
         out[:len(r), j] = r
     return out
-
-
-def sweep_key(gap, spacing, factors, load, lubricant, settings, face,
-              slide_to_roll=None, thermal=None) -> str:
-    """Key of a sweep's checkpoints (``point_KEY_*.npz``): a hash of all its inputs, with
-    ``factors`` a :class:`FlowFactors` or a key string of their inputs."""
-    flow = ((factors.h0, factors.h_m, factors.p_con, factors.A, factors.b, factors.C,
-             factors.d, factors.friction_factor, factors.pressure_friction)
-            if isinstance(factors, FlowFactors) else (str(factors),))
-    inputs = [load, lubricant.__dict__, settings.__dict__]
-    if slide_to_roll is not None:
-        inputs.append(slide_to_roll)
-    if thermal is not None:
-        inputs.append([thermal.settings.__dict__, thermal.law.__dict__,
-                       thermal.boundary_friction])
-    return input_key(np.asarray(gap, float), np.asarray(spacing, float), *flow,
-                     None if face is None else np.asarray(face, bool), inputs, length=12)

@@ -16,16 +16,16 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from ..checks import arguments
+from ..checks import check, plausible
 from ..errors import InputError
 from ..io.checkpoint import load_or_none
 from ..io.figure import save_figure
 from ..io.table import write_csv
-from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
+from ..macro import MixedResult, solve_mixed
 from ..macro.estimate import friction_error
-from ..micro.flow_factors import FlowFactors
 from ..numerics.threads import one_thread
-from .sweep import point_file, sweep_key
+from .request import RollingSliding, SweepRequest
+from .sweep import point_file
 
 #: the CSV header of each column of ``traction.csv``: its name with the SI unit
 HEADERS = {"slide_to_roll": "slide_to_roll", "sliding_speed": "sliding_speed_m_s",
@@ -62,39 +62,45 @@ class TractionCurve:
 
 
 @one_thread
-@arguments(gap="field", spacing="pair", factors=FlowFactors, entrainment="number", load="number", lubricant=Lubricant)
-def traction_sweep(gap, spacing, factors, slide_to_roll=DEFAULT_RATIOS, *, entrainment: float,
-                   load: float, lubricant: Lubricant, face=None,
-                   settings: MacroSettings = MacroSettings(), checkpoint=None,
-                   factors_key: str | None = None, progress: bool = False) -> TractionCurve:
-    """C_f at each slide-to-roll ratio (SRR in [0, 2]) at the entrainment speed [m/s], on
-    the macro gap [m] of ``spacing`` [m]; ``checkpoint``: folder keeping every finished
-    point (keyed by all inputs, as :func:`~fem_twin.stribeck.stribeck_sweep`)."""
+def traction_sweep(request: SweepRequest, slide_to_roll=DEFAULT_RATIOS,
+                   progress: bool = False) -> TractionCurve:
+    """C_f at each slide-to-roll ratio (SRR in [0, 2]) of the ball-on-disk ``request``
+    (:class:`~fem_twin.stribeck.request.RollingSliding`) at its one speed, the
+    entrainment speed u_m [m/s]; every point is checkpointed in its ``checkpoint`` folder
+    (keyed by all inputs, as :func:`~fem_twin.stribeck.stribeck_sweep`)."""
+    check("traction_sweep: request", request, SweepRequest)
     ratios = np.unique(np.asarray(slide_to_roll, float))
-    if ratios.size == 0 or np.any(~np.isfinite(ratios)) or ratios[0] < 0 or ratios[-1] > 2:
-        raise InputError(f"slide-to-roll ratios must lie in [0, 2], got {slide_to_roll}")
-    if not (np.isfinite(entrainment) and entrainment > 0):
-        raise InputError(f"the entrainment speed must be positive [m/s], got {entrainment}")
-    key = sweep_key(gap, spacing, factors if factors_key is None else factors_key, load,
-                    lubricant, settings, face, ("traction", float(entrainment)))
-    folder = None if checkpoint is None else Path(checkpoint)
+    if ratios.size == 0 or np.any(~np.isfinite(ratios)):
+        raise InputError(f"slide-to-roll ratios must be finite numbers, got {slide_to_roll}")
+    plausible("slide-to-roll ratios", ratios, "slide_to_roll")
+    if ratios[0] < 0:
+        raise InputError(f"slide-to-roll ratios: a traction curve runs from pure rolling (0) "
+                         f"up, the disk the slower surface; got {ratios[0]:g}")
+    if not isinstance(request.motion, RollingSliding) or request.speeds.size != 1:
+        raise InputError("a traction curve is a ball's (motion RollingSliding) at one "
+                         f"entrainment speed, got {request.motion} at {request.speeds.size} "
+                         "speeds")
+    r, entrainment = request, float(request.speeds[0])
+    key = r.input_key(("traction", entrainment))
+    folder = None if r.checkpoint is None else Path(r.checkpoint)
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
+    common = dict(load=r.load, entrainment=entrainment, lubricant=r.lubricant, face=r.face,
+                  settings=r.settings)
     results, previous = {}, None
-    for srr in tqdm(ratios[::-1], desc=f"traction mu0={lubricant.viscosity:g}",
+    for srr in tqdm(ratios[::-1], desc=f"traction mu0={r.lubricant.viscosity:g}",
                     disable=not progress, unit="point"):
         path = None if folder is None else point_file(folder, key, srr)
         res = None if path is None else load_or_none(path, MixedResult.load)
         if res is None:
-            common = dict(load=load, entrainment=float(entrainment), lubricant=lubricant,
-                          face=face, settings=settings)
-            res = solve_mixed(gap, spacing, factors, speed=float(srr * entrainment),
+            res = solve_mixed(r.gap, r.spacing, r.factors, speed=float(srr * entrainment),
                               initial=previous, **common)
-            estimate = friction_error(res, gap, spacing, factors, **common)
+            estimate = friction_error(res, r.gap, r.spacing, r.factors, **common)
             res = replace(res, meta={**res.meta, "error_estimate": estimate})
             if path is not None:
                 res.save(path)
         results[srr] = previous = res
+    load, lubricant = r.load, r.lubricant
     get = lambda name: np.array([getattr(results[s], name) for s in ratios])  # noqa: E731
     return TractionCurve(
         slide_to_roll=ratios, entrainment=float(entrainment), viscosity=lubricant.viscosity,

@@ -1,0 +1,155 @@
+"""What one Stribeck sweep is asked to solve, as a value: :class:`SweepRequest`, with the
+contact's motion a value of its own (:class:`Sliding` or :class:`RollingSliding`).
+
+Every command builds its sweeps as requests (:func:`fem_twin.stages.requests.sweep_request`
+from a case) and changes them with :func:`dataclasses.replace`; a request's :attr:`key`
+names its point checkpoints (:func:`~fem_twin.stribeck.sweep.point_file`)."""
+
+from __future__ import annotations
+
+from dataclasses import KW_ONLY, dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..checks import as_field, as_pair, check, number, plausible
+from ..errors import InputError
+from ..io.checkpoint import input_key
+from ..macro import Lubricant, MacroSettings
+from ..macro.nested import coarsened
+from ..micro.flow_factors import FlowFactors
+
+
+@dataclass(frozen=True)
+class Sliding:
+    """A pin sliding on the disk (the paper): a sweep's speeds are sliding speeds U [m/s]."""
+
+    @property
+    def key(self):
+        """What the motion adds to a sweep's checkpoint key (nothing: the paper's)."""
+        return None
+
+    def speeds(self, speed: float) -> dict:
+        """``solve_mixed``'s speeds at the sweep speed U [m/s]: the sliding speed."""
+        return {"speed": speed}
+
+    def sweep_speed(self, speed: float, meta: dict) -> float:
+        """The sweep speed of a point that slid at ``speed`` [m/s] (its ``meta``)."""
+        return speed
+
+
+@dataclass(frozen=True)
+class RollingSliding:
+    """A ball rolling and sliding on the disk at ``slide_to_roll`` = u_r / u_m in (0, 2]
+    (MTM convention; 2: the ball at rest): a sweep's speeds are entrainment speeds u_m
+    [m/s].  Pure rolling (0) slides at no speed: it is a traction curve's SRR 0
+    (:func:`~fem_twin.stribeck.traction.traction_sweep`)."""
+
+    slide_to_roll: float
+
+    def __post_init__(self):
+        plausible("slide_to_roll", self.slide_to_roll, "slide_to_roll")
+        if not self.slide_to_roll > 0:
+            raise InputError("slide_to_roll: a Stribeck curve slides at u_r / u_m in (0, 2]; "
+                             "pure rolling (0) is a traction curve's SRR 0")
+
+    @property
+    def key(self) -> float:
+        """What the motion adds to a sweep's checkpoint key: its ratio."""
+        return self.slide_to_roll
+
+    def speeds(self, u_m: float) -> dict:
+        """``solve_mixed``'s speeds at the entrainment speed u_m [m/s]."""
+        return {"speed": self.slide_to_roll * u_m, "entrainment": u_m}
+
+    def sweep_speed(self, speed: float, meta: dict) -> float:
+        """The sweep speed of a point: its entrainment speed u_m [m/s] (in its ``meta``)."""
+        return meta["entrainment"]
+
+
+@dataclass(frozen=True, eq=False)
+class SweepRequest:
+    """One viscosity's sweep: the macro ``gap`` [m] on a grid of ``spacing`` [m], the flow
+    ``factors``, the ``speeds`` [m/s] (fast to slow), the face's ``load`` [N] (eq 28),
+    the ``lubricant``, the ``motion``, D of the Hersey number ``hersey_length`` [m] (eq
+    46), the pin ``face`` (None: the whole grid), the macro ``settings`` and a ``thermal``
+    model (None: isothermal).  ``factors_key``: a key of the factors' inputs, hashed
+    instead of their bits; ``checkpoint``: the points' folder; ``fields``: a VTU per
+    speed there (``origin`` [m]); ``error_estimate``: each point's C_f error;
+    ``keep_level``: keep each point's nested solve that many coarsenings down, which a
+    sweep with ``guide`` (that level's key, :meth:`level_key`) starts from."""
+
+    gap: np.ndarray
+    spacing: tuple
+    factors: FlowFactors
+    speeds: np.ndarray
+    _: KW_ONLY
+    load: float
+    lubricant: Lubricant
+    motion: Sliding | RollingSliding = Sliding()
+    hersey_length: float = 8e-3
+    face: np.ndarray | None = None
+    settings: MacroSettings = MacroSettings()
+    thermal: object = None
+    factors_key: str | None = None
+    checkpoint: Path | None = None
+    fields: Path | None = None
+    origin: tuple = (0.0, 0.0)
+    error_estimate: bool = False
+    keep_level: int = 0
+    guide: str | None = None
+
+    def __post_init__(self):
+        name = "SweepRequest"
+        speeds = np.asarray(self.speeds, float)
+        if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
+            raise InputError(f"{name}: speeds must be a non-empty list of positive values "
+                             "[m/s]")
+        for field_, kind in (("factors", FlowFactors), ("lubricant", Lubricant),
+                             ("motion", (Sliding, RollingSliding))):
+            check(f"{name}: {field_}", getattr(self, field_), kind)
+        object.__setattr__(self, "gap", as_field(f"{name}: gap", self.gap))
+        object.__setattr__(self, "spacing", as_pair(f"{name}: spacing", self.spacing))
+        object.__setattr__(self, "speeds", speeds)
+        object.__setattr__(self, "load", number(f"{name}: load", self.load, "load"))
+
+    @property
+    def key(self) -> str:
+        """The key of the sweep's point checkpoints: a hash of all that sets its points."""
+        return self.input_key(self.motion.key)
+
+    def input_key(self, motion_key) -> str:
+        """:attr:`key` with ``motion_key`` for the motion's (a traction curve's)."""
+        factors = self.factors if self.factors_key is None else self.factors_key
+        return sweep_key(self.gap, self.spacing, factors, self.load, self.lubricant,
+                         self.settings, self.face, motion_key, self.thermal)
+
+    def level_key(self, level: int) -> str:
+        """The :attr:`key` of this sweep on the grid coarsened ``level`` times
+        (:func:`~fem_twin.macro.nested.coarsened`): where ``keep_level`` keeps its nested
+        solves."""
+        return self.coarsened(level).key
+
+    def coarsened(self, level: int = 1) -> SweepRequest:
+        """This sweep on the grid coarsened ``level`` times."""
+        gap, spacing, face = self.gap, self.spacing, self.face
+        for _ in range(level):
+            gap, spacing, face = coarsened(gap, spacing, face)
+        return replace(self, gap=gap, spacing=spacing, face=face)
+
+
+def sweep_key(gap, spacing, factors, load, lubricant, settings, face, motion_key=None,
+              thermal=None) -> str:
+    """Key of a sweep's checkpoints (``point_KEY_*.npz``): a hash of all its inputs, with
+    ``factors`` a :class:`FlowFactors` or a key string of their inputs."""
+    flow = ((factors.h0, factors.h_m, factors.p_con, factors.A, factors.b, factors.C,
+             factors.d, factors.friction_factor, factors.pressure_friction)
+            if isinstance(factors, FlowFactors) else (str(factors),))
+    inputs = [load, lubricant.__dict__, settings.__dict__]
+    if motion_key is not None:
+        inputs.append(motion_key)
+    if thermal is not None:
+        inputs.append([thermal.settings.__dict__, thermal.law.__dict__,
+                       thermal.boundary_friction])
+    return input_key(np.asarray(gap, float), np.asarray(spacing, float), *flow,
+                     None if face is None else np.asarray(face, bool), inputs, length=12)
