@@ -200,11 +200,13 @@ def check_choices(settings) -> None:
     """Refuse a text setting of the dataclass ``settings`` outside its declared choices."""
     from dataclasses import fields
     for f in fields(settings):
-        choices = f.metadata.get("choices")
-        value = getattr(settings, f.name)
-        if choices and value not in choices:
-            raise InputError(f"{f.name} must be one of {', '.join(map(repr, choices))}, got "
-                             f"{value!r}")
+        check_choice(f.name, getattr(settings, f.name), f.metadata.get("choices"))
+
+
+def check_choice(name: str, value, choices) -> None:
+    """Refuse ``value`` outside ``choices`` (none: any), naming ``name``."""
+    if choices and value not in choices:
+        raise InputError(f"{name}: one of {', '.join(map(repr, choices))}, got {value!r}")
 
 
 def describe(f) -> dict:

@@ -5,12 +5,13 @@ from __future__ import annotations
 import math
 import os
 import tomllib
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import MISSING, fields
 from pathlib import Path
 
-from ..checks import QUANTITIES, memory_shortfall
+from ..checks import check_choice, memory_shortfall, plausible
 from ..errors import InputError
 from ..macro.thermal import ThermalSettings
+from ..stribeck.request import RollingSliding
 from .sections import (SECTIONS, Case, Geometry, LubricantSpec, MacroSpec, Materials,
                        MicroSpec, RunSpec, SweepSpec, Tribometer)
 from ..topography.prepare import MacroOptions
@@ -44,7 +45,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if "geometry" not in data:
         raise CaseError(f"{where}: missing [geometry] section")
     tribometer = _tribometer(data, where)
-    geometry = _geometry(data["geometry"], base, where, tribometer.ball)
+    geometry = _geometry(data, base, where, tribometer.ball)
     if geometry.ball is not None and "ball_radius" in data.get("tribometer", {}):
         raise CaseError(f"{where} [tribometer] ball_radius: the measured cap's fitted sphere "
                         "gives the radius ([geometry] ball); remove one of the two")
@@ -92,10 +93,11 @@ BALL_ONLY = {("tribometer", "slide_to_roll"): 'kind = "ball-on-disk"',
 
 def _tribometer(data, where) -> Tribometer:
     srr = data.get("tribometer", {}).get("slide_to_roll")
-    if isinstance(srr, (int, float)) and not isinstance(srr, bool) and not 0 < srr <= 2:
-        raise CaseError(f"{where} [tribometer] slide_to_roll = {srr}: a ball's Stribeck curve "
-                        "slides at u_r / u_m in (0, 2] (2: a stationary ball); pure rolling "
-                        "(0) is fem-twin traction's SRR 0")
+    if isinstance(srr, (int, float)) and not isinstance(srr, bool):
+        try:
+            RollingSliding(srr)                     # the ball's Stribeck curve: its rule
+        except InputError as err:
+            raise CaseError(f"{where} [tribometer] {err}") from None
     tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
     if not tribometer.ball:
         for (section, key), needs in BALL_ONLY.items():
@@ -108,41 +110,45 @@ def _tribometer(data, where) -> Tribometer:
     return tribometer
 
 
-def _geometry(g, base, where, ball) -> Geometry:
+def _geometry(data, base, where, ball) -> Geometry:
     """[geometry]: the instrument files (resolved, existing) and the patch window."""
-    _only(g, {"pins", "disks", "patches", "patch_shape", "patch_start", "ball"},
-          f"{where} [geometry]")
-
-    def files(key, value):
-        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-            raise CaseError(f"{where} [geometry] {key}: expected a list of file paths")
-        out = tuple((base / v).resolve() for v in value)
-        for p in out:
-            if not p.is_file():
-                raise CaseError(f"{where} [geometry] {key}: file not found: {p}")
-        return out
-
-    if "ball" in g and not ball:
+    g = data["geometry"]
+    if isinstance(g, dict) and "ball" in g and not ball:
         raise CaseError(f"{where} [geometry] ball: a measured ball cap needs [tribometer] "
                         "kind = \"ball-on-disk\"")
-    if not ball and ("pins" not in g or not g["pins"]):
+    if isinstance(g, dict) and not ball and not g.get("pins"):
         raise CaseError(f"{where} [geometry]: at least one pin file is required in 'pins'")
-    patches = g.get("patches", [])
-    if not isinstance(patches, list) or not all(isinstance(p, list) and len(p) == 2
-                                                for p in patches):
-        raise CaseError(f"{where} [geometry] patches: expected a list of [pin, disk] file pairs")
-    geometry = Geometry(
-        pins=files("pins", g.get("pins", [])), disks=files("disks", g.get("disks", [])),
-        patches=tuple(files("patches", p) for p in patches),
-        patch_shape=_int_pair(g.get("patch_shape", [256, 256]),
-                              f"{where} [geometry] patch_shape"),
-        patch_start=_int_pair(g.get("patch_start", [0, 0]), f"{where} [geometry] patch_start",
-                              0),
-        ball=files("ball", [g["ball"]])[0] if "ball" in g else None)
+    geometry = _section(data, "geometry", Geometry, where, files=_files(base, where))
+    _int_pair(list(geometry.patch_shape), f"{where} [geometry] patch_shape")
+    _int_pair(list(geometry.patch_start), f"{where} [geometry] patch_start", 0)
     if geometry.disks and len(geometry.disks) != len(geometry.pins):
         raise CaseError(f"{where} [geometry]: {len(geometry.pins)} pins but "
                         f"{len(geometry.disks)} disks (give one disk per pin, or none for flat)")
     return geometry
+
+
+def _files(base: Path, where: str):
+    """The reader of ``[geometry]``'s file settings, by their declared unit ("file path",
+    "file paths", "file path pairs"): paths relative to ``base`` resolved, each existing."""
+    def one(key, value):
+        if not isinstance(value, str):
+            raise CaseError(f"{where} [geometry] {key}: expected a file path")
+        path = (base / value).resolve()
+        if not path.is_file():
+            raise CaseError(f"{where} [geometry] {key}: file not found: {path}")
+        return path
+
+    def files(key, value, unit):
+        if unit == "file path":
+            return one(key, value)
+        pairs = unit == "file path pairs"
+        if not isinstance(value, list) or not all(
+                isinstance(v, list) and len(v) == 2 if pairs else True for v in value):
+            raise CaseError(f"{where} [geometry] {key}: expected a list of "
+                            + ("[pin, disk] file pairs" if pairs else "file paths"))
+        return tuple(tuple(one(key, v) for v in pair) if pairs else one(key, pair)
+                     for pair in value)
+    return files
 
 
 def _preprocessing(data, where) -> MacroOptions:
@@ -155,8 +161,9 @@ def _preprocessing(data, where) -> MacroOptions:
     if not 0 < opts.clip <= 1e-3:
         raise CaseError(f"{where} [preprocessing] clip: expected metres in (0, 1e-3], "
                         f"got {opts.clip} (20 um is 20e-6)")
-    if opts.fwhm_px < 0:
-        raise CaseError(f"{where} [preprocessing] fwhm_px must be >= 0 pixels")
+    if 0 < opts.fwhm_px < 1:
+        raise CaseError(f"{where} [preprocessing] fwhm_px = {opts.fwhm_px}: the filter width "
+                        "is in pixels (0: no filter, else at least 1; the paper's is 9)")
     return opts
 
 
@@ -167,8 +174,6 @@ def _lubricant(data, where) -> LubricantSpec:
         raise CaseError(f"{where} [lubricant] viscosities: give at least one mu_0 [Pa s]")
     if len(lubricant.temperatures) != len(lubricant.viscosities):
         raise CaseError(f"{where} [lubricant]: give one temperature per viscosity")
-    if any(v > 10 for v in lubricant.viscosities):
-        raise CaseError(f"{where} [lubricant] viscosities: expected Pa s (0.066, not 66 mPa s)")
     return lubricant
 
 
@@ -243,8 +248,9 @@ def _measured(val, base, where, lubricant) -> tuple:
     return measured
 
 
-def _section(data, name, cls, where, positive=False, zero_ok=()):
-    """A table of scalars/lists into the dataclass ``cls`` (lists become tuples)."""
+def _section(data, name, cls, where, positive=False, zero_ok=(), files=None):
+    """A table of scalars/lists into the dataclass ``cls`` (lists become tuples); the
+    settings declared with a file unit read by ``files(key, value, unit)``."""
     table = data.get(name, {})
     _only(table, {f.name for f in fields(cls)}, f"{where} [{name}]")
     values = {}
@@ -257,6 +263,9 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
         _plausible(name, f, table[f.name], where)
         _choice(name, f, table[f.name], where)
         v = table[f.name]
+        if files is not None and f.metadata.get("unit", "").startswith("file path"):
+            values[f.name] = files(f.name, v, f.metadata["unit"])
+            continue
         # the declared default: an instance's may be normalised (time_tol 0 -> None)
         default = f.default if f.default is not MISSING else getattr(cls(), f.name)
         if isinstance(default, tuple):
@@ -296,28 +305,24 @@ def _section(data, name, cls, where, positive=False, zero_ok=()):
 
 
 def _plausible(section: str, f, value, where):
-    """Refuse a value outside the plausible SI range its declaration names
-    (:func:`fem_twin.checks.setting`), naming the key."""
+    """Refuse a number outside the plausible SI range its declaration names
+    (:func:`fem_twin.checks.plausible`), naming the key; other values are the type checks'."""
     quantity = f.metadata.get("quantity")
-    if quantity is None or isinstance(value, bool):
-        return
-    lo, hi, unit = QUANTITIES[quantity]
     values = value if isinstance(value, list) else [value]
-    for v in values:
-        if isinstance(v, (int, float)) and math.isfinite(v) and not lo <= v <= hi:
-            raise CaseError(f"{where} [{section}] {f.name} = {v}: implausible; expected "
-                            f"{lo:g} to {hi:g} {unit}")
-    if f.name == "fwhm_px" and isinstance(value, (int, float)) and 0 < value < 1:
-        raise CaseError(f"{where} [preprocessing] fwhm_px = {value}: the filter width is in "
-                        "pixels (0: no filter, else at least 1; the paper's is 9)")
+    if quantity and values and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                   and math.isfinite(v) for v in values):
+        try:
+            plausible(f"{where} [{section}] {f.name}", values, quantity)
+        except InputError as err:
+            raise CaseError(str(err)) from None
 
 
 def _choice(section: str, f, value, where):
-    """Refuse a text setting outside its declared choices."""
-    choices = f.metadata.get("choices")
-    if choices and value not in choices:
-        raise CaseError(f"{where} [{section}] {f.name}: one of "
-                        f"{', '.join(repr(c) for c in choices)}, got {value!r}")
+    """Refuse a text setting outside its declared choices (:func:`fem_twin.checks.check_choice`)."""
+    try:
+        check_choice(f"{where} [{section}] {f.name}", value, f.metadata.get("choices"))
+    except InputError as err:
+        raise CaseError(str(err)) from None
 
 
 def _only(section, allowed: set, where: str):
