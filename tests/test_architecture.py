@@ -141,3 +141,33 @@ def test_result_variables_are_declared_once():
              if f.type == "np.ndarray" or f.name == "viscosity"}
     assert curve == set(COLUMNS) == set(HEADERS), curve ^ set(COLUMNS)
     assert set(COLUMNS) - {"speed", "viscosity"} <= set(UNITS)
+
+
+def test_every_setting_another_section_sets_is_filled_from_it():
+    """Issue 63 item 2: a stage setting declared ``setting(..., section=...)`` (E' and the
+    hardness from [materials], C_f,b and the track radius from [tribometer], the cells'
+    sliding kinematics) is filled from that section in one place, ``Case.filled``, which
+    the stages' settings go through: a case's own values reach the cells and the macro
+    solver."""
+    from dataclasses import fields, replace
+
+    from fem_twin.case.sections import FILLED, SECTIONS, Case, Geometry
+    from fem_twin.macro import MacroSettings
+    from fem_twin.macro.thermal import ThermalSettings
+    from fem_twin.micro.sliding import CellSettings
+    from fem_twin.stages.factors import cell_settings
+    from fem_twin.stages.requests import macro_settings
+    classes = (CellSettings, MacroSettings, ThermalSettings, *SECTIONS.values())
+    marked = {(cls.__name__, f.name): f.metadata["section"] for cls in classes
+              for f in fields(cls) if f.metadata.get("section")}
+    assert {name for _, name in marked} == set(FILLED)
+    assert all(FILLED[name][0] == section for (_, name), section in marked.items())
+    case = Case("filled", Geometry())
+    case = replace(case, materials=replace(case.materials, e_pin=100e9, hardness=3e9),
+                   tribometer=replace(case.tribometer, boundary_friction=0.12,
+                                      sliding_radius=0.05))
+    cell, macro = cell_settings(case), macro_settings(case)
+    assert cell.e_reduced == macro.e_reduced == case.materials.e_reduced
+    assert cell.e_reduced != CellSettings().e_reduced and cell.hardness == 3e9
+    assert macro.boundary_friction == 0.12 and macro.track_radius == 0.05
+    assert cell.slide_to_roll == 2.0                 # the cells slide; a ball's SRR comes later

@@ -13,6 +13,7 @@ from .. import tables as T
 from ..checks import setting
 from ..macro.settings import MacroSettings
 from ..macro.thermal import ThermalSettings
+from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN
 from ..micro.rolling import SLIDING
 from ..micro.sliding import CellSettings
 from ..topography.prepare import MacroOptions
@@ -139,10 +140,10 @@ class MicroSpec(CellSettings):
 
     resolution: tuple[int, int] = setting((256, 256), "patches resampled (periodically) to "
                                           "this grid, at least 8 each", unit="px")
-    h0_min: float = setting(1e-7, "smallest separation h0", "separation")
-    h0_max: float = setting(1e-6, "largest separation h0 (above: the paper's rules)",
+    h0_min: float = setting(H0_MIN, "smallest separation h0", "separation")
+    h0_max: float = setting(H0_MAX, "largest separation h0 (above: the paper's rules)",
                             "separation")
-    h0_count: int = setting(100, "h0 candidates, log-spaced (the paper: 100)", unit="-")
+    h0_count: int = setting(H0_COUNT, "h0 candidates, log-spaced (the paper: 100)", unit="-")
     h0_tol: float = setting(0.01, "adaptive h0: solve the candidates the log-h0 "
                             "interpolant needs to read the others within this (0: all, the "
                             "paper)", unit="fraction")

@@ -11,7 +11,8 @@ from pathlib import Path
 from . import runs
 from . import steps
 from ..errors import NotConverged, RunLocked, SchedulerUnreachable
-from ..case.sections import LubricantSpec, MicroSpec, Tribometer
+from .. import tables as T
+from ..case.sections import Geometry, LubricantSpec, MicroSpec, Tribometer
 from ..stribeck.fit import PARAMETERS
 from ..topography.prepare import MacroOptions
 
@@ -226,11 +227,13 @@ def _add_contact(sub):
     """contact level|average: dry contact of pins."""
     c = sub.add_parser("contact", help="dry contact: pin levelling by torque balance, set averaging")
     cs = c.add_subparsers(dest="step", required=True, metavar="STEP")
-    lv = cs.add_parser("level", help="tilt a mounted pin until the 50 N contact torques vanish")
+    lv = cs.add_parser("level", help="tilt a mounted pin until the contact torques vanish "
+                       f"(Table 4: at {T.LEVELLING_LOAD:g} N)")
     lv.add_argument("pin", type=Path, help="mounted pin (fem-twin topography prepare-pin)")
     lv.add_argument("output", type=Path)
     lv.add_argument("--disk", type=Path, help="flipped disk on the same grid (default: flat)")
-    lv.add_argument("--load", type=float, default=50.0, help="imposed load [N]")
+    lv.add_argument("--load", type=float, default=T.LEVELLING_LOAD,
+                    help="imposed load [N] (default: %(default)s)")
     lv.add_argument("--method", choices=("broyden", "pid"), default="broyden")
     lv.set_defaults(func=steps.contact_level)
     av = cs.add_parser("average", help="set average of levelled pins, then level it again")
@@ -360,9 +363,10 @@ def _step_options(name, s):
         s.add_argument("--fwhm", type=float, required=True, help="FWHM in pixels")
     elif name in ("resample", "patch", "prepare-patch"):
         s.add_argument("--shape", type=int, nargs=2, metavar=("NY", "NX"),
-                       required=name == "resample", default=(256, 256))
+                       required=name == "resample", default=Geometry().patch_shape)
         if name != "resample":
-            s.add_argument("--start", type=int, nargs=2, default=(0, 0), metavar=("ROW", "COL"))
+            s.add_argument("--start", type=int, nargs=2, default=Geometry().patch_start,
+                           metavar=("ROW", "COL"))
         s.add_argument("--method", choices=("linear", "cubic", "nearest"), default="linear")
         if name == "prepare-patch":
             s.add_argument("--upper", action="store_true", help="disk patch: flip above the pin")

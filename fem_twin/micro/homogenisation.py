@@ -30,7 +30,8 @@ from .sliding import CellSettings, factors_from_moments
 from .store import cell_key
 
 #: the paper's separations: 100 values geometrically spaced in [0.1, 1] um
-DEFAULT_H0 = np.geomspace(1e-7, 1e-6, 100)
+H0_MIN, H0_MAX, H0_COUNT = 1e-7, 1e-6, 100
+DEFAULT_H0 = np.geomspace(H0_MIN, H0_MAX, H0_COUNT)
 
 
 @one_thread
