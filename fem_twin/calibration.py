@@ -1,27 +1,16 @@
 """Calibration studies (paper 3.2, Figures 9-13): how the Stribeck curve depends on choices.
 
 Each study runs variants of a case and reports C_f,dev (eq 35) of every variant against a
-reference curve, at the case's first viscosity:
+reference curve at the case's first viscosity: ``filter``, the macro geometry's Gaussian
+FWHM [px] (reference 11 px); ``resolution``, the macro grid [px] (by default the paper's
+Figure 10: 128, 256, 500, 999 and 1997 px, the reference the maps' own resolution or else
+the largest, the finer grids swept at :data:`FINE_SPEEDS` only); ``disk``, measured disks
+against a flat one; ``pins``, every levelled pin against the set average; ``patches``,
+every patch's flow factors against their average.
 
-``filter``
-    Gaussian FWHM of the macro geometry [px] (0: unfiltered); reference 11 px
-``resolution``
-    macro grid size [px]; by default the paper's study (Figure 10): 128, 256, 500, 999 and
-    1997 px interpolated from the measured maps, the two finest keeping every measured
-    point, the reference the maps' own resolution (500 px, as the paper's) or else the
-    largest, and the grids finer than the reference swept at the paper's five speeds
-    (:data:`FINE_SPEEDS`) only
-``disk``
-    measured disks against a flat disk; reference: measured
-``pins``
-    every single levelled pin against the set average; reference: average
-``patches``
-    flow factors of every single patch against the patch average; reference: the average
-
-The micro scale is computed once (it does not depend on the macro choices) and shared by
-the variants; each variant's sweep is a task on the study's workers (``[run] workers``),
-its points checkpointed as they finish, so an interrupted study resumes.
-"""
+The micro scale is computed once and shared by the variants; each variant's sweep is a
+task on the study's workers (``[run] workers``), its points checkpointed as they finish,
+so an interrupted study resumes."""
 
 from __future__ import annotations
 

@@ -1,21 +1,14 @@
 """The bundled sample twin: a seeded, documented stand-in for the paper's measurements.
 
-The paper's measured topographies are not public.  This generator makes a set of files
-with the same structure (see ``meshes/README.md``):
-
-* 3 worn pins, FRT-like: 500 x 500 px over 8 x 8 mm, 8 mm face with a crown of a few um
-  and an edge roll-off, a small measurement tilt, fine roughness and noise to be filtered
-  out, the holder/chamfer far below the face, invalid pixels on the chamfer and dropouts.
-* 3 matching disks: flat with waviness below 1 um, a faint wear track (the pin's path on a
-  30 mm sliding radius), fine roughness, a few dropouts.
-* 6 roughness patch pairs, Sensofar-like: 768 x 576 px over 84.9 x 63.7 um, self-affine
-  (Hurst 0.8), whose Sq after levelling equals Table 5 of the paper (disk = upper
-  surface, pin = lower surface).
-
-Heights are stored as integer multiples of a quantum, as instruments do (1 nm for the
-macro maps, 0.1 nm for the patches), in the fem_twin ``.npz`` format, with fixed zip
-timestamps so that regenerating gives byte-identical files on the same library versions.
-"""
+The paper's measured topographies are not public; this generator makes files of the same
+structure (``meshes/README.md``): 3 worn pins, FRT-like (500 x 500 px over 8 x 8 mm: a
+crowned 8 mm face with an edge roll-off, a small tilt, fine roughness, noise, the holder
+far below, invalid pixels and dropouts); 3 matching disks (flat, waviness below 1 um, a
+faint wear track at 30 mm, dropouts); and 6 roughness patch pairs, Sensofar-like
+(768 x 576 px over 84.9 x 63.7 um, self-affine with Hurst 0.8, Sq after levelling as Table
+5 of the paper).  Heights are integer multiples of a quantum, as instruments store them
+(1 nm macro, 0.1 nm patches), in fem_twin's ``.npz`` with fixed zip timestamps, so
+regenerating gives byte-identical files on the same library versions."""
 
 from __future__ import annotations
 

@@ -1,26 +1,16 @@
 """The task graph of a finished run, and what it would take on more workers.
 
-A run's independent work is a graph of tasks, each timed as it ran:
-
-* the roughness scale, per patch pair: rounds of separations h0 (the adaptive sampler of
-  :mod:`fem_twin.micro.sampling` asks for a round only after the previous one; each h0 a
-  task, its time the contact and cell seconds in its checkpoint), then the coarsened cell's
-  pass for the grid-error estimate at the chosen h0;
-* the macro scale, after every patch: one sweep per viscosity over the case's speeds (a
-  chain of warm-started points: one task, the sum of its points' solve, nested coarse solve
-  and error-estimate seconds, and a thermal run's earlier iterations), the refinement's
-  added speeds of each (after all first passes), and the patch band's sweeps (after the
-  refinement: they start from the main points' nested solves on their grid).
-
-The rounds are replayed from the checkpoints (the sampler is deterministic), so the graph
-of any finished run can be read back.  :func:`makespan` schedules the graph greedily on
-``workers`` processes (a task starts on the first free worker once what it depends on has
-finished), :func:`critical_path` is the bound no number of workers beats.  Left out: the
-geometry, levelling and result writing (serial, in the main process), and the cost of one
-h0 per task: a chunk of several h0 warm-starts contact along them, which one-h0 tasks on
-a large cluster cannot (contact is about half of an h0's time, cold starts cost about 20 %
-more of it).
-"""
+Each task is timed as it ran: per patch pair, rounds of separations h0 (the adaptive
+sampler asks for a round only after the previous one; each h0 a task), then the coarsened
+cell's pass of the grid-error estimate; after every patch, one sweep per viscosity (a chain
+of warm-started points: one task of its points' solve, nested coarse solve, error estimate
+and a thermal run's earlier iterations), the refinement's added speeds, and the patch
+band's sweeps (which start from the main points' nested solves).  The rounds are replayed
+from the checkpoints (the sampler is deterministic).  :func:`makespan` schedules the graph
+greedily on ``workers`` processes, :func:`critical_path` is the bound no number of workers
+beats.  Left out: the geometry, levelling and result writing (serial), and what one-h0
+tasks lose against chunks of several h0, which warm-start contact along them
+(docs/performance.md, "How many workers")."""
 
 from __future__ import annotations
 

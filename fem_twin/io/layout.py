@@ -1,25 +1,16 @@
 """The output folder of a run: every file and folder it writes and reads, named once.
 
-``fem-twin run CASE -o OUT`` writes (see docs/reference/outputs.md)::
-
-    OUT/summary.json, run.log, stage_keys.json, .lock
-    OUT/geometry/    pin_K.npz, disk_K.npz, macro_K.vtu, patch_K_low.npz, patch_K_up.npz,
-                     patch_K.vtu
-    OUT/levelling/   pin_K.npz, pin_average.npz
-    OUT/micro/       flow_factors.npz (patch average), patch_K/flow_factors.npz,
-                     patch_K/checkpoints/
-    OUT/flow_factors.csv, flow_factors.png
-    OUT/stribeck/checkpoints/point_*.npz, OUT/fields/ (VTU + PVD per sweep)
-    OUT/stribeck.csv, stribeck_speed.png, stribeck_hersey.png, fields_muX.png,
-    OUT/validation.csv, validation_muX.png, results.nc, fields.nc, report.html
-
-``fem-twin compare`` adds ``compare*.{json,csv,png}``, ``fe/``, ``fvm/`` and ``reference/``
-(sub-runs); ``fem-twin calibrate`` adds ``calibration.json``, ``cf_dev.png`` and
-``variant_K/``.
+``fem-twin run CASE -o OUT`` writes ``summary.json``, ``run.log``, ``stage_keys.json``;
+``geometry/`` (the prepared pins, disks, patches and their VTU), ``levelling/``, ``micro/``
+(the flow factors of every patch and their average, with the per-h0 checkpoints),
+``stribeck/checkpoints/`` (one file per point), ``fields/`` (VTU + PVD per sweep), and
+``stribeck.csv``, its plots, ``results.nc``, ``fields.nc``, ``validation*`` and
+``report.html``.  ``compare`` and ``calibrate`` add their files and sub-runs (``fe/``,
+``fvm/``, ``reference/``, ``variant_K/``); every file is listed with its units in
+docs/reference/outputs.md.
 
 The pipeline, ``compare``, ``calibrate``, ``report``, ``results`` and the CLI take their paths
-from a :class:`RunLayout`; pin, disk and patch numbers ``k`` count from 1.
-"""
+from a :class:`RunLayout`; pin, disk and patch numbers ``k`` count from 1."""
 
 from __future__ import annotations
 

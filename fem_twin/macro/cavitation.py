@@ -2,20 +2,14 @@
 (``MacroSettings(complementarity=...)``, ``solve_reynolds(..., complementarity=...)``).
 
 JFO cavitation (eq 18) couples ``p = p_hd - p_cav`` and the cavity fraction ``theta`` by
-``p theta = 0``, ``p >= 0``, ``theta >= 0``, carried in one unknown per node, ``phi``.  A
-model provides:
-
-``solve(K, B, dirichlet, p_boundary, scale, *, phi0, tol, max_iter, inexact[, settle])``
-    ``K p + B (1 - theta) = 0`` on the interior (``p = p_boundary``, ``theta = 0`` at the
-    Dirichlet nodes): ``(phi, iterations, residual history)``; ``settle`` where the class's
-    ``settles`` is true (:func:`.switch.solve_complementarity`);
-``split(phi, scale)`` and ``unknown(p, theta, scale)``
-    ``(p, theta)`` of an unknown, and the unknown of a solved state (warm starts);
-``derivatives(phi, scale)``
-    ``(dp/dphi, d(1 - theta)/dphi)`` for the Newton coupling's Jacobian (:mod:`.newton`).
-
-Adding one: ARCHITECTURE.md, "Adding a cavitation model".
-"""
+``p theta = 0``, ``p >= 0``, ``theta >= 0``, in one unknown per node, ``phi``.  A model
+provides ``solve(K, B, dirichlet, p_boundary, scale, *, phi0, tol, max_iter, inexact[,
+settle])``, the interior's ``K p + B (1 - theta) = 0`` with ``p = p_boundary``, ``theta = 0``
+at the Dirichlet nodes, returning ``(phi, iterations, residual history)`` (``settle`` where
+the class's ``settles`` is true); ``split(phi, scale) -> (p, theta)`` and
+``unknown(p, theta, scale)`` (warm starts); and ``derivatives(phi, scale)``,
+``(dp/dphi, d(1 - theta)/dphi)`` for the Newton coupling's Jacobian (:mod:`.newton`).
+Adding one: ARCHITECTURE.md, "Adding a cavitation model"."""
 
 from __future__ import annotations
 

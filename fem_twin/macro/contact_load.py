@@ -2,27 +2,16 @@
 factors' ``p_con(h0)`` (eq 11) into the load balance (eq 28), the elastic deformation
 (eqs 20-22) and the boundary friction (eq 32).
 
-``p_con`` falls by orders of magnitude over a few tens of nanometres of ``h0`` (the bundled
-patches: a factor of about 3 per 40 nm), while across one pixel of a crowned pin face ``h0``
-changes by as much (60 nm at 128^2 over 8 mm).  Read at the nodes, as the paper does
-(``"nodal"``), the contact pressure misjudges the load the pixels around a node carry: on
-the bundled pin at 128^2 it overstates the contact load of the film it is given by 3-8 %,
-and by 9-22 % on the grid coarsened by two (mixed regime; docs/accuracy.md).
-
-``"gauss"`` (the default) takes the Galerkin load of the contact pressure over the Q1 film,
-lumped onto the nodes:
+``p_con`` falls by orders of magnitude over a few tens of nanometres of ``h0``, about what
+``h0`` changes across one pixel of a crowned face, so read at the nodes (the paper,
+``"nodal"``) it misjudges the load the pixels around a node carry.  ``"gauss"`` (the
+default) gives each node the Galerkin load over the Q1 film, lumped:
 
     p_i = int p_con(h0_h(x)) phi_i(x) dx / int phi_i(x) dx,
 
-with ``h0_h`` the bilinear interpolant of the nodal separations (the film the FE Reynolds
-problem sees) and ``POINTS x POINTS`` Gauss points per pixel.  The lumped mass
-``int phi_i`` is the trapezoid weight of node ``i``, so ``sum_i a_i p_i`` is the contact
-load of the whole film.  Measured on the bundled case's average pin (0.2 to 0.005 m/s,
-0.066 Pa s): C_f changed from 64^2 to 128^2 by up to 1.08 % C_f,b read at the nodes and
-0.35 % so; from 128^2 to 256^2 by 0.31 % and 0.065 %; 128^2 stood 0.37 % and 0.12 % C_f,b
-from 512^2; the two rules meet as the grid is refined (0.14 % apart at 256^2, 0.04 % at
-512^2); no slower (16.6 s against 16.9 s for the 9-point sweep at 128^2).
-"""
+with ``h0_h`` the bilinear interpolant of the nodal separations and ``POINTS x POINTS``
+Gauss points per pixel; ``sum_i a_i p_i`` is then the contact load of the whole film
+(docs/accuracy.md, "The contact pressure on the macro grid")."""
 
 from __future__ import annotations
 

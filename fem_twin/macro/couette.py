@@ -1,23 +1,17 @@
 """The Couette term of eq 17, ``div(q (1 - theta))``, on the dual cells of the node grid.
 
-Every face between two neighbouring nodes ``a -> b`` carries the liquid flux
+Every face between neighbouring nodes ``a -> b`` carries the liquid flux
 ``width * q_f * s_up`` (``s = 1 - theta``) out of ``a``'s dual cell into ``b``'s, so mass is
-conserved face by face whatever the scheme.  The liquid fraction is always the upstream
-node's (the sign of the face's ``q`` decides): in a cavity the equation is pure transport of
-``s h``, and only an upwind ``s`` keeps theta in [0, 1] and monotone.  The schemes differ in
-the face value ``q_f`` of the Couette coefficient ``q = rho h_m u_m b``:
-
-``"central"`` (default)
-    ``q_f = (q_a + q_b) / 2`` (Ausas, Jai and Buscaglia, J. Tribol. 131, 2009, 031702, with
-    Elrod and Adams' upwind saturation): second order in full film, ``q_f s_up`` constant
-    along the flow in a cavity (docs/accuracy.md: Swift-Stieber, a pocketed pad, EHL).
-``"upwind"``
-    ``q_f = q_up``: the paper's first-order flux, a numerical diffusion ``|q| dx / 2``.
-
-As face matrices, per direction ``k``: ``outflow = D_k ((J_k q_k) * (U_k s))`` with ``D`` the
-signed face widths, ``J`` the face coefficient and ``U`` the upwind pick, so the Newton
-coupling gets both derivatives (:meth:`Couette.matrix`, :meth:`Couette.q_derivatives`).
-"""
+conserved face by face.  The liquid fraction is always the upstream node's: in a cavity the
+equation is pure transport of ``s h``, and only an upwind ``s`` keeps theta in [0, 1] and
+monotone.  The face value of ``q = rho h_m u_m b``: ``"central"`` (default),
+``q_f = (q_a + q_b) / 2`` (Ausas, Jai and Buscaglia, J. Tribol. 131, 2009, 031702), second
+order in full film and ``q_f s_up`` constant along the flow in a cavity (docs/accuracy.md);
+``"upwind"``, ``q_f = q_up``, the paper's first-order flux (a numerical diffusion
+``|q| dx / 2``).  As face matrices, per direction ``k``: ``outflow = D_k ((J_k q_k) *
+(U_k s))`` with ``D`` the signed face widths, ``J`` the face coefficient and ``U`` the
+upwind pick, so the Newton coupling gets both derivatives (:meth:`Couette.matrix`,
+:meth:`Couette.q_derivatives`)."""
 
 from __future__ import annotations
 

@@ -1,24 +1,18 @@
 """The discretisation error of an operating point's friction coefficient C_f (eq 34).
 
-Each part is a change of C_f [-] (docs/accuracy.md, "The error bar on every friction
-coefficient", has the measurements behind each choice):
-
-``"macro"``
-    the point on the macro grid coarsened by two, warm from the converged state:
-    ``|C_f(h) - C_f(2h)| / (2^p - 1)`` with ``p = MACRO_ORDER``.
-``"time"``, ``"grid"``, ``"h0"``
-    the flow factors' own estimates carried into C_f: the point solved with each variant
-    of the factors (:meth:`FlowFactors.variants`) on the level :func:`micro_parts_level`
-    gives, minus the point there; ``"h0"`` over ``H0_SPACING_RATIO``.
-``"film"``
-    the point's own fields re-evaluated with the friction factor of half and of twice the
-    boundary film, the larger change (a model part; no solve).
+Each part is a change of C_f [-] (the measurements behind each choice: docs/accuracy.md,
+"The error bar on every friction coefficient"): ``"macro"``, the point on the macro grid
+coarsened by two, ``|C_f(h) - C_f(2h)| / (2^p - 1)`` with ``p = MACRO_ORDER``; ``"time"``,
+``"grid"``, ``"h0"``, the flow factors' own estimates carried into C_f (the point solved
+with each variant of the factors, :meth:`FlowFactors.variants`, on the level
+:func:`micro_parts_level` gives, minus the point there; ``"h0"`` over
+``H0_SPACING_RATIO``); ``"film"``, the point's fields re-evaluated with the friction factor
+of half and twice the boundary film (a model part; no solve).
 
 ``"total"`` sums the parts' magnitudes (a root sum of squares fell below the truth where
-the parts' errors add with one sign); ``"signed"`` keeps each part's sign for studies.  A
-part that could not be estimated is NaN, left out of the total and named in
-``"missing"``, with the reason in ``"failed"``.  Smooth factors have no micro parts (0).
-"""
+the parts' errors add with one sign); ``"signed"`` keeps each part's sign.  A part that
+could not be estimated is NaN, left out of the total and named in ``"missing"``, with the
+reason in ``"failed"``.  Smooth factors have no micro parts (0)."""
 
 from __future__ import annotations
 

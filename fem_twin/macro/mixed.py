@@ -1,27 +1,18 @@
 """Homogenised mixed elasto-hydrodynamic operating point (paper 2.2.2, eqs 17-34).
 
-One operating point (imposed load F_N,imp, sliding speed U) of the pin-on-disk contact:
+One operating point (imposed load F_N,imp, sliding speed U): homogenised Reynolds with JFO
+cavitation (eqs 17-18) with the flow factors at the local separation ``h0``
+(:meth:`FlowFactors.at`), Roelands viscosity (eq 23) and Dowson-Higginson density (eq 24);
+``h0 = h_d + h_g + h_el`` (eq 19) with ``h_el`` from ``p_hd + p_con - p_amb`` by the FFT
+half-space (eqs 20-22); the contact pressure ``p_con(h0)`` (eqs 25-27), the load balance on
+``h_d`` (eqs 28-30) and the friction (eqs 31-34).
 
-* homogenised Reynolds with JFO cavitation (eqs 17-18) on the macro grid, with the flow
-  factors ``A, b`` and the mean gap ``h_m`` of the micro scale at the local separation
-  ``h0`` (:meth:`FlowFactors.at`), Roelands viscosity (eq 23) and Dowson-Higginson density
-  (eq 24) at the current pressure;
-* ``h0 = h_d + h_g + h_el`` (eq 19), ``h_el`` from ``p_tot - p_amb = p_hd + p_con - p_amb``
-  by the non-periodic FFT half-space operator (eqs 20-22);
-* the mean asperity contact pressure ``p_con(h0)`` (eqs 25-27) and the load balance on
-  ``h_d`` (eqs 28-30);
-* friction from eqs 31-34 over the pin face.
-
-Three couplings reach the same state: ``"anderson"`` and the paper's ``"pid"`` fixed
-points (:mod:`.fixed_point`) and the monolithic ``"newton"`` coupling (:mod:`.newton`);
-``"auto"`` (default) takes Anderson and switches to Newton for elastically dominated
-contacts or when Anderson fails.  The problem is a value (:mod:`.problem`), the converged
-point a :class:`MixedResult` (:mod:`.result`); the cold start is in :mod:`.start`.
-Converged when, between two iterations, all of the following are below ``tol`` (1e-4):
-the change of ``h_el`` / h_ref, the update of ``p_con`` / p_ref (eq 27), the change of
-``p`` / p_ref (lagged viscosity and density) and the load residual (eq 30).  Otherwise
-:class:`MixedNotConverged` carries the history.
-"""
+Three couplings reach the same state: ``"anderson"`` and the paper's ``"pid"`` fixed points
+(:mod:`.fixed_point`) and the monolithic ``"newton"`` (:mod:`.newton`); ``"auto"`` (default)
+takes Anderson and switches to Newton for elastically dominated contacts or when Anderson
+fails.  Converged when the changes of ``h_el`` / h_ref, ``p_con`` / p_ref and ``p`` / p_ref
+between two iterations and the load residual (eq 30) are all below ``tol``; otherwise
+:class:`MixedNotConverged` carries the history."""
 
 from __future__ import annotations
 

@@ -1,29 +1,18 @@
 """Sweep points started from the grid coarsened by two: nested iteration with a coarse-grid
-correction.
+correction (the full approximation scheme, Brandt 1977).
 
-A point warm-started from the previous speed's state starts from a film the speed change
-has moved everywhere, and the coupling needs 20-50 iterations to move it back (more on
-finer grids).  Solved first on every other node (a quarter of the nodes), warm from the
-previous speed's coarse state, the speed change is known on the coarse grid; the fine
-start is then the previous fine state plus that change, interpolated:
+A point is solved first on every other node, warm from the previous speed's coarse state;
+the fine start is then the previous fine state plus the coarse change, interpolated,
 
-    x_0(h) = x_prev(h) + P (x(2h) - x_prev(2h))
+    x_0(h) = x_prev(h) + P (x(2h) - x_prev(2h)),
 
-for the elastic deformation, contact pressure and ``h_d`` (the full approximation scheme's
-correction, Brandt 1977); the film pressure and cavity fraction, whose free boundary the
-coarse solution places closer, are the coarse solution's, interpolated.  The fine grid
-keeps its own detail and needs 8-10 iterations instead of 19-26 (sample pin 1 at 256^2, 8
-speeds of the paper's sweep: 33.5 s against 46.5 s, C_f the same to 7e-9 C_f,b).  The
-coarse point is itself solved so, from the next coarser grid, down to the coarse start: a
-sweep keeps every level of its last point.  The coarse solution is also the base of the
-point's macro error estimate (:mod:`fem_twin.macro.estimate`), which no longer solves it.
-Each level's Anderson coupling, in a cold point, also starts from the coarser level's last
-differences (:class:`~fem_twin.macro.fixed_point.Secants`), which carry the slow modes the
-coarse solve has already found (the 512^2 level of a cold point: 10 iterations against 14).
-A warm point's levels start from the previous point's and gain nothing from them (three
-warm points at 512^2: 92 against 95 iterations over all levels), and at 56^2 from a 28^2
-level they cost iterations (25 against 21).
-"""
+for the elastic deformation, the contact pressure and ``h_d``; the film pressure and the
+cavity fraction, whose free boundary the coarse solve places closer, are the coarse
+solution's, interpolated.  The coarse point is itself solved so, down to the coarsest
+level; a sweep keeps every level of its last point, and the coarse solution is the base
+of the point's macro error estimate (:mod:`fem_twin.macro.estimate`).  A cold point's
+Anderson coupling also starts from the coarser level's last differences.  What it saves:
+docs/performance.md, "Design choices, measured"."""
 
 from __future__ import annotations
 

@@ -1,21 +1,15 @@
 """Monolithic Newton coupling of the macro problem, for elastically dominated contacts.
 
-When the elastic deformation is much larger than the film (a ball on a disk: ~1.5 um of
-deformation over a 0.2 um film) no fixed point on ``h_el`` converges; the paper's EHL-FBNS
-puts the elastic operator into its Newton system, and so does this module.  The unknowns
-are ``phi`` (the p-theta switch of :mod:`.reynolds`, interior nodes), the elastic
-deformation ``w = h_el`` (all nodes) and ``h_d``; the equations, all fully implicit:
-
-* ``R = K(g) p + B(q) (1 - theta) = 0`` on the interior (eqs 17-18), with
-  ``g = rho h_m^3 / (12 mu)`` and ``q = rho h_m u_m`` at ``p`` and
-  ``h0 = h_d + h_g + w`` (eq 19), Roelands (23) and Dowson-Higginson (24);
-* ``G = w - E (p + p_cav + p_con(h0) - p_amb) = 0`` (eqs 20-22, ``E`` the FFT half-space);
-* ``L = sum(a (p + p_cav + p_con - p_amb)) - F_N,imp = 0`` (eq 28).
-
-The Jacobian is exact, and each Newton step is solved by preconditioned GMRES
-(:mod:`.jacobian`).  Steps are limited so no film thins by more than half, then backtracked
-on the scaled residual.
-"""
+When the elastic deformation is much larger than the film (a ball: ~1.5 um over a 0.2 um
+film) no fixed point on ``h_el`` converges; as the paper's EHL-FBNS, the elastic operator
+goes into the Newton system.  Unknowns: ``phi`` (the p-theta switch, interior nodes), the
+deformation ``w = h_el`` (all nodes) and ``h_d``; equations, fully implicit:
+``R = K(g) p + B(q) (1 - theta) = 0`` (eqs 17-18, with ``h0 = h_d + h_g + w``, eq 19, Roelands
+and Dowson-Higginson), ``G = w - E (p + p_cav + p_con(h0) - p_amb) = 0`` (eqs 20-22, ``E``
+the FFT half-space) and ``L = sum(a (p + p_cav + p_con - p_amb)) - F_N,imp = 0`` (eq 28).
+The Jacobian is exact and each step is solved by preconditioned GMRES (:mod:`.jacobian`);
+steps are limited so no film thins by more than half, then backtracked on the scaled
+residual."""
 
 from __future__ import annotations
 

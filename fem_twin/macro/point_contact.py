@@ -1,25 +1,18 @@
 """Concentrated (ball-on-disk) contacts: Hertz, Moes parameters, Hamrock-Dowson films.
 
-The smooth elastohydrodynamic point contact is the reference case of the concentrated
-contacts: a sphere of radius ``R`` on a flat, reduced modulus ``E'`` (eq 22), normal load
-``F``, mean entrainment speed ``u_m = (u_1 + u_2)/2``, lubricant ``mu_0`` and pressure-viscosity
-coefficient ``alpha``.
+A sphere of radius ``R`` on a flat, reduced modulus ``E'`` (eq 22), load ``F``, entrainment
+speed ``u_m``, lubricant ``mu_0`` and pressure-viscosity coefficient ``alpha``: Hertz
+``a = (3 F R / (2 E'))^(1/3)``, ``p_H = 3 F / (2 pi a^2)``; Hamrock and Dowson's (1977)
+``U = mu_0 u_m / (E' R)``, ``W = F / (E' R^2)``, ``G = alpha E'`` and central and minimum
+films ``h_c / R = 2.69 U^0.67 G^0.53 W^-0.067 (1 - 0.61 e^(-0.73 k))``,
+``h_min / R = 3.63 U^0.68 G^0.49 W^-0.073 (1 - e^(-0.68 k))``; Moes'
+``M = W (2U)^(-3/4)``, ``L = G (2U)^(1/4)``.  An elliptical contact (``radius_y = R_y > R_x``,
+entrainment along x) takes Hamrock and Brewe's (1983) ``k = 1.0339 (R_y/R_x)^0.636`` and
+``E = 1.0003 + 0.5968 R_x/R_y``, ``a = (6 E F R' / (pi k E'))^(1/3)``, ``b = k a``.
 
-* Hertz: ``a = (3 F R / (2 E'))^(1/3)``, ``p_H = 3 F / (2 pi a^2)``, approach ``a^2 / R``.
-* Dimensionless groups (Hamrock and Dowson 1977): ``U = mu_0 u_m / (E' R)``,
-  ``W = F / (E' R^2)``, ``G = alpha E'``; Moes: ``M = W (2U)^(-3/4)``, ``L = G (2U)^(1/4)``.
-* Hamrock-Dowson fits (R = R_x, ellipticity k = b/a):
-  ``h_c / R = 2.69 U^0.67 G^0.53 W^-0.067 (1 - 0.61 e^(-0.73 k))`` and
-  ``h_min / R = 3.63 U^0.68 G^0.49 W^-0.073 (1 - e^(-0.68 k))``.
-* An elliptical (line-like) contact has ``radius_y = R_y > R_x`` (the entrainment along x):
-  Hamrock and Brewe's (1983) ``k = 1.0339 (R_y/R_x)^0.636``,
-  ``E = 1.0003 + 0.5968 R_x/R_y``, ``a = (6 E F R' / (pi k E'))^(1/3)``, ``b = k a`` with
-  ``1/R' = 1/R_x + 1/R_y`` (within a few per cent of the exact Hertz ellipse).
-
-In :func:`fem_twin.macro.solve_mixed` the disk slides at ``U_s`` under a stationary pin
-(``u_m = U_s / 2``); a rolling contact with entrainment speed ``u_m`` is given as
-``speed = 2 u_m`` (eq 17 only sees ``u_m``; the shear of eq 31 sees the sliding speed).
-"""
+In :func:`fem_twin.macro.solve_mixed` a rolling contact at entrainment speed ``u_m`` is
+given as ``speed = 2 u_m`` for a stationary ball, or with ``entrainment=u_m`` (eq 17 sees
+only ``u_m``; the shear of eq 31 sees the sliding speed)."""
 
 from __future__ import annotations
 

@@ -2,25 +2,16 @@
 
     0 = div( G grad p - q (1 - theta) ),   p theta = 0,  p >= 0,  theta >= 0,
 
-with ``p = p_hd - p_cav``, ``G = rho h^3 A / (12 mu)`` and ``q = rho h u_m b`` (smooth, rigid:
-``A = I``, ``b = e1``).  Nodes are pixels, ``p = p_amb - p_cav`` and ``theta = 0`` on the
-four edges (flooded inlet) and wherever the gap opens beyond ``OPEN_GAP`` (the oil bath).
-
-Discretisation.  The Poiseuille term is the Q1 finite-element stiffness of ``G`` (scikit-fem
-form, 2 x 2 Gauss) for ``method="fe"``, or the paper's 5-point central finite volumes for
-``method="fvm"``.  The Couette term is in both a flux through the faces of the node's dual
-cell with the liquid fraction ``1 - theta`` from the upstream node
-(:mod:`fem_twin.macro.couette`): the face-centred, second-order ``"central"`` scheme by
-default, the paper's first-order ``"upwind"`` one as an option.  A Galerkin Couette term is
-unstable here: in a cavitated zone the equation is pure transport of ``(1 - theta) h`` with
-no pressure diffusion at all (infinite Peclet number), so only an upwind liquid fraction
-keeps theta monotone, and the face fluxes conserve mass exactly (each leaves one dual cell
-and enters the next).
-
-Complementarity.  One unknown per node, ``phi``, carries ``p`` and ``theta`` as the
-cavitation model says (:mod:`fem_twin.macro.cavitation`: the p-theta switch, solved by
-semismooth Newton in :mod:`fem_twin.macro.switch`, or the paper's FBNS).
-"""
+with ``p = p_hd - p_cav``, ``G = rho h^3 A / (12 mu)`` and ``q = rho h u_m b``.  Nodes are
+pixels; ``p = p_amb - p_cav`` and ``theta = 0`` on the four edges (flooded inlet) and
+wherever the gap opens beyond ``OPEN_GAP`` (the oil bath).  The Poiseuille term is the Q1
+finite-element stiffness of ``G`` (scikit-fem form, 2 x 2 Gauss; ``method="fe"``) or the
+paper's 5-point finite volumes (``"fvm"``).  The Couette term is in both a flux through
+the faces of each node's dual cell with the liquid fraction from the upstream node
+(:mod:`fem_twin.macro.couette`): a Galerkin Couette term is unstable here, as a cavitated
+zone is pure transport of ``(1 - theta) h`` (infinite Peclet number), and the face fluxes
+conserve mass exactly.  One unknown per node, ``phi``, carries ``p`` and ``theta`` as the
+cavitation model says (:mod:`fem_twin.macro.cavitation`)."""
 
 from __future__ import annotations
 
@@ -251,7 +242,6 @@ class PoiseuilleAssembly:
         if A is not None and np.shape(A) != (*self.shape, 2, 2):
             raise InputError(f"flow factor field shape {np.shape(A)} is not {(*self.shape, 2, 2)}")
         ny, nx = self.shape
-        nq = self._phi.shape[1]
         A4 = None if A is None else np.asarray(A, float).reshape(ny, nx, 4).transpose(2, 0, 1)
         S = np.zeros((ny, nx, 3, 3))
         rows = max(1, BLOCK // (nx - 1))

@@ -1,21 +1,16 @@
 """Newton steps of the p-theta switch (:mod:`.switch`) on the grid's 3x3 stencil.
 
-The Newton matrix ``J = K diag(pos) + B diag(dtheta)`` of the interior lives on a pattern
-fixed per grid: PARDISO's symbolic factorisation is computed once per grid, in the grid's
-nested-dissection order (:func:`fem_twin.numerics.ordering.subgrid_order`), and where each entry of
-``K`` and ``B`` lands in that pattern once per sparsity pattern of theirs, so a step costs
-one numeric factorisation and a solve.  On grids of more than ``SINGLE_UNKNOWNS`` unknowns
-the factors are single precision, refined with the residual in double precision (one step
-reaches ``STEP_RTOL``; half the factors' memory), the products ``J x`` taken from ``K`` and
-``B`` themselves.  The factors of a step serve the next steps of the same inner solve: a
-matrix that differs in the ``m`` columns of the nodes switched since is solved with them
-updated by the Woodbury identity (Hager 1989, SIAM Review 31), ``J^-1 = J_0^-1 - W (I +
-V^T W)^-1 V^T J_0^-1`` with ``W = J_0^-1 U``, as the refinement's preconditioner, when
-that takes at most :meth:`_Grid.budget` solves (else it factorises anew).  A step is
-returned only when it solves ``J x = rhs`` to ``STEP_RTOL``; the factors are freed when
-the inner solve ends (``step.release()``).  The measurements behind these choices, and
-what was tried and dropped, are in ``benchmarks/README.md`` ("stencil_solver").
-"""
+The Newton matrix ``J = K diag(pos) + B diag(dtheta)`` lives on a pattern fixed per grid:
+PARDISO's symbolic factorisation is computed once per grid in its nested-dissection order
+(:func:`fem_twin.numerics.ordering.subgrid_order`), so a step costs one numeric
+factorisation and a solve.  Above ``SINGLE_UNKNOWNS`` unknowns the factors are single
+precision, refined with the double-precision residual.  The factors of a step serve the
+next steps of the same inner solve: a matrix that differs in the ``m`` columns of nodes
+switched since is solved with them updated by the Woodbury identity (Hager 1989) as the
+refinement's preconditioner, when that takes at most :meth:`_Grid.budget` solves.  A step
+is returned only when it solves ``J x = rhs`` to ``STEP_RTOL``; the factors are freed when
+the inner solve ends (``step.release()``).  Measurements: ``benchmarks/README.md``
+("stencil_solver")."""
 
 from __future__ import annotations
 

@@ -1,22 +1,16 @@
 """The contact's temperature from its own frictional heat (beyond the paper).
 
-The frictional power ``Q = F_T U`` [W] enters pin and disk through the face as the surface
-flux ``q = tau U`` (the point's traction times the local sliding speed, scaled to Q).  Three
-temperature rises add to the oil's (docs/thermal.md has the model and its checks):
-
-* **bulk**, ``R_b Q``: the rig's lumped thermal resistance ``R_b`` [K/W] (pin, holder,
-  disk, bath), a parameter to fit;
-* **face flash**, Blok's partition of ``q`` between the pin, a stationary half-space, and
-  the disk, a half-space moving at ``U`` under the face (Jaeger 1942; Carslaw and Jaeger
-  1959, 10.7): the share that makes the two face-mean temperatures equal;
-* **asperity flash**, the same for one contact spot of radius ``a`` carrying the boundary
-  shear's flux ``C_f,b p_spot U`` (Archard 1959), reported, not fed back (C_f,b is a
-  constant of the model).
-
-The film sees the oil temperature plus bulk and face flash; its viscosity follows the
-Walther law of the case's viscosities (:mod:`.viscosity`).  Each operating point is
-iterated to that temperature (:func:`thermal_point`).
-"""
+The frictional power ``Q = F_T U`` [W] enters pin and disk through the face as the flux
+``q = tau U`` (the point's traction times the local sliding speed).  Three rises add to the
+oil's temperature (docs/thermal.md has the model and its checks): the **bulk** rise
+``R_b Q``, the rig's lumped resistance ``R_b`` [K/W] to its oil bath, a parameter to fit;
+the **face flash**, Blok's partition of ``q`` between the pin, a half-space at rest, and the
+disk, a half-space moving at ``U`` (Jaeger 1942; Carslaw and Jaeger 1959, 10.7), the share
+that makes the two face-mean temperatures equal; the **asperity flash** of one contact
+spot of radius ``a`` carrying ``C_f,b p_spot U`` (Archard 1959), reported, not fed back.
+The film sees the oil temperature plus bulk and face flash, its viscosity by the case's
+Walther law (:mod:`.viscosity`); each operating point is iterated to that temperature
+(:func:`thermal_point`)."""
 
 from __future__ import annotations
 

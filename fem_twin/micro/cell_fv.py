@@ -1,28 +1,17 @@
 """Finite-volume cell problems (paper eqs 8-10, its own discretisation).
 
 Cell-centred finite volumes on the periodic pixel grid: one control volume per pixel and
-second-order central fluxes,
+second-order central fluxes, ``c_f ((chi_2[i+1] - chi_2[i]) / dx1 + 1)`` through an x1
+face, with the face conductance ``c_f`` for ``h^3`` and the arithmetic mean ``h_f`` for the
+Couette flux of eq 8, whose time term sits at the cell centre.  The averages (eqs 13-16)
+are face averages of the fluxes, ``A[i, j] = <c_f (delta_ij + D_i chi_{j+2})>``, which keeps
+``A`` exactly symmetric.  One pixel is pinned (chi = 0).
 
-    flux of chi_2 through an x1 face = c_f ((chi_2[i+1] - chi_2[i]) / dx1 + 1),
-
-with the face conductance ``c_f`` for ``h^3`` and the arithmetic mean ``h_f`` for the Couette
-flux of eq 8, whose time term sits at the cell centre.  Averages (eqs 13-16) are face
-averages of the fluxes: ``A[i, j] = <c_f (delta_ij + D_i chi_{j+2})>`` over the faces normal
-to x_i, which keeps ``A`` exactly symmetric.  One pixel is pinned (chi = 0).
-
-Face conductance (``face=``).  The flux through a face is the face integral of
-``h^3 (d chi / dn + ...)`` with the central difference of chi constant along the face.
-``"bilinear"`` (default) integrates ``h^3`` exactly along the face for the bilinear gap
-through the pixel centres, the gap the FE path interpolates: from the face centre
-``m0 = (h_P + h_E) / 2`` the gap varies linearly to the corners
-``(h_P + h_E + h_N + h_NE) / 4`` (and likewise to the south), and the mean of the cube of a
-linear function from ``a`` to ``b`` is ``(a + b)(a^2 + b^2) / 4``.  ``"arithmetic"`` is the
-two-point mean ``(h_P^3 + h_E^3) / 2``.  Both are second order for a smooth gap; they differ
-where contact spots (gaps at the 1 nm floor) meet open pixels, where the two-point mean
-leaks flow through the contact.  Measured on sample patch 3 at 256^2 and h0 = 0.15 um (18 %
-contact, one steady step): the bilinear-gap continuum (FE on the gap refined 4x) has
-A11 = 0.0331; FE gives 0.0337, FVM ``"bilinear"`` 0.0336, FVM ``"arithmetic"`` 0.0355.
-"""
+Face conductance (``face=``): ``"bilinear"`` (default) integrates ``h^3`` exactly along the
+face for the bilinear gap through the pixel centres (the FE path's gap; the mean cube of a
+linear function from ``a`` to ``b`` is ``(a + b)(a^2 + b^2) / 4``); ``"arithmetic"`` is the
+two-point mean ``(h_P^3 + h_E^3) / 2``, which leaks flow where contact spots meet open
+pixels (docs/accuracy.md, "Design choices, measured")."""
 
 from __future__ import annotations
 

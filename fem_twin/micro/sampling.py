@@ -1,28 +1,17 @@
 """Adaptive choice of the separations h0 at which the cell problems are solved.
 
 The macro scale reads the flow factors between the computed separations by monotone cubic
-interpolation in ``log h0`` (:meth:`FlowFactors.at`), and the factors are smooth in
-``log h0`` over most of the paper's range, so most of its 100 fixed values add nothing the
-interpolant does not already give.  Here the separations are a subset of a dense candidate
-set (default: the paper's 100 values): a coarse start bisected once, then, while the
-interpolant through all the other points misses a point by more than a relative tolerance
-(leave one out), the gaps on either side of that point are bisected, down to neighbouring
-candidates at most.
-
-A point left out doubles the spacing around it, so its miss overestimates the error of the
-final interpolant between the points (by about 4x where the factors are smooth, 2x at a
-kink): the largest miss over the points next to skipped candidates is the error estimate,
-the error check against a denser sample.  Misses are relative to the local value, floored
-at ``FLOOR`` times the largest magnitude over the range, so a factor that vanishes at one
-end of the range (``p_con`` out of contact) is not refined where it is negligible; ``d1``,
-which corrects the sliding shear of eq 31, is measured against that term.
-
-A miss within ``JITTER`` times the time-sampling error (``|f_N - f_N/2|``, the estimate of
-:mod:`fem_twin.micro.estimate`) of the point or a neighbour is not a reason to refine: in
-contact the factors jitter from one separation to the next as pixels enter contact between
-instants (``d1`` by 2-3 % on a 128^2 cell at 16 steps), and a denser h0 sample only
-resolves that jitter, which is error of the time average, not information.
-"""
+interpolation in ``log h0`` (:meth:`FlowFactors.at`), so the separations are a subset of a
+dense candidate set (default: the paper's 100 values): a coarse start bisected once, then,
+while the interpolant through the other points misses a point by more than the relative
+tolerance (leave one out), the gaps on either side of it are bisected, down to
+neighbouring candidates.  The largest miss next to skipped candidates is the error
+estimate (it overstates the final interpolant's error, by 2-4x).  Misses are relative to
+the local value, floored at ``FLOOR`` times the largest magnitude; a miss within
+``JITTER`` times the time-sampling error of the point or a neighbour
+(:mod:`fem_twin.micro.estimate`) is not refined: in contact the factors jitter between
+separations as pixels enter contact between instants, which is error of the time average,
+not information (docs/accuracy.md, "Flow factors")."""
 
 from __future__ import annotations
 

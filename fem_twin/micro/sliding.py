@@ -1,21 +1,16 @@
 """One sliding pass of a roughness cell at one separation: contact, squeeze term and the
 three cell problems at each instant, and their time average (paper eqs 8-16).
 
-The pin is at rest and the disk moves at ``U = 2 u_m``: one pass over the period ``L_r1``
-in ``N_t`` instants, the disk patch shifted by ``L_r1 / N_t`` each.  The gap is ``h = h0 +
-z_up(x1 - U t, x2) - z_low + w`` with the contact deformation ``w``, so the time term of
-eq 8 is exactly ``tau = (1 / u_m) dh/dt = -2 d z_up / dx1 + (1 / u_m) dw/dt``, free of u_m;
+The disk moves at ``U = 2 u_m`` over the pin at rest: one pass over the period ``L_r1`` in
+``N_t`` instants.  With ``h = h0 + z_up(x1 - U t, x2) - z_low + w`` the time term of eq 8 is
+exactly ``tau = (1 / u_m) dh/dt = -2 d z_up / dx1 + (1 / u_m) dw/dt``;
 ``time_derivative="exact"`` (default) evaluates it at every instant (``dw/dt`` from the
-contact problem's tangent), leaving only the trapezoidal rule of a periodic time average.
-The paper's implicit Euler (``"backward"``) is first order in ``1 / N_t``.
-
-Frames (``moving``): the disk's frame (``"lower"``) gives ``A' = A``, ``C' = C``, ``b' =
-2 e1 - b``, ``d' = -d`` (tested); the mean-speed frame (``"both"``, the default: the disk
-at ``+U/2``, the pin at ``-U/2``) has no Couette term in eq 8, so the spurious pressure the
-pin's frame leaves at contact edges (its Couette and squeeze terms cancel only to the grid
-error) does not arise; its factors are the pin frame's exactly (:mod:`.rolling`).
-docs/rolling_sliding.md has the measurements.
-"""
+contact's tangent), leaving only the trapezoidal rule of a periodic average; the paper's
+implicit Euler (``"backward"``) is first order in ``1 / N_t``.  Frames (``moving``): the
+disk's (``"lower"``) gives ``A' = A``, ``C' = C``, ``b' = 2 e1 - b``, ``d' = -d``; the
+mean-speed frame (``"both"``, default) has no Couette term in eq 8, so the spurious pressure
+the pin's frame leaves at contact edges does not arise, and its factors are the pin frame's
+exactly (:mod:`.rolling`; measurements in docs/rolling_sliding.md)."""
 
 from __future__ import annotations
 

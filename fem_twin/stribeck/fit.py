@@ -1,25 +1,17 @@
 """Fitting the twin's unknowns to measured Stribeck curves, with 95 % intervals.
 
-Parameters, by their case-file keys; none re-runs the micro stage:
+Parameters, by their case-file keys (none re-runs the micro stage): ``boundary_friction``,
+C_f,b of eq 32, from a simulated curve's force parts; ``temperature``, one oil temperature
+per curve through the case's Walther law, the simulated curve at ``mu_S`` giving the one at
+``mu`` at the speeds ``U mu / mu_S`` (the Hersey collapse, eq 46); ``load_share``, the pin
+face's share of the load, the first viscosity swept at :data:`LOAD_SHARES`;
+``bulk_resistance``, the thermal twin's R_b [K/W], every curve swept at
+:data:`RESISTANCES` (both interpolated by PCHIP, per speed).
 
-``boundary_friction``
-    C_f,b of eq 32: C_f = (F_hd + C_f,b F_con) / F_N from a simulated curve's force parts.
-``temperature``
-    one oil temperature per curve [C] through the case's Walther law; the simulated curve
-    at ``mu_S`` gives the one at ``mu`` at the speeds ``U mu / mu_S`` (the Hersey collapse,
-    eq 46: 0.1 % C_f,b isothermal, about 1 % with the thermal twin's heating).
-``load_share``
-    the pin face's share of the imposed load: the first viscosity swept at
-    :data:`LOAD_SHARES`, C_f interpolated (PCHIP in the share, per speed).
-``bulk_resistance``
-    the thermal twin's R_b [K/W]: every curve swept at :data:`RESISTANCES`, C_f
-    interpolated (PCHIP in R_b, per speed).
-
-Least squares on C_f,dev (eq 35) at the measured speeds (PCHIP in log speed).  Weights:
+Least squares on C_f,dev (eq 35) at the measured speeds (PCHIP in log speed), weighted by
 ``sigma = (cf_max - cf_min) / 1.693`` where the measured CSV gives its scatter, else equal
 weights with the HC3 covariance (:func:`_covariance`); intervals ``t_{0.975, n - p}`` times
-its diagonal's root.
-"""
+its diagonal's root."""
 
 from __future__ import annotations
 
