@@ -232,7 +232,7 @@ def validate(args):
     plot_stribeck([curve], png,
                   labels=[f"simulated, $\\mu_0$ = {curve.viscosity:g} Pa s"],
                   reference=(measured.speed, measured.friction_coefficient, band),
-                  boundary=boundary)
+                  boundary_friction=boundary)
     write_csv(table, {"speed_m_s": measured.speed, "measured_cf": measured.friction_coefficient,
                       "cf_dev": dev})
     inside = np.isfinite(dev)

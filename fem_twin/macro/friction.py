@@ -80,10 +80,10 @@ def face_slope(gap, face, dx1: float) -> np.ndarray:
     return np.where(face, slope / dx1, 0.0)
 
 
-@arguments(contact_pressure="numbers", coefficient="number")
-def boundary_shear(contact_pressure, coefficient: float = BOUNDARY_FRICTION) -> np.ndarray:
+@arguments(contact_pressure="numbers", boundary_friction="number")
+def boundary_shear(contact_pressure, boundary_friction: float = BOUNDARY_FRICTION) -> np.ndarray:
     """tau_con = C_f,b p_con of eq 32 [Pa], where the surfaces slide (u_r > 0): a pure
     rolling contact has none (the operating point applies it only then; the creep of
     partial slip at small slide-to-roll ratios is not modelled, so any sliding gives the
     whole of it)."""
-    return coefficient * np.asarray(contact_pressure, float)
+    return boundary_friction * np.asarray(contact_pressure, float)

@@ -250,7 +250,7 @@ def plot_curves(case: Case, curves, band, out: RunLayout,
     tr = case.tribometer
     for x in ("speed", "hersey"):
         writers.write(plot_stribeck, curves, out.stribeck_png(x), x=x,
-                     labels=curve_labels(case, curves), boundary=tr.boundary_friction,
+                     labels=curve_labels(case, curves), boundary_friction=tr.boundary_friction,
                      bands=band, measured=measured, diameter=hersey_length(case),
                      load=tr.load, speed_label=("entrainment speed $u_m$ [m/s], SRR "
                                                 f"{tr.slide_to_roll:g}" if tr.ball else

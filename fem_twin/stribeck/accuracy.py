@@ -19,16 +19,16 @@ from ..macro.estimate import PARTS
 log = logging.getLogger("fem_twin")
 
 
-def error_summary(curves, boundary: float, tolerance: float) -> dict:
+def error_summary(curves, boundary_friction: float, tolerance: float) -> dict:
     """The largest estimated C_f error of ``curves`` over C_f,b, in total and per part, and
     the number of points above ``tolerance`` (a fraction of C_f,b), with a logged warning
     naming the worst one."""
     def largest(values):
-        values = np.concatenate(values) / boundary
+        values = np.concatenate(values) / boundary_friction
         return float(np.nanmax(values)) if np.isfinite(values).any() else float("nan")
 
-    above = [(e / boundary, c.viscosity, u) for c in curves
-             for u, e in zip(c.speed, c.friction_error) if e > tolerance * boundary]
+    above = [(e / boundary_friction, c.viscosity, u) for c in curves
+             for u, e in zip(c.speed, c.friction_error) if e > tolerance * boundary_friction]
     if above:
         worst = max(above)
         log.warning("C_f: estimated discretisation error above %.2g %% of C_f,b at %d of %d "

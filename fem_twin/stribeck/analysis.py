@@ -45,8 +45,8 @@ def transition_speeds(curves, step: float) -> np.ndarray:
     return np.unique(np.round(extra, 12))
 
 
-def hersey_collapse(curves, boundary: float = BOUNDARY_FRICTION) -> float:
-    """``max |C_f,dev|`` (eq 35, relative to ``boundary`` = C_f,b) between the first curve and
+def hersey_collapse(curves, boundary_friction: float = BOUNDARY_FRICTION) -> float:
+    """``max |C_f,dev|`` (eq 35, relative to ``boundary_friction`` = C_f,b) between the first curve and
     the others over the Hersey numbers where they overlap (the others' points, interpolated
     on the first curve)."""
     ref = curves[0]
@@ -55,5 +55,5 @@ def hersey_collapse(curves, boundary: float = BOUNDARY_FRICTION) -> float:
         cf_ref = ref.at_hersey(c.hersey)
         ok = np.isfinite(cf_ref)
         devs.extend(np.abs(friction_deviation(c.friction_coefficient[ok], cf_ref[ok],
-                                              boundary)))
+                                              boundary_friction)))
     return float(max(devs)) if devs else float("nan")

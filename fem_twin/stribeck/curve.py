@@ -46,10 +46,10 @@ def hersey_number(viscosity, speed, diameter: float, load: float):
     return np.asarray(viscosity) * np.asarray(speed) * diameter / load
 
 
-@arguments(cf="numbers", cf_ref="numbers", boundary="number")
-def friction_deviation(cf, cf_ref, boundary: float = BOUNDARY_FRICTION):
+@arguments(cf="numbers", cf_ref="numbers", boundary_friction="number")
+def friction_deviation(cf, cf_ref, boundary_friction: float = BOUNDARY_FRICTION):
     """C_f,dev = (C_f - C_f,ref) / C_f,b of eq 35 [-]."""
-    return (np.asarray(cf) - np.asarray(cf_ref)) / boundary
+    return (np.asarray(cf) - np.asarray(cf_ref)) / boundary_friction
 
 
 @dataclass(frozen=True, eq=False)
@@ -190,13 +190,13 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
 
 @arguments(curves=[StribeckCurve], path="path")
 def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None,
-                  boundary: float = BOUNDARY_FRICTION, bands=None, measured=None,
+                  boundary_friction: float = BOUNDARY_FRICTION, bands=None, measured=None,
                   diameter: float = 8e-3, load: float = 150.0,
                   speed_label: str = "sliding speed $U$ [m/s]") -> Path:
     """C_f versus sliding speed (``x="speed"``) or Hersey number (``"hersey"``), log x.
 
     ``reference``: optional measured curve ``(x values, C_f, optional (low, high) band)``;
-    ``boundary``: C_f,b of eq 32, drawn as the boundary-friction limit; ``bands``: optional
+    ``boundary_friction``: C_f,b of eq 32, drawn as the boundary-friction limit; ``bands``: optional
     ``(cf_min, cf_max)`` per curve, drawn as a shaded band (the patch scatter, Figure 13);
     ``measured``: optional :class:`MeasuredCurve` (or None) per curve, drawn on top in the
     curve's colour; a curve's ``friction_error`` is drawn as error bars (capped, distinct
@@ -224,9 +224,9 @@ def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None
         ax.plot(reference[0], reference[1], "k--", label="measured")
         if len(reference) > 2 and reference[2] is not None:
             ax.fill_between(reference[0], *reference[2], color="0.8", label="scatter")
-    ax.axhline(boundary, color="0.4", lw=1.0, ls=":",
-               label=f"boundary friction $C_{{f,b}}$ = {boundary:g} (eq 32)")
-    ax.set_ylim(0, 1.15 * boundary)
+    ax.axhline(boundary_friction, color="0.4", lw=1.0, ls=":",
+               label=f"boundary friction $C_{{f,b}}$ = {boundary_friction:g} (eq 32)")
+    ax.set_ylim(0, 1.15 * boundary_friction)
     ax.set_xscale("log")
     ax.set_xlabel(speed_label if x == "speed" else
                   "Hersey number $H = \\mu_0 U D / F_N$ [-] (eq 46)")
@@ -313,9 +313,9 @@ def read_measured_csv(path, unit: str = "m/s") -> MeasuredCurve:
     return MeasuredCurve(speed, cf, low if band else None, high if band else None)
 
 
-@arguments(curve=StribeckCurve, measured=MeasuredCurve, boundary="number")
+@arguments(curve=StribeckCurve, measured=MeasuredCurve, boundary_friction="number")
 def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve,
-                            boundary: float = BOUNDARY_FRICTION):
+                            boundary_friction: float = BOUNDARY_FRICTION):
     """C_f,dev (eq 35) of the simulated curve against the measured one, at the measured
     speeds inside the simulated range (PCHIP in log speed); NaN outside it."""
     from scipy.interpolate import PchipInterpolator
@@ -324,5 +324,5 @@ def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve,
     u = np.log(measured.speed)
     inside = (u >= x[0]) & (u <= x[-1])
     sim = PchipInterpolator(x, curve.friction_coefficient[order])(np.clip(u, x[0], x[-1]))
-    return np.where(inside, friction_deviation(sim, measured.friction_coefficient, boundary),
+    return np.where(inside, friction_deviation(sim, measured.friction_coefficient, boundary_friction),
                     np.nan)

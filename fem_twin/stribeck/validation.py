@@ -9,8 +9,8 @@ from ..io.table import write_csv
 from .curve import deviation_from_measured, plot_stribeck, read_measured_csv
 
 
-def validate_curves(curves, measured, boundary: float, labels, table, plot_of) -> list:
-    """C_f,dev (eq 35, relative to ``boundary`` = C_f,b) of each simulated curve against its
+def validate_curves(curves, measured, boundary_friction: float, labels, table, plot_of) -> list:
+    """C_f,dev (eq 35, relative to ``boundary_friction`` = C_f,b) of each simulated curve against its
     measured CSV (``measured``: a path or None per curve); all rows into the CSV ``table``,
     one plot per curve at ``plot_of(viscosity)``.  Returns ``max |C_f,dev|`` per curve."""
     rows, result = [], []
@@ -18,12 +18,12 @@ def validate_curves(curves, measured, boundary: float, labels, table, plot_of) -
         if path is None:
             continue
         m = read_measured_csv(path)
-        dev = deviation_from_measured(curve, m, boundary)
+        dev = deviation_from_measured(curve, m, boundary_friction)
         rows += [(curve.viscosity, u, cf, d) for u, cf, d in
                  zip(m.speed, m.friction_coefficient, dev)]
         band = None if m.low is None else (m.low, m.high)
         plot_stribeck([curve], plot_of(curve.viscosity), labels=[label],
-                      reference=(m.speed, m.friction_coefficient, band), boundary=boundary)
+                      reference=(m.speed, m.friction_coefficient, band), boundary_friction=boundary_friction)
         result.append({"viscosity_Pa_s": curve.viscosity, "measured": str(path),
                        "max_abs_cf_dev": float(np.nanmax(np.abs(dev)))})
     write_csv(table, dict(zip(("viscosity_Pa_s", "speed_m_s", "measured_cf", "cf_dev"),
