@@ -27,7 +27,7 @@ from .micro import FlowFactors
 from .micro.sampling import adaptive_separations
 from .micro.sliding import factors_from_moments
 from .micro.store import load_point
-from .stribeck.sweep import LEVEL_OF, point_files, point_key, point_meta
+from .stribeck.sweep import GUIDED_BY, LEVEL_OF, point_files, point_key, point_meta
 
 
 @dataclass(frozen=True)
@@ -96,10 +96,11 @@ def _seconds(moments) -> float:
 
 
 def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task]:
-    """The sweeps of the macro scale: first passes, then the refinements, then the band's
-    (the nested levels the main points kept for the band are part of those points)."""
+    """The sweeps of the macro scale: the first passes (a guide's chain, then each of its
+    points a task; or a sweep as one chain), then the refinement's, then the band's (the
+    nested levels the main points kept for the band are part of those points)."""
     first = np.asarray(case.sweep.speeds, float)
-    sweeps = defaultdict(list)
+    chains, points = defaultdict(list), []
     for path in point_files(out.points):
         scalars, meta = point_meta(path)
         if LEVEL_OF in meta:
@@ -107,19 +108,26 @@ def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task
         speed = meta.get("entrainment") if case.tribometer.ball else scalars["speed"]
         seconds = sum(meta.get(k, 0.0) for k in ("seconds", "seconds_coarse",
                                                    "seconds_estimate", "seconds_thermal"))
-        sweeps[point_key(path)].append((speed, seconds, "error_estimate" in meta))
-    main = {k: v for k, v in sweeps.items() if any(e for _, _, e in v)}
-    split = {}
-    for key, points in main.items():
-        mine = np.isclose([u for u, _, _ in points], first[:, None], rtol=1e-9).any(axis=0)
-        split[key] = [sum(s for (_, s, _), m in zip(points, mine) if m == want)
-                      for want in (True, False)]
-    passes = [Task(f"sweep {key}", s[0], micro) for key, s in split.items()]
-    refined = [Task(f"refinement {key}", s[1], tuple(t.name for t in passes))
-               for key, s in split.items()]
-    band_after = tuple(t.name for t in (refined if case.sweep.refine else passes))
-    return passes + refined + [Task(f"band sweep {key}", sum(s for _, s, _ in v), band_after)
-                               for key, v in sweeps.items() if key not in main]
+        if GUIDED_BY in meta:
+            points.append((point_key(path), speed, seconds, meta[GUIDED_BY]))
+        else:
+            chains[point_key(path)].append((speed, seconds, "error_estimate" in meta))
+    guides = {g for *_, g in points}
+    main = {k: v for k, v in chains.items() if k in guides or any(e for _, _, e in v)}
+    in_first = lambda u: bool(np.isclose(u, first, rtol=1e-9).any())  # noqa: E731
+    passes = [Task(f"sweep {k}", sum(s for u, s, _ in v if in_first(u)), micro)
+              for k, v in main.items()]
+    ahead = [Task(f"point {k} {u:.9e}", s, (f"sweep {g}",))
+             for k, u, s, g in points if in_first(u)]
+    done = tuple(t.name for t in passes + ahead)
+    refined = [Task(f"refinement {k}", sum(s for u, s, _ in v if not in_first(u)), done)
+               for k, v in main.items()]
+    later = [Task(f"point {k} {u:.9e}", s, (f"refinement {g}",))
+             for k, u, s, g in points if not in_first(u)]
+    band_after = tuple(t.name for t in refined + later) if case.sweep.refine else done
+    return passes + ahead + refined + later + [
+        Task(f"band sweep {k}", sum(s for _, s, _ in v), band_after)
+        for k, v in chains.items() if k not in main]
 
 
 def makespan(tasks, workers: int) -> float:

@@ -49,13 +49,14 @@ def solve_nested(gap, spacing, factors, *, previous: tuple[MixedResult, ...] = (
     (:data:`~fem_twin.macro.mixed.COARSE_START`), finest first: ``(point, coarse, ...)``.
 
     ``previous``: the last point's levels as this returned them (empty for a cold point; a
-    point reloaded from its checkpoint without its levels: ``(point,)``); ``point`` the
-    other arguments of :func:`~fem_twin.macro.solve_mixed` (``load``, ``speed``,
-    ``lubricant``, ...).  Each level starts from the previous point's same level moved by
-    the change one level down (the full approximation scheme, recursively): only the
-    coarsest grid iterates the whole speed change (sample pin at 2048^2, warm point: the
-    1024^2 level took 30 iterations from the previous point alone).  A level whose solve
-    fails leaves the finer ones to start from ``previous`` alone, and is left out."""
+    point reloaded from its checkpoint without its levels: ``(point,)``), or a guide: this
+    point solved on a coarser grid, which starts that level, the finer ones each from the
+    coarser level's solution as in a cold point.  ``point``: the other arguments of
+    :func:`~fem_twin.macro.solve_mixed` (``load``, ``speed``, ``lubricant``, ...).  Each
+    level starts from the previous point's same level moved by the change one level down
+    (the full approximation scheme, recursively): only the coarsest grid iterates the whole
+    speed change.  A level whose solve fails leaves the finer ones to start from
+    ``previous`` alone, and is left out."""
     return _levels(gap, spacing, factors, tuple(previous), face, point)[0]
 
 
@@ -66,22 +67,24 @@ def _levels(gap, spacing, factors, previous, face, point):
                                        initial=_last(previous), **point)
         return (result,), secants
     gap2, spacing2, face2 = coarsened(gap, spacing, face)
+    guide = bool(previous) and min(previous[0].pressure.shape) < min(np.shape(gap))
     try:
-        levels, secants = _levels(gap2, spacing2, factors, previous[1:] or previous[:1],
+        levels, secants = _levels(gap2, spacing2, factors,
+                                  previous if guide else previous[1:] or previous[:1],
                                   face2, point)
     except MixedNotConverged:
         result, secants = seeded_point(gap, spacing, factors, face=face,
                                        initial=_last(previous), **point)
         return (result,), secants
     coarse = levels[0]
-    if not previous:
+    if not previous or guide:
         start = coarse
     elif len(previous) > 1 and previous[1].pressure.shape == coarse.pressure.shape:
         start = _film_from(coarse, corrected(previous[0], previous[1], coarse))
     else:
         start = previous[0]
     result, own = seeded_point(gap, spacing, factors, face=face, initial=start,
-                               secants=None if previous else secants, **point)
+                               secants=secants if guide or not previous else None, **point)
     return (result, *levels), own
 
 

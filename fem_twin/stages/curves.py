@@ -28,7 +28,7 @@ from ..stribeck.validation import validate_curves
 from .geometry import ball_contact, hersey_length
 from .provenance import provenance
 from .requests import per_viscosity, sweep_request
-from .sweeps import run_sweeps
+from .sweeps import guide_of, run_sweeps
 
 log = logging.getLogger("fem_twin")
 
@@ -300,7 +300,9 @@ def _attributes(case: Case) -> dict:
 
 def _prune_points(folder: Path, tasks) -> None:
     """Remove the Stribeck checkpoints of no current sweep or guide (changed inputs)."""
-    keys = {task.key for task in tasks} | {task.guide for task in tasks}
+    guides = [guide_of(task) for task in tasks]
+    keys = ({task.key for task in tasks} | {task.guide for task in tasks}
+            | {guide.key for guide in guides if guide is not None})
     stale = [p for p in point_files(folder) if point_key(p) not in keys]
     for p in stale:
         p.unlink()

@@ -1,5 +1,5 @@
-"""The Stribeck sweeps of a stage as tasks: serial, or chains of speeds on a pool of
-workers (local processes or Dask), largest first."""
+"""The Stribeck sweeps of a stage as tasks: serial, or on a pool of workers (local processes
+or Dask), largest first: a sweep's points each a task after its guide, or chains of speeds."""
 
 from __future__ import annotations
 
@@ -9,9 +9,10 @@ from dataclasses import replace
 import numpy as np
 from tqdm import tqdm
 
+from ..macro.nested import nested_levels
 from ..stribeck import stribeck_sweep
 from ..stribeck.curve import joined
-from ..stribeck.sweep import point_files, point_key
+from ..stribeck.sweep import point_file, point_files, point_key
 from ..numerics.threads import worker_heap
 
 #: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH (the resolution
@@ -21,30 +22,76 @@ COST_GROWTH = 1.35
 
 
 def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points"):
-    """The sweep requests ``tasks``: serial, or in process tasks on ``executor``.
+    """The sweep requests ``tasks``, serial or as process tasks on ``executor``; their curves
+    in the order of ``tasks``.
 
-    In parallel a sweep that costs more than a worker's even share (:func:`chains`) is cut
-    into chains of consecutive speeds, each started cold, so that the resolution study's
-    1997^2 sweep runs on both cores instead of alone on one; the chains are submitted
-    largest first, and the bar counts the finished points of all sweeps (their checkpoint
-    files, written as each point finishes in its worker).  The curves come back in the
-    order of ``tasks``, each one's chains joined."""
-    pieces = [] if executor is None else chains(tasks, getattr(executor, "n_workers", 1))
-    if len(pieces) <= 1:
-        return [_sweep_task((task, progress)) for task in tasks]
-    order = sorted(range(len(pieces)), key=lambda j: -_cost(pieces[j][1]))
-    submitted = {j: executor.submit(_sweep_task, (pieces[j][1], False)) for j in order}
-    futures = [submitted[j] for j in range(len(pieces))]
-    total = sum(task.speeds.size for task in tasks)
-    keys = {task.key for task in tasks if task.factors_key}
-    folder = tasks[0].checkpoint
+    A checkpointed sweep without a guide runs as guided points: first its guide
+    (:func:`guide_of`, a chain on the coarsest nested grid), then every speed a task of its
+    own, started from the guide's point there (``solve_nested``'s guide), then its curve
+    read back from the checkpoints (with its fields, in this process).  The others run as
+    chains of speeds (:func:`chains`): a band sweep, each point warm from its previous one
+    and its guide's change (a band point from its guide alone can take ten times as long in
+    the mixed regime), a sweep without checkpoints or coarser levels.  Tasks go largest
+    first; the work is the same whatever the workers, so the curves do not depend on them."""
+    guides = [guide_of(task) for task in tasks]
+    workers = 1 if executor is None else getattr(executor, "n_workers", 1)
+    unguided = [i for i, guide in enumerate(guides) if guide is None]
+    pieces = chains([tasks[i] for i in unguided], workers)     # (index in unguided, piece)
+    leading = [g for g in guides if g is not None]
+    swept = _run(leading + [piece for _, piece in pieces], executor, progress,
+                 desc)[len(leading):]
+    _run([point for i, (task, guide) in enumerate(zip(tasks, guides)) if i not in unguided
+          for point in guided_points(task, guide.key)],
+         executor, progress, desc)
+    own = {}
+    for (j, _), curve in zip(pieces, swept):
+        own.setdefault(unguided[j], []).append(curve)
+    return [joined(own[i]) if i in own else stribeck_sweep(task)   # from the checkpoints
+            for i, task in enumerate(tasks)]
+
+
+def guide_of(request):
+    """The guide of a checkpointed ``request`` without one: the same sweep on the coarsest
+    nested grid (:func:`~fem_twin.macro.nested.nested_levels`), a chain of warm-started
+    points, without estimates or fields; None where the grid has no coarser level."""
+    levels = nested_levels(request.gap.shape)
+    if request.checkpoint is None or request.guide is not None or levels == 0:
+        return None
+    return replace(request.coarsened(levels), error_estimate=False, fields=None,
+                   keep_level=0)
+
+
+def guided_points(request, guide: str) -> list:
+    """Each speed of ``request`` not yet checkpointed as a sweep of its own, started from
+    the point there of the sweep ``guide`` (its key); a kept level that is the guide's is
+    the guide's own point."""
+    keep = 0 if request.level_key(request.keep_level) == guide else request.keep_level
+    key = request.key
+    return [replace(request, speeds=request.speeds[i:i + 1], guide=guide, fields=None,
+                    keep_level=keep) for i in range(request.speeds.size)
+            if not point_file(request.checkpoint, key, request.speeds[i]).exists()]
+
+
+def _run(requests, executor, progress: bool, desc: str) -> list:
+    """The sweeps ``requests``, serial or on ``executor`` largest first (:func:`_cost`); the
+    bar counts their finished points (checkpoint files, written as each point finishes)."""
+    if executor is None or len(requests) <= 1:
+        if len(requests) == 1:
+            return [_sweep_task((requests[0], progress))]
+        return [_sweep_task((r, False)) for r in tqdm(requests, desc=desc, unit="task",
+                                                      disable=not progress)]
+    order = sorted(range(len(requests)), key=lambda j: -_cost(requests[j]))
+    submitted = {j: executor.submit(_sweep_task, (requests[j], False)) for j in order}
+    futures = [submitted[j] for j in range(len(requests))]
+    total = sum(r.speeds.size for r in requests)
+    keys = {r.key for r in requests if r.factors_key and r.checkpoint is not None}
+    folders = {r.checkpoint for r in requests if r.checkpoint is not None}
     with tqdm(total=total, desc=desc, unit="point", disable=not progress) as bar:
         while wait(futures, timeout=0.5).not_done:            # the bar, twice a second
-            if folder is not None and keys:                   # points finished so far
-                bar.update(sum(point_key(p) in keys for p in point_files(folder)) - bar.n)
+            done = sum(point_key(p) in keys for f in folders for p in point_files(f))
+            bar.update(min(done, total) - bar.n)
         bar.update(total - bar.n)
-    return [joined([f.result() for (i, _), f in zip(pieces, futures) if i == task])
-            for task in range(len(tasks))]
+    return [f.result() for f in futures]
 
 
 def chains(tasks, workers: int) -> list:

@@ -31,6 +31,9 @@ LEVEL_OF = "level_of"
 #: separation (:meth:`~fem_twin.macro.MixedResult.contact_load_below`), read without the
 #: point's fields by the run's range check
 LOAD_BELOW = "load_share_below_h0_min"
+#: the ``meta`` entry of a point solved as a task of its own, started from its guide's point
+#: (``stages.sweeps.guided_points``): the guide's key, which the run's task graph reads
+GUIDED_BY = "guided_by"
 
 
 def point_file(folder, key: str, speed: float) -> Path:
@@ -114,8 +117,11 @@ class _Point:
         """The levels of the point at ``speed`` warm from ``start``, checkpointed at
         ``path`` with its coarse C_f, and its level ``keep = (folder, key, level,
         sweep key)`` kept for a guided sweep."""
-        res, *coarser = _solve_point(self.request, speed, start)
-        meta = {LOAD_BELOW: res.contact_load_below(self.request.factors.h0[0])}
+        r = self.request
+        res, *coarser = _solve_point(r, speed, start)
+        meta = {LOAD_BELOW: res.contact_load_below(r.factors.h0[0])}
+        if r.guide is not None and r.speeds.size == 1:          # a task of its own
+            meta[GUIDED_BY] = r.guide
         if coarser:
             meta.update({COARSE_CF: [c.friction_coefficient for c in coarser],
                          "seconds_coarse": coarser[0].meta["seconds"]})
