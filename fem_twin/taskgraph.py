@@ -2,41 +2,32 @@
 
 Each task is timed as it ran: per patch pair, rounds of separations h0 (the adaptive
 sampler asks for a round only after the previous one; each h0 a task), then the coarsened
-cell's pass of the grid-error estimate; after every patch, one sweep per viscosity (a chain
-of warm-started points: one task of its points' solve, nested coarse solve, error estimate
-and a thermal run's earlier iterations), the refinement's added speeds, and the patch
-band's sweeps (which start from the main points' nested solves).  The rounds are replayed
-from the checkpoints (the sampler is deterministic).  :func:`makespan` schedules the graph
-greedily on ``workers`` processes, :func:`critical_path` is the bound no number of workers
-beats.  Left out: the geometry, levelling and result writing (serial), and what one-h0
-tasks lose against chunks of several h0, which warm-start contact along them
+cell's pass of the grid-error estimate; after every patch, per viscosity, the sweep's guide
+(one chain of warm-started points on the coarsest grid) and then each of its points (its
+solve, nested coarse solve, error estimate and a thermal run's earlier iterations), the
+refinement's guide and added points, and the patch band's sweeps (chains, which start from
+the guide's points).  The rounds are replayed from the checkpoints (the sampler is
+deterministic).  :func:`~fem_twin.case.schedule.makespan` schedules the graph greedily on
+``workers`` processes, :func:`~fem_twin.case.schedule.critical_path` is the bound no number
+of workers beats.  Left out: the geometry, levelling and result writing (serial), and what
+one-h0 tasks lose against chunks of several h0, which warm-start contact along them
 (docs/performance.md, "How many workers")."""
 
 from __future__ import annotations
 
-import heapq
 from collections import defaultdict
-from dataclasses import dataclass
 
 import numpy as np
 
 from .case import Case
-from .errors import InputError, MissingFile
+from .case.schedule import Task, critical_path, makespan
+from .errors import MissingFile
 from .io.layout import RunLayout
 from .micro import FlowFactors
 from .micro.sampling import adaptive_separations
 from .micro.sliding import factors_from_moments
 from .micro.store import load_point
 from .stribeck.sweep import GUIDED_BY, LEVEL_OF, point_files, point_key, point_meta
-
-
-@dataclass(frozen=True)
-class Task:
-    """One unit of work: its ``name``, measured ``seconds`` and the tasks it waits for."""
-
-    name: str
-    seconds: float
-    after: tuple[str, ...] = ()
 
 
 def run_task_graph(case: Case, outdir) -> list[Task]:
@@ -121,42 +112,15 @@ def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task
              for k, u, s, g in points if in_first(u)]
     done = tuple(t.name for t in passes + ahead)
     refined = [Task(f"refinement {k}", sum(s for u, s, _ in v if not in_first(u)), done)
-               for k, v in main.items()]
-    later = [Task(f"point {k} {u:.9e}", s, (f"refinement {g}",))
+               for k, v in main.items() if k not in guides]
+    refined += [Task(f"refinement {k} {u:.9e}", s, done)              # side by side
+                for k, v in main.items() if k in guides for u, s, _ in v if not in_first(u)]
+    later = [Task(f"point {k} {u:.9e}", s, (f"refinement {g} {u:.9e}",))
              for k, u, s, g in points if not in_first(u)]
     band_after = tuple(t.name for t in refined + later) if case.sweep.refine else done
     return passes + ahead + refined + later + [
         Task(f"band sweep {k}", sum(s for _, s, _ in v), band_after)
         for k, v in chains.items() if k not in main]
-
-
-def makespan(tasks, workers: int) -> float:
-    """Wall time [s] of ``tasks`` on ``workers`` processes, scheduled greedily: the ready
-    task that became ready first (then in submission order) starts on the first free
-    worker."""
-    if workers < 1:
-        raise InputError(f"workers must be at least 1, got {workers}")
-    finish, waiting = {}, list(tasks)
-    free = [0.0] * workers
-    while waiting:
-        ready = [(max((finish[d] for d in t.after), default=0.0), i)
-                 for i, t in enumerate(waiting) if all(d in finish for d in t.after)]
-        if not ready:
-            raise InputError("the task graph has a cycle or an unknown dependency")
-        at, i = min(ready)
-        task = waiting.pop(i)
-        start = max(heapq.heappop(free), at)
-        finish[task.name] = start + task.seconds
-        heapq.heappush(free, finish[task.name])
-    return max(finish.values(), default=0.0)
-
-
-def critical_path(tasks) -> float:
-    """The longest chain of dependent tasks [s]: the wall time on unlimited workers."""
-    done = {}
-    for t in tasks:                               # submission order is topological
-        done[t.name] = t.seconds + max((done[d] for d in t.after), default=0.0)
-    return max(done.values(), default=0.0)
 
 
 #: worker counts of :func:`scaling`'s estimates

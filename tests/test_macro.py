@@ -670,3 +670,45 @@ def test_the_newton_merit_of_an_overflowing_trial_step_is_inf():
     assert merit(ev, (1.0, 1.0, 1e-200)) == np.inf
     ev = SimpleNamespace(R=np.ones(3), G=np.ones(3), L=3.0)
     assert merit(ev, (1.0, 2.0, 1.0)) == pytest.approx(np.sqrt(1 + 0.25 + 9), rel=1e-14)
+
+
+def test_a_sweeps_points_run_in_parallel_from_its_guide(factors, tmp_path):
+    """Issue 62 item 1: a checkpointed sweep runs as its guide (the same sweep on the
+    coarsest nested grid, one warm-started chain) and then every speed as a task of its
+    own, started from the guide's point there.  Into the mixed regime (sample pin 1 at
+    96^2, 0.1 -> 0.02 m/s) its C_f equals the chained sweep's within ten times the coupling
+    tolerance (measured: 1.0e-7 C_f,b at tol 1e-6), bit for bit on one worker and on two, and
+    the run's task graph has each point as a task after the guide: its critical path is the
+    guide and the longest point."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from fem_twin.numerics.threads import executor_for
+    from fem_twin.stages.sweeps import guide_of, run_sweeps
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
+    from fem_twin.stribeck.sweep import GUIDED_BY, point_files, point_meta
+    from fem_twin.taskgraph import critical_path, sweep_tasks
+    gap, dx, face = macro_case(96)
+    speeds = [0.1, 0.05, 0.03, 0.02]
+    request = SweepRequest(gap, dx, factors, speeds, load=150.0, lubricant=Lubricant(0.066),
+                           face=face, settings=MacroSettings(tol=TIGHT),
+                           checkpoint=tmp_path / "one", factors_key="average")
+    chained = stribeck_sweep(replace(request, checkpoint=None))
+    guide = guide_of(request)
+    assert guide.gap.shape == (48, 48)
+    one, = run_sweeps([request], None, progress=False)
+    assert np.abs(one.friction_coefficient - chained.friction_coefficient).max() < (
+        10 * TIGHT * BOUNDARY_FRICTION)
+    with executor_for(2) as pool:
+        two, = run_sweeps([replace(request, checkpoint=tmp_path / "two")], pool,
+                          progress=False)
+    assert np.array_equal(one.friction_coefficient, two.friction_coefficient)
+    metas = [point_meta(p)[1] for p in point_files(tmp_path / "one", request.key)]
+    assert len(metas) == 4 and all(m[GUIDED_BY] == guide.key for m in metas)
+    case = SimpleNamespace(sweep=SimpleNamespace(speeds=np.array(speeds), refine=0),
+                           tribometer=SimpleNamespace(ball=False))
+    tasks = sweep_tasks(case, SimpleNamespace(points=tmp_path / "one"), ())
+    lead = next(t for t in tasks if t.name == f"sweep {guide.key}")
+    points = [t for t in tasks if t.name.startswith("point")]
+    assert len(points) == 4 and all(t.after == (lead.name,) for t in points)
+    assert critical_path(tasks) == pytest.approx(lead.seconds + max(t.seconds for t in points))

@@ -27,6 +27,7 @@ class Scheduled:
     fields: str | None = None
     factors_key: str | None = None
     checkpoint: str | None = None
+    guide: str | None = None
 
 
 def small_sweep():

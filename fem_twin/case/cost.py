@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import math
 
+from .schedule import Task, makespan
+
 #: a warm Stribeck point of a pin at 128^2 [s], its growth with the pixels, and the cost of
 #: a main-curve point with its C_f error estimate in plain points
 POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 1.38, 0.7, 1.28
@@ -22,8 +24,12 @@ BAND_POINT_COST = {"coarse": 0.14, "full": 0.54}
 #: a band point on a grid coarsened once more, against one on the grid before
 BAND_LEVEL_COST = 0.33
 #: the Stribeck stage of the thermal twin (``[thermal] model = "flash"``) against the
-#: isothermal one: each point iterates its film temperature (2-5 warm solves)
+#: isothermal one: each point iterates its film temperature (from its guide's)
 THERMAL_COST = 1.5
+#: a guide point (the sweep on its coarsest nested grid, warm-started) in points
+GUIDE_COST = 0.15
+#: rounds of the adaptive h0 sampler per patch pair (a start, bisection, refinement)
+H0_ROUNDS = 3
 #: micro stage cost per cell pixel, time step and separation on one core [s] (the cell
 #: problems, the periodic contact and the coarsened cell of the error estimate)
 MICRO_SECONDS = 3.5e-6
@@ -34,32 +40,67 @@ ADAPTIVE_H0 = (5.5, 2.7)
 
 def estimated_seconds(case, cores: int = 2) -> float:
     """Rough wall time of ``fem-twin run`` of ``case`` (a :class:`~fem_twin.case.Case`) on
-    ``cores`` cores of the calibration machine [s]: the micro stage at ``MICRO_SECONDS``
-    per cell pixel, step and separation on one core, and one sweep per viscosity (and per
-    patch with ``[run] patch_band``) of warm points at ``POINT_SECONDS`` (a ball's at
-    ``BALL_POINT_SECONDS``), the main curves' with their error estimates."""
+    ``cores`` workers of the calibration machine [s]: its work as tasks
+    (:func:`cost_tasks`) scheduled on them (:func:`~fem_twin.case.schedule.makespan`)."""
+    return makespan(cost_tasks(case), max(cores, 1))
+
+
+def cost_tasks(case) -> list[Task]:
+    """The run's work as tasks with their seconds on one core of the calibration machine,
+    as the run's own task graph has them (:mod:`fem_twin.taskgraph`): per patch pair the
+    h0 of each of :data:`H0_ROUNDS` rounds at ``MICRO_SECONDS`` per cell pixel, step and
+    separation; per viscosity the sweep's guide, each point (a warm point of
+    ``POINT_SECONDS``, a ball's of ``BALL_POINT_SECONDS``, with its error estimate), each
+    refined speed's guide point and point (half the speeds per pass), then the band's
+    chains."""
+    micro = _micro_tasks(case)
+    point = _point_seconds(case) * (THERMAL_COST if case.thermal.model != "none" else 1.0)
+    estimate = 1.0 if case.tribometer.ball else ESTIMATE_COST
+    count = case.sweep.count
+    added = int(round(count * 0.5 * case.sweep.refine))
+    after, tasks = tuple(t.name for t in micro), []
+    for v in range(len(case.lubricant.viscosities)):
+        guide = Task(f"guide {v}", GUIDE_COST * point * count, after)
+        first = [Task(f"point {v} {i}", estimate * point, (guide.name,)) for i in range(count)]
+        tasks += [guide, *first]
+        for i in range(added):                 # a refined speed: its guide point, then it
+            again = Task(f"guide {v} {count + i}", GUIDE_COST * point,
+                         tuple(t.name for t in first))
+            tasks += [again, Task(f"point {v} {count + i}", estimate * point, (again.name,))]
     patches = len(case.geometry.patches)
+    if case.run.patch_band and patches > 1:
+        done = tuple(t.name for t in tasks)
+        tasks += [Task(f"band {v} {k}", _band_point_cost(case) * point * (count + added), done)
+                  for v in range(len(case.lubricant.viscosities)) for k in range(patches)]
+    return micro + tasks
+
+
+def _micro_tasks(case) -> list[Task]:
+    """Per patch pair, its separations in :data:`H0_ROUNDS` rounds, one task each."""
     mc = case.micro
     h0 = mc.h0_count
     if mc.h0_tol:
         a, k = ADAPTIVE_H0
         h0 = min(h0, a + k / math.sqrt(mc.h0_tol))
-    pixels = mc.resolution[0] * mc.resolution[1]
-    micro = MICRO_SECONDS * pixels * mc.steps * h0 * patches / max(cores, 1)
-    if case.tribometer.ball:         # Newton coupling
-        point = BALL_POINT_SECONDS * (case.macro.grid / 73) ** BALL_POINT_GROWTH
-        estimate = 1.0
-    else:
-        res = case.preprocessing.resolution or (256, 256)
-        point = POINT_SECONDS * ((res[0] * res[1]) / 128 ** 2) ** POINT_GROWTH
-        estimate = ESTIMATE_COST
-    n_mu = len(case.lubricant.viscosities)
-    points = case.sweep.count * (1 + 0.5 * case.sweep.refine)   # refinement: ~+50 %
-    band = patches if case.run.patch_band and patches > 1 else 0
-    band *= _band_point_cost(case)
-    sweeps = n_mu * (1 + (patches if band else 0))
-    macro = point * points * n_mu * (estimate + band) / max(1, min(cores, sweeps))
-    return micro + macro * (THERMAL_COST if case.thermal.model != "none" else 1.0)
+    seconds = MICRO_SECONDS * mc.resolution[0] * mc.resolution[1] * mc.steps
+    per_round = max(1, int(round(h0 / H0_ROUNDS)))
+    tasks = []
+    for k in range(len(case.geometry.patches)):
+        before = ()
+        for r in range(H0_ROUNDS):
+            new = [Task(f"patch {k} round {r} h0 {i}", seconds, before) for i in range(per_round)]
+            tasks += new
+            before = tuple(t.name for t in new)
+    return tasks
+
+
+def _point_seconds(case) -> float:
+    """A warm Stribeck point on one core [s]: a pin's by its macro grid, a ball's (Newton
+    coupling) by its grid's side."""
+    if case.tribometer.ball:
+        return BALL_POINT_SECONDS * (case.macro.grid / 73) ** BALL_POINT_GROWTH
+    res = case.preprocessing.resolution or (256, 256)
+    return POINT_SECONDS * ((res[0] * res[1]) / 128 ** 2) ** POINT_GROWTH
 
 
 def _band_point_cost(case) -> float:

@@ -37,7 +37,7 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     workers = 1 if executor is None else getattr(executor, "n_workers", 1)
     unguided = [i for i, guide in enumerate(guides) if guide is None]
     pieces = chains([tasks[i] for i in unguided], workers)     # (index in unguided, piece)
-    leading = [g for g in guides if g is not None]
+    leading = [piece for g in guides if g is not None for piece in guide_chains(g)]
     swept = _run(leading + [piece for _, piece in pieces], executor, progress,
                  desc)[len(leading):]
     _run([point for i, (task, guide) in enumerate(zip(tasks, guides)) if i not in unguided
@@ -59,6 +59,19 @@ def guide_of(request):
         return None
     return replace(request.coarsened(levels), error_estimate=False, fields=None,
                    keep_level=0)
+
+
+def guide_chains(guide) -> list:
+    """The ``guide`` sweep as chains: whole while none of its points is checkpointed (a
+    first pass), else each run of missing speeds after the checkpointed point before it
+    (a refinement's midpoints, side by side)."""
+    key = guide.key
+    have = [point_file(guide.checkpoint, key, u).exists() for u in guide.speeds]
+    if not any(have) or all(have):
+        return [guide] if not all(have) else []
+    starts = [i for i in range(len(have)) if not have[i] and (i == 0 or have[i - 1])]
+    ends = [next((j for j in range(i, len(have)) if have[j]), len(have)) for i in starts]
+    return [replace(guide, speeds=guide.speeds[max(i - 1, 0):j]) for i, j in zip(starts, ends)]
 
 
 def guided_points(request, guide: str) -> list:

@@ -103,6 +103,7 @@ class SweepRequest:
 
     def __post_init__(self):
         name = "SweepRequest"
+        check(f"{name}: speeds", self.speeds, "numbers")
         speeds = np.asarray(self.speeds, float)
         if speeds.ndim != 1 or speeds.size == 0 or np.any(~(speeds > 0)):
             raise InputError(f"{name}: speeds must be a non-empty list of positive values "
