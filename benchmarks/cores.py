@@ -1,7 +1,8 @@
-"""The ``cores`` group: the bundled case end to end on 1, 2 and all workers.
+"""The ``cores`` group: the bundled case end to end on 1, 2 and all workers, and on a Dask
+LocalCluster of all workers (with the cluster extra).
 
 Each run is a fresh ``fem-twin run`` of ``examples/pin_on_disk.toml`` with ``[run] workers``
-set, in its own process and folder.  Printed per run: the wall time, the run's own
+(and ``scheduler = "local"``) set, in its own process and folder.  Printed per run: the wall time, the run's own
 estimate, and from its task graph (``summary.json``, :mod:`fem_twin.taskgraph`) the CPU
 time, the critical path and the wall times it predicts on 16 and 64 workers.  The
 baseline is the one-worker run.
@@ -9,6 +10,7 @@ baseline is the one-worker run.
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import subprocess
@@ -20,21 +22,24 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _case(folder: Path, workers: int) -> Path:
-    """The bundled case with absolute paths and ``workers`` processes."""
+def _case(folder: Path, workers: int, dask: bool) -> Path:
+    """The bundled case with absolute paths and ``workers`` processes (on a Dask
+    LocalCluster: ``dask``)."""
     text = (ROOT / "examples" / "pin_on_disk.toml").read_text()
     text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
-    text = text.replace("workers = 0 ", f"workers = {workers} ", 1)
-    path = folder / f"case_{workers}.toml"
+    line = f"workers = {workers} " + ('\nscheduler = "local" ' if dask else "")
+    text = text.replace("workers = 0 ", line, 1)
+    path = folder / f"case_{workers}{'_dask' * dask}.toml"
     path.write_text(text)
     return path
 
 
-def _run(folder: Path, workers: int) -> tuple[float, dict]:
+def _run(folder: Path, workers: int, dask: bool = False) -> tuple[float, dict]:
     """Wall time [s] of one run and its summary."""
-    out = folder / f"out_{workers}"
+    out = folder / f"out_{workers}{'_dask' * dask}"
     start = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "fem_twin.cli", "run", str(_case(folder, workers)),
+    subprocess.run([sys.executable, "-m", "fem_twin.cli", "run",
+                    str(_case(folder, workers, dask)),
                     "-o", str(out), "--no-progress", "--yes"], check=True,
                    capture_output=True, text=True)
     return time.perf_counter() - start, json.loads((out / "summary.json").read_text())
@@ -42,14 +47,17 @@ def _run(folder: Path, workers: int) -> tuple[float, dict]:
 
 def bench_cores():
     """The bundled case on 1, 2 and all workers (see the module docstring)."""
-    counts = sorted({1, 2, os.cpu_count() or 1})
+    counts = [(n, False) for n in sorted({1, 2, os.cpu_count() or 1})]
+    if importlib.util.find_spec("distributed") is not None:          # the cluster extra
+        counts.append((os.cpu_count() or 1, True))
     rows, base = [], None
     with tempfile.TemporaryDirectory() as tmp:
-        for n in counts:
-            wall, summary = _run(Path(tmp), n)
+        for n, dask in counts:
+            wall, summary = _run(Path(tmp), n, dask)
             graph = summary["task_graph"]
             base = wall if base is None else base
-            rows.append((f"bundled case, {n} worker{'s' if n > 1 else ''}", wall,
+            where = "Dask LocalCluster of " if dask else ""
+            rows.append((f"bundled case, {where}{n} worker{'s' if n > 1 else ''}", wall,
                          f"estimate {summary['estimated_s']:.0f} s; task graph "
                          f"{graph['cpu_s']:.0f} CPU s, critical path "
                          f"{graph['critical_path_s']:.0f} s, predicts "
