@@ -25,7 +25,7 @@ BAND_POINT_COST = {"coarse": 0.14, "full": 0.54}
 BAND_LEVEL_COST = 0.33
 #: the Stribeck stage of the thermal twin (``[thermal] model = "flash"``) against the
 #: isothermal one: each point iterates its film temperature (from its guide's)
-THERMAL_COST = 1.5
+THERMAL_COST = 1.25
 #: a guide point (the sweep on its coarsest nested grid, warm-started) in points
 GUIDE_COST = 0.15
 #: rounds of the adaptive h0 sampler per patch pair (a start, bisection, refinement)

@@ -17,7 +17,7 @@ from ..io.layout import RunLayout
 
 #: the bundled case's estimate on 2 cores of the calibration machine [s]
 #: (``examples/pin_on_disk.toml``; tests/test_cli.py holds it to the estimate)
-BUNDLED_SECONDS = 110.0
+BUNDLED_SECONDS = 99.5
 #: a run estimated above this many times the bundled case (both on the calibration
 #: machine: the question does not depend on this machine's speed or load) asks for --yes
 LONG_RUN_RATIO = 7.0
@@ -42,8 +42,9 @@ def _confirm_cost(case, yes: bool) -> float | None:
           f"{mc.resolution[1]}, {mc.h0_count} h0 x {mc.steps} steps"
           f"{f' (adaptive h0, tolerance {mc.h0_tol:g})' if mc.h0_tol else ''}; "
           f"{len(case.lubricant.viscosities)} x {case.sweep.count} speeds; estimated "
-          f"{duration(seconds)} on {cores} cores (this machine takes {speed:.2g}x the "
-          "calibration machine's time now)", file=sys.stderr)
+          f"{duration(seconds)} on {cores} cores, {duration(case.estimated_seconds(16) * speed)}"
+          f" on 16 and {duration(case.estimated_seconds(64) * speed)} on 64 (this machine "
+          f"takes {speed:.2g}x the calibration machine's time now)", file=sys.stderr)
     if calibration > LONG_RUN_SECONDS and not yes:
         ratio = calibration / BUNDLED_SECONDS
         print(f"fem-twin run: error: this run is estimated at {duration(seconds)}, "
