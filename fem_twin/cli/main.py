@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import inspect
 import logging
 import os
 import sys
@@ -13,6 +14,7 @@ from . import steps
 from ..errors import NotConverged, RunLocked, SchedulerUnreachable
 from .. import tables as T
 from ..case.sections import Geometry, LubricantSpec, MicroSpec, Tribometer
+from ..contact.levelling import level_pin
 from ..stribeck.fit import PARAMETERS
 from ..topography.prepare import MacroOptions
 
@@ -234,7 +236,8 @@ def _add_contact(sub):
     lv.add_argument("--disk", type=Path, help="flipped disk on the same grid (default: flat)")
     lv.add_argument("--load", type=float, default=T.LEVELLING_LOAD,
                     help="imposed load [N] (default: %(default)s)")
-    lv.add_argument("--method", choices=("broyden", "pid"), default="broyden")
+    lv.add_argument("--method", choices=("broyden", "pid"),
+                    default=inspect.signature(level_pin).parameters["method"].default)
     lv.set_defaults(func=steps.contact_level)
     av = cs.add_parser("average", help="set average of levelled pins, then level it again")
     av.add_argument("pins", type=Path, nargs="+")
