@@ -47,8 +47,8 @@ def patch_tasks(case: Case, out: RunLayout, k: int) -> list[Task]:
     rounds = _rounds(h0, folder, keys[0], ff.meta.get("h0_tol"))
     tasks, before = [], ()
     for r, indices in enumerate(rounds):
-        new = [Task(f"patch {k} round {r + 1} h0 {h0[i]:.4e}",
-                    _seconds(_moments(folder, keys[0], h0[i])), before) for i in indices]
+        new = [Task(f"patch {k} round {r + 1} h0 {h0[i]:.4e}{name}", seconds, before)
+               for i in indices for name, seconds in _halves(_moments(folder, keys[0], h0[i]))]
         tasks += new
         before = tuple(t.name for t in new)
     if len(keys) > 1:                                    # the coarse cell (grid estimate)
@@ -84,6 +84,15 @@ def _moments(folder, key, h0) -> dict:
 
 def _seconds(moments) -> float:
     return float(moments.get("seconds_contact", 0.0) + moments.get("seconds_cell", 0.0))
+
+
+def _halves(moments) -> list:
+    """``[(name, seconds)]`` of one separation's tasks: its even and odd instants where it
+    ran them apart (:func:`~fem_twin.micro.schedule.halves`), else one."""
+    if "seconds_halves" in moments:
+        return [(f" {half} instants", float(s)) for half, s in
+                zip(("even", "odd"), moments["seconds_halves"])]
+    return [("", _seconds(moments))]
 
 
 def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task]:

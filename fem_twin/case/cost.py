@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 
+from ..micro.schedule import halves
 from .schedule import Task, makespan
 
 #: a warm Stribeck point of a pin at 128^2 [s], its growth with the pixels, and the cost of
@@ -76,14 +77,16 @@ def cost_tasks(case) -> list[Task]:
 
 
 def _micro_tasks(case) -> list[Task]:
-    """Per patch pair, its separations in :data:`H0_ROUNDS` rounds, one task each."""
+    """Per patch pair, its separations in :data:`H0_ROUNDS` rounds, each one task or two
+    (its even and odd instants, :func:`~fem_twin.micro.schedule.halves`)."""
     mc = case.micro
     h0 = mc.h0_count
     if mc.h0_tol:
         a, k = ADAPTIVE_H0
         h0 = min(h0, a + k / math.sqrt(mc.h0_tol))
-    seconds = MICRO_SECONDS * mc.resolution[0] * mc.resolution[1] * mc.steps
-    per_round = max(1, int(round(h0 / H0_ROUNDS)))
+    parts = halves(dict(settings=mc))
+    seconds = MICRO_SECONDS * mc.resolution[0] * mc.resolution[1] * mc.steps / parts
+    per_round = max(1, int(round(h0 / H0_ROUNDS))) * parts
     tasks = []
     for k in range(len(case.geometry.patches)):
         before = ()

@@ -48,20 +48,28 @@ class Separations:
         serial = self.workers <= 1 and self.executor is None
         chunks = [[(i, self.h0[i]) for i in c]
                   for c in split_chunks(todo, 1 if serial else 4 * max(self.workers, 2))]
-        for i, m in (self._serial(chunks) if serial else self._parallel(chunks)):
+        jobs = [(c, part) for c in chunks for part in range(halves(self.args))]
+        parts = {}
+        for i, m in (self._serial(jobs) if serial else self._parallel(jobs)):
+            if "part" in m:                              # a half of the instants
+                parts.setdefault(i, {})[m["part"]] = m
+                if len(parts[i]) < 2:
+                    continue
+                m = joined_halves(parts.pop(i), self.args, self.h0[i])
             self.done[i] = m
             self.computed.append(i)
             self.bar.update(1)
         return [self.done[i] for i in indices]
 
-    def _serial(self, chunks):
-        for chunk in chunks:
-            yield from run_chunk(chunk, **self.args)
+    def _serial(self, jobs):
+        for chunk, part in jobs:
+            yield from run_chunk(chunk, **self.args, part=part)
 
-    def _parallel(self, chunks):
+    def _parallel(self, jobs):
         if self.executor is None:            # one own pool for all the calls of a run
             self.executor, self.own = process_pool(self.workers), True
-        futures = [self.executor.submit(chunk_task, (c, self.args)) for c in chunks]
+        futures = [self.executor.submit(chunk_task, (c, {**self.args, "part": part}))
+                   for c, part in jobs]
         try:
             for fut in as_completed(futures):
                 yield from fut.result()
@@ -91,20 +99,51 @@ def chunk_task(job):
     return run_chunk(points, **args)
 
 
-def run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, resume=False,
-               half_pass=True):
-    """Moments for ``points = [(index, h0), ...]`` in order, warm-starting contact."""
+def halves(args) -> int:
+    """How many tasks each separation's instants take: two, the even and the odd ones,
+    where they are independent of each other and the even ones are the half pass of the
+    time-error estimate (the exact squeeze term, an even number of fixed instants); else
+    one."""
+    s = args["settings"]
+    return 2 if (args.get("half_pass", True) and s.time_derivative == "exact"
+                 and s.time_tol is None and s.steps % 2 == 0) else 1
+
+
+def joined_halves(parts: dict, args: dict, h0: float) -> dict:
+    """The moments of one separation from its two halves of instants (:func:`halves`):
+    the mean over all instants, the even ones' as the half pass; checkpointed."""
+    even, odd = parts[0], parts[1]
+    n = even["n"] + odd["n"]
+    moments = {k: (even["sum"][k] + odd["sum"][k]) / n for k in even["sum"]}
+    moments.update({"half_" + k: v / even["n"] for k, v in even["sum"].items()})
+    moments["n_steps"] = n
+    moments["seconds_contact"] = even["seconds"][0] + odd["seconds"][0]
+    moments["seconds_cell"] = even["seconds"][1] + odd["seconds"][1]
+    moments["seconds_halves"] = [sum(even["seconds"]), sum(odd["seconds"])]
+    if args["folder"] is not None:
+        save_point(Path(args["folder"]), args["key"], h0, moments)
+    return moments
+
+
+def run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, half_pass=True,
+              part=0):
+    """Moments for ``points = [(index, h0), ...]`` in order, warm-starting contact; with
+    :func:`halves` two, only the even (``part`` 0) or the odd instants, their sums."""
     solver = cell_solver(z_low.shape, spacing, settings.method)
     sliding = sliding_pass(z_low, z_up, spacing, settings)
-    warm, midpoints = [None] * settings.steps, {}
+    split = halves(dict(settings=settings, half_pass=half_pass)) == 2
+    if split:
+        sliding = replace(sliding, shapes=sliding.shapes[part::2],
+                          moving=sliding.moving[part::2],
+                          rigid_rate=sliding.rigid_rate[part::2])
+    warm, midpoints = [None] * len(sliding.shapes), {}
     out = []
     for i, h0 in points:
-        if resume and folder is not None:
-            m = load_point(Path(folder), key, h0)
-            if m is not None:
-                out.append((i, m))
-                continue
         contacts, steps, seconds = instants(sliding, h0, warm, solver, spacing, settings)
+        if split:
+            out.append((i, {"part": part, "n": len(steps), "seconds": seconds,
+                            "sum": {k: sum(m[k] for m in steps) for k in steps[0]}}))
+            continue
         if settings.time_tol is not None:
             contacts, steps, more = refine_instants(contacts, steps, h0, z_low, z_up, solver,
                                                     spacing, settings, midpoints)
