@@ -19,8 +19,9 @@ from .store import cell_key, load_point, save_point
 
 class Separations:
     """The moments at the separations ``h0[i]`` of one run: resumed from the checkpoint
-    folder or computed (in this process, or as ``4 workers`` chunks on a pool or
-    ``executor``, each large to small so that contact warm-starts along h0)."""
+    folder or computed (in this process, or as ``4 workers`` jobs on a pool or
+    ``executor``: chunks of h0, each large to small so that contact warm-starts along h0,
+    and each in its two halves of instants, :func:`halves`)."""
 
     def __init__(self, h0, args, workers, executor, bar):
         self.h0, self.args, self.workers, self.executor, self.bar = (h0, args, workers,
@@ -45,10 +46,10 @@ class Separations:
                 self.done[i] = m
                 self.bar.update(1)
         todo = [i for i in todo if i not in self.done]
-        serial = self.workers <= 1 and self.executor is None
-        chunks = [[(i, self.h0[i]) for i in c]
-                  for c in split_chunks(todo, 1 if serial else 4 * max(self.workers, 2))]
-        jobs = [(c, part) for c in chunks for part in range(halves(self.args))]
+        serial, parts = self.workers <= 1 and self.executor is None, halves(self.args)
+        chunks = [[(i, self.h0[i]) for i in c] for c in split_chunks(
+            todo, 1 if serial else max(1, 4 * max(self.workers, 2) // parts))]
+        jobs = [(c, part) for c in chunks for part in range(parts)]
         parts = {}
         for i, m in (self._serial(jobs) if serial else self._parallel(jobs)):
             if "part" in m:                              # a half of the instants
