@@ -127,8 +127,9 @@ def test_the_schedule_of_a_task_graph():
 
 def test_the_task_graph_of_a_finished_run(tmp_path):
     """Issue 28 item 4: the graph read back from a run's checkpoints holds every h0 the
-    micro stage solved (round by round, the rounds replayed from the checkpoints), the
-    coarse cells of the grid estimate and one task per sweep; on one worker it takes the
+    micro stage solved (round by round, the rounds replayed from the checkpoints; each h0
+    its even and odd instants, issue 62), the coarse cells of the grid estimate, each
+    sweep's guide and points, and the band's sweeps; on one worker it takes the
     CPU time the run measured for them, on the run's own 2 workers no longer than the
     run's wall time."""
     import json
@@ -146,11 +147,12 @@ def test_the_task_graph_of_a_finished_run(tmp_path):
     tasks = run_task_graph(load_case(path), out)
     summary = json.loads((out / "summary.json").read_text())
     solved = summary["stages"]["micro"]["h0_solved"]
-    for k, n in enumerate(solved, start=1):
-        assert sum(t.name.startswith(f"patch {k} round") for t in tasks) == n
+    for k, n in enumerate(solved, start=1):             # each h0 its even and odd instants
+        rounds = [t.name for t in tasks if t.name.startswith(f"patch {k} round")]
+        assert len(rounds) == 2 * n and sum(r.endswith(" even instants") for r in rounds) == n
         assert sum(t.name.startswith(f"patch {k} coarse") for t in tasks) == n
         first = 2 * START - 1                      # the start, bisected once
-        assert sum(t.name.startswith(f"patch {k} round 1 ") for t in tasks) == first < n
+        assert sum(t.name.startswith(f"patch {k} round 1 ") for t in tasks) == 2 * first < 2 * n
     sweeps = [t for t in tasks if "sweep" in t.name]
     assert len(sweeps) == 2 + 3 * 2               # average, two patches and the coarse average
     assert all(t.seconds > 0 for t in tasks if not t.name.startswith("refinement"))
