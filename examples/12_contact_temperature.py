@@ -18,6 +18,7 @@ coarser grid, fewer speeds).
 
 import argparse
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -52,8 +53,8 @@ def flash_curves(peclet, n):
     return np.array(square), np.array(band)
 
 
-def sample_pin(n, speeds, thermal):
-    """The Stribeck curve of sample pin 1 on an n^2 grid at 24 C."""
+def sample_sweep(n, speeds):
+    """The Stribeck sweep of sample pin 1 on an n^2 grid at 24 C, isothermal."""
     opts = MacroOptions(resolution=(n, n))
     pin = prepare_pin(read_topography(SAMPLE / "pin_1.npz"), opts)
     disk = prepare_disk(read_topography(SAMPLE / "disk_1.npz"), opts)
@@ -61,10 +62,9 @@ def sample_pin(n, speeds, thermal):
     up = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"), upper=True),
                        (32, 32))
     factors = homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), n_steps=4)
-    return stribeck_sweep(SweepRequest(disk.heights - pin.heights, pin.spacing, factors, speeds,
-                          load=150.0, lubricant=Lubricant(0.066),
-                          face=pin.heights > opts.holder_height / 2,
-                          settings=MacroSettings(track_radius=30e-3), thermal=thermal))
+    return SweepRequest(disk.heights - pin.heights, pin.spacing, factors, speeds, load=150.0,
+                        lubricant=Lubricant(0.066), face=pin.heights > opts.holder_height / 2,
+                        settings=MacroSettings(track_radius=30e-3))
 
 
 def main(out="out/contact_temperature", quick=False):
@@ -83,8 +83,9 @@ def main(out="out/contact_temperature", quick=False):
     left.legend(fontsize="small")
     speeds = np.geomspace(2.0, 0.005, 8 if quick else 16)
     law = WaltherLaw.through((24.0, 50.0), (0.066, 0.024), 875.0)
-    iso = sample_pin(48 if quick else 96, speeds, None)
-    hot = sample_pin(48 if quick else 96, speeds, ContactThermal(STEEL, law, 0.1924500897))
+    sweep = sample_sweep(48 if quick else 96, speeds)
+    iso = stribeck_sweep(sweep)
+    hot = stribeck_sweep(replace(sweep, thermal=ContactThermal(STEEL, law, 0.1924500897)))
     right.loglog(speeds, iso.friction_coefficient, "o-", label="isothermal (the paper)")
     right.loglog(speeds, hot.friction_coefficient, "s--", label="thermal, R_b = 1 K/W")
     right.set(xlabel="sliding speed U [m/s]", ylabel="C_f", title="sample pin at 24 C")

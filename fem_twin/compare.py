@@ -100,10 +100,10 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     against = {m: discrepancy(factors[m], reference) for m in ("fe", "fvm")}
     ffd = flow_factor_differences(factors["fe"], factors["fvm"])
     curves, points = {}, {}
+    common = sweep_request(case, out, factors=factors["fe"], thermal=None)
     for method in ("fe", "fvm"):                  # isothermal: the methods, not the heat
-        request = sweep_request(case, out, factors=factors[method], thermal=None,
-                                settings=macro_settings(case, method),
-                                checkpoint=out.sub(method).points)
+        request = replace(common, factors=factors[method], settings=macro_settings(
+            case, method), checkpoint=out.sub(method).points)
         curves[method] = stribeck_sweep(request, progress).with_load_share(
             case.tribometer.load_share)
         points[method] = sorted((MixedResult.load(p) for p in point_files(request.checkpoint)),

@@ -678,9 +678,8 @@ def test_a_separations_instants_run_as_two_halves():
     settings = CellSettings(steps=8)
     args = dict(z_low=low.heights, z_up=up.heights, spacing=dx, settings=settings,
                 folder=None, key="k")
-    assert halves(args) == 2 and halves({**args, "half_pass": False}) == 1
-    assert halves({**args, "settings": CellSettings(steps=8, time_derivative="backward",
-                                                   moving="upper")}) == 1
+    assert halves(settings) == 2 and halves(settings, half_pass=False) == 1
+    assert halves(CellSettings(steps=8, time_derivative="backward", moving="upper")) == 1
     h0 = np.array([0.3e-6, 0.6e-6])
     sliding, solver, warm = sliding_pass(low.heights, up.heights, dx, settings), cell_solver(
         (32, 32), dx, "fe"), [None] * 8

@@ -84,7 +84,7 @@ def _micro_tasks(case) -> list[Task]:
     if mc.h0_tol:
         a, k = ADAPTIVE_H0
         h0 = min(h0, a + k / math.sqrt(mc.h0_tol))
-    parts = halves(dict(settings=mc))
+    parts = halves(mc)
     seconds = MICRO_SECONDS * mc.resolution[0] * mc.resolution[1] * mc.steps / parts
     per_round = max(1, int(round(h0 / H0_ROUNDS))) * parts
     tasks = []

@@ -46,7 +46,8 @@ class Separations:
                 self.done[i] = m
                 self.bar.update(1)
         todo = [i for i in todo if i not in self.done]
-        serial, parts = self.workers <= 1 and self.executor is None, halves(self.args)
+        serial = self.workers <= 1 and self.executor is None
+        parts = halves(self.args["settings"], self.args.get("half_pass", True))
         chunks = [[(i, self.h0[i]) for i in c] for c in split_chunks(
             todo, 1 if serial else max(1, 4 * max(self.workers, 2) // parts))]
         jobs = [(c, part) for c in chunks for part in range(parts)]
@@ -100,14 +101,13 @@ def chunk_task(job):
     return run_chunk(points, **args)
 
 
-def halves(args) -> int:
-    """How many tasks each separation's instants take: two, the even and the odd ones,
-    where they are independent of each other and the even ones are the half pass of the
-    time-error estimate (the exact squeeze term, an even number of fixed instants); else
-    one."""
-    s = args["settings"]
-    return 2 if (args.get("half_pass", True) and s.time_derivative == "exact"
-                 and s.time_tol is None and s.steps % 2 == 0) else 1
+def halves(settings, half_pass: bool = True) -> int:
+    """How many tasks each separation's instants take under ``settings``: two, the even and
+    the odd ones, where they are independent of each other and the even ones are the half
+    pass of the time-error estimate (``half_pass``; the exact squeeze term, an even number
+    of fixed instants); else one."""
+    return 2 if (half_pass and settings.time_derivative == "exact"
+                 and settings.time_tol is None and settings.steps % 2 == 0) else 1
 
 
 def joined_halves(parts: dict, args: dict, h0: float) -> dict:
@@ -132,7 +132,7 @@ def run_chunk(points, *, z_low, z_up, spacing, settings, folder, key, half_pass=
     :func:`halves` two, only the even (``part`` 0) or the odd instants, their sums."""
     solver = cell_solver(z_low.shape, spacing, settings.method)
     sliding = sliding_pass(z_low, z_up, spacing, settings)
-    split = halves(dict(settings=settings, half_pass=half_pass)) == 2
+    split = halves(settings, half_pass) == 2
     if split:
         sliding = replace(sliding, shapes=sliding.shapes[part::2],
                           moving=sliding.moving[part::2],

@@ -67,8 +67,10 @@ def guide_chains(guide) -> list:
     (a refinement's midpoints, side by side)."""
     key = guide.key
     have = [point_file(guide.checkpoint, key, u).exists() for u in guide.speeds]
-    if not any(have) or all(have):
-        return [guide] if not all(have) else []
+    if all(have):
+        return []
+    if not any(have):
+        return [guide]
     starts = [i for i in range(len(have)) if not have[i] and (i == 0 or have[i - 1])]
     ends = [next((j for j in range(i, len(have)) if have[j]), len(have)) for i in starts]
     return [replace(guide, speeds=guide.speeds[max(i - 1, 0):j]) for i, j in zip(starts, ends)]
@@ -78,8 +80,9 @@ def guided_points(request, guide: str) -> list:
     """Each speed of ``request`` not yet checkpointed as a sweep of its own, started from
     the point there of the sweep ``guide`` (its key); a kept level that is the guide's is
     the guide's own point."""
-    keep = 0 if request.level_key(request.keep_level) == guide else request.keep_level
     key = request.key
+    kept = request.level_key(request.keep_level) if request.keep_level else key
+    keep = 0 if kept == guide else request.keep_level
     return [replace(request, speeds=request.speeds[i:i + 1], guide=guide, fields=None,
                     keep_level=keep) for i in range(request.speeds.size)
             if not point_file(request.checkpoint, key, request.speeds[i]).exists()]

@@ -119,9 +119,9 @@ class SweepRequest:
     @property
     def key(self) -> str:
         """The key of the sweep's point checkpoints: a hash of all that sets its points."""
-        return self.input_key(self.motion.key)
+        return self.key_with(self.motion.key)
 
-    def input_key(self, motion_key) -> str:
+    def key_with(self, motion_key) -> str:
         """:attr:`key` with ``motion_key`` for the motion's (a traction curve's)."""
         factors = self.factors if self.factors_key is None else self.factors_key
         return sweep_key(self.gap, self.spacing, factors, self.load, self.lubricant,

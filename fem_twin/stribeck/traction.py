@@ -81,7 +81,7 @@ def traction_sweep(request: SweepRequest, slide_to_roll=DEFAULT_RATIOS,
                          f"entrainment speed, got {request.motion} at {request.speeds.size} "
                          "speeds")
     r, entrainment = request, float(request.speeds[0])
-    key = r.input_key(("traction", entrainment))
+    key = r.key_with(("traction", entrainment))
     folder = None if r.checkpoint is None else Path(r.checkpoint)
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
