@@ -26,6 +26,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 from common import SAMPLE, best_of, macro_factors, macro_gap  # noqa: E402
 from cores import bench_cores  # noqa: E402
+from defaults import bench_defaults  # noqa: E402
 from scale import bench_scale  # noqa: E402
 
 
@@ -574,12 +575,12 @@ GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": ben
           "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "paper": bench_paper, "stribeck": bench_stribeck,
           "estimate": bench_estimate, "scale": bench_scale, "cores": bench_cores,
           "estimate-paper": lambda: bench_estimate("paper.toml"),
-          "micro-full": lambda: bench_micro(full=True)}
+          "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults}
 
 
 def main(argv):
     groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "estimate-paper",
-                                                        "scale", "cores")]
+                                                        "scale", "cores", "defaults")]
     for name in groups:
         base, rows = GROUPS[name]()
         print(f"\n## {name}")
