@@ -1,7 +1,7 @@
 """The ``defaults`` group: what cheaper micro settings cost and how far they move C_f.
 
 The paper case (``examples/paper.toml``) with its first patch pair and mu_0 = 0.066 Pa s
-(25 speeds, no refinement pass, no band) on several cell grids and step counts, against a
+(25 speeds, no refinement pass, no band, isothermal) on several cell grids and step counts, against a
 reference at twice the macro grid (512^2), the patches' own 256 px, 128 steps and every
 one of the 100 h0 candidates (``h0_tol = 0``).  Per setting: its task graph's CPU time, the
 largest C_f error estimate and the largest change to the reference, both in % C_f,b, and
@@ -31,9 +31,11 @@ CANDIDATES = (("cells 256^2, 32 steps (the paper)", 256, 32),
 
 
 def _pair_case():
-    """The paper case reduced to its first patch pair, one viscosity, one pass."""
+    """The paper case reduced to its first patch pair, one viscosity, one pass, isothermal
+    (the film-temperature law needs two viscosities)."""
     case = load_case(os.path.join(HERE, "..", "examples", "paper.toml"))
     return replace(case, geometry=replace(case.geometry, patches=case.geometry.patches[:1]),
+                   thermal=replace(case.thermal, model="none"),
                    lubricant=replace(case.lubricant, viscosities=(0.066,),
                                      temperatures=case.lubricant.temperatures[:1]),
                    sweep=replace(case.sweep, refine=0), measured=(),

@@ -548,6 +548,7 @@ def bench_estimate(case_file="pin_on_disk.toml", viscosity=0.066):
 
     case = load_case(os.path.join(HERE, "..", "examples", case_file))
     case = replace(case, geometry=replace(case.geometry, patches=case.geometry.patches[:1]),
+                   thermal=replace(case.thermal, model="none"),
                    lubricant=replace(case.lubricant, viscosities=(viscosity,),
                                      temperatures=case.lubricant.temperatures[:1]),
                    sweep=replace(case.sweep, refine=0), measured=(),
