@@ -24,6 +24,7 @@ from .stribeck.curve import read_stribeck_csv
 from .stribeck.fit import (LOAD_SHARES, RESISTANCES, FitModel, check_parameters, fit_curves,
                            plot_fit, predict)
 from .numerics.threads import executor_for
+from .taskgraph import fit_scaling
 
 
 def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: bool = True,
@@ -75,6 +76,8 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     result = fit_curves(model, curves_measured, params, verbose=progress,
                         start_temperatures=nominal if "temperature" in params else None)
     result["measured"] = [str(p) for p in paths]
+    if shares or resistances:
+        result["task_graph"] = fit_scaling(case, outdir)
     result["case"] = {"temperatures": nominal, "load_N": case.tribometer.load,
                       "law": None if law is None else vars(law)}
     with atomic_path(out.fit) as tmp:

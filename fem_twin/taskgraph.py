@@ -35,7 +35,9 @@ def run_task_graph(case: Case, outdir) -> list[Task]:
     out = RunLayout(outdir)
     micro = [t for k in range(1, len(case.geometry.patches) + 1)
              for t in patch_tasks(case, out, k)]
-    return micro + sweep_tasks(case, out, tuple(t.name for t in micro))
+    return micro + sweep_tasks(out.points, case.sweep.speeds, tuple(t.name for t in micro),
+                               ball=case.tribometer.ball, refine=case.sweep.refine > 0,
+                               band_beside=case.band_after_guides(case.macro_shape))
 
 
 def patch_tasks(case: Case, out: RunLayout, k: int) -> list[Task]:
@@ -95,17 +97,20 @@ def _halves(moments) -> list:
     return [("", _seconds(moments))]
 
 
-def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task]:
-    """The sweeps of the macro scale: the first passes (a guide's chain, then each of its
-    points a task; or a sweep as one chain), then the refinement's, then the band's (the
-    nested levels the main points kept for the band are part of those points)."""
-    first = np.asarray(case.sweep.speeds, float)
+def sweep_tasks(folder, first, micro: tuple[str, ...], *, ball: bool = False,
+                refine: bool = True, band_beside: bool = False) -> list[Task]:
+    """The sweeps checkpointed in ``folder``, after the tasks ``micro``: the first passes
+    over the speeds ``first`` (a guide's chain, then each of its points a task; or a sweep
+    as one chain), then the refinement's, then the band's (the nested levels the main
+    points kept for the band are part of those points), after the main points or, with
+    ``band_beside``, beside them (:meth:`~fem_twin.case.Case.band_after_guides`)."""
+    first = np.asarray(first, float)
     chains, points = defaultdict(list), []
-    for path in point_files(out.points):
+    for path in point_files(folder):
         scalars, meta = point_meta(path)
         if LEVEL_OF in meta:
             continue
-        speed = meta.get("entrainment") if case.tribometer.ball else scalars["speed"]
+        speed = meta.get("entrainment") if ball else scalars["speed"]
         seconds = sum(meta.get(k, 0.0) for k in ("seconds", "seconds_coarse",
                                                    "seconds_estimate", "seconds_thermal"))
         if GUIDED_BY in meta:
@@ -126,10 +131,24 @@ def sweep_tasks(case: Case, out: RunLayout, micro: tuple[str, ...]) -> list[Task
                 for k, v in main.items() if k in guides for u, s, _ in v if not in_first(u)]
     later = [Task(f"point {k} {u:.9e}", s, (f"refinement {g} {u:.9e}",))
              for k, u, s, g in points if not in_first(u)]
-    band_after = tuple(t.name for t in refined + later) if case.sweep.refine else done
+    band = {k: v for k, v in chains.items() if k not in main}
+    if band_beside:
+        return passes + ahead + refined + later + _band_beside(
+            band, guides, in_first, {t.name for t in refined})
+    band_after = tuple(t.name for t in refined + later) if refine else done
     return passes + ahead + refined + later + [
-        Task(f"band sweep {k}", sum(s for _, s, _ in v), band_after)
-        for k, v in chains.items() if k not in main]
+        Task(f"band sweep {k}", sum(s for _, s, _ in v), band_after) for k, v in band.items()]
+
+
+def _band_beside(band: dict, guides: set, in_first, refined: set) -> list[Task]:
+    """The band's chains where they start from the guides: each first pass after the
+    guides' first passes, each refined speed after the band's first pass and the guides'
+    points there (among the ``refined`` task names)."""
+    tasks = [Task(f"band sweep {k}", sum(s for u, s, _ in v if in_first(u)),
+                  tuple(f"sweep {g}" for g in guides)) for k, v in band.items()]
+    return tasks + [Task(f"band refinement {k} {u:.9e}", s, (f"band sweep {k}", *(
+        name for g in guides if (name := f"refinement {g} {u:.9e}") in refined)))
+                    for k, v in band.items() for u, s, _ in v if not in_first(u)]
 
 
 #: worker counts of :func:`scaling`'s estimates
@@ -140,7 +159,20 @@ def scaling(case: Case, outdir) -> dict:
     """The run's task graph in numbers (``summary.json`` ``"task_graph"``): task count, CPU
     seconds, critical path and the wall time of its tasks on each of :data:`WORKERS`
     processes [s] (the serial stages and the writing of results not included)."""
-    tasks = run_task_graph(case, outdir)
+    return in_numbers(run_task_graph(case, outdir))
+
+
+def fit_scaling(case: Case, outdir) -> dict:
+    """The task graph of a fit's own sweeps (``OUT/fit/checkpoints``: load shares, thermal
+    resistances; each a guide, then its points) in numbers (``fit.json`` ``"task_graph"``),
+    as :func:`scaling`'s.  Every speed of a fit's sweep runs in one pass."""
+    folder = RunLayout(outdir).fit_points
+    speeds = sorted({point_meta(p)[0]["speed"] for p in point_files(folder)})
+    return in_numbers(sweep_tasks(folder, speeds, (), ball=case.tribometer.ball))
+
+
+def in_numbers(tasks) -> dict:
+    """Task count, CPU seconds, critical path and wall on :data:`WORKERS` workers [s]."""
     return {"tasks": len(tasks), "cpu_s": round(sum(t.seconds for t in tasks), 1),
             "critical_path_s": round(critical_path(tasks), 1),
             "wall_s": {str(w): round(makespan(tasks, w), 1) for w in WORKERS}}

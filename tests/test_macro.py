@@ -681,7 +681,6 @@ def test_a_sweeps_points_run_in_parallel_from_its_guide(factors, tmp_path):
     the run's task graph has each point as a task after the guide: its critical path is the
     guide and the longest point."""
     from dataclasses import replace
-    from types import SimpleNamespace
 
     from fem_twin.numerics.threads import executor_for
     from fem_twin.stages.sweeps import guide_of, run_sweeps
@@ -705,9 +704,7 @@ def test_a_sweeps_points_run_in_parallel_from_its_guide(factors, tmp_path):
     assert np.array_equal(one.friction_coefficient, two.friction_coefficient)
     metas = [point_meta(p)[1] for p in point_files(tmp_path / "one", request.key)]
     assert len(metas) == 4 and all(m[GUIDED_BY] == guide.key for m in metas)
-    case = SimpleNamespace(sweep=SimpleNamespace(speeds=np.array(speeds), refine=0),
-                           tribometer=SimpleNamespace(ball=False))
-    tasks = sweep_tasks(case, SimpleNamespace(points=tmp_path / "one"), ())
+    tasks = sweep_tasks(tmp_path / "one", speeds, (), refine=False)
     lead = next(t for t in tasks if t.name == f"sweep {guide.key}")
     points = [t for t in tasks if t.name.startswith("point")]
     assert len(points) == 4 and all(t.after == (lead.name,) for t in points)

@@ -53,27 +53,43 @@ def cost_tasks(case) -> list[Task]:
     separation; per viscosity the sweep's guide, each point (a warm point of
     ``POINT_SECONDS``, a ball's of ``BALL_POINT_SECONDS``, with its error estimate), each
     refined speed's guide point and point (half the speeds per pass), then the band's
-    chains."""
+    chains (:func:`_band_tasks`)."""
     micro = _micro_tasks(case)
     point = _point_seconds(case) * (THERMAL_COST if case.thermal.model != "none" else 1.0)
     estimate = 1.0 if case.tribometer.ball else ESTIMATE_COST
     count = case.sweep.count
     added = int(round(count * 0.5 * case.sweep.refine))
-    after, tasks = tuple(t.name for t in micro), []
+    after, tasks, guides, again = tuple(t.name for t in micro), [], [], []
     for v in range(len(case.lubricant.viscosities)):
-        guide = Task(f"guide {v}", GUIDE_COST * point * count, after)
-        first = [Task(f"point {v} {i}", estimate * point, (guide.name,)) for i in range(count)]
-        tasks += [guide, *first]
+        guides.append(Task(f"guide {v}", GUIDE_COST * point * count, after))
+        first = [Task(f"point {v} {i}", estimate * point, (guides[-1].name,))
+                 for i in range(count)]
+        tasks += [guides[-1], *first]
         for i in range(added):                 # a refined speed: its guide point, then it
-            again = Task(f"guide {v} {count + i}", GUIDE_COST * point,
-                         tuple(t.name for t in first))
-            tasks += [again, Task(f"point {v} {count + i}", estimate * point, (again.name,))]
-    patches = len(case.geometry.patches)
-    if case.run.patch_band and patches > 1:
+            again.append(Task(f"guide {v} {count + i}", GUIDE_COST * point,
+                              tuple(t.name for t in first)))
+            tasks += [again[-1], Task(f"point {v} {count + i}", estimate * point,
+                                      (again[-1].name,))]
+    return micro + tasks + _band_tasks(case, point, tasks, guides, again)
+
+
+def _band_tasks(case, point: float, tasks, guides, again) -> list[Task]:
+    """The band's chains, one per patch and viscosity: after the main points, or, where
+    the band starts from the guides, its first pass after theirs and each refined speed
+    after the guides' refined points."""
+    patches, count = len(case.geometry.patches), case.sweep.count
+    if not case.run.patch_band or patches < 2:
+        return []
+    band, added = _band_point_cost(case) * point, len(again) // len(guides)
+    pairs = [(v, k) for v in range(len(guides)) for k in range(patches)]
+    if not case.band_after_guides(case.macro_shape):
         done = tuple(t.name for t in tasks)
-        tasks += [Task(f"band {v} {k}", _band_point_cost(case) * point * (count + added), done)
-                  for v in range(len(case.lubricant.viscosities)) for k in range(patches)]
-    return micro + tasks
+        return [Task(f"band {v} {k}", band * (count + added), done) for v, k in pairs]
+    first = [Task(f"band {v} {k}", band * count, tuple(g.name for g in guides))
+             for v, k in pairs]
+    after = tuple(t.name for t in again + first)
+    return first + [Task(f"band {v} {k} {i}", band, after) for v, k in pairs
+                    for i in range(added)]
 
 
 def _micro_tasks(case) -> list[Task]:
@@ -102,7 +118,7 @@ def _point_seconds(case) -> float:
     coupling) by its grid's side."""
     if case.tribometer.ball:
         return BALL_POINT_SECONDS * (case.macro.grid / 73) ** BALL_POINT_GROWTH
-    res = case.preprocessing.resolution or (256, 256)
+    res = case.macro_shape
     return POINT_SECONDS * ((res[0] * res[1]) / 128 ** 2) ** POINT_GROWTH
 
 
@@ -111,6 +127,5 @@ def _band_point_cost(case) -> float:
     (``BAND_LEVEL_COST`` for each coarsening beyond the first)."""
     if case.run.band_grid != "coarsest":
         return BAND_POINT_COST[case.run.band_grid]
-    shape = ((case.macro.grid,) * 2 if case.tribometer.ball
-             else case.preprocessing.resolution or (256, 256))
-    return BAND_POINT_COST["coarse"] * BAND_LEVEL_COST ** (case.band_coarsening(shape) - 1)
+    return (BAND_POINT_COST["coarse"]
+            * BAND_LEVEL_COST ** (case.band_coarsening(case.macro_shape) - 1))

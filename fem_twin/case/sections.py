@@ -259,6 +259,14 @@ class Case:
         machine [s] (:func:`fem_twin.case.cost.estimated_seconds`)."""
         return estimated_seconds(self, cores)
 
+    @property
+    def macro_shape(self) -> tuple[int, int]:
+        """The macro grid's nodes: a ball's ``[macro] grid`` a side, else the pin's
+        ``[preprocessing] resolution`` (256^2 where the maps' own grid is kept)."""
+        if self.tribometer.ball:
+            return (self.macro.grid,) * 2
+        return tuple(self.preprocessing.resolution or (256, 256))
+
     def band_coarsening(self, shape) -> int:
         """Coarsenings by two of the band's grid below a macro grid of ``shape``
         (``[run] band_grid``): none ("full"), one ("coarse"), or down to the main sweeps'
@@ -267,3 +275,10 @@ class Case:
         from ..macro.nested import nested_levels
         return {"full": 0, "coarse": 1}.get(self.run.band_grid,
                                             max(1, nested_levels(shape)))
+
+    def band_after_guides(self, shape) -> bool:
+        """Whether the band's sweeps start from the main sweeps' guides (their grid is the
+        guides' coarsest nested grid), so each pass of the band runs beside the main
+        points, rather than from the points' kept levels, after them."""
+        from ..macro.nested import nested_levels
+        return self.run.patch_band and self.band_coarsening(shape) == nested_levels(shape)

@@ -81,16 +81,21 @@ def refined_curves(case: Case, out: RunLayout, request, executor=None,
     """The main curves (with their C_f error estimates) of the sweep ``request`` over the
     case's viscosities, then ``[sweep] refine`` passes adding the midpoints where C_f
     jumps; ``(curves, speeds)``.  With the patch band on, each point also keeps its solve
-    on the band's grid (``keep_level``), which the band's sweeps start from."""
+    on the band's grid (``keep_level``), which the band's sweeps start from; where that
+    grid is the guides' (:meth:`~fem_twin.case.Case.band_after_guides`), each pass of the
+    band runs beside the main points."""
     tr, step = case.tribometer, case.sweep.refine_step * case.tribometer.boundary_friction
     speeds = request.speeds
     keep = case.band_coarsening(request.gap.shape) if case.run.patch_band else 0
+    beside = case.band_after_guides(request.gap.shape)
 
     def sweeps(final):                                    # the fields with the final pass
         tasks = per_viscosity(case, replace(request, speeds=speeds, error_estimate=True,
                                             keep_level=keep,
                                             fields=out.fields if final else None))
-        return [c.with_load_share(tr.load_share) for c in run_sweeps(tasks, executor, progress)]
+        band = band_tasks(case, out, replace(request, speeds=speeds)) if beside else ()
+        return [c.with_load_share(tr.load_share)
+                for c in run_sweeps(tasks, executor, progress, followers=band)]
 
     for level in range(case.sweep.refine + 1):
         final = level == case.sweep.refine

@@ -21,9 +21,12 @@ from ..numerics.threads import worker_heap
 COST_GROWTH = 1.35
 
 
-def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points"):
+def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points",
+               followers=()):
     """The sweep requests ``tasks``, serial or as process tasks on ``executor``; their curves
-    in the order of ``tasks``.
+    in the order of ``tasks``.  ``followers``: sweeps that start from the guides' points
+    (the patch band), run beside the guided points as chains of their missing speeds
+    (:func:`missing_chains`) and left in their checkpoints.
 
     A checkpointed sweep without a guide runs as guided points: first its guide
     (:func:`guide_of`, a chain on the coarsest nested grid), then every speed a task of its
@@ -37,12 +40,12 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     workers = 1 if executor is None else getattr(executor, "n_workers", 1)
     unguided = [i for i, guide in enumerate(guides) if guide is None]
     pieces = chains([tasks[i] for i in unguided], workers)     # (index in unguided, piece)
-    leading = [piece for g in guides if g is not None for piece in guide_chains(g)]
+    leading = [piece for g in guides if g is not None for piece in missing_chains(g)]
     swept = _run(leading + [piece for _, piece in pieces], executor, progress,
                  desc)[len(leading):]
     _run([point for i, (task, guide) in enumerate(zip(tasks, guides)) if i not in unguided
-          for point in guided_points(task, guide.key)],
-         executor, progress, desc)
+          for point in guided_points(task, guide.key)]
+         + [piece for f in followers for piece in missing_chains(f)], executor, progress, desc)
     own = {}
     for (j, _), curve in zip(pieces, swept):
         own.setdefault(unguided[j], []).append(curve)
@@ -61,19 +64,19 @@ def guide_of(request):
                    keep_level=0)
 
 
-def guide_chains(guide) -> list:
-    """The ``guide`` sweep as chains: whole while none of its points is checkpointed (a
-    first pass), else each run of missing speeds after the checkpointed point before it
+def missing_chains(sweep) -> list:
+    """The checkpointed ``sweep`` as chains: whole while none of its points is checkpointed
+    (a first pass), else each run of missing speeds after the checkpointed point before it
     (a refinement's midpoints, side by side)."""
-    key = guide.key
-    have = [point_file(guide.checkpoint, key, u).exists() for u in guide.speeds]
+    key = sweep.key
+    have = [point_file(sweep.checkpoint, key, u).exists() for u in sweep.speeds]
     if all(have):
         return []
     if not any(have):
-        return [guide]
+        return [sweep]
     starts = [i for i in range(len(have)) if not have[i] and (i == 0 or have[i - 1])]
     ends = [next((j for j in range(i, len(have)) if have[j]), len(have)) for i in starts]
-    return [replace(guide, speeds=guide.speeds[max(i - 1, 0):j]) for i, j in zip(starts, ends)]
+    return [replace(sweep, speeds=sweep.speeds[max(i - 1, 0):j]) for i, j in zip(starts, ends)]
 
 
 def guided_points(request, guide: str) -> list:
