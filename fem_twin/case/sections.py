@@ -138,8 +138,10 @@ class MicroSpec(CellSettings):
     (:class:`fem_twin.micro.CellSettings`, declared there once: time steps, method, squeeze
     term, adaptive instants, tolerances), the patches' resolution and the h0 candidates."""
 
-    resolution: tuple[int, int] = setting((256, 256), "patches resampled (periodically) to "
-                                          "this grid, at least 8 each", unit="px")
+    resolution: tuple[int, int] = setting((128, 128), "patches resampled (periodically) to "
+                                          "this grid, at least 8 each (the paper: its 256 px "
+                                          "patches as cut; docs/accuracy.md, 'Cheaper "
+                                          "defaults')", unit="px")
     h0_min: float = setting(H0_MIN, "smallest separation h0", "separation")
     h0_max: float = setting(H0_MAX, "largest separation h0 (above: the paper's rules)",
                             "separation")
