@@ -65,10 +65,9 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     run(case, outdir, progress=progress)
     out = RunLayout(outdir)
     simulated = read_stribeck_csv(out.stribeck_csv)[:len(paths)]
-    shares = (share_curves(case, out, simulated[0], progress) if "load_share" in params
-              else ())
-    resistances = (resistance_curves(case, out, simulated, progress)
-                   if "bulk_resistance" in params else ())
+    shares, resistances = extra_curves(
+        case, out, simulated, LOAD_SHARES if "load_share" in params else (),
+        RESISTANCES if "bulk_resistance" in params else (), progress)
     model = FitModel(tuple(simulated), case.tribometer.boundary_friction, case.tribometer.load,
                      law, case.tribometer.load_share, shares, case.thermal.bulk_resistance,
                      resistances)
@@ -105,37 +104,34 @@ def _check_coverage(case: Case, paths, curves, params) -> None:
                          f"an interval ({where}): measure more speeds there or widen [sweep]")
 
 
-def share_curves(case: Case, out: RunLayout, curve, progress: bool = True,
-                 shares=LOAD_SHARES) -> tuple:
-    """``((share, StribeckCurve), ...)``: the case's first viscosity swept at ``shares`` of
-    its load over the speeds of ``curve`` (the case's own share is ``curve``), checkpointed
-    in ``OUT/fit/checkpoints``; the micro stage's flow factors are reused."""
-    tr = case.tribometer
-    request = _fit_sweep(case, out, speeds=np.sort(curve.speed)[::-1])
-    todo = sorted(s for s in shares if not np.isclose(s, tr.load_share, rtol=1e-9))
-    with executor_for(case.run.workers, case.run.scheduler) as executor:
-        swept = run_sweeps([replace(request, load=tr.load * s) for s in todo], executor,
-                           progress, desc="load-share points")
-    return tuple(sorted([*zip(todo, swept), (tr.load_share, curve)], key=lambda p: p[0]))
-
-
-def resistance_curves(case: Case, out: RunLayout, curves, progress: bool = True,
-                      resistances=RESISTANCES) -> tuple:
-    """Per curve, ``((R_b, StribeckCurve), ...)``: each of ``curves`` (the case's K-th
-    viscosity) swept at the rig's thermal ``resistances`` [K/W] over its speeds (the
-    case's own R_b is the curve), checkpointed in ``OUT/fit/checkpoints``."""
-    own = case.thermal.bulk_resistance
-    todo = sorted(r for r in resistances if not np.isclose(r, own, rtol=1e-9, atol=1e-12))
-    tasks = [replace(request, speeds=np.sort(c.speed)[::-1], thermal=replace(
-        request.thermal, settings=replace(request.thermal.settings, bulk_resistance=r)))
+def extra_curves(case: Case, out: RunLayout, curves, shares=(), resistances=(),
+                 progress: bool = True) -> tuple:
+    """The fit's own sweeps, one batch of tasks (:func:`run_sweeps`), checkpointed in
+    ``OUT/fit/checkpoints`` over the speeds of ``curves`` (the case's run, one per
+    viscosity), the micro stage's flow factors reused: ``(share_pairs, resistance_pairs)``,
+    ``((share, StribeckCurve), ...)`` for the first viscosity at the load ``shares`` and,
+    per curve, ``((R_b, StribeckCurve), ...)`` at the thermal ``resistances`` [K/W];
+    each ascending, with the case's own value's curve, empty where none is asked for."""
+    tr, own = case.tribometer, case.thermal.bulk_resistance
+    at_shares = sorted(s for s in shares if not np.isclose(s, tr.load_share, rtol=1e-9))
+    at_resistances = sorted(r for r in resistances
+                            if not np.isclose(r, own, rtol=1e-9, atol=1e-12))
+    first = _fit_sweep(case, out, speeds=np.sort(curves[0].speed)[::-1])
+    tasks = [replace(first, load=tr.load * s) for s in at_shares] + [
+        replace(request, speeds=np.sort(c.speed)[::-1], thermal=replace(
+            request.thermal, settings=replace(request.thermal.settings, bulk_resistance=r)))
         for c, request in zip(curves, per_viscosity(case, _fit_sweep(case, out)))
-        for r in todo]
+        for r in at_resistances]
     with executor_for(case.run.workers, case.run.scheduler) as executor:
-        swept = run_sweeps(tasks, executor, progress, desc="thermal-resistance points")
-    swept = [s.with_load_share(case.tribometer.load_share) for s in swept]
-    return tuple(tuple(sorted([*zip(todo, swept[k * len(todo):(k + 1) * len(todo)]),
-                               (own, c)], key=lambda p: p[0]))
-                 for k, c in enumerate(curves))
+        swept = run_sweeps(tasks, executor, progress, desc="fit points")
+    by_share, rest = swept[:len(at_shares)], swept[len(at_shares):]
+    rest = [c.with_load_share(tr.load_share) for c in rest]
+    ascending = lambda pairs: tuple(sorted(pairs, key=lambda p: p[0]))  # noqa: E731
+    n = len(at_resistances)
+    return (ascending([*zip(at_shares, by_share), (tr.load_share, curves[0])])
+            if len(shares) else (),
+            tuple(ascending([*zip(at_resistances, rest[k * n:(k + 1) * n]), (own, c)])
+                  for k, c in enumerate(curves)) if len(resistances) else ())
 
 
 def _fit_sweep(case: Case, out: RunLayout, **changes):
@@ -210,17 +206,15 @@ def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=Non
     curves = read_stribeck_csv(out.stribeck_csv)
     lb, tr = fitted.lubricant, fitted.tribometer
     law = None if result["case"]["law"] is None else WaltherLaw(**result["case"]["law"])
-    shares = ()
-    if "load_share" in result:
-        lo, hi, _ = QUANTITIES["load_share"]
-        ends = {min(max(result["load_share"][e], lo), hi) for e in ("low", "high")}
-        shares = share_curves(fitted, out, curves[0], progress, shares=ends)
-        shares = shares if len(shares) > 1 else ()      # a zero-width interval
-    resistances = ()
-    if "bulk_resistance" in result:
-        ends = {max(result["bulk_resistance"][e], 0.0) for e in ("low", "high")}
-        resistances = resistance_curves(fitted, out, curves, progress, resistances=ends)
-        resistances = resistances if len(resistances[0]) > 1 else ()
+    lo, hi, _ = QUANTITIES["load_share"]
+    share_ends = ({min(max(result["load_share"][e], lo), hi) for e in ("low", "high")}
+                  if "load_share" in result else ())
+    resistance_ends = ({max(result["bulk_resistance"][e], 0.0) for e in ("low", "high")}
+                       if "bulk_resistance" in result else ())
+    shares, resistances = extra_curves(fitted, out, curves, sorted(share_ends),
+                                       sorted(resistance_ends), progress)
+    shares = shares if len(shares) > 1 else ()                # a zero-width interval
+    resistances = resistances if resistances and len(resistances[0]) > 1 else ()
     model = FitModel(tuple(curves), tr.boundary_friction, tr.load, law, tr.load_share, shares,
                      fitted.thermal.bulk_resistance, resistances)
     offset = temperature_offset(result)
