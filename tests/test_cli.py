@@ -508,9 +508,10 @@ def test_implausible_case_values_are_refused_naming_the_key(tmp_path, old, new, 
 @pytest.mark.parametrize("slowdown", ["0.25", "4"])
 def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, capsys,
                                                                       monkeypatch, slowdown):
-    """Issue 15 item 3: a case cut off after [geometry] is valid TOML; the defaults (the
-    paper's 256^2, 100 h0 x 32 steps) are named before work starts, and a run estimated
-    at more than seven times the bundled case stops with exit 2 unless --yes is given.
+    """Issue 15 item 3: a case cut off after [geometry] (here with 60 speeds) is valid TOML;
+    the defaults (the paper's 256^2 macro grid, cells at 128^2, 100 h0 x 32 steps) are
+    named before work starts, and a run estimated at more than seven times the bundled case
+    stops with exit 2 unless --yes is given.
     Issue 64 item 0: the question does not depend on the machine's speed (the probe forced
     fast and slow), and the bundled case's figure it quotes is the estimate's."""
     from fem_twin.cli.runs import BUNDLED_SECONDS, LONG_RUN_SECONDS
@@ -520,12 +521,12 @@ def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, 
     text = (ROOT / "examples" / "pin_on_disk.toml").read_text()
     text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
     cut = tmp_path / "cut.toml"
-    cut.write_text(text[:text.index("[preprocessing]")])
+    cut.write_text(text[:text.index("[preprocessing]")] + "[sweep]\ncount = 60\n")
     assert load_case(cut).estimated_seconds(2) > LONG_RUN_SECONDS
     assert main(["run", str(cut), "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "defaults used: [preprocessing], [tribometer]" in err and "[micro]" in err
-    assert "256x256, 100 h0 x 32 steps" in err and "--yes" in err
+    assert "128x128, 100 h0 x 32 steps" in err and "--yes" in err
     assert "x the bundled case" in err and f"takes {float(slowdown):.2g}x" in err
     assert not (tmp_path / "o" / "geometry").exists()
     for name in ("pin_on_disk", "paper", "ball_on_disk"):    # the examples run unasked
@@ -903,36 +904,26 @@ def test_inputs_that_failed_late_or_unhelpfully(tmp_path, capsys):
 
 
 def test_run_time_estimates_hold():
-    """Issue 28 item 5: fem-twin run's estimate on the calibration machine lies within 30 %
-    of the wall time measured there on 2 cores the same hour (2026-11-26, 13:20-13:45, the
-    probe of fem_twin.case.machine at 0.17-0.19 s): the bundled case 114 s with its band on the
-    coarse grid and 173 s with it on the full grid, the paper case 605 s with its band at
-    128^2 (band_grid = "coarse", at h0_tol = 0.1; 709 s at 0.05), the bundled ball-on-disk
-    case 102 s; and the paper case with its band at 64^2 (the default "coarsest"), 484 s at
-    16:00 with the probe at 0.87x (so about 556 s on the calibration machine).  (It said
-    55 min for the paper case when it took 25.5; the constants of the day before gave
-    0.60-0.74x of these times, on a machine that ran 1.45x faster in the micro stage.)
-    Those runs were isothermal and swept each curve as one chain; with guided points
-    (2026-11-28, probe 0.51-0.53x) the bundled case took 44 s with the thermal film and 38 s
-    without, the paper case 307 s with it (86, 72 and 590 s on the calibration machine)."""
+    """Issues 28 item 5 and 62 item 3: fem-twin run's estimate on the calibration machine
+    lies within 30 % of the wall time measured on 2 cores, scaled by the probe of
+    fem_twin.case.machine of the same run (2026-11-28, 13:20-13:40): the bundled case
+    50.9 s with the thermal film (probe 0.57x) and 48.6 s without (0.60x), the paper case
+    157.8 s (cells at 128^2, the default; 0.57x) and 317.7 s with its cells at 256^2
+    (0.52x; 307.6 s that morning, 0.52x), the ball-on-disk case 63.5 s (0.53x); on one
+    worker the bundled case 84.6 s (0.55x)."""
     from dataclasses import replace
     cases = {name: load_case(ROOT / "examples" / f"{name}.toml")
              for name in ("pin_on_disk", "paper", "ball_on_disk")}
-    thermal = cases["pin_on_disk"]
-    cases = {k: replace(c, thermal=replace(c.thermal, model="none")) for k, c in cases.items()}
-
-    def run(case, **kw):
-        return replace(case, run=replace(case.run, **kw))
-    paper_thermal = run(load_case(ROOT / "examples" / "paper.toml"))
-    paper = run(cases["paper"], band_grid="coarse")
-    paper_05 = replace(paper, micro=replace(paper.micro, h0_tol=0.05))
-    for case, measured in ((cases["pin_on_disk"], 114), (paper, 605), (paper_05, 709),
-                           (run(cases["pin_on_disk"], band_grid="full"), 173),
-                           (cases["ball_on_disk"], 102), (cases["paper"], 484 / 0.87),
-                           (thermal, 44 / 0.51), (cases["pin_on_disk"], 38 / 0.53),
-                           (paper_thermal, 307 / 0.52)):
-        estimate = case.estimated_seconds(2)
-        assert 0.7 < estimate / measured < 1.3, (case.name, estimate, measured)
+    bundled, paper = cases["pin_on_disk"], cases["paper"]
+    isothermal = replace(bundled, thermal=replace(bundled.thermal, model="none"))
+    paper_256 = replace(paper, micro=replace(paper.micro, resolution=(256, 256)))
+    for case, measured, workers in ((bundled, 50.9 / 0.57, 2), (isothermal, 48.6 / 0.60, 2),
+                                    (paper, 157.8 / 0.57, 2), (paper_256, 317.7 / 0.52, 2),
+                                    (paper_256, 307.6 / 0.52, 2),
+                                    (cases["ball_on_disk"], 63.5 / 0.53, 2),
+                                    (bundled, 84.6 / 0.55, 1)):
+        estimate = case.estimated_seconds(workers)
+        assert 0.7 < estimate / measured < 1.3, (case.name, workers, estimate, measured)
 
 
 def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):

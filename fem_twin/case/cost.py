@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import math
 
+from ..macro.nested import nested_levels
 from ..micro.schedule import halves
 from .schedule import Task, makespan
 
-#: a warm Stribeck point of a pin at 128^2 [s], its growth with the pixels, and the cost of
-#: a main-curve point with its C_f error estimate in plain points
-POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 1.38, 0.7, 1.28
+#: a guided Stribeck point of a pin at 128^2 [s], its growth with the nodes, and the cost
+#: of a main-curve point with its C_f error estimate in plain points
+POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 0.61, 1.08, 1.28
 #: a ball's warm point at 73^2 (Newton coupling) [s] and its growth with the grid's side
 BALL_POINT_SECONDS, BALL_POINT_GROWTH = 3.9, 2.4
 #: a band point in main-curve points, by ``[run] band_grid`` (the band's sweeps converge to
@@ -27,8 +28,12 @@ BAND_LEVEL_COST = 0.33
 #: the Stribeck stage of the thermal twin (``[thermal] model = "flash"``) against the
 #: isothermal one: each point iterates its film temperature (from its guide's)
 THERMAL_COST = 1.25
-#: a guide point (the sweep on its coarsest nested grid, warm-started) in points
-GUIDE_COST = 0.15
+#: a pin's guide point (the sweep on its coarsest nested grid, 48-95 px a side, warm-started)
+#: [s]; a ball's in its points
+GUIDE_SECONDS, GUIDE_COST = 0.24, 0.15
+#: what the main process does alone at a 128^2 macro grid (geometry, levelling, reading
+#: the curves back, writing the results) [s], and its growth with the nodes
+SERIAL_SECONDS, SERIAL_GROWTH = 16.7, 0.66
 #: rounds of the adaptive h0 sampler per patch pair (a start, bisection, refinement)
 H0_ROUNDS = 3
 #: micro stage cost per cell pixel, time step and separation on one core [s] (the cell
@@ -53,24 +58,38 @@ def cost_tasks(case) -> list[Task]:
     separation; per viscosity the sweep's guide, each point (a warm point of
     ``POINT_SECONDS``, a ball's of ``BALL_POINT_SECONDS``, with its error estimate), each
     refined speed's guide point and point (half the speeds per pass), then the band's
-    chains (:func:`_band_tasks`)."""
+    chains (:func:`_band_tasks`); last what the main process does alone."""
     micro = _micro_tasks(case)
-    point = _point_seconds(case) * (THERMAL_COST if case.thermal.model != "none" else 1.0)
+    thermal = THERMAL_COST if case.thermal.model != "none" else 1.0
+    point = _point_seconds(case) * thermal
+    guide = GUIDE_COST * point if case.tribometer.ball else GUIDE_SECONDS * thermal
     estimate = 1.0 if case.tribometer.ball else ESTIMATE_COST
     count = case.sweep.count
     added = int(round(count * 0.5 * case.sweep.refine))
     after, tasks, guides, again = tuple(t.name for t in micro), [], [], []
+    if nested_levels(case.macro_shape) == 0:            # no coarser grid: chains of speeds
+        tasks = [Task(f"sweep {v}", estimate * point * (count + added), after)
+                 for v in range(len(case.lubricant.viscosities))]
+        return micro + tasks + _serial(case, micro + tasks)
     for v in range(len(case.lubricant.viscosities)):
-        guides.append(Task(f"guide {v}", GUIDE_COST * point * count, after))
+        guides.append(Task(f"guide {v}", guide * count, after))
         first = [Task(f"point {v} {i}", estimate * point, (guides[-1].name,))
                  for i in range(count)]
         tasks += [guides[-1], *first]
         for i in range(added):                 # a refined speed: its guide point, then it
-            again.append(Task(f"guide {v} {count + i}", GUIDE_COST * point,
+            again.append(Task(f"guide {v} {count + i}", guide,
                               tuple(t.name for t in first)))
             tasks += [again[-1], Task(f"point {v} {count + i}", estimate * point,
                                       (again[-1].name,))]
-    return micro + tasks + _band_tasks(case, point, tasks, guides, again)
+    tasks += _band_tasks(case, point, tasks, guides, again)
+    return micro + tasks + _serial(case, micro + tasks)
+
+
+def _serial(case, before) -> list[Task]:
+    """What the main process does alone (:data:`SERIAL_SECONDS`), after ``before``."""
+    nodes = case.macro_shape[0] * case.macro_shape[1] / 128 ** 2
+    return [Task("serial", SERIAL_SECONDS * nodes ** SERIAL_GROWTH,
+                 tuple(t.name for t in before))]
 
 
 def _band_tasks(case, point: float, tasks, guides, again) -> list[Task]:
