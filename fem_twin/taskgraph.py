@@ -143,7 +143,8 @@ def sweep_tasks(folder, first, micro: tuple[str, ...], *, ball: bool = False,
 def _band_beside(band: dict, guides: set, in_first, refined: set) -> list[Task]:
     """The band's chains where they start from the guides: each first pass after the
     guides' first passes, each refined speed after the band's first pass and the guides'
-    points there (among the ``refined`` task names)."""
+    points there (among the ``refined`` task names).  The curves of all viscosities share
+    their speeds, so a band sweep waits for every guide, not only its viscosity's."""
     tasks = [Task(f"band sweep {k}", sum(s for u, s, _ in v if in_first(u)),
                   tuple(f"sweep {g}" for g in guides)) for k, v in band.items()]
     return tasks + [Task(f"band refinement {k} {u:.9e}", s, (f"band sweep {k}", *(

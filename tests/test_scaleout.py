@@ -164,6 +164,40 @@ def test_the_task_graph_of_a_finished_run(tmp_path):
     assert graph["wall_s"]["2"] == pytest.approx(makespan(tasks, 2), abs=0.1)
 
 
+def test_the_band_runs_beside_the_main_points(tmp_path):
+    """Issue 62 item 2: on a grid with a coarser level (96^2: guides at 48^2) the band's
+    grid is the guides', so its sweeps start after the guides' first passes, beside the
+    main points, and each refined speed after the band's first pass and the guides' point
+    there; the band then leaves the critical path (the same checkpoints scheduled with the
+    band after the main points give a longer one), and a rerun of the finished run finds
+    every band point checkpointed."""
+    from fem_twin.case import load_case
+    from fem_twin.cli import main
+    from fem_twin.stribeck.sweep import point_files
+    from fem_twin.taskgraph import critical_path, run_task_graph, sweep_tasks
+    from test_cli import small_case
+    path = small_case(tmp_path, workers=2, band=True)
+    path.write_text(path.read_text().replace("resolution = [48, 48] #", "resolution = [96, 96] #")
+                    .replace("refine = 0 ", "refine = 1 "))
+    case, out = load_case(path), tmp_path / "out"
+    assert case.band_after_guides(case.macro_shape)
+    assert main(["run", str(path), "-o", str(out), "--no-progress"]) == 0
+    tasks = run_task_graph(case, out)
+    guides = {t.name for t in tasks if t.name.startswith("sweep ")}
+    band = [t for t in tasks if t.name.startswith("band sweep")]
+    assert len(guides) == 2 and len(band) == 4                # 2 viscosities x 2 patches
+    assert all(set(t.after) == guides for t in band)
+    later = [t for t in tasks if t.name.startswith("band refinement")]
+    assert later and all(t.after[0].startswith("band sweep") and len(t.after) > 1 and all(
+        d.startswith("refinement") for d in t.after[1:]) for t in later)
+    beside, after = (sweep_tasks(out / "stribeck" / "checkpoints", case.sweep.speeds, (),
+                                 band_beside=b) for b in (True, False))
+    assert critical_path(beside) < critical_path(after)
+    first = len(list(point_files(out / "stribeck" / "checkpoints")))
+    assert main(["run", str(path), "-o", str(out), "--no-progress"]) == 0
+    assert len(list(point_files(out / "stribeck" / "checkpoints"))) == first
+
+
 def test_the_largest_sweeps_are_submitted_first(monkeypatch):
     """stages.sweeps.run_sweeps submits the sweeps by nodes times speeds, largest first (the
     resolution study's 1997^2 sweep must not start last on a busy pool), and returns the
