@@ -100,11 +100,11 @@ def _halves(moments) -> list:
 def sweep_tasks(folder, first, micro: tuple[str, ...], *, ball: bool = False,
                 refine: bool = True, band_beside: bool = False) -> list[Task]:
     """The sweeps checkpointed in ``folder``, after the tasks ``micro``: the first passes
-    over the speeds ``first`` (a guide's chain, then each of its points a task; or a sweep
-    as one chain), then the refinement's, then the band's (the nested levels the main
-    points kept for the band are part of those points), after the main points or, with
-    ``band_beside``, beside them (:meth:`~fem_twin.case.Case.band_after_guides`)."""
-    first = np.asarray(first, float)
+    over the speeds ``first`` (all speeds where None; a guide's chain, then each of its
+    points a task; or a sweep as one chain), then the refinement's, then the band's (the
+    nested levels the main points kept for the band are part of those points), after the
+    main points or, with ``band_beside``, beside them
+    (:meth:`~fem_twin.case.Case.band_after_guides`)."""
     chains, points = defaultdict(list), []
     for path in point_files(folder):
         scalars, meta = point_meta(path)
@@ -119,7 +119,11 @@ def sweep_tasks(folder, first, micro: tuple[str, ...], *, ball: bool = False,
             chains[point_key(path)].append((speed, seconds, "error_estimate" in meta))
     guides = {g for *_, g in points}
     main = {k: v for k, v in chains.items() if k in guides or any(e for _, _, e in v)}
-    in_first = lambda u: bool(np.isclose(u, first, rtol=1e-9).any())  # noqa: E731
+    first = None if first is None else np.asarray(first, float)
+
+    def in_first(u) -> bool:
+        return first is None or bool(np.isclose(u, first, rtol=1e-9).any())
+
     passes = [Task(f"sweep {k}", sum(s for u, s, _ in v if in_first(u)), micro)
               for k, v in main.items()]
     ahead = [Task(f"point {k} {u:.9e}", s, (f"sweep {g}",))
@@ -167,9 +171,8 @@ def fit_scaling(case: Case, outdir) -> dict:
     """The task graph of a fit's own sweeps (``OUT/fit/checkpoints``: load shares, thermal
     resistances; each a guide, then its points) in numbers (``fit.json`` ``"task_graph"``),
     as :func:`scaling`'s.  Every speed of a fit's sweep runs in one pass."""
-    folder = RunLayout(outdir).fit_points
-    speeds = sorted({point_meta(p)[0]["speed"] for p in point_files(folder)})
-    return in_numbers(sweep_tasks(folder, speeds, (), ball=case.tribometer.ball))
+    return in_numbers(sweep_tasks(RunLayout(outdir).fit_points, None, (),
+                                  ball=case.tribometer.ball))
 
 
 def in_numbers(tasks) -> dict:

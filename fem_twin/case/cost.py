@@ -81,7 +81,7 @@ def cost_tasks(case) -> list[Task]:
                               tuple(t.name for t in first)))
             tasks += [again[-1], Task(f"point {v} {count + i}", estimate * point,
                                       (again[-1].name,))]
-    tasks += _band_tasks(case, point, tasks, guides, again)
+    tasks += _band_tasks(case, point, added, tasks, guides, again)
     return micro + tasks + _serial(case, micro + tasks)
 
 
@@ -92,14 +92,14 @@ def _serial(case, before) -> list[Task]:
                  tuple(t.name for t in before))]
 
 
-def _band_tasks(case, point: float, tasks, guides, again) -> list[Task]:
+def _band_tasks(case, point: float, added: int, tasks, guides, again) -> list[Task]:
     """The band's chains, one per patch and viscosity: after the main points, or, where
     the band starts from the guides, its first pass after theirs and each refined speed
     after the guides' refined points."""
     patches, count = len(case.geometry.patches), case.sweep.count
     if not case.run.patch_band or patches < 2:
         return []
-    band, added = _band_point_cost(case) * point, len(again) // len(guides)
+    band = _band_point_cost(case) * point
     pairs = [(v, k) for v in range(len(guides)) for k in range(patches)]
     if not case.band_after_guides(case.macro_shape):
         done = tuple(t.name for t in tasks)

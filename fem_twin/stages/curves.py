@@ -87,15 +87,16 @@ def refined_curves(case: Case, out: RunLayout, request, executor=None,
     tr, step = case.tribometer, case.sweep.refine_step * case.tribometer.boundary_friction
     speeds = request.speeds
     keep = case.band_coarsening(request.gap.shape) if case.run.patch_band else 0
-    beside = case.band_after_guides(request.gap.shape)
+    band = (band_tasks(case, out, request) if case.band_after_guides(request.gap.shape)
+            else [])
 
     def sweeps(final):                                    # the fields with the final pass
         tasks = per_viscosity(case, replace(request, speeds=speeds, error_estimate=True,
                                             keep_level=keep,
                                             fields=out.fields if final else None))
-        band = band_tasks(case, out, replace(request, speeds=speeds)) if beside else ()
+        followers = [replace(b, speeds=speeds) for b in band]
         return [c.with_load_share(tr.load_share)
-                for c in run_sweeps(tasks, executor, progress, followers=band)]
+                for c in run_sweeps(tasks, executor, progress, followers=followers)]
 
     for level in range(case.sweep.refine + 1):
         final = level == case.sweep.refine
