@@ -4,6 +4,7 @@
                                               # (micro-full: ~15 min, estimate: ~40 min,
                                               #  estimate-paper: ~100 min, scale: ~10 min,
                                               #  cores: the bundled case on 1, 2, all workers;
+                                              #  deterministic: the mixed regime, ~25 min;
                                               #  only when named)
 """
 
@@ -27,6 +28,7 @@ sys.path.insert(0, HERE)
 from common import SAMPLE, best_of, macro_factors, macro_gap  # noqa: E402
 from cores import bench_cores  # noqa: E402
 from defaults import bench_defaults  # noqa: E402
+from deterministic import bench_deterministic  # noqa: E402
 from scale import bench_scale  # noqa: E402
 
 
@@ -579,19 +581,23 @@ GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": ben
           "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "paper": bench_paper, "stribeck": bench_stribeck,
           "estimate": bench_estimate, "scale": bench_scale, "cores": bench_cores,
           "estimate-paper": lambda: bench_estimate("paper.toml"),
-          "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults}
+          "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults,
+          "deterministic": bench_deterministic}
 
 
 def main(argv):
     groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "estimate-paper",
-                                                        "scale", "cores", "defaults")]
+                                                        "scale", "cores", "defaults",
+                                                        "deterministic")]
     for name in groups:
-        base, rows = GROUPS[name]()
+        base, rows, *summary = GROUPS[name]()
         print(f"\n## {name}")
         print(f"| {'case':50s} | {'time [s]':>9s} | {'x baseline':>10s} | notes")
         print(f"|{'-' * 52}|{'-' * 11}|{'-' * 12}|------")
         for label, t, note in rows:
             print(f"| {label:50s} | {t:9.4f} | {t / base:10.1f} | {note}")
+        for line in summary:                    # a group's one checked line, last
+            print(line)
 
 
 if __name__ == "__main__":

@@ -96,7 +96,7 @@ def test_run_files_are_named_only_by_the_run_layout():
 LAYERS = {"topography": 1, "io.files": 1, "io": 1, "contact": 2, "micro": 3, "macro": 4,
           "fvm": 4, "stribeck": 5,
           "case": 6.0, "results": 6.1, "stages": 6.2, "taskgraph": 6.2, "pipeline": 6.3,
-          "compare": 6.4, "calibration": 6.4, "fitting": 6.4, "report": 6.5, "samples": 6.5,
+          "compare": 6.4, "calibration": 6.4, "verification": 6.4, "fitting": 6.4, "report": 6.5, "samples": 6.5,
           "cli": 7}
 
 

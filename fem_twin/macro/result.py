@@ -12,6 +12,7 @@ from ..io.atomic import atomic_path
 from ..micro.rolling import at_slide_to_roll
 from .friction import boundary_shear, hydrodynamic_shear
 from .kinematics import disk_velocity, rotations
+from .reynolds import trapezoid_weights
 
 #: the grid fields of an operating point and their SI units: declared once, for the
 #: checkpoints, VTU files and ``fields.nc`` (:func:`fem_twin.results.fields_dataset`)
@@ -117,9 +118,9 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
     tau_hd, tau_con = pin_friction(p_hd, ev.theta, ev.mu, ev.h0, loc.h_m, ev.p_con, dx,
                                    P.factors, s, lubricant, speed, P.entrainment, face,
                                    P.velocity)
-    cell = dx[0] * dx[1]
-    F_hd = float(tau_hd[face].sum() * cell)
-    F_con = float(tau_con[face].sum() * cell)
+    weights = area * face                         # the load's trapezoidal rule on the face
+    F_hd = float(np.sum(weights * tau_hd))
+    F_con = float(np.sum(weights * tau_con))
     F_N = ev.F
     return MixedResult(
         speed=float(speed), imposed_load=float(load), normal_load=F_N, h_d=float(h_d),
@@ -168,8 +169,8 @@ def friction_with(result: MixedResult, factors, settings, lubricant) -> float:
                                    result.meta.get("entrainment"), result.face,
                                    disk_velocity(result.face, result.spacing,
                                                  settings.track_radius))
-    cell = result.spacing[0] * result.spacing[1]
-    return float((tau_hd + tau_con)[result.face].sum() * cell / result.normal_load)
+    weights = trapezoid_weights(result.face.shape, result.spacing) * result.face
+    return float(np.sum(weights * (tau_hd + tau_con)) / result.normal_load)
 
 
 def on_grid(result: MixedResult, shape, dx) -> MixedResult:

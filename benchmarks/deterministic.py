@@ -1,0 +1,101 @@
+"""The ``deterministic`` group: the twin against a deterministic solution in the mixed regime.
+
+The crowned pad of :mod:`fem_twin.verification` (sample patch pair 1, 256 px cut, resampled
+to 32 px; 1 MPa mean pressure, 1 um crown, an isoviscous oil of 0.066 Pa s, E' and hardness
+of Table 4) with 2, 4, 8 and 16 cells a side, 8 speeds from full film to 90 % of the load on
+asperities.  Per point: the load share, the separation, the film friction and C_f of both,
+and the differences extrapolated to eps -> 0.  Then what carries the differences, on the
+pad of 8 cells: the film pressure's deformation of the asperities switched off in the
+deterministic solver, and the film cut-off at 5 and 20 nm on both sides.  The baseline is
+the twin's sweep on the finest pad; the last line is the group's summary.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+
+from fem_twin.io.files import read_topography
+from fem_twin.macro import Lubricant
+from fem_twin.topography.prepare import prepare_patch
+from fem_twin import verification as V
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SAMPLE = os.path.join(HERE, "..", "meshes", "sample")
+#: the speeds at two cells a side [m/s] (the finer pads' scale as 2 / tiles)
+SPEEDS = np.geomspace(0.1, 5.0, 8)
+#: the separations of the twin's flow factors [m]
+H0 = np.geomspace(3e-8, 3e-6, 60)
+PIXELS = 32
+
+
+def sample_pad(pixels: int = PIXELS, **options) -> V.RoughPad:
+    """The pad of sample patch pair 1 (an isoviscous oil: the deterministic film's
+    viscosity iteration does not settle at the micro-EHL pressures beside contact spots)."""
+    pin = prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz")))
+    disk = prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")), upper=True)
+    oil = Lubricant(0.066, roelands_alpha=0.0, dh_c2=1.0)
+    return V.patch_pad(pin, disk, pixels, oil, **options)
+
+
+def _row(p: V.Pair, cfb: float, seconds: float):
+    note = (f"U {p.speed:.3g} m/s: share {p.share_det:.3f} / {p.share:.3f}, h_d "
+            f"{p.separation_det * 1e9:.1f} / {p.separation * 1e9:.1f} nm, film "
+            f"{p.film_det * 1e3:.4g} / {p.film * 1e3:.4g} mN, C_f {p.cf_det:.4f} / "
+            f"{p.cf:.4f} ({100 * p.cf_gap(cfb):+.2f} % C_f,b)")
+    return (f"eps 1/{p.tiles}, deterministic / twin", seconds, note)
+
+
+def _diagnostics(pad, tiles, factors, cfb):
+    """Rows of what moves the deterministic points on the pad of ``tiles``: the film's
+    deformation off, the cut-off at 5 and 20 nm (the twin's factors recomputed)."""
+    rows = []
+    base = V.deterministic_sweep(pad, tiles, SPEEDS)
+    still = V.deterministic_sweep(pad, tiles, SPEEDS, V.with_settings(pad, film_deforms=False)
+                                  .settings)
+    moved = max(abs(a.friction_coefficient - b.friction_coefficient) for a, b in zip(base, still))
+    shares = max(abs(a.load_share - b.load_share) for a, b in zip(base, still))
+    rows.append((f"eps 1/{tiles}: film pressure does not deform", 0.0,
+                 f"C_f moves by at most {100 * moved / cfb:.3f} % C_f,b, share {shares:.4f}"))
+    for cut in (5e-9, 20e-9):
+        other = V.with_settings(pad, boundary_film=cut)
+        pairs = V.compared(V.deterministic_sweep(other, tiles, SPEEDS),
+                           V.twin_sweep(other, tiles, SPEEDS, V.pad_factors(other, H0)), tiles)
+        gap = max(abs(p.cf_gap(cfb)) for p in pairs)
+        det = max(abs(d.friction_coefficient - p.cf_det) for d, p in zip(base, pairs))
+        rows.append((f"eps 1/{tiles}: film cut-off {cut * 1e9:.0f} nm", 0.0,
+                     f"worst |C_f - C_f,det| {100 * gap:.2f} % C_f,b; C_f,det moves by "
+                     f"{100 * det / cfb:.2f} % C_f,b from 10 nm"))
+    return rows
+
+
+def bench_deterministic(tiles=V.TILES):
+    """The comparison table (module docstring) and its summary line."""
+    pad = sample_pad()
+    cfb = pad.settings.boundary_friction
+    factors = V.pad_factors(pad, H0)
+    rows, table = [], []
+    for n in tiles:
+        t0 = time.perf_counter()
+        det = V.deterministic_sweep(pad, n, SPEEDS)
+        t1 = time.perf_counter()
+        twin = V.twin_sweep(pad, n, SPEEDS, factors)
+        t_twin = time.perf_counter() - t1
+        table.append(V.compared(det, twin, n))
+        rows += [_row(p, cfb, (t1 - t0) / len(SPEEDS)) for p in table[-1]]
+    eps = [1 / n for n in tiles]
+    for k, speed in enumerate(SPEEDS):
+        share, order = V.to_zero(eps, [t[k].share - t[k].share_det for t in table])
+        cf, _ = V.to_zero(eps, [t[k].cf_gap(cfb) for t in table])
+        rows.append((f"eps -> 0 (speed {speed:.3g} m/s at eps 1/2)", 0.0,
+                     f"share - share,det {share:+.4f} (order {order:.2f}), C_f - C_f,det "
+                     f"{100 * cf:+.2f} % C_f,b"))
+    rows += _diagnostics(pad, 8, factors, cfb)
+    finest = table[-1]
+    summary = (f"mixed regime: worst |C_f - C_f,det| = "
+               f"{100 * max(abs(p.cf_gap(cfb)) for p in finest):.2f} % C_f,b, worst |share - "
+               f"share,det| = {max(abs(p.share - p.share_det) for p in finest):.3f}, at "
+               f"{100 * max(p.share_det for p in finest):.0f} % asperity load")
+    return t_twin / len(SPEEDS), rows, summary

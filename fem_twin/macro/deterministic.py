@@ -1,0 +1,237 @@
+"""Deterministic mixed lubrication of a pad whose gap carries the resolved roughness: the
+reference the homogenised twin is verified against in the mixed regime (docs/accuracy.md,
+"The mixed regime against a deterministic solution").  Nothing here is homogenised.
+
+The pin at rest over the disk sliding at U along +x1 (steady: the roughness is the pin's);
+on one node grid the gap is ``h = h_d + shape + K (p + p_con)`` (eqs 19-22 resolved), with
+``p`` the film pressure of Reynolds with JFO cavitation (eqs 17-18 with A = I, b = e1; Q1
+Poiseuille and the central Couette flux, the cells' discretisation; eqs 23-24 at the local
+pressure), ``p_con`` the asperity pressure (CG-FFT with the hardness cap at imposed
+separation, :func:`fem_twin.contact.solve`) and ``K`` the non-periodic half-space.
+Ambient and cavitation pressure 0 (gauge).  A staggered iteration solves the contact against
+the shape deformed by the film pressure, then the film on the contact's gap (floored at
+``gap_floor``, as in the cells), until that deformation settles; ``h_d`` balances the load
+(Brent on the log of the load).  Friction on the pin (:func:`pad_friction`) plus ``C_f,b``
+times the contact load (eq 32); integrals by the trapezoidal rule."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import brentq
+
+from .. import tables as T
+from ..checks import as_field, as_pair, number, plausible, setting
+from ..contact import solve as contact_solve
+from ..contact.elastic import elastic_operator
+from ..errors import InputError, NotConverged
+from ..numerics.anderson import Anderson
+from .cavitation import cavitation_model
+from .couette import couette_matrix
+from .lubricant import Lubricant
+from .problem import MAX_COEFFICIENT_PRESSURE
+from .reynolds import fe_poiseuille, trapezoid_weights
+
+__all__ = ["DeterministicNotConverged", "DeterministicResult", "DeterministicSettings",
+           "pad_friction", "solve_deterministic"]
+
+
+#: Anderson mixing of the film's deformation (the micro-EHL coupling): depth and damping
+ANDERSON_DEPTH, ANDERSON_DAMPING = 6, 0.5
+
+
+class DeterministicNotConverged(NotConverged):
+    """The load balance or the film-contact iteration missed its tolerance."""
+
+
+@dataclass(frozen=True)
+class DeterministicSettings:
+    """Materials and numerics of :func:`solve_deterministic` (SI units)."""
+
+    boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", unit="-")
+    e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", "reduced_modulus")
+    hardness: float = setting(T.HARDNESS, "the cap on the contact pressure", "hardness")
+    boundary_film: float = setting(10e-9, "films thinner than this carry no wall shear",
+                                   unit="m")
+    gap_floor: float = setting(1e-9, "the film in a contact spot", unit="m")
+    film_deforms: bool = setting(True, "the film pressure deforms the surfaces (False: the "
+                                 "asperities feel their contact pressure alone)", unit="-")
+    tol: float = setting(1e-7, "relative load residual, and the film deformation's change "
+                         "per micrometre", unit="-")
+    contact_tol: float = setting(1e-9, "tolerance of each contact solve", unit="-")
+    max_iter: int = setting(60, "load evaluations, and film-contact passes per evaluation",
+                            unit="-")
+
+    def __post_init__(self):
+        plausible("e_reduced [Pa]", self.e_reduced, "reduced_modulus")
+        plausible("hardness [Pa]", self.hardness, "hardness")
+        plausible("boundary_friction", self.boundary_friction, "friction")
+        if not (0 < self.gap_floor < self.boundary_film < 1e-6 and 0 < self.tol < 1
+                and 0 < self.contact_tol < 1 and self.max_iter >= 2):
+            raise InputError("DeterministicSettings: need 0 < gap_floor < boundary_film < 1 um, "
+                             "tolerances in (0, 1) and max_iter >= 2")
+
+
+@dataclass(frozen=True, eq=False)
+class DeterministicResult:
+    """A converged deterministic point (SI units): ``separation`` h_d [m]; ``film_load``,
+    ``contact_load``, ``load`` [N]; ``film_friction`` (wall shear and film pressure on the
+    pin), ``boundary_force`` (C_f,b times the contact load) [N]; fields ``pressure``,
+    ``contact_pressure`` [Pa], ``cavity_fraction`` [-], ``gap`` [m]; ``history``: the log
+    load residual of each evaluation."""
+
+    speed: float
+    load: float
+    separation: float
+    film_load: float
+    contact_load: float
+    film_friction: float
+    boundary_force: float
+    spacing: tuple
+    pressure: np.ndarray
+    contact_pressure: np.ndarray
+    cavity_fraction: np.ndarray
+    gap: np.ndarray
+    history: tuple = field(default=())
+
+    @property
+    def load_share(self) -> float:
+        """The share of the load the asperities carry [-]."""
+        return self.contact_load / self.load
+
+    @property
+    def friction_coefficient(self) -> float:
+        """C_f = (film friction + C_f,b contact load) / load (eq 34) [-]."""
+        return (self.film_friction + self.boundary_force) / self.load
+
+
+def pad_friction(pressure, gap, cavity_fraction, viscosity, spacing, speed: float,
+                 boundary_film: float) -> float:
+    """The film's force on the pin along +x1 [N]: ``int mu U / h (1 - theta) dA`` over the
+    films thicker than ``boundary_film`` [m] plus ``int (h / 2) dp/dx1 dA``, which is the
+    pin's wall shear and the film pressure on its surface (``-(h/2) dp/dx1 - p dh/dx1``)
+    integrated by parts with ``p = 0`` on the edge; trapezoidal rule, central differences."""
+    h, p = np.asarray(gap, float), np.asarray(pressure, float)
+    dp1 = np.gradient(p, spacing[0], axis=1)
+    shear = np.where(h > boundary_film, viscosity * speed / h, 0.0) * (1 - cavity_fraction)
+    return float(np.sum(trapezoid_weights(h.shape, spacing) * (shear + h / 2 * dp1)))
+
+
+@dataclass
+class _Pad:
+    """What one solve keeps between evaluations: the grid's operators and the warm starts."""
+
+    shape: np.ndarray
+    spacing: tuple
+    speed: float
+    lubricant: Lubricant
+    settings: DeterministicSettings
+    area: np.ndarray = None
+    boundary: np.ndarray = None
+    elastic: object = None
+    p_con: np.ndarray | None = None
+    phi: np.ndarray | None = None
+    film_deformation: np.ndarray | None = None
+
+    def __post_init__(self):
+        self.area = trapezoid_weights(self.shape.shape, self.spacing)
+        self.boundary = np.zeros(self.shape.shape, bool)
+        self.boundary[[0, -1], :] = self.boundary[:, [0, -1]] = True
+        self.elastic = elastic_operator(self.shape.shape, self.spacing, self.settings.e_reduced)
+        self.film_deformation = np.zeros_like(self.shape)
+
+    def film(self, gap):
+        """Reynolds with JFO on ``gap``: ``(p, theta, mu)``, eqs 23-24 by Picard steps."""
+        model, lub, dx = cavitation_model("switch"), self.lubricant, self.spacing
+        scale = 6 * lub.viscosity * self.speed * float(np.mean(dx)) / float(np.mean(gap)) ** 2
+        p_old, mu, rho, changes = None, lub.viscosity, 1.0, []
+        for _ in range(self.settings.max_iter):
+            B = couette_matrix(rho * gap * self.speed / 2, np.zeros_like(gap), dx, "central")
+            self.phi, _, _ = model.solve(fe_poiseuille(rho * gap ** 3 / (12 * mu), dx), B,
+                                         self.boundary, 0.0, scale, phi0=self.phi, tol=1e-10)
+            p, theta = (v.reshape(gap.shape) for v in model.split(self.phi, scale))
+            if p_old is not None:
+                changes.append(float(np.abs(p - p_old).max() / max(p.max(), 1.0)))
+                if changes[-1] <= 1e-9:
+                    return p, theta, mu
+            p_old, clipped = p, np.minimum(p, MAX_COEFFICIENT_PRESSURE)
+            mu, rho = lub.viscosity_at(clipped), lub.density_ratio(clipped)
+        raise DeterministicNotConverged("the film's viscosity iteration (eqs 23-24 at the "
+                                        "local pressure) did not settle: micro-EHL "
+                                        "pressures; use an isoviscous Lubricant", changes)
+
+    def at(self, separation: float):
+        """The film and the contact at the rigid separation ``h_d`` [m]: a dict of fields
+        and loads; the film's deformation iterated with the contact's (``film_deforms``)."""
+        s, history, mixer = self.settings, [], Anderson(ANDERSON_DEPTH, ANDERSON_DAMPING)
+        for _ in range(s.max_iter):
+            c = contact_solve(self.shape + self.film_deformation, self.spacing, s.e_reduced,
+                              separation=separation, hardness=s.hardness,
+                              gap_floor=s.gap_floor, initial_pressure=self.p_con,
+                              tol=s.contact_tol)
+            self.p_con = c.pressure if c.load > 0 else None
+            p, theta, mu = self.film(c.gap)
+            if not s.film_deforms:
+                break
+            change = self.elastic(p) - self.film_deformation
+            history.append(float(np.abs(change).max()) / 1e-6)
+            if history[-1] < s.tol:
+                break
+            self.film_deformation = mixer.step(self.film_deformation.ravel(),
+                                               change.ravel()).reshape(self.shape.shape)
+        else:
+            raise DeterministicNotConverged("the film's deformation of the asperities did "
+                                            "not settle", history)
+        return {"p": p, "theta": theta, "mu": mu, "p_con": c.pressure, "gap": c.gap,
+                "film_load": float(np.sum(self.area * p)),
+                "contact_load": float(np.sum(self.area * c.pressure))}
+
+
+def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant: Lubricant,
+                        settings: DeterministicSettings,
+                        initial: DeterministicResult | None = None) -> DeterministicResult:
+    """Solve one operating point of the resolved pad (module docstring).
+
+    shape : (ny, nx) undeformed gap at zero separation, the pad's form plus its roughness,
+        ``disk - pin`` [m], x1 (sliding) along the columns; the pad fills the grid
+    spacing : (dx1, dx2) [m];  load : F_N [N];  speed : the disk's U [m/s]
+    initial : a neighbouring point whose separation starts the bracket of h_d
+    """
+    s = as_field("shape [m]", shape, 5)
+    dx = as_pair("spacing [m]", spacing)
+    plausible("spacing [m]", dx, "pitch")
+    load, speed = number("load [N]", load, "load"), number("speed [m/s]", speed, "speed")
+    if not isinstance(lubricant, Lubricant) or not isinstance(settings, DeterministicSettings):
+        raise InputError("lubricant must be a Lubricant and settings DeterministicSettings")
+    pad = _Pad(s, dx, speed, lubricant, settings)
+    states, history = {}, []
+
+    def residual(h_d):
+        states[h_d] = pad.at(h_d)
+        history.append(np.log((states[h_d]["film_load"] + states[h_d]["contact_load"]) / load))
+        return history[-1]
+
+    lo, hi = _bracket(residual, initial.separation if initial else 2 * float(np.std(s)),
+                      max(float(np.std(s)) / 4, 1e-9), settings.max_iter)
+    h_d = brentq(residual, lo, hi, xtol=1e-15, rtol=1e-10, maxiter=settings.max_iter)
+    if abs(residual(h_d)) > settings.tol:
+        raise DeterministicNotConverged("the load balance missed its tolerance", history)
+    st = states[h_d]
+    film = pad_friction(st["p"], st["gap"], st["theta"], st["mu"], dx, speed,
+                        settings.boundary_film)
+    return DeterministicResult(speed, load, float(h_d), st["film_load"], st["contact_load"],
+                               film, settings.boundary_friction * st["contact_load"], dx,
+                               st["p"], st["p_con"], st["theta"], st["gap"], tuple(history))
+
+
+def _bracket(residual, start: float, step: float, max_iter: int):
+    """``(lo, hi)`` separations [m] around the balance: from ``start``, steps that double."""
+    a, fa = start, residual(start)
+    for _ in range(max_iter):
+        b = a + (step if fa > 0 else -step)
+        fb = residual(b)
+        if fa * fb <= 0:
+            return min(a, b), max(a, b)
+        a, fa, step = b, fb, 2 * step
+    raise DeterministicNotConverged("no separation found that carries the load", [fa])

@@ -1,0 +1,192 @@
+"""The mixed regime against a deterministic solution on the same roughness (docs/accuracy.md,
+"The mixed regime against a deterministic solution").
+
+A crowned square pad carries a roughness cell (the composite ``disk - pin`` of a patch pair,
+on the pin at rest; the disk smooth and sliding along +x1) tiled ``n`` times per side, so the
+wavelength ratio is ``eps = 1/n``.  :func:`fem_twin.macro.deterministic.solve_deterministic`
+solves it resolved; the twin solves the same pad with the flow factors of that cell
+(:func:`fem_twin.micro.homogenise`) on a macro grid.  The pad grows with ``n`` at a fixed
+mean pressure and crown, and the speed falls as ``1/n``: ``mu U L / (p h^2)`` and the load
+share are then the same problem at every ``eps`` (the macro deformation, ``p L / E'``, is
+below a picometre), and the film's friction coefficient scales as ``h / L``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .errors import InputError
+from .macro import Lubricant, MacroSettings, solve_mixed
+from .macro.deterministic import DeterministicSettings, solve_deterministic
+from .micro import homogenise
+from .topography import Topography, resample_cell
+
+#: the pads' tile counts of ``benchmarks/run.py deterministic`` (eps = 1/2 .. 1/16)
+TILES = (2, 4, 8, 16)
+
+
+@dataclass(frozen=True)
+class RoughPad:
+    """A crowned square pad with a tiled roughness cell (SI units).
+
+    roughness : (m, m) periodic ``disk - pin`` heights of the cell [m], zero mean
+    pitch : its pixel pitch [m];  crown : the form's rise from the centre to the edges' middle
+        [m] (a paraboloid);  mean_pressure : load over the pad's area [Pa]
+    lubricant : both solvers' oil;  settings : the deterministic solver's materials, cut-off
+        and C_f,b, which the twin's cells and macro scale take too
+    macro_nodes : the twin's macro grid per side
+    """
+
+    roughness: np.ndarray
+    pitch: float
+    lubricant: Lubricant
+    settings: DeterministicSettings = field(default_factory=DeterministicSettings)
+    crown: float = 1e-6
+    mean_pressure: float = 1e6
+    macro_nodes: int = 65
+
+    def __post_init__(self):
+        r = np.asarray(self.roughness, float)
+        if r.ndim != 2 or r.shape[0] != r.shape[1] or not np.all(np.isfinite(r)):
+            raise InputError("roughness must be a finite square (m, m) cell [m]")
+        object.__setattr__(self, "roughness", r - r.mean())
+
+    def length(self, tiles: int) -> float:
+        """The side of the pad of ``tiles`` cells a side [m]."""
+        return tiles * self.roughness.shape[0] * self.pitch
+
+    def load(self, tiles: int) -> float:
+        """The load [N] of the pad of ``tiles`` cells a side."""
+        return self.mean_pressure * self.length(tiles) ** 2
+
+    def form(self, nodes: int) -> np.ndarray:
+        """The crown on ``nodes`` x ``nodes`` nodes spanning the pad [m], 0 at its centre."""
+        xi = np.linspace(-1.0, 1.0, nodes)
+        return self.crown * (xi[None, :] ** 2 + xi[:, None] ** 2)
+
+    def resolved(self, tiles: int):
+        """``(shape, spacing)`` of the deterministic pad: the crown plus the tiled cell on
+        ``tiles m + 1`` nodes a side (the cell's period closed)."""
+        tiled = np.pad(np.tile(self.roughness, (tiles, tiles)), ((0, 1), (0, 1)), mode="wrap")
+        return self.form(tiled.shape[0]) + tiled, (self.pitch, self.pitch)
+
+    def macro(self, tiles: int):
+        """``(gap, spacing)`` of the twin's pad: the crown on ``macro_nodes`` a side."""
+        step = self.length(tiles) / (self.macro_nodes - 1)
+        return self.form(self.macro_nodes), (step, step)
+
+
+def patch_pad(pin: Topography, disk: Topography, pixels: int, lubricant: Lubricant,
+              **options) -> RoughPad:
+    """The :class:`RoughPad` of a prepared patch pair (``disk`` flipped over ``pin``,
+    :func:`fem_twin.topography.prepare.prepare_patch`) resampled periodically to ``pixels``
+    a side (:func:`fem_twin.topography.resample_cell`, as the micro stage does)."""
+    low, up = resample_cell(pin, (pixels, pixels)), resample_cell(disk, (pixels, pixels))
+    return RoughPad(up.heights - low.heights, float(low.spacing[0]), lubricant, **options)
+
+
+def pad_factors(pad: RoughPad, h0, **cell):
+    """The twin's flow factors of the pad's cell at the separations ``h0`` [m]: the
+    roughness on the pin at rest, the disk smooth (one instant: a steady cell), with the
+    pad's materials and film cut-off; ``cell``: other :class:`~fem_twin.micro.CellSettings`."""
+    s = pad.settings
+    pin = Topography(-pad.roughness, (pad.pitch, pad.pitch))
+    disk = Topography(np.zeros_like(pad.roughness), (pad.pitch, pad.pitch))
+    return homogenise(pin, disk, h0, n_steps=1, e_reduced=s.e_reduced, hardness=s.hardness,
+                      boundary_film=s.boundary_film, gap_floor=s.gap_floor,
+                      error_estimate=False, **cell)
+
+
+def pad_speeds(speeds, tiles: int) -> np.ndarray:
+    """The speeds [m/s] of the pad of ``tiles`` cells a side for ``speeds`` given at two
+    tiles: ``U 2 / tiles``, the same ``mu U L`` at every eps."""
+    return np.asarray(speeds, float) * 2.0 / tiles
+
+
+def deterministic_sweep(pad: RoughPad, tiles: int, speeds, settings=None) -> list:
+    """:func:`solve_deterministic` at each of ``speeds`` (given at two tiles,
+    :func:`pad_speeds`), each started from the one before; ``settings`` replace the pad's."""
+    shape, dx = pad.resolved(tiles)
+    out, last = [], None
+    for u in pad_speeds(speeds, tiles):
+        last = solve_deterministic(shape, dx, load=pad.load(tiles), speed=u,
+                                   lubricant=pad.lubricant,
+                                   settings=settings or pad.settings, initial=last)
+        out.append(last)
+    return out
+
+
+def twin_sweep(pad: RoughPad, tiles: int, speeds, factors) -> list:
+    """The twin's points (:func:`fem_twin.macro.solve_mixed`) on the same pad, loads and
+    speeds, with ``factors`` of the pad's cell (:func:`pad_factors`); the face is the pad."""
+    gap, dx = pad.macro(tiles)
+    s = pad.settings
+    settings = MacroSettings(e_reduced=s.e_reduced, boundary_friction=s.boundary_friction,
+                             ambient_pressure=0.0, cavitation_pressure=0.0, tol=1e-7)
+    out, last = [], None
+    for u in pad_speeds(speeds, tiles):
+        last = solve_mixed(gap, dx, factors, load=pad.load(tiles), speed=u,
+                           lubricant=pad.lubricant, settings=settings, initial=last)
+        out.append(last)
+    return out
+
+
+@dataclass(frozen=True)
+class Pair:
+    """One compared point: ``tiles``, ``speed`` [m/s], the load share [-], the separation
+    h_d [m], the film friction [N] and C_f [-] of the deterministic solution (``*_det``)
+    and of the twin."""
+
+    tiles: int
+    speed: float
+    share_det: float
+    share: float
+    separation_det: float
+    separation: float
+    film_det: float
+    film: float
+    cf_det: float
+    cf: float
+
+    def cf_gap(self, boundary_friction: float) -> float:
+        """C_f - C_f,det in units of C_f,b [-]."""
+        return (self.cf - self.cf_det) / boundary_friction
+
+
+def compared(det: list, twin: list, tiles: int) -> list:
+    """The :class:`Pair` of each speed of two sweeps on the pad of ``tiles``."""
+    return [Pair(tiles, d.speed, d.load_share, t.contact_load / t.normal_load, d.separation,
+                 t.h_d, d.film_friction, t.hydrodynamic_friction, d.friction_coefficient,
+                 t.friction_coefficient) for d, t in zip(det, twin)]
+
+
+def compare_pad(pad: RoughPad, speeds, factors, tiles=TILES, progress=None) -> list:
+    """Both sweeps on each pad of ``tiles`` cells a side: a list of :class:`Pair` lists."""
+    out = []
+    for n in tiles:
+        out.append(compared(deterministic_sweep(pad, n, speeds),
+                            twin_sweep(pad, n, speeds, factors), n))
+        if progress is not None:
+            progress(n, out[-1])
+    return out
+
+
+def to_zero(eps, values) -> tuple[float, float]:
+    """``(value at eps -> 0, observed order)`` from the values at the three finest ``eps``
+    (Richardson with the observed order, which is taken as 1 where the differences do not
+    shrink monotonically); from two values, first order."""
+    e, v = np.asarray(eps, float), np.asarray(values, float)
+    order = np.argsort(e)
+    e, v = e[order], v[order]
+    if len(e) >= 3:
+        d1, d2 = v[1] - v[0], v[2] - v[1]
+        if d1 * d2 > 0 and abs(d2) > abs(d1):
+            p = np.log(abs(d2 / d1)) / np.log(e[2] / e[1])
+            return float(v[0] - d1 / ((e[1] / e[0]) ** p - 1)), float(p)
+    return float(v[0] - (v[1] - v[0]) / (e[1] / e[0] - 1)), 1.0
+
+
+def with_settings(pad: RoughPad, **changes) -> RoughPad:
+    """The pad with its deterministic settings changed (``film_deforms``, ``boundary_film``)."""
+    return replace(pad, settings=replace(pad.settings, **changes))
