@@ -17,9 +17,6 @@ import time
 
 import numpy as np
 
-from fem_twin.io.files import read_topography
-from fem_twin.macro import Lubricant
-from fem_twin.topography.prepare import prepare_patch
 from fem_twin import verification as V
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -29,15 +26,6 @@ SPEEDS = np.geomspace(0.1, 5.0, 8)
 #: the separations of the twin's flow factors [m]
 H0 = np.geomspace(3e-8, 3e-6, 60)
 PIXELS = 32
-
-
-def sample_pad(pixels: int = PIXELS, **options) -> V.RoughPad:
-    """The pad of sample patch pair 1 (an isoviscous oil: the deterministic film's
-    viscosity iteration does not settle at the micro-EHL pressures beside contact spots)."""
-    pin = prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_pin.npz")))
-    disk = prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")), upper=True)
-    oil = Lubricant(0.066, roelands_alpha=0.0, dh_c2=1.0)
-    return V.patch_pad(pin, disk, pixels, oil, **options)
 
 
 def _row(p: V.Pair, cfb: float, seconds: float):
@@ -73,7 +61,7 @@ def _diagnostics(pad, tiles, factors, cfb):
 
 def bench_deterministic(tiles=V.TILES):
     """The comparison table (module docstring) and its summary line."""
-    pad = sample_pad()
+    pad = V.sample_pad(SAMPLE, PIXELS)
     cfb = pad.settings.boundary_friction
     factors = V.pad_factors(pad, H0)
     rows, table = [], []

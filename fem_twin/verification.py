@@ -20,7 +20,9 @@ from .errors import InputError
 from .macro import Lubricant, MacroSettings, solve_mixed
 from .macro.deterministic import DeterministicSettings, solve_deterministic
 from .micro import homogenise
+from .io.files import read_topography
 from .topography import Topography, resample_cell
+from .topography.prepare import prepare_patch
 
 #: the pads' tile counts of ``benchmarks/run.py deterministic`` (eps = 1/2 .. 1/16)
 TILES = (2, 4, 8, 16)
@@ -84,6 +86,19 @@ def patch_pad(pin: Topography, disk: Topography, pixels: int, lubricant: Lubrica
     a side (:func:`fem_twin.topography.resample_cell`, as the micro stage does)."""
     low, up = resample_cell(pin, (pixels, pixels)), resample_cell(disk, (pixels, pixels))
     return RoughPad(up.heights - low.heights, float(low.spacing[0]), lubricant, **options)
+
+
+def sample_pad(folder, pixels: int = 32, pair: int = 1, **options) -> RoughPad:
+    """The :class:`RoughPad` of patch pair ``pair`` of the bundled sample (``folder``: the
+    repository's ``meshes/sample``), cut at 256 px as the bundled case does, with an
+    isoviscous oil of 0.066 Pa s: the deterministic film's viscosity iteration does not
+    settle at the micro-EHL pressures beside contact spots."""
+    from pathlib import Path
+    folder = Path(folder)
+    pin = prepare_patch(read_topography(folder / f"patch_{pair}_pin.npz"))
+    disk = prepare_patch(read_topography(folder / f"patch_{pair}_disk.npz"), upper=True)
+    return patch_pad(pin, disk, pixels, Lubricant(0.066, roelands_alpha=0.0, dh_c2=1.0),
+                     **options)
 
 
 def pad_factors(pad: RoughPad, h0, **cell):

@@ -163,12 +163,7 @@ def test_the_twin_meets_the_deterministic_pad():
     0.6 %); at 2 cells a side (0.3 m/s), where the crown rises 1 um across a cell, the
     twin misses the share by 0.06 and the separation by 50 nm: scale separation."""
     from fem_twin import verification as V
-    from fem_twin.io.files import read_topography
-    from fem_twin.topography.prepare import prepare_patch
-    sample = Path(__file__).parents[1] / "meshes" / "sample"
-    pin = prepare_patch(read_topography(sample / "patch_1_pin.npz"))
-    disk = prepare_patch(read_topography(sample / "patch_1_disk.npz"), upper=True)
-    pad = V.patch_pad(pin, disk, 16, Lubricant(0.066, roelands_alpha=0.0, dh_c2=1.0))
+    pad = V.sample_pad(Path(__file__).parents[1] / "meshes" / "sample", 16)
     factors = V.pad_factors(pad, np.geomspace(3e-8, 3e-6, 60))
     gaps = {}
     for tiles in (2, 8):
