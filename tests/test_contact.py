@@ -1,4 +1,4 @@
-"""Dry contact against closed forms (../shared/REFERENCES.md): Love, Hertz, Westergaard, KKT."""
+"""Dry contact against closed forms (docs/references.md): Love, Hertz, Westergaard, KKT."""
 
 import numpy as np
 import pytest

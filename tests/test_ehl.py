@@ -1,6 +1,6 @@
 """Concentrated contacts: the smooth EHL point contact against published and measured films.
 
-References: Hamrock and Dowson (1977) film fits (../shared/REFERENCES.md), whose own accuracy
+References: Hamrock and Dowson (1977) film fits (docs/references.md), whose own accuracy
 is about 10 %; the ball-on-disk films measured by interferometry by Mourier et al. (2006)
 and simulated with EHL-FBNS by Hansen et al. (2022) (../shared/references/ehl/).
 Grids have ``n - 1`` divisible by 6 so that a node sits on the contact centre.

@@ -33,7 +33,7 @@ def ridges(n, body):
 def striated_closed_form():
     """``s_C = h_m (4 <1/h> - 3 <h^-2>^2 / <h^-3>)`` of ``h = H0 - a cos``: the force on the
     pin with its ridges at rest under a smooth disk, the wall shear ``mu U / h - (h/2) p'``
-    plus the flank pressure ``h p'`` (REFERENCES.md's averages, by fine quadrature)."""
+    plus the flank pressure ``h p'`` (docs/references.md's averages, by fine quadrature)."""
     h = H0 - AMP * np.cos(2 * np.pi * np.arange(4096) / 4096)
     return h.mean() * (4 * np.mean(1 / h) - 3 * np.mean(h ** -2) ** 2 / np.mean(h ** -3))
 

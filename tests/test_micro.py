@@ -25,7 +25,7 @@ def ridges(n, along):
 
 
 def exact_ridges():
-    """REFERENCES.md: <h^3>, <h^-3>, <h^-2> of h = H + a cos."""
+    """docs/references.md: <h^3>, <h^-3>, <h^-2> of h = H + a cos."""
     h3 = H ** 3 + 1.5 * H * AMP ** 2
     hm3 = (H ** 2 + AMP ** 2 / 2) * (H ** 2 - AMP ** 2) ** -2.5
     hm2 = H * (H ** 2 - AMP ** 2) ** -1.5
@@ -70,7 +70,7 @@ def test_smooth_limit_is_exact(method):
 @pytest.mark.parametrize("method", ["fe", "fvm"])
 def test_striated_roughness_converges_second_order(method):
     """Transverse ridges on the pin: A11 = 1/(<h^-3> h_m^3), b1 = <h^-2>/(<h^-3> h_m)
-    (REFERENCES.md).  Both discretisations are second order: the error falls 4x per
+    (docs/references.md).  Both discretisations are second order: the error falls 4x per
     refinement; at 64 px per period it is below 2.5e-3 (measured 1.5e-3 FE, 1.3e-3 FVM)."""
     h3, hm3, hm2 = exact_ridges()
     errors = []
@@ -262,7 +262,7 @@ def test_time_error_estimate_bounds_the_true_error():
 
 def test_grid_error_estimate_bounds_the_true_error():
     """meta["error_estimate"]["grid"] compares with the cell coarsened by two.  On the
-    transverse ridges (second order, exact A11 and b1 from REFERENCES.md) it bounds the true
+    transverse ridges (second order, exact A11 and b1 from docs/references.md) it bounds the true
     error by about 2^2 - 1 = 3 (it assumes first order, the order of rough contacts)."""
     h3, hm3, hm2 = exact_ridges()
     pin, disk = ridges(64, "x1")

@@ -22,7 +22,7 @@ def strip(h_x, dx, ny=41, wide=40):
 @pytest.mark.parametrize("method", ["fe", "fvm"])
 @pytest.mark.parametrize("K, W_ref", [(0.5, 2.623252e4), (1.0, 3.177662e4), (2.0, 2.958369e4)])
 def test_inclined_slider(method, K, W_ref):
-    """REFERENCES.md slider loads; second order: 2e-4 at 101 nodes, 4x less at 201."""
+    """docs/references.md slider loads; second order: 2e-4 at 101 nodes, 4x less at 201."""
     L, ho = 20e-3, 10e-6
     errs = []
     for nx in (101, 201):
@@ -62,7 +62,7 @@ def swift_stieber(x_in):
 
 
 def test_swift_stieber_reference_quadrature():
-    """The quadrature reproduces REFERENCES.md for an inlet at -infinity."""
+    """The quadrature reproduces docs/references.md for an inlet at -infinity."""
     Xc, W = swift_stieber(1e3)
     assert Xc == pytest.approx(0.47513, abs=2e-5) and W == pytest.approx(4.8950, rel=1e-4)
 
