@@ -88,17 +88,16 @@ def patch_pad(pin: Topography, disk: Topography, pixels: int, lubricant: Lubrica
     return RoughPad(up.heights - low.heights, float(low.spacing[0]), lubricant, **options)
 
 
-def sample_pad(folder, pixels: int = 32, pair: int = 1, **options) -> RoughPad:
+def sample_pad(folder, pixels: int = 32, pair: int = 1,
+               lubricant: Lubricant = Lubricant(0.066), **options) -> RoughPad:
     """The :class:`RoughPad` of patch pair ``pair`` of the bundled sample (``folder``: the
-    repository's ``meshes/sample``), cut at 256 px as the bundled case does, with an
-    isoviscous oil of 0.066 Pa s: the deterministic film's viscosity iteration does not
-    settle at the micro-EHL pressures beside contact spots."""
+    repository's ``meshes/sample``), cut at 256 px as the bundled case does; ``lubricant``
+    default: the bundled case's oil at 24 C (0.066 Pa s, eqs 23-24 of Table 6)."""
     from pathlib import Path
     folder = Path(folder)
     pin = prepare_patch(read_topography(folder / f"patch_{pair}_pin.npz"))
     disk = prepare_patch(read_topography(folder / f"patch_{pair}_disk.npz"), upper=True)
-    return patch_pad(pin, disk, pixels, Lubricant(0.066, roelands_alpha=0.0, dh_c2=1.0),
-                     **options)
+    return patch_pad(pin, disk, pixels, lubricant, **options)
 
 
 def pad_factors(pad: RoughPad, h0, **cell):

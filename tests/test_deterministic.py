@@ -157,11 +157,12 @@ def test_bad_inputs_and_no_convergence_are_clear():
 
 def test_the_twin_meets_the_deterministic_pad():
     """The mixed regime: sample patch pair 1 at 16 px tiled 8 x 8 on the crowned pad of
-    fem_twin.verification (1 MPa, 0.075 m/s): the deterministic solution carries 70 % of the
-    load on asperities, and the twin with that cell's flow factors agrees within 0.02 in
-    load share, 5 nm in separation and 2 % in film friction (measured 0.012, 2.9 nm,
-    0.6 %); at 2 cells a side (0.3 m/s), where the crown rises 1 um across a cell, the
-    twin misses the share by 0.06 and the separation by 50 nm: scale separation."""
+    fem_twin.verification (1 MPa, 0.075 m/s, the bundled oil at 24 C): the deterministic
+    solution carries 70 % of the load on asperities, and the twin with that cell's flow
+    factors agrees within 0.02 in load share, 5 nm in separation and 2 % in film friction
+    (measured 0.012, 3.0 nm, 0.45 %); at 2 cells a side (0.3 m/s), where the crown rises
+    1 um across a cell, the twin misses the share by 0.06 and the separation by 49 nm:
+    scale separation."""
     from fem_twin import verification as V
     pad = V.sample_pad(Path(__file__).parents[1] / "meshes" / "sample", 16)
     factors = V.pad_factors(pad, np.geomspace(3e-8, 3e-6, 60))

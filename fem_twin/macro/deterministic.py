@@ -57,8 +57,8 @@ class DeterministicSettings:
     gap_floor: float = setting(1e-9, "the film in a contact spot", unit="m")
     film_deforms: bool = setting(True, "the film pressure deforms the surfaces (False: the "
                                  "asperities feel their contact pressure alone)", unit="-")
-    tol: float = setting(1e-7, "relative load residual, and the film deformation's change "
-                         "per micrometre", unit="-")
+    tol: float = setting(1e-7, "log load residual; the film's deformation per micrometre, "
+                         "log viscosity and density ratio changes", unit="-")
     contact_tol: float = setting(1e-9, "tolerance of each contact solve", unit="-")
     max_iter: int = setting(60, "load evaluations, and film-contact passes per evaluation",
                             unit="-")
@@ -118,9 +118,15 @@ def pad_friction(pressure, gap, cavity_fraction, viscosity, spacing, speed: floa
     return float(np.sum(trapezoid_weights(h.shape, spacing) * (shear + h / 2 * dp1)))
 
 
+#: the film deformation's scale in the mixed state [m]: its change per micrometre
+H_REF = 1e-6
+
+
 @dataclass
 class _Pad:
-    """What one solve keeps between evaluations: the grid's operators and the warm starts."""
+    """What one solve keeps between evaluations: the grid's operators and the warm starts,
+    ``coupled``: the film's deformation over ``H_REF``, its log viscosity ratio and its
+    density ratio, stacked (the fixed point's unknowns)."""
 
     shape: np.ndarray
     spacing: tuple
@@ -132,57 +138,57 @@ class _Pad:
     elastic: object = None
     p_con: np.ndarray | None = None
     phi: np.ndarray | None = None
-    film_deformation: np.ndarray | None = None
+    coupled: np.ndarray | None = None
 
     def __post_init__(self):
         self.area = trapezoid_weights(self.shape.shape, self.spacing)
         self.boundary = np.zeros(self.shape.shape, bool)
         self.boundary[[0, -1], :] = self.boundary[:, [0, -1]] = True
         self.elastic = elastic_operator(self.shape.shape, self.spacing, self.settings.e_reduced)
-        self.film_deformation = np.zeros_like(self.shape)
+        self.coupled = np.zeros((3, *self.shape.shape))
+        self.coupled[2] = 1.0
 
-    def film(self, gap):
-        """Reynolds with JFO on ``gap``: ``(p, theta, mu)``, eqs 23-24 by Picard steps."""
-        model, lub, dx = cavitation_model("switch"), self.lubricant, self.spacing
-        scale = 6 * lub.viscosity * self.speed * float(np.mean(dx)) / float(np.mean(gap)) ** 2
-        p_old, mu, rho, changes = None, lub.viscosity, 1.0, []
-        for _ in range(self.settings.max_iter):
-            B = couette_matrix(rho * gap * self.speed / 2, np.zeros_like(gap), dx, "central")
-            self.phi, _, _ = model.solve(fe_poiseuille(rho * gap ** 3 / (12 * mu), dx), B,
-                                         self.boundary, 0.0, scale, phi0=self.phi, tol=1e-10)
-            p, theta = (v.reshape(gap.shape) for v in model.split(self.phi, scale))
-            if p_old is not None:
-                changes.append(float(np.abs(p - p_old).max() / max(p.max(), 1.0)))
-                if changes[-1] <= 1e-9:
-                    return p, theta, mu
-            p_old, clipped = p, np.minimum(p, MAX_COEFFICIENT_PRESSURE)
-            mu, rho = lub.viscosity_at(clipped), lub.density_ratio(clipped)
-        raise DeterministicNotConverged("the film's viscosity iteration (eqs 23-24 at the "
-                                        "local pressure) did not settle: micro-EHL "
-                                        "pressures; use an isoviscous Lubricant", changes)
+    def film(self, gap, mu, rho):
+        """Reynolds with JFO on ``gap`` [m] at the viscosity ``mu`` and density ratio ``rho``
+        (fields): ``(p, theta)`` [Pa, -]."""
+        model, dx = cavitation_model("switch"), self.spacing
+        scale = (6 * self.lubricant.viscosity * self.speed * float(np.mean(dx))
+                 / float(np.mean(gap)) ** 2)
+        B = couette_matrix(rho * gap * self.speed / 2, np.zeros_like(gap), dx, "central")
+        self.phi, _, _ = model.solve(fe_poiseuille(rho * gap ** 3 / (12 * mu), dx), B,
+                                     self.boundary, 0.0, scale, phi0=self.phi, tol=1e-10)
+        return (v.reshape(gap.shape) for v in model.split(self.phi, scale))
+
+    def coupling(self, p) -> np.ndarray:
+        """The stacked unknowns the film pressure ``p`` [Pa] implies (eqs 20-24)."""
+        lub, clipped = self.lubricant, np.minimum(p, MAX_COEFFICIENT_PRESSURE)
+        deform = self.elastic(p) / H_REF if self.settings.film_deforms else 0 * p
+        return np.stack([deform, np.log(lub.viscosity_at(clipped) / lub.viscosity),
+                         lub.density_ratio(clipped)])
 
     def at(self, separation: float):
         """The film and the contact at the rigid separation ``h_d`` [m]: a dict of fields
-        and loads; the film's deformation iterated with the contact's (``film_deforms``)."""
+        and loads.  Each pass solves the contact against the shape deformed by the film,
+        then the film; the film's deformation, viscosity and density are mixed (Anderson)
+        until they change by less than ``tol``."""
         s, history, mixer = self.settings, [], Anderson(ANDERSON_DEPTH, ANDERSON_DAMPING)
         for _ in range(s.max_iter):
-            c = contact_solve(self.shape + self.film_deformation, self.spacing, s.e_reduced,
-                              separation=separation, hardness=s.hardness,
+            c = contact_solve(self.shape + H_REF * self.coupled[0], self.spacing,
+                              s.e_reduced, separation=separation, hardness=s.hardness,
                               gap_floor=s.gap_floor, initial_pressure=self.p_con,
                               tol=s.contact_tol)
             self.p_con = c.pressure if c.load > 0 else None
-            p, theta, mu = self.film(c.gap)
-            if not s.film_deforms:
-                break
-            change = self.elastic(p) - self.film_deformation
-            history.append(float(np.abs(change).max()) / 1e-6)
+            mu = self.lubricant.viscosity * np.exp(self.coupled[1])
+            p, theta = self.film(c.gap, mu, self.coupled[2])
+            change = self.coupling(p) - self.coupled
+            history.append(float(np.abs(change).max()))
             if history[-1] < s.tol:
                 break
-            self.film_deformation = mixer.step(self.film_deformation.ravel(),
-                                               change.ravel()).reshape(self.shape.shape)
+            self.coupled = mixer.step(self.coupled.ravel(), change.ravel()).reshape(
+                self.coupled.shape)
         else:
-            raise DeterministicNotConverged("the film's deformation of the asperities did "
-                                            "not settle", history)
+            raise DeterministicNotConverged("the film's deformation and viscosity did not "
+                                            "settle with the contact", history)
         return {"p": p, "theta": theta, "mu": mu, "p_con": c.pressure, "gap": c.gap,
                 "film_load": float(np.sum(self.area * p)),
                 "contact_load": float(np.sum(self.area * c.pressure))}
