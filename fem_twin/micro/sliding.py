@@ -25,6 +25,7 @@ from .. import tables as T
 from ..checks import arguments, check_choices, plausible, setting
 from ..errors import InputError
 from .cell_fv import CellSolverFV
+from .film import mean_inverse_film
 from .flow_factors import FlowFactors
 from .rolling import SLIDING
 
@@ -242,14 +243,15 @@ def film_moments(contact, cell: dict, settings: CellSettings) -> dict:
     fraction, and the film's dissipation per ``mu u_r^2``, ``s_c = <1/h> + 3 k^2 <h^3
     |grad chi_1|^2>`` [1/m] (Couette shear and the sliding flow's pressure; ``cell``: the
     instant's cell moments, ``k = 2 u_m / u_r`` of the cell's frame), the friction on the
-    pin times u_r (docs/model.md, "Friction on the pin"), over the film thicker than
+    pin times u_r (docs/model.md, "Friction on the pin"; ``<1/h>`` exact on the linear
+    interpolant of the gap, :mod:`.film`), over the film thicker than
     ``settings.boundary_film``, then half and twice it (:data:`FILM_CUTS`): contact spots
     carry the boundary shear (eq 32) instead, and thinner films near them are boundary
     films.  ``h3_g1_pin``: eq 14's ``<h^3 grad chi_1>`` with the pin at rest (``k`` times
     the frame's), for the Poiseuille friction ``2 e1 - b``."""
     k = 2 * frame_speed_ratio(settings)
-    h_inv = np.array([np.mean(np.where(contact.gap > c * settings.boundary_film,
-                                       1.0 / contact.gap, 0.0)) for c in FILM_CUTS])
+    h_inv = np.array([mean_inverse_film(contact.raw_gap, c * settings.boundary_film)
+                      for c in FILM_CUTS])
     return {"p_con": float(contact.pressure.mean()),
             "contact_fraction": contact.contact_fraction,
             "h3_g1_pin": k * cell["h3_g1"], "s_c": h_inv + 3 * k * k * cell["h3_g1g1"]}
