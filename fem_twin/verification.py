@@ -17,10 +17,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .errors import InputError
+from .io.files import read_topography
 from .macro import Lubricant, MacroSettings, solve_mixed
 from .macro.deterministic import DeterministicSettings, solve_deterministic
 from .micro import homogenise
-from .io.files import read_topography
 from .topography import Topography, resample_cell
 from .topography.prepare import prepare_patch
 
@@ -88,8 +88,8 @@ def patch_pad(pin: Topography, disk: Topography, pixels: int, lubricant: Lubrica
     return RoughPad(up.heights - low.heights, float(low.spacing[0]), lubricant, **options)
 
 
-def sample_pad(folder, pixels: int = 32, pair: int = 1,
-               lubricant: Lubricant = Lubricant(0.066), **options) -> RoughPad:
+def sample_pad(folder, pixels: int = 32, pair: int = 1, lubricant: Lubricant | None = None,
+               **options) -> RoughPad:
     """The :class:`RoughPad` of patch pair ``pair`` of the bundled sample (``folder``: the
     repository's ``meshes/sample``), cut at 256 px as the bundled case does; ``lubricant``
     default: the bundled case's oil at 24 C (0.066 Pa s, eqs 23-24 of Table 6)."""
@@ -97,7 +97,7 @@ def sample_pad(folder, pixels: int = 32, pair: int = 1,
     folder = Path(folder)
     pin = prepare_patch(read_topography(folder / f"patch_{pair}_pin.npz"))
     disk = prepare_patch(read_topography(folder / f"patch_{pair}_disk.npz"), upper=True)
-    return patch_pad(pin, disk, pixels, lubricant, **options)
+    return patch_pad(pin, disk, pixels, lubricant or Lubricant(0.066), **options)
 
 
 def pad_factors(pad: RoughPad, h0, **cell):

@@ -14,12 +14,16 @@ from fem_twin.contact import solve as contact_solve
 from fem_twin.contact.elastic import elastic_operator
 from fem_twin.errors import InputError
 from fem_twin.macro import Lubricant, MacroSettings, solve_mixed, solve_reynolds
-from fem_twin.macro.deterministic import (DeterministicNotConverged, DeterministicSettings,
-                                          pad_friction, solve_deterministic)
+from fem_twin.macro.deterministic import (
+    DeterministicNotConverged,
+    DeterministicSettings,
+    pad_friction,
+    solve_deterministic,
+)
 from fem_twin.micro import FlowFactors
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_friction import MU, RATIO, SLIDER, U, resolved_slider, strip  # noqa: E402
+from test_friction import MU, RATIO, SLIDER, U, resolved_slider, strip
 
 OIL = Lubricant(MU, roelands_alpha=0.0, dh_c2=1.0)
 #: rigid: the film does not deform the surfaces, E' of the contact at its plausible maximum
