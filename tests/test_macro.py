@@ -7,20 +7,26 @@ couplings agree to about 1e-5 (two independent 1e-6 stops); exact invariances ho
 """
 
 import pickle
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from fem_twin.fvm import fvm_poiseuille
 from fem_twin.io.files import read_topography
-from fem_twin.macro import (BOUNDARY_FRICTION, Lubricant, MacroSettings, MixedNotConverged,
-                            MixedResult, solve_mixed, solve_reynolds)
+from fem_twin.macro import (
+    BOUNDARY_FRICTION,
+    Lubricant,
+    MacroSettings,
+    MixedNotConverged,
+    MixedResult,
+    solve_mixed,
+    solve_reynolds,
+)
 from fem_twin.macro.reynolds import fe_poiseuille
 from fem_twin.micro import FlowFactors, homogenise
 from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
-
-from pathlib import Path
 
 SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "sample"
 
@@ -143,8 +149,7 @@ def test_every_coupling_takes_its_cavitation_model_from_the_registry(case32, fac
     solve_reynolds, the fixed point and the Newton coupling (its inner solve, split and
     derivatives), so adding one touches that module and a test only.  A counting copy of
     the switch gives the switch's state."""
-    from fem_twin.macro import cavitation
-    from fem_twin.macro import solve_reynolds
+    from fem_twin.macro import cavitation, solve_reynolds
     calls = {"solve": 0, "split": 0, "unknown": 0, "derivatives": 0}
 
     class Counting(cavitation.PThetaSwitch):
@@ -398,8 +403,7 @@ def test_friction_error_parts(case32, factors):
     factors without variants report theirs as missing (NaN, left out of the total)."""
     from dataclasses import replace
 
-    from fem_twin.macro.estimate import (FILM_COUPLING, MACRO_ORDER, PARTS, coarsened,
-                                         friction_error)
+    from fem_twin.macro.estimate import FILM_COUPLING, MACRO_ORDER, PARTS, coarsened, friction_error
     gap, dx, face = case32
     kw = dict(load=150.0, lubricant=Lubricant(0.066), settings=MacroSettings())
     res = solve_mixed(gap, dx, factors, speed=0.05, face=face, **kw)
@@ -507,7 +511,8 @@ def test_nested_levels_each_start_from_the_next_coarser_change(factors, monkeypa
     from the previous point's middle level alone (measured 2026-11-26: 21 against 26), and
     every level reaches the point a plain warm start reaches (C_f within 1e-6 C_f,b: both
     stop at the coupling tolerance 1e-6)."""
-    from fem_twin.macro import mixed, nested as nest
+    from fem_twin.macro import mixed
+    from fem_twin.macro import nested as nest
     monkeypatch.setattr(mixed, "COARSE_START", 28)
     monkeypatch.setattr(nest, "COARSE_START", 28)
     gap, dx, face = macro_case(112)
