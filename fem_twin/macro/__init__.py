@@ -1,6 +1,7 @@
 """Macro scale: homogenised Reynolds with mass-conserving cavitation, elastic deformation,
 contact pressure and load balance (eqs 17-34)."""
 
+from .deterministic import DeterministicResult, DeterministicSettings, solve_deterministic
 from .friction import BOUNDARY_FRICTION, boundary_shear, hydrodynamic_shear
 from .kinematics import disk_velocity
 from .lubricant import Lubricant
@@ -8,6 +9,7 @@ from .mixed import MacroSettings, MixedNotConverged, MixedResult, solve_mixed
 from .reynolds import ReynoldsNotConverged, ReynoldsResult, solve_reynolds
 
 __all__ = ["BOUNDARY_FRICTION", "boundary_shear", "hydrodynamic_shear", "disk_velocity",
+           "DeterministicResult", "DeterministicSettings", "solve_deterministic",
            "Lubricant",
            "MacroSettings", "MixedNotConverged", "MixedResult", "solve_mixed",
            "ReynoldsNotConverged", "ReynoldsResult", "solve_reynolds"]
