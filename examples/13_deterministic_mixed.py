@@ -21,6 +21,7 @@ cells, eps down to 1/8), 2 min without (32 px).
 """
 
 import argparse
+import sys
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -28,7 +29,7 @@ import numpy as np
 
 from fem_twin import verification as V
 
-SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "sample"
+SAMPLE = Path(sys.argv[0]).resolve().parents[1] / "meshes" / "sample"
 
 
 def main(out="out/deterministic_mixed", quick=False):
