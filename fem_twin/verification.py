@@ -32,11 +32,15 @@ TILES = (2, 4, 8, 16)
 class RoughPad:
     """A crowned square pad with a tiled roughness cell (SI units).
 
+    Attributes
+    ----------
     roughness : (m, m) periodic ``disk - pin`` heights of the cell [m], zero mean
-    pitch : its pixel pitch [m];  crown : the form's rise from the centre to the edges' middle
-        [m] (a paraboloid);  mean_pressure : load over the pad's area [Pa]
-    lubricant : both solvers' oil;  settings : the deterministic solver's materials, cut-off
-        and C_f,b, which the twin's cells and macro scale take too
+    pitch : its pixel pitch [m]
+    lubricant : both solvers' oil
+    settings : the deterministic solver's materials, cut-off and C_f,b
+        which the twin's cells and macro scale take too
+    crown : the form's rise from the centre to the edges' middle [m] (a paraboloid)
+    mean_pressure : load over the pad's area [Pa]
     macro_nodes : the twin's macro grid per side
     """
 

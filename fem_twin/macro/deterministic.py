@@ -199,9 +199,14 @@ def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant:
                         initial: DeterministicResult | None = None) -> DeterministicResult:
     """Solve one operating point of the resolved pad (module docstring).
 
-    shape : (ny, nx) undeformed gap at zero separation, the pad's form plus its roughness,
-        ``disk - pin`` [m], x1 (sliding) along the columns; the pad fills the grid
-    spacing : (dx1, dx2) [m];  load : F_N [N];  speed : the disk's U [m/s]
+    Parameters
+    ----------
+    shape : (ny, nx) undeformed gap at zero separation [m]
+        the pad's form plus its roughness, ``disk - pin``, x1 (sliding) along the columns;
+        the pad fills the grid
+    spacing : (dx1, dx2) [m]
+    load : F_N [N]
+    speed : the disk's U [m/s]
     initial : a neighbouring point whose separation starts the bracket of h_d
     """
     s = as_field("shape [m]", shape, 5)
