@@ -96,9 +96,4 @@ def bench_deterministic(tiles=V.TILES):
                 f"{100 * cf:+.2f} % C_f,b")
         rows.append((f"eps -> 0 (speed {speed:.3g} m/s at eps 1/2)", 0.0, note))
     rows += _diagnostics(pad, 8, cfb)
-    finest = table[-1]
-    summary = (f"mixed regime: worst |C_f - C_f,det| = "
-               f"{100 * max(abs(p.cf_gap(cfb)) for p in finest):.2f} % C_f,b, worst |share - "
-               f"share,det| = {max(abs(p.share - p.share_det) for p in finest):.3f}, at "
-               f"{100 * max(p.share_det for p in finest):.0f} % asperity load")
-    return t_twin / len(SPEEDS), rows, summary
+    return t_twin / len(SPEEDS), rows, V.summary(table[-1], cfb)

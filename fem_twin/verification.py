@@ -190,6 +190,16 @@ def compare_pad(pad: RoughPad, speeds, factors, tiles=TILES, progress=None) -> l
     return out
 
 
+def summary(pairs, boundary_friction: float) -> str:
+    """The one line of ``benchmarks/run.py deterministic``: the largest C_f gap [% C_f,b] and
+    load-share gap over ``pairs`` (:class:`Pair`), and the largest resolved share [%]."""
+    cf = max(abs(p.cf_gap(boundary_friction)) for p in pairs)
+    share = max(abs(p.share - p.share_det) for p in pairs)
+    return (f"mixed regime: worst |C_f - C_f,det| = {100 * cf:.2f} % C_f,b, worst |share - "
+            f"share,det| = {share:.3f}, at {100 * max(p.share_det for p in pairs):.0f} % "
+            "asperity load")
+
+
 def to_zero(eps, values) -> tuple[float, float]:
     """``(value at eps -> 0, observed order)`` from the values at the three finest ``eps``
     (Richardson with the observed order, which is taken as 1 where the differences do not

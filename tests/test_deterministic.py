@@ -188,3 +188,13 @@ def test_the_extrapolation_to_scale_separation_is_exact_on_a_power_law(order):
     eps = [1 / 2, 1 / 4, 1 / 8, 1 / 16]
     limit, p = to_zero(eps, [0.3 + 0.05 * e ** order for e in eps])
     assert limit == pytest.approx(0.3, abs=1e-12) and p == pytest.approx(order)
+
+
+def test_the_benchmarks_summary_line():
+    """``benchmarks/run.py deterministic`` ends in exactly this line (issue 70's bar), from
+    the worst point of the finest pad."""
+    from fem_twin.verification import Pair, summary
+    pairs = [Pair(16, 0.1, 0.223, 0.234, 2e-7, 2e-7, 1e-3, 1e-3, 0.0556, 0.0577),
+             Pair(16, 0.01, 0.899, 0.900, 2e-7, 2e-7, 1e-3, 1e-3, 0.1744, 0.1747)]
+    assert summary(pairs, 0.19245) == ("mixed regime: worst |C_f - C_f,det| = 1.09 % C_f,b, "
+                                       "worst |share - share,det| = 0.011, at 90 % asperity load")
