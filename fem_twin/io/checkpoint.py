@@ -7,7 +7,8 @@ files of keys they no longer use).  Every stage writes atomically
 (:func:`fem_twin.io.atomic.atomic_path`), so a file is either complete or absent after a crash; a file
 that still cannot be read (a disk error, a truncated copy, a hand edit) must not stop every
 later run.  :func:`load_or_none` returns the loaded result, or None after moving the bad file
-to ``NAME.corrupt`` with a warning in the log, and the caller recomputes it.
+to ``NAME.corrupt`` with a warning in the log, and the caller recomputes it; so does a file
+whose metadata names another key or point than its own (:func:`check_made_for`).
 """
 
 from __future__ import annotations
@@ -42,6 +43,25 @@ def load_or_none(path, loader):
         log.warning("unreadable result %s (%s: %s): moved to %s, recomputing", path,
                     type(err).__name__, err, aside.name)
         return None
+
+
+#: the entry of a checkpoint's metadata that names what it was made for
+MADE_FOR = "made_for"
+
+
+def made_for(key: str, at: float) -> dict:
+    """The metadata entry of a checkpoint made for ``key`` at ``at`` (a speed, a separation)."""
+    return {MADE_FOR: {"key": key, "at": float(at)}}
+
+
+def check_made_for(meta: dict, key: str, at: float, path) -> None:
+    """Refuse (``ValueError``, which :func:`load_or_none` sets aside) a checkpoint whose
+    metadata does not name ``key`` and ``at``: a file copied over another's, or made by
+    another version of the store."""
+    got = meta.get(MADE_FOR) or {}
+    if got.get("key") != key or not np.isclose(got.get("at", np.nan), at, rtol=1e-9, atol=0):
+        raise ValueError(f"{Path(path).name} was made for {got or 'an unnamed input'}, not "
+                         f"{key} at {at:.9g}")
 
 
 def input_key(*parts, length: int = 16) -> str:

@@ -1,6 +1,6 @@
 """The checkpoints of the roughness scale: one JSON file of space-time moments per h0,
-named by a hash of the surfaces and the cell settings (written atomically; an unreadable one
-is recomputed)."""
+named by a hash of the surfaces and the cell settings, which it also records (written
+atomically; an unreadable one, or one made for another key or h0, is recomputed)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.atomic import atomic_path
-from ..io.checkpoint import input_key, load_or_none
+from ..io.checkpoint import check_made_for, input_key, load_or_none, made_for
 
 
 def cell_key(z_low, z_up, spacing, settings) -> str:
@@ -26,7 +26,7 @@ def save_point(folder, key, h0, moments):
     data = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in moments.items()}
     path = point_path(folder, key, h0)
     with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps({"h0": float(h0), "moments": data}))
+        tmp.write_text(json.dumps({"h0": float(h0), "moments": data, **made_for(key, h0)}))
 
 
 #: the moments a checkpoint must hold (eqs 11-16)
@@ -34,8 +34,12 @@ MOMENTS = ("h", "h3_grad", "h3_g1", "h_grad", "h_g1", "h3_g1g1", "s_c", "h3_g1_p
            "p_con", "contact_fraction")
 
 
-def read_point(path):
+def read_point(path, key=None, h0=None):
+    """The moments of an h0 checkpoint; with ``key`` and ``h0``, refused (``ValueError``)
+    unless it was made for them."""
     data = json.loads(path.read_text())
+    if key is not None:
+        check_made_for(data, key, h0, path)
     moments = {k: (np.array(v) if isinstance(v, list) else v)
                for k, v in data["moments"].items()}
     missing = [k for k in MOMENTS if k not in moments]
@@ -45,7 +49,7 @@ def read_point(path):
 
 
 def load_point(folder, key, h0):
-    return load_or_none(point_path(folder, key, h0), read_point)
+    return load_or_none(point_path(folder, key, h0), lambda p: read_point(p, key, h0))
 
 
 def prune_checkpoints(folder, keep) -> int:

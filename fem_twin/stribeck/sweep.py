@@ -11,7 +11,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ..checks import check
-from ..io.checkpoint import load_or_none
+from ..io.checkpoint import check_made_for, load_or_none, made_for
 from ..io.mesh import write_pvd
 from ..macro import MixedResult
 from ..macro.estimate import PARTS, friction_error
@@ -44,6 +44,17 @@ def point_file(folder, key: str, speed: float) -> Path:
 def point_files(folder, key: str = "*") -> list[Path]:
     """The Stribeck point checkpoints in ``folder`` (of the sweep ``key``, or all)."""
     return sorted(Path(folder).glob(f"point_{key}_*.npz"))
+
+
+def load_point(path, key: str, speed: float):
+    """The :class:`~fem_twin.macro.MixedResult` checkpointed at ``path`` for the sweep
+    ``key`` at ``speed``, or None: missing, damaged, or made for another key or speed (set
+    aside, :func:`fem_twin.io.checkpoint.check_made_for`)."""
+    def loader(p):
+        res = MixedResult.load(p)
+        check_made_for(res.meta, key, speed, p)
+        return res
+    return load_or_none(path, loader)
 
 
 def point_key(path) -> str:
@@ -83,7 +94,7 @@ def stribeck_sweep(request: SweepRequest, progress: bool = False) -> StribeckCur
     for i, speed in enumerate(tqdm(r.speeds, desc=f"Stribeck mu0={mu:g}",
                                    disable=not progress, unit="speed")):
         path = None if folder is None else point_file(folder, key, speed)
-        res = None if path is None else load_or_none(path, MixedResult.load)
+        res = None if path is None else load_point(path, key, speed)
         coarser = []                        # the point on each coarsening of the grid
         if res is None:
             res, *coarser = point.solve(float(speed), guided.start(r.speeds, i, previous),
@@ -118,8 +129,9 @@ class _Point:
         ``path`` with its coarse C_f, and its level ``keep = (folder, key, level,
         sweep key)`` kept for a guided sweep."""
         r = self.request
+        folder, kept, level, key = keep
         res, *coarser = _solve_point(r, speed, start)
-        meta = {LOAD_BELOW: res.contact_load_below(r.factors.h0[0])}
+        meta = {LOAD_BELOW: res.contact_load_below(r.factors.h0[0]), **made_for(key, speed)}
         if r.guide is not None and r.speeds.size == 1:          # a task of its own
             meta[GUIDED_BY] = r.guide
         if coarser:
@@ -128,9 +140,9 @@ class _Point:
         res = replace(res, meta={**res.meta, **meta})
         if path is not None:
             res.save(path)
-        folder, kept, level, key = keep
         if kept and len(coarser) >= level:
-            replace(coarser[level - 1], meta={**coarser[level - 1].meta, LEVEL_OF: key}).save(
+            replace(coarser[level - 1], meta={**coarser[level - 1].meta, LEVEL_OF: key,
+                                              **made_for(kept, speed)}).save(
                 point_file(folder, kept, speed))
         return (res, *coarser)
 
@@ -201,8 +213,8 @@ class _Guide:
         read as ``here``, then as ``before`` of the next speed)."""
         if speed not in self.read:
             last = dict(list(self.read.items())[-1:])
-            self.read = {**last, speed: load_or_none(
-                point_file(self.folder, self.guide, speed), MixedResult.load)}
+            self.read = {**last, speed: load_point(
+                point_file(self.folder, self.guide, speed), self.guide, speed)}
         return self.read[speed]
 
 

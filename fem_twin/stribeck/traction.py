@@ -18,14 +18,14 @@ from tqdm import tqdm
 
 from ..checks import check, plausible
 from ..errors import InputError
-from ..io.checkpoint import load_or_none
+from ..io.checkpoint import made_for
 from ..io.figure import save_figure
 from ..io.table import write_csv
-from ..macro import MixedResult, solve_mixed
+from ..macro import solve_mixed
 from ..macro.estimate import friction_error
 from ..numerics.threads import one_thread
 from .request import RollingSliding, SweepRequest
-from .sweep import point_file
+from .sweep import load_point, point_file
 
 #: the CSV header of each column of ``traction.csv``: its name with the SI unit
 HEADERS = {"slide_to_roll": "slide_to_roll", "sliding_speed": "sliding_speed_m_s",
@@ -91,12 +91,13 @@ def traction_sweep(request: SweepRequest, slide_to_roll=DEFAULT_RATIOS,
     for srr in tqdm(ratios[::-1], desc=f"traction mu0={r.lubricant.viscosity:g}",
                     disable=not progress, unit="point"):
         path = None if folder is None else point_file(folder, key, srr)
-        res = None if path is None else load_or_none(path, MixedResult.load)
+        res = None if path is None else load_point(path, key, srr)
         if res is None:
             res = solve_mixed(r.gap, r.spacing, r.factors, speed=float(srr * entrainment),
                               initial=previous, **common)
             estimate = friction_error(res, r.gap, r.spacing, r.factors, **common)
-            res = replace(res, meta={**res.meta, "error_estimate": estimate})
+            res = replace(res, meta={**res.meta, "error_estimate": estimate,
+                                     **made_for(key, srr)})
             if path is not None:
                 res.save(path)
         results[srr] = previous = res

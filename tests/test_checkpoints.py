@@ -1,0 +1,50 @@
+"""A checkpoint is read back only for what it was made for: a valid file copied over
+another's (another speed, another h0) is set aside as damaged and recomputed."""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from fem_twin import Topography
+from fem_twin.macro import Lubricant, MacroSettings
+from fem_twin.micro import homogenise
+from fem_twin.stribeck import SweepRequest, stribeck_sweep
+from fem_twin.stribeck.sweep import point_files
+from fem_twin.topography.synthetic import self_affine
+
+sys.path.insert(0, str(Path(__file__).parent))
+from test_macro import macro_case, smooth_factors  # noqa: E402
+
+
+def test_a_stribeck_point_copied_over_another_is_recomputed(tmp_path):
+    """Sample pin 1 at 32^2, smooth factors, two speeds: the 0.5 m/s point's file copied
+    over the 1 m/s one's is moved to ``.corrupt`` on the rerun and the 1 m/s point solved
+    again, to the first run's C_f (it was read back as the other point, whose C_f differs
+    by more than 10 %)."""
+    gap, dx, face = macro_case(32)
+    request = SweepRequest(gap, dx, smooth_factors(), [1.0, 0.5], load=150.0,
+                           lubricant=Lubricant(0.066), face=face, checkpoint=tmp_path,
+                           settings=MacroSettings(tol=1e-6))
+    first = stribeck_sweep(request)
+    fast, slow = sorted(point_files(tmp_path), key=lambda p: -float(p.stem.rsplit("_", 1)[1]))
+    fast.write_bytes(slow.read_bytes())
+    again = stribeck_sweep(request)
+    assert fast.with_name(fast.name + ".corrupt").is_file()
+    assert np.array_equal(again.friction_coefficient, first.friction_coefficient)
+    assert abs(first.friction_coefficient[1] / first.friction_coefficient[0] - 1) > 0.1
+
+
+def test_an_h0_checkpoint_copied_over_another_is_recomputed(tmp_path):
+    """A random cell at two separations: the 0.4 um moments copied over the 0.2 um file are
+    set aside and recomputed, the factors equal to the first run's."""
+    dx = 40e-6 / 16
+    pin = self_affine((16, 16), (dx, dx), 0.8, 0.1e-6, rng=4)
+    disk = Topography(np.zeros((16, 16)), (dx, dx))
+    kw = dict(n_steps=2, error_estimate=False, checkpoint=tmp_path)
+    first = homogenise(pin, disk, [0.2e-6, 0.4e-6], **kw)
+    low, high = sorted(tmp_path.glob("*_h0_*.json"))
+    low.write_text(high.read_text())
+    again = homogenise(pin, disk, [0.2e-6, 0.4e-6], **kw)
+    assert low.with_name(low.name + ".corrupt").is_file()
+    assert np.array_equal(again.A, first.A) and np.array_equal(again.h_m, first.h_m)
