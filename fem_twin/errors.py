@@ -20,6 +20,11 @@ class InputError(FemTwinError, ValueError):
     """Bad input (a case file, a topography file, an argument), found before work starts."""
 
 
+class ForeignCheckpoint(FemTwinError, ValueError):
+    """A checkpoint made for another key or point than the one it is read as (set aside
+    and recomputed like a damaged one)."""
+
+
 class FileSystemError(FemTwinError, OSError):
     """A file or folder of a run cannot be read or written as it should."""
 

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..errors import ForeignCheckpoint
 
 log = logging.getLogger("fem_twin")
 
@@ -55,12 +56,13 @@ def made_for(key: str, at: float) -> dict:
 
 
 def check_made_for(meta: dict, key: str, at: float, path) -> None:
-    """Refuse (``ValueError``, which :func:`load_or_none` sets aside) a checkpoint whose
+    """Refuse (:class:`~fem_twin.errors.ForeignCheckpoint`, which :func:`load_or_none` sets
+    aside) a checkpoint whose
     metadata does not name ``key`` and ``at``: a file copied over another's, or made by
     another version of the store."""
     got = meta.get(MADE_FOR) or {}
     if got.get("key") != key or not np.isclose(got.get("at", np.nan), at, rtol=1e-9, atol=0):
-        raise ValueError(f"{Path(path).name} was made for {got or 'an unnamed input'}, not "
+        raise ForeignCheckpoint(f"{Path(path).name} was made for {got or 'an unnamed input'}, not "
                          f"{key} at {at:.9g}")
 
 

@@ -35,8 +35,8 @@ MOMENTS = ("h", "h3_grad", "h3_g1", "h_grad", "h_g1", "h3_g1g1", "s_c", "h3_g1_p
 
 
 def read_point(path, key=None, h0=None):
-    """The moments of an h0 checkpoint; with ``key`` and ``h0``, refused (``ValueError``)
-    unless it was made for them."""
+    """The moments of an h0 checkpoint; with ``key`` and ``h0``, refused
+    (:class:`~fem_twin.errors.ForeignCheckpoint`) unless it was made for them."""
     data = json.loads(path.read_text())
     if key is not None:
         check_made_for(data, key, h0, path)
