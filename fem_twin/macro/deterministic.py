@@ -8,10 +8,10 @@ on one node grid the gap is ``h = h_d + shape + K (p + p_con)`` (eqs 19-22 resol
 Poiseuille and the central Couette flux, the cells' discretisation; eqs 23-24 at the local
 pressure), ``p_con`` the asperity pressure (CG-FFT with the hardness cap at imposed
 separation, :func:`fem_twin.contact.solve`) and ``K`` the non-periodic half-space.
-Ambient and cavitation pressure 0 (gauge).  A staggered iteration solves the contact against
-the shape deformed by the film pressure, then the film on the contact's gap (floored at
-``gap_floor``, as in the cells), until that deformation settles; ``h_d`` balances the load
-(Brent on the log of the load).  Friction on the pin (:func:`pad_friction`) plus ``C_f,b``
+Ambient and cavitation pressure 0 (gauge).  Each pass solves the contact against the shape
+deformed by the film pressure, then the film on the contact's gap (floored at ``gap_floor``,
+as in the cells); the film's deformation, viscosity and density are mixed (Anderson) until
+they settle; ``h_d`` balances the load (Brent on the log of the load).  Friction on the pin (:func:`pad_friction`) plus ``C_f,b``
 times the contact load (eq 32); integrals by the trapezoidal rule."""
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ from ..checks import as_field, as_pair, number, plausible, setting
 from ..contact import solve as contact_solve
 from ..contact.elastic import elastic_operator
 from ..errors import InputError, NotConverged
+from ..micro.sliding import CellSettings
 from ..numerics.anderson import Anderson
 from .cavitation import cavitation_model
 from .couette import couette_matrix
@@ -37,7 +38,8 @@ __all__ = ["DeterministicNotConverged", "DeterministicResult", "DeterministicSet
            "pad_friction", "solve_deterministic"]
 
 
-#: Anderson mixing of the film's deformation (the micro-EHL coupling): depth and damping
+#: Anderson mixing of the film's deformation, viscosity and density (the micro-EHL
+#: coupling): depth and damping
 ANDERSON_DEPTH, ANDERSON_DAMPING = 6, 0.5
 
 
@@ -52,9 +54,10 @@ class DeterministicSettings:
     boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", unit="-")
     e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", "reduced_modulus")
     hardness: float = setting(T.HARDNESS, "the cap on the contact pressure", "hardness")
-    boundary_film: float = setting(10e-9, "films thinner than this carry no wall shear",
-                                   unit="m")
-    gap_floor: float = setting(1e-9, "the film in a contact spot", unit="m")
+    boundary_film: float = setting(CellSettings.boundary_film, "films thinner than this "
+                                   "carry no wall shear (the cells' default)", unit="m")
+    gap_floor: float = setting(CellSettings.gap_floor, "the film in a contact spot (the "
+                               "cells' default)", unit="m")
     film_deforms: bool = setting(True, "the film pressure deforms the surfaces (False: the "
                                  "asperities feel their contact pressure alone)", unit="-")
     tol: float = setting(1e-7, "log load residual; the film's deformation per micrometre, "
