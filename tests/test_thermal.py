@@ -20,9 +20,16 @@ import pytest
 from scipy.integrate import quad
 from scipy.special import k0e
 
+from fem_twin.errors import NotConverged
 from fem_twin.macro import Lubricant, MacroSettings, solve_mixed
-from fem_twin.macro.thermal import (ContactThermal, ThermalNotConverged, ThermalSettings,
-                                    face_flash, surface_temperature, thermal_point)
+from fem_twin.macro.thermal import (
+    ContactThermal,
+    ThermalNotConverged,
+    ThermalSettings,
+    face_flash,
+    surface_temperature,
+    thermal_point,
+)
 from fem_twin.macro.viscosity import WaltherLaw
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -125,13 +132,15 @@ def test_ideal_heat_sinks_recover_the_isothermal_twin(point, factors):
 
 def test_a_temperature_that_does_not_settle_raises_with_its_history(point, factors):
     """max_iter 1 with a large resistance: ThermalNotConverged carries |dT| per iteration,
-    and survives pickling to and from a worker process."""
+    survives pickling to and from a worker process, and is a NotConverged (the CLI's
+    documented exit 3, not an internal error)."""
     s = ThermalSettings(bulk_resistance=20.0, max_iter=1)
     with pytest.raises(ThermalNotConverged) as err:
         thermal_point(point, Lubricant(0.066), ContactThermal(s, LAW, 0.2), factors, (0.0, 1.0))
     assert len(err.value.history) == 1 and err.value.history[0] > 10
     again = pickle.loads(pickle.dumps(err.value))
     assert again.history == err.value.history and str(again) == str(err.value)
+    assert isinstance(err.value, NotConverged)
 
 
 def test_thermal_settings_refuse_nonsense():

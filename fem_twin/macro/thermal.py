@@ -22,22 +22,16 @@ import scipy.fft as fft
 
 from ..checks import setting
 from ..contact.elastic import love_rectangle
-from ..errors import InputError, SolverError
+from ..errors import InputError, NotConverged
 
 #: sub-samples a side of a cell for the moving part of the kernel (it varies over 2 kappa / U)
 SUBSAMPLES = 8
 
 
-class ThermalNotConverged(SolverError):
+class ThermalNotConverged(NotConverged):
     """The temperature of an operating point did not settle; ``history``: the film
-    temperature's change ``abs(dT)`` [K] per iteration."""
-
-    def __init__(self, message, history=()):
-        super().__init__(message)
-        self.history = tuple(history)
-
-    def __reduce__(self):
-        return (type(self), (self.args[0], self.history))
+    temperature's change ``abs(dT)`` [K] per iteration (a :class:`NotConverged`: the CLI's
+    exit 3)."""
 
 
 @dataclass(frozen=True)
