@@ -490,6 +490,7 @@ def test_a_lost_micro_checkpoint_does_not_recompute_the_sweep(tmp_path):
     ("resolution = [16, 16]", "resolution = [100000, 100000]", "GiB"),
     ("level_radius = 3e-3", "level_radius = 3", "level_radius"),
     ("workers = 0", "workers = -1", "workers"), ("workers = 0", "workers = 10000", "workers"),
+    ("workers = 0", "workers = 0\nscheduler = 5", "scheduler"),
     ("viscosities = [0.066, 0.024] # mu_0 [Pa s] at the temperatures below\n"
      "temperatures = [24.0, 50.0]", "viscosities = []\ntemperatures = []", "viscosities")])
 def test_implausible_case_values_are_refused_naming_the_key(tmp_path, old, new, key):

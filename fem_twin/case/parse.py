@@ -60,6 +60,9 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if run.workers < 0:
         raise CaseError(f"{where} [run] workers: a number of processes >= 0 (0: all cores), "
                         f"got {run.workers}")
+    if run.scheduler is not None and not isinstance(run.scheduler, str):
+        raise CaseError(f"{where} [run] scheduler: a Dask scheduler's address as a string "
+                        f'("tcp://10.0.0.1:8786") or "local", got {run.scheduler!r}')
     most = WORKERS_PER_CORE * (os.cpu_count() or 1)
     if run.workers > most and run.scheduler in (None, "local"):
         raise CaseError(f"{where} [run] workers = {run.workers}: at most {WORKERS_PER_CORE} "
