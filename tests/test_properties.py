@@ -112,3 +112,20 @@ def test_properties_with_ten_times_the_examples():
     done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-m", "not slow", __file__],
                           env=env, capture_output=True, text=True)
     assert done.returncode == 0, done.stdout[-2000:]
+
+
+@settings(max_examples=max(EXAMPLES // 2, 10), deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.integers(min_value=0, max_value=10_000))
+def test_a_cut_stribeck_csv_is_refused_naming_the_file(tmp_path, finished_run, cut):
+    """A run's stribeck.csv cut at any byte reads back whole (the cut at its end) or is
+    refused with an InputError naming the file, never a Python error from inside."""
+    from fem_twin.errors import InputError
+    from fem_twin.stribeck.curve import read_stribeck_csv
+    text = (finished_run / "stribeck.csv").read_bytes()
+    path = tmp_path / "stribeck.csv"
+    path.write_bytes(text[:cut % (len(text) + 1)])
+    try:
+        read_stribeck_csv(path)
+    except InputError as err:
+        assert str(path) in str(err)

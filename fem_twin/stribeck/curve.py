@@ -177,6 +177,15 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
                  **({"cf_err": r["cf_err"]} if "cf_err" in r else {})} for r in rows]
     if not rows or set(COLUMNS) - set(rows[0]):
         raise InputError(f"{path}: not a Stribeck CSV with columns {tuple(HEADERS.values())}")
+    try:
+        return _curves(rows)
+    except (TypeError, ValueError) as err:        # a cut or hand-edited row
+        raise InputError(f"{path}: a damaged row ({err}); run fem-twin run again to rewrite "
+                         "it") from None
+
+
+def _curves(rows) -> list[StribeckCurve]:
+    """One :class:`StribeckCurve` per viscosity of the CSV ``rows`` (dicts of strings)."""
     out = []
     for mu in dict.fromkeys(float(r["viscosity"]) for r in rows):
         sel = [r for r in rows if float(r["viscosity"]) == mu]
