@@ -145,6 +145,9 @@ def apply_fit(case: Case, result: dict) -> Case:
     share, and viscosities from the fit's Walther law at the case's temperatures plus the
     mean fitted offset of the contact temperature."""
     tr, lb = case.tribometer, case.lubricant
+    if "bulk_resistance" in result["fit"]["parameters"] and case.thermal.model == "none":
+        raise InputError("the fit's bulk_resistance is a thermal model's: the case has "
+                         '[thermal] model = "none"; set model = "flash" or fit without it')
     get = lambda name, default: result.get(name, {}).get("value", default)  # noqa: E731
     tr = replace(tr, boundary_friction=get("boundary_friction", tr.boundary_friction),
                  load_share=get("load_share", tr.load_share))
@@ -182,6 +185,7 @@ def read_fit(path) -> dict:
                 "bulk_resistance": "thermal_resistance"}
     for name, value in values.items():          # the case parser's ranges
         plausible(f"{path} {name}", value, quantity[name])
+        result[name]["value"] = value           # a number, whatever the file spelled
     if offset is not None and not -100.0 <= offset <= 100.0:
         raise InputError(f"{path}: the fitted contact temperature lies {offset:+.3g} K from "
                          "the oil's; at most 100 K either way")

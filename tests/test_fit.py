@@ -218,3 +218,26 @@ def test_fit_recovers_the_rigs_thermal_resistance(resistances):
         hits += [out[n]["low"] < v < out[n]["high"]
                  for n, v in (("boundary_friction", CFB_TRUE), ("bulk_resistance", 1.5))]
     assert np.all(hits >= 0.85 * 40), hits
+
+
+def test_a_fit_file_is_read_as_numbers_and_checked_against_the_case(tmp_path):
+    """``run --from-fit``'s reading, before any work: a value written as a string is read as
+    its number (it reached the case as text), and a fitted bulk_resistance on a case whose
+    [thermal] model is "none" is refused (it failed after the whole run)."""
+    import json
+    from dataclasses import replace
+
+    from fem_twin.case import load_case
+    from fem_twin.fitting import apply_fit, read_fit
+    case = load_case(Path(__file__).parents[1] / "examples" / "pin_on_disk.toml")
+    fit = {"fit": {"parameters": ["boundary_friction", "bulk_resistance"]},
+           "case": {"temperatures": [24.0, 50.0]},
+           "boundary_friction": {"value": "0.15"}, "bulk_resistance": {"value": 1.2}}
+    path = tmp_path / "fit.json"
+    path.write_text(json.dumps(fit))
+    fitted = apply_fit(case, read_fit(path))
+    assert fitted.tribometer.boundary_friction == 0.15
+    assert fitted.thermal.bulk_resistance == 1.2
+    isothermal = replace(case, thermal=replace(case.thermal, model="none"))
+    with pytest.raises(InputError, match="bulk_resistance"):
+        apply_fit(isothermal, read_fit(path))
