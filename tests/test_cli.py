@@ -1129,3 +1129,15 @@ def test_outputs_and_study_values_are_checked_before_any_work(tmp_path, capsys):
     assert main(["compare", str(tmp_path / "ball.toml"), "-o", str(tmp_path / "b"),
                  "--no-progress"]) == 2                     # issue 63 item 1: refused
     assert "pin-on-disk cases" in capsys.readouterr().err and not (tmp_path / "b").exists()
+
+
+@pytest.mark.parametrize("raw, words", [(b"\xff\xfen\x00a\x00", "UTF-16"),
+                                        (b'name = "\xe9"\n', "not UTF-8")])
+def test_a_case_file_in_another_encoding_is_named_with_a_fix(tmp_path, raw, words):
+    """A UTF-16 case file (as some Windows editors save it) or Latin-1 text: one line naming
+    the file, the encoding and the fix, exit 2."""
+    path = tmp_path / "case.toml"
+    path.write_bytes(raw)
+    with pytest.raises(CaseError, match=f"{words}.*UTF-8"):
+        load_case(path)
+    assert main(["run", str(path), "-o", str(tmp_path / "o"), "--no-progress"]) == 2

@@ -31,8 +31,15 @@ def load_case(path) -> Case:
     path = Path(path)
     if not path.is_file():
         raise CaseError(f"case file not found: {path}")
+    raw = path.read_bytes()
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise CaseError(f"{path}: a UTF-16 text file (as some Windows editors save it); save "
+                        "it as UTF-8 (in Notepad: Save as, Encoding UTF-8)")
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))   # a BOM is harmless
+        data = tomllib.loads(raw.decode("utf-8-sig"))                # a BOM is harmless
+    except UnicodeDecodeError as err:
+        raise CaseError(f"{path}: not UTF-8 text ({err.reason} at byte {err.start}); save it "
+                        "as UTF-8") from err
     except tomllib.TOMLDecodeError as err:
         raise CaseError(f"{path}: not valid TOML: {err}") from err
     return parse_case(data, base=path.parent, source=path)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import shlex
 import sys
 from pathlib import Path
 
@@ -146,7 +147,7 @@ def _short_summary(summary: dict, out: Path) -> str:
                      f"path {graph['critical_path_s']:.0f} s; fem_twin.taskgraph)")
     lines.append(f"results in {out}/ (stribeck.csv, plots, results.nc and fields.nc for "
                  f"fem_twin.results.open_run, fields/ for ParaView, summary.json, run.log); "
-                 f"the figures on one page: fem-twin report {out}")
+                 f"the figures on one page: fem-twin report {shlex.quote(str(out))}")
     return "\n".join(lines)
 
 
