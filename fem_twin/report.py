@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import MissingFile
+from .errors import InputError, MissingFile
 from .io.atomic import atomic_path
 from .io.figure import save_figure
 from .io.files import read_topography
@@ -32,7 +32,14 @@ def write_report(outdir, path=None, *, render: bool = True) -> Path:
     if not summary_path.is_file():
         raise MissingFile(f"{summary_path} not found: give the output folder of a "
                                 "finished fem-twin run")
-    summary = json.loads(summary_path.read_text())
+    try:
+        summary = json.loads(summary_path.read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise InputError(f"{summary_path}: damaged ({err}); run fem-twin run on the case "
+                         "again to rewrite it (finished work is kept)") from None
+    if not isinstance(summary, dict):
+        raise InputError(f"{summary_path}: not a run's summary (a JSON object); run fem-twin "
+                         "run on the case again to rewrite it")
     work = out.report_figures
     work.mkdir(exist_ok=True)
     sections = [geometry_section(out, work, render), levelling_section(out, work),

@@ -1141,3 +1141,12 @@ def test_a_case_file_in_another_encoding_is_named_with_a_fix(tmp_path, raw, word
     with pytest.raises(CaseError, match=f"{words}.*UTF-8"):
         load_case(path)
     assert main(["run", str(path), "-o", str(tmp_path / "o"), "--no-progress"]) == 2
+
+
+@pytest.mark.parametrize("content", ["{broken", "[1, 2]", "\udcff"])
+def test_report_names_a_damaged_summary(tmp_path, capsys, content):
+    """``fem-twin report`` on a folder whose summary.json is cut, not an object or not
+    text: one line naming the file and the fix, exit 2."""
+    (tmp_path / "summary.json").write_bytes(content.encode("utf-8", "surrogateescape"))
+    assert main(["report", str(tmp_path)]) == 2
+    assert "summary.json" in capsys.readouterr().err
