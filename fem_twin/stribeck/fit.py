@@ -102,8 +102,8 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     (:class:`MeasuredCurve`, one per ``model.curves``); ``start_temperatures`` [C] start the
     temperature of each curve; without ``temperature`` they are the known temperatures, or,
     when None, each simulated curve keeps its own viscosity (``model.law`` may be None).
-    Returns ``{name: {"value", "low", "high"}}`` (``temperature_K`` and its
-    ``viscosity_K`` per curve K from 1) with the residuals and the fit's statistics.
+    Returns ``{name: {"value", "low", "high"}}`` (:func:`interval`; ``temperature_K`` and
+    its ``viscosity_K`` per curve K from 1) with the residuals and the fit's statistics.
     ``verbose``: a line per iteration (scipy's).  Raises :class:`~fem_twin.errors.InputError`
     when no parameter set fits (:func:`check_misfit`)."""
     check_parameters(params)
@@ -150,7 +150,7 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
                                  verbose=2 if verbose else 0)
     if not sol.success:
         raise NotConverged(f"fit did not converge: {sol.message}", [float(sol.cost)])
-    out = _summary(model, measured, names, sol, weighted, unpack)
+    out = _summary(model, measured, names, sol, weighted, unpack, (lower, upper))
     check_misfit(out, names, sol.x, lower, upper)
     return out
 
@@ -212,7 +212,18 @@ def _sigma(m: MeasuredCurve):
     return np.maximum(s, 1e-3 * np.abs(m.friction_coefficient).max())
 
 
-def _summary(model, measured, names, sol, weighted, unpack) -> dict:
+def interval(value: float, half: float, lower: float, upper: float) -> dict:
+    """A fitted value with its 95 % interval ``value +- half``, clipped to the parameter's
+    bounds ``[lower, upper]`` (a share above 1, a negative resistance); a clipped interval
+    names the bounds (``"clipped_to_bounds"``)."""
+    low, high = max(value - half, lower), min(value + half, upper)
+    out = {"value": float(value), "low": float(low), "high": float(high)}
+    if low > value - half or high < value + half:
+        out["clipped_to_bounds"] = [float(lower), float(upper)]
+    return out
+
+
+def _summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
     n, p = sol.fun.size, sol.x.size
     dof = n - p
     size = np.linalg.norm(sol.jac, axis=0)
@@ -225,8 +236,8 @@ def _summary(model, measured, names, sol, weighted, unpack) -> dict:
     cov = _covariance(sol.jac, sol.fun, weighted)
     from scipy import stats
     half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
-    out = {name: {"value": float(v), "low": float(v - h), "high": float(v + h)}
-           for name, v, h in zip(names, sol.x, half)}
+    out = {name: interval(v, h, lo, hi)
+           for name, v, h, lo, hi in zip(names, sol.x, half, *bounds)}
     cfb, mus, share, resistance = unpack(sol.x)
     for k in range(len(measured)):
         t = out.get(f"temperature_{k + 1}")
