@@ -56,3 +56,24 @@ def test_estimate_bounds_the_change_to_a_refined_run(runs, speed):
     floor = 5e-4 * BOUNDARY_FRICTION
     assert (estimate < floor and actual < floor) or 1.0 <= estimate / actual <= 10.0, (
         f"estimate {estimate / BOUNDARY_FRICTION:.3%}, actual {actual / BOUNDARY_FRICTION:.3%}")
+
+
+def test_the_accuracy_warning_names_the_cases_macro_grid_key(caplog):
+    """Points above the tolerance: the warning names the key that sets the macro grid, a
+    pin's ``[preprocessing] resolution`` or a ball's ``[macro] grid``."""
+    import logging
+
+    import numpy as np
+
+    from fem_twin.macro.estimate import PARTS
+    from fem_twin.stribeck.accuracy import error_summary
+    from fem_twin.stribeck.curve import StribeckCurve
+    u = np.array([1.0, 0.1])
+    one = np.ones(2)
+    curve = StribeckCurve(u, u, u, 0.066, one, one, one, one, one, friction_error=0.1 * one,
+                          friction_error_parts={p: 0.02 * one for p in PARTS})
+    for ball, key in ((False, "[preprocessing] resolution"), (True, "[macro] grid")):
+        caplog.clear()
+        with caplog.at_level(logging.WARNING, logger="fem_twin"):
+            summary = error_summary([curve], 0.19245, 0.005, ball)
+        assert summary["points_above"] == 2 and key in caplog.text

@@ -169,7 +169,7 @@ def _summary(case: Case, out: RunLayout, curves, band) -> dict:
     if band is not None:
         summary["patch_band_max_width"] = float(max(np.max(hi - lo) for lo, hi in band))
     summary["cf_error"] = error_summary(curves, case.tribometer.boundary_friction,
-                                        case.sweep.error_tolerance)
+                                        case.sweep.error_tolerance, case.tribometer.ball)
     return summary
 
 

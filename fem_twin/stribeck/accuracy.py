@@ -19,10 +19,15 @@ from ..macro.estimate import PARTS
 log = logging.getLogger("fem_twin")
 
 
-def error_summary(curves, boundary_friction: float, tolerance: float) -> dict:
+#: where a case sets its macro grid: a pin's from its maps, a ball's on its own
+MACRO_GRID_KEYS = {False: "[preprocessing] resolution", True: "[macro] grid"}
+
+
+def error_summary(curves, boundary_friction: float, tolerance: float,
+                  ball: bool = False) -> dict:
     """The largest estimated C_f error of ``curves`` over C_f,b, in total and per part, and
     the number of points above ``tolerance`` (a fraction of C_f,b), with a logged warning
-    naming the worst one."""
+    naming the worst one and the keys to refine (``ball``: its macro grid's)."""
     def largest(values):
         values = np.concatenate(values) / boundary_friction
         return float(np.nanmax(values)) if np.isfinite(values).any() else float("nan")
@@ -33,9 +38,10 @@ def error_summary(curves, boundary_friction: float, tolerance: float) -> dict:
         worst = max(above)
         log.warning("C_f: estimated discretisation error above %.2g %% of C_f,b at %d of %d "
                     "points (largest %.2f %% at mu_0 = %g Pa s, U = %.3g m/s; its parts in "
-                    "summary.json): refine [preprocessing] resolution (the macro grid) or "
-                    "[micro] resolution, steps or h0_count", 100 * tolerance, len(above),
-                    sum(c.speed.size for c in curves), 100 * worst[0], worst[1], worst[2])
+                    "summary.json): refine %s (the macro grid) or [micro] resolution, "
+                    "steps or h0_count", 100 * tolerance, len(above),
+                    sum(c.speed.size for c in curves), 100 * worst[0], worst[1], worst[2],
+                    MACRO_GRID_KEYS[ball])
     return {"max_relative": largest([c.friction_error for c in curves]),
             "parts_max_relative": {part: largest([c.friction_error_parts[part]
                                                   for c in curves]) for part in PARTS},
