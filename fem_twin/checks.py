@@ -43,6 +43,12 @@ QUANTITIES = {
     "speed": (1e-6, 100.0, "m/s"),
     "pitch": (1e-9, 1e-2, "m (0.3 um is 3e-7, 31 um is 3.1e-5)"),
     "fwhm_px": (0.0, 200.0, "pixels (0 or at least 1)"),
+    "temperature_C": (-40.0, 300.0, "degrees Celsius, not kelvin (24 C is 24.0, not 297.15)"),
+    "conductivity": (0.1, 500.0, "W/(m K) (steel: 46)"),
+    "diffusivity": (1e-8, 1e-3, "m^2/s (steel: 12 mm^2/s is 1.2e-5)"),
+    "spot_radius": (0.0, 1e-3, "m (5 um is 5e-6)"),
+    "temperature_tol": (1e-5, 10.0, "K (0.01 K)"),
+    "boundary_film": (1e-10, 5e-8, "m, a few nanometres (10 nm is 10e-9)"),
 }
 
 

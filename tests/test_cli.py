@@ -1150,3 +1150,44 @@ def test_report_names_a_damaged_summary(tmp_path, capsys, content):
     (tmp_path / "summary.json").write_bytes(content.encode("utf-8", "surrogateescape"))
     assert main(["report", str(tmp_path)]) == 2
     assert "summary.json" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("section, key, value, words", [
+    ("thermal", "conductivity", 0.046, "conductivity.*W/\\(m K\\)"),   # kW typed as W
+    ("thermal", "conductivity", 1e12, "conductivity"),
+    ("thermal", "diffusivity", 12.0, "diffusivity.*mm\\^2/s"),          # mm^2/s typed as m^2/s
+    ("thermal", "spot_radius", 5.0, "spot_radius.*5 um"),               # um typed as m
+    ("thermal", "tol", 1e9, "tol"),
+    ("micro", "boundary_film", 10.0, "boundary_film.*10 nm"),           # nm typed as m
+    ("micro", "boundary_film", 1e-3, "boundary_film"),
+    ("micro", "boundary_film", 5e-6, "boundary_film"),
+    ("micro", "h0_min", 5e-9, "boundary_film.*h0_min"),                # the cut-off above h0
+    ("lubricant", "temperatures", [297.15, 323.15], "temperatures.*kelvin"),
+    ("lubricant", "temperatures", [50.0, 24.0], "swapped")])
+def test_a_unit_slip_in_a_physical_input_is_refused_naming_key_and_unit(section, key, value,
+                                                                         words):
+    """Issue 72 item 1: the silent nonsense of its probes (the film at 1384 C, all film
+    friction dropped, the oil read at 300 C) refused when the case is read, with the key,
+    the unit and the likely slip named."""
+    import tomllib
+
+    from fem_twin.case import parse_case
+    example = ROOT / "examples" / "pin_on_disk.toml"
+    data = tomllib.loads(example.read_text())
+    data.setdefault(section, {})[key] = value
+    with pytest.raises(CaseError, match=words):
+        parse_case(data, base=example.parent, source=example)
+
+
+@pytest.mark.parametrize("temperatures", [[0.0, 50.0], [-10.0, 50.0]])
+def test_a_cold_oil_is_a_valid_temperature(temperatures):
+    """Oil temperatures are in degrees Celsius: 0 and -10 C are valid (they were refused as
+    not positive)."""
+    import tomllib
+
+    from fem_twin.case import parse_case
+    example = ROOT / "examples" / "pin_on_disk.toml"
+    data = tomllib.loads(example.read_text())
+    data["lubricant"]["temperatures"] = temperatures
+    assert parse_case(data, base=example.parent, source=example).lubricant.temperatures == (
+        tuple(temperatures))

@@ -206,6 +206,9 @@ def _micro(data, where) -> MicroSpec:
     if not (0 < micro.h0_min < micro.h0_max < 1e-3) or micro.h0_count < 2 or micro.steps < 1:
         raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
                         "h0_count >= 2 and steps >= 1")
+    if micro.boundary_film >= micro.h0_min:
+        raise CaseError(f"{where} [micro] boundary_film = {micro.boundary_film:g} m: below the "
+                        f"smallest separation h0_min = {micro.h0_min:g} m (10 nm is 10e-9)")
     return micro
 
 
@@ -227,6 +230,13 @@ def _thermal(data, where, lubricant) -> ThermalSettings:
         raise CaseError(f"{where} [thermal] model = \"{thermal.model}\": the film's viscosity "
                         "at its temperature needs [lubricant] viscosities at two temperatures "
                         "(the Walther law); give them, or set [thermal] model = \"none\"")
+    pairs = sorted(zip(lubricant.temperatures, lubricant.viscosities))
+    if thermal.model != "none" and any(t1 > t0 and m1 >= m0 for (t0, m0), (t1, m1)
+                                       in zip(pairs, pairs[1:])):
+        raise CaseError(f"{where} [lubricant]: an oil thins as it warms, but the viscosities "
+                        f"{list(lubricant.viscosities)} Pa s do not fall as the temperatures "
+                        f"{list(lubricant.temperatures)} C rise (swapped?); the thermal model's "
+                        "Walther law needs them in order")
     return thermal
 
 
@@ -276,6 +286,7 @@ def _section(data, name, cls, where, positive=False, zero_ok=(), files=None):
         if files is not None and f.metadata.get("unit", "").startswith("file path"):
             values[f.name] = files(f.name, v, f.metadata["unit"])
             continue
+        ranged = f.metadata.get("quantity") is not None     # its range replaces "positive"
         # the declared default: an instance's may be normalised (time_tol 0 -> None)
         default = f.default if f.default is not MISSING else getattr(cls(), f.name)
         if isinstance(default, tuple):
@@ -287,7 +298,7 @@ def _section(data, name, cls, where, positive=False, zero_ok=(), files=None):
             v = tuple(type(default[0])(x) if default else x for x in v)
             if not all(math.isfinite(x) for x in v):
                 raise CaseError(f"{where} [{name}] {f.name}: values must be finite numbers")
-            if positive and any(x <= 0 for x in v):
+            if positive and not ranged and any(x <= 0 for x in v):
                 raise CaseError(f"{where} [{name}] {f.name}: values must be positive (SI units)")
         elif isinstance(default, bool):
             if not isinstance(v, bool):
@@ -302,7 +313,7 @@ def _section(data, name, cls, where, positive=False, zero_ok=(), files=None):
                 raise CaseError(f"{where} [{name}] {f.name}: expected a whole number, got {v}")
             if not math.isfinite(v):
                 raise CaseError(f"{where} [{name}] {f.name}: must be a finite number, got {v}")
-            if positive and (v < 0 if f.name in zero_ok else v <= 0):
+            if positive and not ranged and (v < 0 if f.name in zero_ok else v <= 0):
                 raise CaseError(f"{where} [{name}] {f.name}: must be positive (SI units)")
             v = type(default)(v) if isinstance(default, float) else v
         values[f.name] = v

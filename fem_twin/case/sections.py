@@ -94,7 +94,7 @@ class LubricantSpec:
         "viscosity")
     temperatures: tuple[float, ...] = setting(
         (24.0, 50.0), "oil temperature of each viscosity: curve labels, and the Walther law "
-        "of fem-twin fit", unit="C")
+        "of fem-twin fit", "temperature_C")
     density: float = setting(T.DENSITY, "rho_0 at ambient pressure (eq 24)", "density")
     roelands_alpha: float = setting(T.ROELANDS_ALPHA, "pressure-viscosity coefficient of "
                                     "Roelands (eq 23)", "pressure_viscosity")

@@ -14,13 +14,13 @@ Walther law (:mod:`.viscosity`); each operating point is iterated to that temper
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from functools import lru_cache
 
 import numpy as np
 import scipy.fft as fft
 
-from ..checks import setting
+from ..checks import plausible, setting
 from ..contact.elastic import love_rectangle
 from ..errors import InputError, NotConverged
 
@@ -45,24 +45,24 @@ class ThermalSettings:
                                      "to the oil bath (a parameter to fit)",
                                      "thermal_resistance")
     conductivity: float = setting(46.0, "thermal conductivity k of pin and disk (steel)",
-                                  unit="W/(m K)")
+                                  "conductivity")
     diffusivity: float = setting(1.2e-5, "thermal diffusivity kappa of pin and disk (steel)",
-                                 unit="m^2/s")
+                                 "diffusivity")
     spot_radius: float = setting(5e-6, "radius a of an asperity contact for its flash "
-                                 "temperature (a parameter to fit; reported only)", unit="m")
+                                 "temperature (a parameter to fit; reported only)",
+                                 "spot_radius")
     tol: float = setting(0.01, "the film temperature's iteration stops when it moves by "
-                         "less", unit="K")
+                         "less", "temperature_tol")
     max_iter: int = setting(30, "iterations before the temperature gives up", unit="-")
     grid: int = setting(64, "nodes a side of the face's heat-flux grid at most", unit="-")
 
     def __post_init__(self):
         if self.model not in ("flash", "none"):
             raise InputError(f"model must be 'flash' or 'none', got {self.model!r}")
-        bad = [k for k in ("bulk_resistance", "conductivity", "diffusivity", "spot_radius",
-                           "tol") if not (np.isfinite(getattr(self, k)) and getattr(self, k) >= 0)]
-        if bad or self.conductivity <= 0 or self.diffusivity <= 0 or self.tol <= 0:
-            raise InputError(f"{', '.join(bad) or 'conductivity, diffusivity, tol'}: "
-                             "must be positive (bulk_resistance and spot_radius may be 0)")
+        for f in fields(self):                  # each declared range (fem_twin.checks)
+            if f.metadata.get("quantity"):
+                plausible(f"ThermalSettings.{f.name}", getattr(self, f.name),
+                          f.metadata["quantity"])
         if int(self.max_iter) != self.max_iter or self.max_iter < 1 or self.grid < 8:
             raise InputError("max_iter must be a positive integer and grid >= 8")
 

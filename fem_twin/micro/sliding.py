@@ -44,7 +44,8 @@ class CellSettings:
     gap_floor: float = setting(1e-9, "smallest film of the cell problems (a contact spot)",
                                unit="m")
     boundary_film: float = setting(10e-9, "films thinner than this carry no film friction "
-                                   "(contact spots carry the boundary shear, eq 32)", unit="m")
+                                   "(contact spots carry the boundary shear, eq 32)",
+                                   "boundary_film")
     method: str = setting("fe", "cell problems by Q1 finite elements or the paper's finite "
                           "volumes", choices=("fe", "fvm"))
     moving: str = setting("both", "the cell's frame: the disk at +U/2 and the pin at -U/2 "
@@ -90,6 +91,7 @@ class CellSettings:
             raise InputError("e_reduced, hardness, gap_floor, contact_tol, rate_tol and "
                              "boundary_film must be positive (Pa, Pa, m, -, -, m)")
         plausible("slide_to_roll", self.slide_to_roll, "slide_to_roll")
+        plausible("boundary_film [m]", self.boundary_film, "boundary_film")
         for name in ("e_reduced", "hardness", "gap_floor", "slide_to_roll",
                      "boundary_film"):                                    # 2e11 = 2e11.0
             object.__setattr__(self, name, float(getattr(self, name)))
