@@ -209,6 +209,16 @@ def check_choices(settings) -> None:
         check_choice(f.name, getattr(settings, f.name), f.metadata.get("choices"))
 
 
+def check_ranges(settings) -> None:
+    """Refuse a number of the dataclass ``settings`` outside the plausible range its
+    declaration names (:func:`setting`'s ``quantity``), naming the class and the field."""
+    from dataclasses import fields
+    for f in fields(settings):
+        if f.metadata.get("quantity"):
+            plausible(f"{type(settings).__name__}.{f.name}", getattr(settings, f.name),
+                      f.metadata["quantity"])
+
+
 def check_choice(name: str, value, choices) -> None:
     """Refuse ``value`` outside ``choices`` (none: any), naming ``name``."""
     if choices and value not in choices:

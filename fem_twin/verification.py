@@ -13,6 +13,7 @@ below a picometre), and the film's friction coefficient scales as ``h / L``."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -97,7 +98,6 @@ def sample_pad(folder, pixels: int = 32, pair: int = 1, lubricant: Lubricant | N
     """The :class:`RoughPad` of patch pair ``pair`` of the bundled sample (``folder``: the
     repository's ``meshes/sample``), cut at 256 px as the bundled case does; ``lubricant``
     default: the bundled case's oil at 24 C (0.066 Pa s, eqs 23-24 of Table 6)."""
-    from pathlib import Path
     folder = Path(folder)
     pin = prepare_patch(read_topography(folder / f"patch_{pair}_pin.npz"))
     disk = prepare_patch(read_topography(folder / f"patch_{pair}_disk.npz"), upper=True)
@@ -177,17 +177,6 @@ def compared(det: list, twin: list, tiles: int) -> list:
     return [Pair(tiles, d.speed, d.load_share, t.contact_load / t.normal_load, d.separation,
                  t.h_d, d.film_friction, t.hydrodynamic_friction, d.friction_coefficient,
                  t.friction_coefficient) for d, t in zip(det, twin)]
-
-
-def compare_pad(pad: RoughPad, speeds, factors, tiles=TILES, progress=None) -> list:
-    """Both sweeps on each pad of ``tiles`` cells a side: a list of :class:`Pair` lists."""
-    out = []
-    for n in tiles:
-        out.append(compared(deterministic_sweep(pad, n, speeds),
-                            twin_sweep(pad, n, speeds, factors), n))
-        if progress is not None:
-            progress(n, out[-1])
-    return out
 
 
 def summary(pairs, boundary_friction: float) -> str:

@@ -331,7 +331,7 @@ def test_the_friction_factor_converges_through_contact_onset():
     y = (np.arange(400000) + 0.5) / 400000
     h = np.maximum(h0[:, None] - amplitude * np.cos(2 * np.pi * y), 1e-9)
     closed = h.mean(1) * np.mean(np.where(h > 10e-9, 1 / h, 0.0), 1)
-    rigid = dict(n_steps=1, e_reduced=4e12, hardness=1e9, error_estimate=False)
+    rigid = {"n_steps": 1, "e_reduced": 4e12, "hardness": 1e9, "error_estimate": False}
     for n, tol in ((64, 0.04), (128, 0.025)):
         z = np.tile(amplitude * np.cos(2 * np.pi * np.arange(n) / n)[:, None], (1, 4))
         pin = Topography(z, (64e-6 / n,) * 2)

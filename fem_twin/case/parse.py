@@ -6,6 +6,7 @@ import math
 import os
 import tomllib
 from dataclasses import MISSING, fields
+from itertools import pairwise
 from pathlib import Path
 
 from ..checks import check_choice, memory_shortfall, plausible
@@ -230,9 +231,8 @@ def _thermal(data, where, lubricant) -> ThermalSettings:
         raise CaseError(f"{where} [thermal] model = \"{thermal.model}\": the film's viscosity "
                         "at its temperature needs [lubricant] viscosities at two temperatures "
                         "(the Walther law); give them, or set [thermal] model = \"none\"")
-    pairs = sorted(zip(lubricant.temperatures, lubricant.viscosities))
-    if thermal.model != "none" and any(t1 > t0 and m1 >= m0 for (t0, m0), (t1, m1)
-                                       in zip(pairs, pairs[1:])):
+    pairs = pairwise(sorted(zip(lubricant.temperatures, lubricant.viscosities)))
+    if thermal.model != "none" and any(t1 > t0 and m1 >= m0 for (t0, m0), (t1, m1) in pairs):
         raise CaseError(f"{where} [lubricant]: an oil thins as it warms, but the viscosities "
                         f"{list(lubricant.viscosities)} Pa s do not fall as the temperatures "
                         f"{list(lubricant.temperatures)} C rise (swapped?); the thermal model's "

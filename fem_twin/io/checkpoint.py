@@ -57,13 +57,12 @@ def made_for(key: str, at: float) -> dict:
 
 def check_made_for(meta: dict, key: str, at: float, path) -> None:
     """Refuse (:class:`~fem_twin.errors.ForeignCheckpoint`, which :func:`load_or_none` sets
-    aside) a checkpoint whose
-    metadata does not name ``key`` and ``at``: a file copied over another's, or made by
-    another version of the store."""
+    aside) a checkpoint whose metadata does not name ``key`` and ``at``: a file copied over
+    another's, or made by another version of the store."""
     got = meta.get(MADE_FOR) or {}
     if got.get("key") != key or not np.isclose(got.get("at", np.nan), at, rtol=1e-9, atol=0):
-        raise ForeignCheckpoint(f"{Path(path).name} was made for {got or 'an unnamed input'}, not "
-                         f"{key} at {at:.9g}")
+        raise ForeignCheckpoint(f"{Path(path).name} was made for {got or 'an unnamed input'}, "
+                                f"not {key} at {at:.9g}")
 
 
 def input_key(*parts, length: int = 16) -> str:

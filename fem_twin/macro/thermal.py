@@ -14,13 +14,13 @@ Walther law (:mod:`.viscosity`); each operating point is iterated to that temper
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
 import scipy.fft as fft
 
-from ..checks import plausible, setting
+from ..checks import check_ranges, setting
 from ..contact.elastic import love_rectangle
 from ..errors import InputError, NotConverged
 
@@ -59,10 +59,7 @@ class ThermalSettings:
     def __post_init__(self):
         if self.model not in ("flash", "none"):
             raise InputError(f"model must be 'flash' or 'none', got {self.model!r}")
-        for f in fields(self):                  # each declared range (fem_twin.checks)
-            if f.metadata.get("quantity"):
-                plausible(f"ThermalSettings.{f.name}", getattr(self, f.name),
-                          f.metadata["quantity"])
+        check_ranges(self)
         if int(self.max_iter) != self.max_iter or self.max_iter < 1 or self.grid < 8:
             raise InputError("max_iter must be a positive integer and grid >= 8")
 

@@ -22,7 +22,7 @@ import numpy as np
 from ..contact import contact_rate
 from ..contact import solve as contact_solve
 from .. import tables as T
-from ..checks import arguments, check_choices, plausible, setting
+from ..checks import arguments, check_choices, check_ranges, setting
 from ..errors import InputError
 from .cell_fv import CellSolverFV
 from .film import mean_inverse_film
@@ -90,8 +90,7 @@ class CellSettings:
                 and self.contact_tol > 0 and self.rate_tol > 0 and self.boundary_film > 0):
             raise InputError("e_reduced, hardness, gap_floor, contact_tol, rate_tol and "
                              "boundary_film must be positive (Pa, Pa, m, -, -, m)")
-        plausible("slide_to_roll", self.slide_to_roll, "slide_to_roll")
-        plausible("boundary_film [m]", self.boundary_film, "boundary_film")
+        check_ranges(self)
         for name in ("e_reduced", "hardness", "gap_floor", "slide_to_roll",
                      "boundary_film"):                                    # 2e11 = 2e11.0
             object.__setattr__(self, name, float(getattr(self, name)))
