@@ -4,7 +4,7 @@
                                               # (micro-full: ~15 min, estimate: ~40 min,
                                               #  estimate-paper: ~100 min, scale: ~10 min,
                                               #  cores: the bundled case on 1, 2, all workers;
-                                              #  deterministic: the mixed regime, ~25 min;
+                                              #  deterministic: the mixed regime, ~20 min;
                                               #  only when named)
 """
 
