@@ -37,11 +37,13 @@ QUANTITIES = {
     "eyring_stress": (0.0, 1e9, "Pa (5 MPa is 5e6; 0: Newtonian)"),
     "modulus": (1e8, 2e12, "Pa (210 GPa is 210e9)"),
     "reduced_modulus": (1e8, 4e12, "Pa (231 GPa is 231e9)"),
+    "solver_modulus": (1e8, 1e30, "Pa (231 GPa is 231e9; a rigid limit, 1e20, is allowed)"),
     "poisson": (0.0, 0.4999, "Poisson ratio in [0, 0.5)"),
     "hardness": (1e7, 1e11, "Pa (6.99 GPa is 6.99e9)"),
     "separation": (1e-10, 1e-4, "m (0.1 um is 1e-7)"),
     "speed": (1e-6, 100.0, "m/s"),
     "pitch": (1e-9, 1e-2, "m (0.3 um is 3e-7, 31 um is 3.1e-5)"),
+    "map_pitch": (1e-9, 1e-3, "m per pixel of a measured map (16 um is 1.6e-5, not 0.016)"),
     "fwhm_px": (0.0, 200.0, "pixels (0 or at least 1)"),
     "temperature_C": (-40.0, 300.0, "degrees Celsius, not kelvin (24 C is 24.0, not 297.15)"),
     "conductivity": (0.1, 500.0, "W/(m K) (steel: 46)"),
@@ -49,6 +51,28 @@ QUANTITIES = {
     "spot_radius": (0.0, 1e-3, "m (5 um is 5e-6)"),
     "temperature_tol": (1e-5, 10.0, "K (0.01 K)"),
     "boundary_film": (1e-10, 5e-8, "m, a few nanometres (10 nm is 10e-9)"),
+    "gap_floor": (1e-12, 1e-8, "m, about a nanometre (1 nm is 1e-9)"),
+    "height": (1e-8, 1e-3, "m, a height on the surface (20 um is 20e-6)"),
+    "depth": (-1e-2, -1e-8, "m below the face, negative (-20 um is -20e-6, -1 mm is -1e-3)"),
+    "pixels": (2, 16384, "pixels a side, whole numbers"),
+    "pixel_offset": (0, 1000000, "pixels from the first row or column, whole numbers"),
+    "nodes": (8, 4096, "nodes a side, whole numbers"),
+    "pressure": (0.0, 1e7, "Pa, absolute (1 bar is 1e5)"),
+    "pressure_scale": (1e5, 1e11, "Pa (0.196 GPa is 1.96e8)"),
+    "dh_ratio": (0.1, 100.0, "(the Dowson-Higginson C_2: 1.34)"),
+    "time_steps": (1, 4096, "time steps of one sliding pass (the paper: 32)"),
+    "samples": (1, 100000, "a count, whole number"),
+    "iterations": (1, 100000, "iterations, a whole number"),
+    "newton_steps": (0, 1000, "Newton steps, a whole number (0: to convergence)"),
+    "history": (1, 100, "iterates kept, a whole number"),
+    "passes": (0, 4, "passes, a whole number"),
+    "workers": (0, 4096, "processes, a whole number (0: one per core)"),
+    "pin_number": (1, 1000, "a pin number from 1"),
+    "relaxation": (1e-6, 1.0, "a relaxation factor in (0, 1]"),
+    "pid_gain": (0.0, 100.0, "(the paper's K_P, K_I, K_D: 0.012, 0.024, 0.0015)"),
+    "solver_tolerance": (1e-15, 0.1, "a relative tolerance (e.g. 1e-6)"),
+    "adaptive_tolerance": (0.0, 0.5, "a fraction (1 % is 0.01; 0: off)"),
+    "share": (1e-6, 0.999, "a fraction of C_f,b (0.5 % is 0.005)"),
 }
 
 
@@ -211,12 +235,24 @@ def check_choices(settings) -> None:
 
 def check_ranges(settings) -> None:
     """Refuse a number of the dataclass ``settings`` outside the plausible range its
-    declaration names (:func:`setting`'s ``quantity``), naming the class and the field."""
+    declaration names (:func:`setting`'s ``quantity``), or a fraction where the declared
+    default is a whole number, naming the class and the field; None and text (a pin's
+    "average") are the settings' own rules."""
     from dataclasses import fields
     for f in fields(settings):
-        if f.metadata.get("quantity"):
-            plausible(f"{type(settings).__name__}.{f.name}", getattr(settings, f.name),
-                      f.metadata["quantity"])
+        value = getattr(settings, f.name)
+        if not f.metadata.get("quantity") or value is None or isinstance(value, str):
+            continue
+        name = f"{type(settings).__name__}.{f.name}"
+        plausible(name, value, f.metadata["quantity"])
+        if _whole(f.default) and not np.all(np.mod(np.asarray(value, float), 1) == 0):
+            raise InputError(f"{name}: expected whole numbers, got {value!r}")
+
+
+def _whole(default) -> bool:
+    """Whether a declared default is a whole number (or a tuple of them)."""
+    first = default[0] if isinstance(default, tuple) and default else default
+    return isinstance(first, (int, np.integer)) and not isinstance(first, bool)
 
 
 def check_choice(name: str, value, choices) -> None:

@@ -5,13 +5,15 @@ measured curves (:mod:`fem_twin.stribeck.fit`), ``OUT/fit.json`` and ``OUT/fit.p
 from __future__ import annotations
 
 import json
+import logging
+import re
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from .case import Case
-from .checks import QUANTITIES, plausible
+from .checks import QUANTITIES, arguments, plausible
 from .errors import InputError
 from .io.atomic import atomic_path
 from .io.layout import RunLayout
@@ -21,10 +23,12 @@ from .stages.requests import per_viscosity, sweep_request
 from .stages.sweeps import run_sweeps
 from .stribeck import read_measured_csv
 from .stribeck.curve import read_stribeck_csv
-from .stribeck.fit import (LOAD_SHARES, RESISTANCES, FitModel, check_parameters, fit_curves,
-                           plot_fit, predict)
+from .stribeck.fit import (LOAD_SHARES, PARAMETERS, RESISTANCES, FitModel, check_parameters,
+                           fit_curves, plot_fit, predict)
 from .numerics.threads import executor_for
 from .taskgraph import fit_scaling
+
+log = logging.getLogger("fem_twin")
 
 
 def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: bool = True,
@@ -78,7 +82,7 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     if shares or resistances:
         result["task_graph"] = fit_scaling(case, outdir)
     result["case"] = {"temperatures": nominal, "load_N": case.tribometer.load,
-                      "law": None if law is None else vars(law)}
+                      "kind": case.tribometer.kind, "law": None if law is None else vars(law)}
     with atomic_path(out.fit) as tmp:
         tmp.write_text(json.dumps(result, indent=2))
     plot_fit(result, out.fit_png, labels=[f"{t:g} C in the case" for t in lb.temperatures])
@@ -95,6 +99,11 @@ def _check_coverage(case: Case, paths, curves, params) -> None:
     sw = case.sweep
     inside = [int(np.sum((c.speed >= sw.speed_min) & (c.speed <= sw.speed_max)))
               for c in curves]
+    outside = [p.name for p, n in zip(paths, inside) if n == 0]
+    if outside:
+        raise InputError(f"{', '.join(outside)}: no measured point lies inside the case's "
+                         f"speeds ({sw.speed_min:g} to {sw.speed_max:g} m/s); widen [sweep] or "
+                         "leave the curve out")
     unknowns = len(params) + (len(curves) - 1 if "temperature" in params else 0)
     if sum(inside) <= unknowns:
         where = ", ".join(f"{p.name}: {n} of {c.speed.size}" for p, n, c in
@@ -140,14 +149,23 @@ def _fit_sweep(case: Case, out: RunLayout, **changes):
     return sweep_request(case, out, checkpoint=out.fit_points, **changes)
 
 
+@arguments(case=Case, result=dict)
 def apply_fit(case: Case, result: dict) -> Case:
     """``case`` with the fitted parameters of ``result`` (a ``fit.json``): C_f,b, the load
     share, and viscosities from the fit's Walther law at the case's temperatures plus the
     mean fitted offset of the contact temperature."""
+    result = check_fit(result)
     tr, lb = case.tribometer, case.lubricant
-    if "bulk_resistance" in result["fit"]["parameters"] and case.thermal.model == "none":
+    params, made = result["fit"]["parameters"], result["case"]
+    if "bulk_resistance" in params and case.thermal.model == "none":
         raise InputError("the fit's bulk_resistance is a thermal model's: the case has "
                          '[thermal] model = "none"; set model = "flash" or fit without it')
+    if made.get("kind", tr.kind) != tr.kind:
+        raise InputError(f"the fit was made on a {made['kind']} case and this is a {tr.kind} "
+                         "case: its contact and kinematics differ; fit this tribometer's curves")
+    if "load_share" in params and not np.isclose(made.get("load_N", tr.load), tr.load):
+        log.warning("the load share was fitted at %g N and is applied at %g N: a face's share "
+                    "may change with the load", made["load_N"], tr.load)
     get = lambda name, default: result.get(name, {}).get("value", default)  # noqa: E731
     tr = replace(tr, boundary_friction=get("boundary_friction", tr.boundary_friction),
                  load_share=get("load_share", tr.load_share))
@@ -172,22 +190,40 @@ def temperature_offset(result: dict) -> float | None:
 
 
 def read_fit(path) -> dict:
-    """A ``fit.json`` of ``fem-twin fit``, checked for what :func:`apply_fit` reads."""
+    """A ``fit.json`` of ``fem-twin fit``, checked for what :func:`apply_fit` reads
+    (:func:`check_fit`)."""
     try:
         result = json.loads(Path(path).read_text())
-        result["fit"]["parameters"], result["case"]["temperatures"]
+    except (OSError, ValueError) as err:
+        raise InputError(f"{path}: not a fit.json of fem-twin fit ({err})") from err
+    return check_fit(result, str(path))
+
+
+def check_fit(result, where: str = "fit") -> dict:
+    """``result`` (a ``fit.json``'s content) with its fitted values as numbers, or
+    :class:`InputError` naming ``where``: a known parameter set, values inside the case
+    parser's ranges, a contact temperature within 100 K of the oil's."""
+    try:
+        result["case"]["temperatures"]
+        unknown = [k for k in result["fit"]["parameters"] if k not in PARAMETERS
+                   and not re.fullmatch(r"temperature_[1-9][0-9]*", k)]
         values = {k: float(result[k]["value"]) for k in ("boundary_friction", "load_share",
                                                          "bulk_resistance") if k in result}
         offset = temperature_offset(result)
-    except (OSError, ValueError, KeyError, TypeError) as err:
-        raise InputError(f"{path}: not a fit.json of fem-twin fit ({err})") from err
+        law = None if offset is None else WaltherLaw(**result["case"]["law"])
+        law is None or float(law.viscosity(20.0))
+    except (ValueError, KeyError, TypeError, IndexError) as err:
+        raise InputError(f"{where}: not a fit.json of fem-twin fit ({err!r})") from err
+    if unknown:
+        raise InputError(f"{where}: unknown fitted parameter(s) {unknown}; fem-twin fit writes "
+                         f"{', '.join(PARAMETERS)} and temperature_K")
     quantity = {"boundary_friction": "friction", "load_share": "load_share",
                 "bulk_resistance": "thermal_resistance"}
     for name, value in values.items():          # the case parser's ranges
-        plausible(f"{path} {name}", value, quantity[name])
+        plausible(f"{where} {name}", value, quantity[name])
         result[name]["value"] = value           # a number, whatever the file spelled
     if offset is not None and not -100.0 <= offset <= 100.0:
-        raise InputError(f"{path}: the fitted contact temperature lies {offset:+.3g} K from "
+        raise InputError(f"{where}: the fitted contact temperature lies {offset:+.3g} K from "
                          "the oil's; at most 100 K either way")
     return result
 

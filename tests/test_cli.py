@@ -88,7 +88,7 @@ def test_case_validation(tmp_path):
         "nopatch.toml": ('[geometry]\npins = ["pin.npz"]\n', "patch pair"),
         "typo.toml": ('[geometry]\npins = ["pin.npz"]\n[preprocessing]\nfwhm = 9\n', "unknown key"),
         "missing.toml": ('[geometry]\npins = ["nope.npz"]\n', "file not found"),
-        "units.toml": ('[geometry]\npins = ["pin.npz"]\n[preprocessing]\nclip = 20\n', "metres"),
+        "units.toml": ('[geometry]\npins = ["pin.npz"]\n[preprocessing]\nclip = 20\n', r"clip = 20: implausible.* m, a height"),
         "toml.toml": ("[geometry\n", "not valid TOML"),
         "nopin.toml": ("[geometry]\npins = []\n", "at least one pin"),
     }
@@ -486,11 +486,21 @@ def test_a_lost_micro_checkpoint_does_not_recompute_the_sweep(tmp_path):
     ("count = 5", "count = 4.5", "count"), ("h0_count = 6", "h0_count = 6.5", "h0_count"),
     ("resolution = [16, 16]", "resolution = [2, 2]", "resolution"),
     ("resolution = [16, 16]", "resolution = [16.5, 16]", "resolution"),
-    ("resolution = [48, 48]", "resolution = [100000, 100000]", "GiB"),
-    ("resolution = [16, 16]", "resolution = [100000, 100000]", "GiB"),
+    ("resolution = [48, 48]", "resolution = [16000, 16000]", "GiB"),
+    ("resolution = [16, 16]", "resolution = [16000, 16000]", "GiB"),
     ("level_radius = 3e-3", "level_radius = 3", "level_radius"),
     ("workers = 0", "workers = -1", "workers"), ("workers = 0", "workers = 10000", "workers"),
     ("workers = 0", "workers = 0\nscheduler = 5", "scheduler"),
+    ("sliding_radius = 30e-3", "sliding_radius = 3e-3", "sliding_radius = 0.003 m: the "
+     "disk's axis would lie under the pin's face"),
+    ("holder_height = -1e-3", "holder_height = -1e-5", "holder_height = -1e-05 m: below"),
+    ("holder_height = -1e-3", "holder_height = -1", r"holder_height = -1: implausible.*-1 mm"),
+    ("boundary_film = 10e-9", "boundary_film = 10e-9\ngap_floor = 1", "gap_floor = 1: "
+     "implausible"),
+    ("boundary_film = 10e-9", "boundary_film = 10e-9\ncontact_tol = 5", "contact_tol"),
+    ("refine_step = 0.1", "refine_step = 10", "refine_step = 10: implausible"),
+    ("load = 150.0", "load = 150.0\nkind = \"ball-on-disk\"",
+     "sliding_radius: a pin's track, unused by a ball"),
     ("viscosities = [0.066, 0.024] # mu_0 [Pa s] at the temperatures below\n"
      "temperatures = [24.0, 50.0]", "viscosities = []\ntemperatures = []", "viscosities")])
 def test_implausible_case_values_are_refused_naming_the_key(tmp_path, old, new, key):

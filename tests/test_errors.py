@@ -145,10 +145,24 @@ WRONG = [None, "x", object(), np.zeros(0), np.zeros((0, 0)), np.full((6, 6), np.
          np.ones((6, 6), dtype=int)]
 
 
+def _extra_callables() -> dict:
+    """Public callables outside the packages' ``__all__``: the thermal, kinematics,
+    viscosity-law, case-reading and fit-application functions (issue 72 item 5)."""
+    from fem_twin import fitting
+    from fem_twin.case import load_case
+    from fem_twin.macro import kinematics, thermal
+    from fem_twin.macro.viscosity import WaltherLaw
+    return {"ThermalSettings": thermal.ThermalSettings,
+            "surface_temperature": thermal.surface_temperature,
+            "face_flash": thermal.face_flash, "disk_velocity": kinematics.disk_velocity,
+            "WaltherLaw.through": WaltherLaw.through, "load_case": load_case,
+            "apply_fit": fitting.apply_fit, "check_fit": fitting.check_fit}
+
+
 def public_callables():
     import importlib
     import inspect
-    seen = {}
+    seen = {id(obj): (name, obj) for name, obj in _extra_callables().items()}
     for name in PUBLIC:
         module = importlib.import_module(name)
         for attr in getattr(module, "__all__", []):
@@ -184,3 +198,51 @@ def test_every_public_function_refuses_wrong_arguments_with_a_fem_twin_error():
             except Exception as err:                     # noqa: BLE001 (what escapes)
                 escaped.append(f"{name}({type(bad).__name__}): {type(err).__name__}: {err}")
     assert not escaped, "\n".join(escaped)
+
+
+#: settings that carry no number: file paths, switches, text and addresses
+UNRANGED_UNITS = {"file path", "file paths", "file path pairs", "true or false", "address",
+                  "a registered model"}
+
+
+def _declared_settings():
+    from dataclasses import fields
+
+    from fem_twin.case.sections import SECTIONS
+    from fem_twin.macro import MacroSettings
+    from fem_twin.macro.thermal import ThermalSettings
+    from fem_twin.micro.sliding import CellSettings
+    for cls in {CellSettings, MacroSettings, ThermalSettings, *SECTIONS.values()}:
+        for f in fields(cls):
+            yield cls, f
+
+
+def test_every_numeric_setting_declares_a_plausible_range():
+    """Issue 72 item 1: every setting of the case file and of the stages' settings objects
+    either names a quantity of ``checks.QUANTITIES`` (its plausible range and unit, shown
+    in the generated case-file reference) or is text, a switch or a file; its default lies
+    inside that range, and an API object built with a value a thousand times outside it
+    (a unit slip) is refused with the field named."""
+    from dataclasses import MISSING
+
+    from fem_twin.checks import QUANTITIES
+    missing = [f"{cls.__name__}.{f.name}" for cls, f in _declared_settings()
+               if not f.metadata.get("quantity") and not f.metadata.get("choices")
+               and f.metadata.get("unit") not in UNRANGED_UNITS]
+    assert not missing, f"settings without a declared range: {missing}"
+    for cls, f in _declared_settings():
+        quantity = f.metadata.get("quantity")
+        if not quantity or f.default is MISSING or f.default is None:
+            continue
+        lo, hi, _ = QUANTITIES[quantity]
+        value = f.default if f.name != "pin" else 1
+        assert np.all((lo <= np.asarray(value, float)) & (np.asarray(value, float) <= hi)), (
+            cls.__name__, f.name)
+        if not f.metadata.get("section") and quantity not in ("pin_number",):
+            slip = hi * 1000 if hi > 0 else lo * 1000
+            bad = (slip,) * len(value) if isinstance(value, tuple) else slip
+            with pytest.raises(InputError, match=f.name):
+                cls(**{f.name: type(value)(bad) if not isinstance(value, tuple) else bad})
+    from fem_twin.macro import MacroSettings
+    with pytest.raises(InputError, match="max_iter: expected whole numbers"):
+        MacroSettings(max_iter=10.5)

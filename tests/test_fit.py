@@ -73,6 +73,25 @@ def test_fit_recovers_boundary_friction_and_temperature(twin):
                    start_temperatures=[24.0])
 
 
+def test_measured_points_outside_the_simulated_speeds_are_not_counted(twin):
+    """Issue 72 item 2: points beyond the simulated speeds (where C_f would be held at the
+    ends) are left out of the fit, counted and named; the fit of the rest is the fit
+    without them, to rounding; a curve wholly outside is refused."""
+    sim, cf = twin
+    model = FitModel((sim[0.066],), CFB, 150.0, LAW)
+    params, start = ["boundary_friction"], dict(start_temperatures=[35.0])
+    inside = fit_curves(model, [MeasuredCurve(SPEEDS, cf[35.0])], params, **start)
+    fast = np.array([20.0, 50.0])                 # beyond the simulated 2 m/s at mu(35 C)
+    extended = MeasuredCurve(np.r_[fast, SPEEDS], np.r_[0.3, 0.3, cf[35.0]])
+    out = fit_curves(model, [extended], params, **start)
+    assert out["fit"]["points_not_counted"] == [2] and out["fit"]["points"] == SPEEDS.size
+    assert "2 measured point(s) outside" in out["fit"]["warnings"][0]
+    assert out["boundary_friction"]["value"] == pytest.approx(
+        inside["boundary_friction"]["value"], rel=1e-9)
+    with pytest.raises(InputError, match="all 2 points lie outside"):
+        fit_curves(model, [MeasuredCurve(fast, np.r_[0.3, 0.3])], params, **start)
+
+
 def test_prediction_at_another_temperature_holds_the_twin(twin):
     """Fitted at 35 C (C_f,b = 0.15, noise 1 %), predicted at 45 C from simulated curves at
     24 and 50 C: the twin run at mu(45 C) directly lies within 0.5 % C_f,b of the predicted
@@ -223,7 +242,8 @@ def test_fit_recovers_the_rigs_thermal_resistance(resistances):
 def test_a_fit_file_is_read_as_numbers_and_checked_against_the_case(tmp_path):
     """``run --from-fit``'s reading, before any work: a value written as a string is read as
     its number (it reached the case as text), and a fitted bulk_resistance on a case whose
-    [thermal] model is "none" is refused (it failed after the whole run)."""
+    [thermal] model is "none" is refused (it failed after the whole run), and so are a fit
+    made on another kind of tribometer and a parameter fem-twin fit does not write."""
     import json
     from dataclasses import replace
 
@@ -241,6 +261,13 @@ def test_a_fit_file_is_read_as_numbers_and_checked_against_the_case(tmp_path):
     isothermal = replace(case, thermal=replace(case.thermal, model="none"))
     with pytest.raises(InputError, match="bulk_resistance"):
         apply_fit(isothermal, read_fit(path))
+    ball = replace(case, tribometer=replace(case.tribometer, kind="ball-on-disk"))
+    path.write_text(json.dumps({**fit, "case": {**fit["case"], "kind": "pin-on-disk"}}))
+    with pytest.raises(InputError, match="made on a pin-on-disk case"):
+        apply_fit(ball, read_fit(path))                 # its C_f,b and kinematics: a pin's
+    path.write_text(json.dumps({**fit, "fit": {"parameters": ["boundary_friction", "mu"]}}))
+    with pytest.raises(InputError, match=r"unknown fitted parameter\(s\) \['mu'\]"):
+        read_fit(path)
 
 
 def test_a_fitted_interval_stays_inside_the_parameters_bounds():

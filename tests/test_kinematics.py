@@ -217,3 +217,21 @@ def test_the_case_turns_the_disk_at_its_track_radius(tmp_path):
     (tmp_path / "radius.toml").write_text(text.replace("[macro]", "[macro]\ntrack_radius = 0.03", 1))
     with pytest.raises(CaseError, match="set by"):
         load_case(tmp_path / "radius.toml")
+
+
+def test_a_disk_axis_under_the_ball_is_refused_when_the_case_is_read():
+    """Issue 72 item 2: a track radius inside the ball's grid (three Hertz radii, 322 um for
+    the bundled ball: a = 107 um) is refused when the case is read, naming the key, rather
+    than at the Stribeck stage after the micro stage."""
+    import tomllib
+    from pathlib import Path
+
+    from fem_twin.case import parse_case
+    from fem_twin.errors import InputError
+    path = Path(__file__).parents[1] / "examples" / "ball_on_disk.toml"
+    data = tomllib.loads(path.read_text())
+    data["tribometer"]["track_radius"] = 2e-4
+    with pytest.raises(InputError, match=r"track_radius = 0.0002 m: .*0.00032\d* m"):
+        parse_case(data, base=path.parent, source=path)
+    data["tribometer"]["track_radius"] = 4e-4
+    assert parse_case(data, base=path.parent, source=path).tribometer.track_radius == 4e-4

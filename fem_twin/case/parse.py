@@ -9,7 +9,7 @@ from dataclasses import MISSING, fields
 from itertools import pairwise
 from pathlib import Path
 
-from ..checks import check_choice, memory_shortfall, plausible
+from ..checks import arguments, check_choice, memory_shortfall, plausible
 from ..errors import InputError
 from ..macro.thermal import ThermalSettings
 from ..stribeck.request import RollingSliding
@@ -27,6 +27,7 @@ class CaseError(InputError):
 WORKERS_PER_CORE = 4
 
 
+@arguments(path="path")
 def load_case(path) -> Case:
     """Read and validate a TOML case file."""
     path = Path(path)
@@ -64,6 +65,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     macro = _macro(data, where, tribometer, geometry)
     sweep = _sweep(data, where)
     thermal = _thermal(data, where, lubricant)
+    _disk_axis(tribometer, materials, geometry, where)
     run = _section(data, "run", RunSpec, where)
     if run.workers < 0:
         raise CaseError(f"{where} [run] workers: a number of processes >= 0 (0: all cores), "
@@ -110,6 +112,9 @@ def _tribometer(data, where) -> Tribometer:
         except InputError as err:
             raise CaseError(f"{where} [tribometer] {err}") from None
     tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
+    if tribometer.ball and "sliding_radius" in data.get("tribometer", {}):
+        raise CaseError(f"{where} [tribometer] sliding_radius: a pin's track, unused by a ball; "
+                        "a ball's is track_radius")
     if not tribometer.ball:
         for (section, key), needs in BALL_ONLY.items():
             if key in data.get(section, {}):
@@ -119,6 +124,24 @@ def _tribometer(data, where) -> Tribometer:
         raise CaseError(f"{where} [tribometer] load_share: a ball carries the whole load "
                         "(load_share = 1); it is a pin face's share")
     return tribometer
+
+
+def _disk_axis(tribometer, materials, geometry, where) -> None:
+    """Refuse a turning disk whose axis lies under the face: within a pin's radius, or
+    within the half-width of a smooth ball's grid (three Hertz radii)."""
+    radius = tribometer.disk_radius
+    if radius is None or (tribometer.ball and geometry.ball is not None):
+        return
+    if tribometer.ball:
+        hertz = (3 * tribometer.load * tribometer.ball_radius / (2 * materials.e_reduced)
+                 ) ** (1 / 3)
+        reach, key, what = 3 * hertz, "track_radius", "the ball's grid (3 Hertz radii)"
+    else:
+        reach, key, what = tribometer.pin_diameter / 2, "sliding_radius", "the pin's face"
+    if radius <= reach:
+        raise CaseError(f"{where} [tribometer] {key} = {radius:g} m: the disk's axis would lie "
+                        f"under {what}, {reach:g} m from its centre; the track's radius in "
+                        "metres (30 mm is 30e-3)")
 
 
 def _geometry(data, base, where, ball) -> Geometry:
@@ -169,9 +192,10 @@ def _preprocessing(data, where) -> MacroOptions:
     short = memory_shortfall(rows * cols, "macro")
     if short:
         raise CaseError(f"{where} [preprocessing] resolution: {short}")
-    if not 0 < opts.clip <= 1e-3:
-        raise CaseError(f"{where} [preprocessing] clip: expected metres in (0, 1e-3], "
-                        f"got {opts.clip} (20 um is 20e-6)")
+    if opts.holder_height >= opts.truncation:
+        raise CaseError(f"{where} [preprocessing] holder_height = {opts.holder_height:g} m: "
+                        f"below the truncation height {opts.truncation:g} m (the holder "
+                        "under the face: -1 mm is -1e-3)")
     if 0 < opts.fwhm_px < 1:
         raise CaseError(f"{where} [preprocessing] fwhm_px = {opts.fwhm_px}: the filter width "
                         "is in pixels (0: no filter, else at least 1; the paper's is 9)")

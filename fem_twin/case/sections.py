@@ -10,7 +10,7 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 from .. import tables as T
-from ..checks import setting
+from ..checks import check_ranges, setting
 from ..macro.settings import MacroSettings
 from ..macro.thermal import ThermalSettings
 from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN
@@ -34,13 +34,16 @@ class Geometry:
         (), "roughness patch pairs [pin patch, disk patch], one micro problem each",
         unit="file path pairs")
     patch_shape: tuple[int, int] = setting(
-        (256, 256), "rows and columns of each patch, cut without interpolation", unit="px")
+        (256, 256), "rows and columns of each patch, cut without interpolation", "pixels")
     patch_start: tuple[int, int] = setting((0, 0), "first row and column of the cut",
-                                           unit="px")
+                                           "pixel_offset")
     ball: Path | None = setting(
         None, "a measured ball cap, the ball-on-disk's macro gap (its sphere fitted for the "
         "radius, the cap read around its apex); none: the smooth sphere of ball_radius",
         unit="file path")
+
+    def __post_init__(self):
+        check_ranges(self)
 
 
 @dataclass(frozen=True)
@@ -72,6 +75,9 @@ class Tribometer:
     track_radius: float = setting(20e-3, "radius of a ball's track on the disk (its "
                                   "contact's centre's)", "length")
 
+    def __post_init__(self):
+        check_ranges(self)
+
     @property
     def ball(self) -> bool:
         return self.kind == "ball-on-disk"
@@ -99,11 +105,14 @@ class LubricantSpec:
     roelands_alpha: float = setting(T.ROELANDS_ALPHA, "pressure-viscosity coefficient of "
                                     "Roelands (eq 23)", "pressure_viscosity")
     roelands_p0: float = setting(T.ROELANDS_P0, "Roelands reference pressure p_0 (eq 23)",
-                                 unit="Pa")
-    dh_c1: float = setting(T.DH_C1, "Dowson-Higginson C_1 (eq 24)", unit="Pa")
-    dh_c2: float = setting(T.DH_C2, "Dowson-Higginson C_2 (eq 24)", unit="-")
+                                 "pressure_scale")
+    dh_c1: float = setting(T.DH_C1, "Dowson-Higginson C_1 (eq 24)", "pressure_scale")
+    dh_c2: float = setting(T.DH_C2, "Dowson-Higginson C_2 (eq 24)", "dh_ratio")
     eyring_stress: float = setting(0.0, "tau_0 of Eyring shear thinning (0: Newtonian; "
                                    "needed for EHL traction)", "eyring_stress")
+
+    def __post_init__(self):
+        check_ranges(self)
 
     def lubricants(self) -> list:
         """One :class:`fem_twin.macro.Lubricant` per viscosity."""
@@ -125,6 +134,9 @@ class Materials:
     hardness: float = setting(T.HARDNESS, "hardness: the cap on the contact pressure",
                               "hardness")
 
+    def __post_init__(self):
+        check_ranges(self)
+
     @property
     def e_reduced(self) -> float:
         """E' of eq 22 [Pa]."""
@@ -141,14 +153,14 @@ class MicroSpec(CellSettings):
     resolution: tuple[int, int] = setting((128, 128), "patches resampled (periodically) to "
                                           "this grid, at least 8 each (the paper: its 256 px "
                                           "patches as cut; docs/accuracy.md, 'Cheaper "
-                                          "defaults')", unit="px")
+                                          "defaults')", "pixels")
     h0_min: float = setting(H0_MIN, "smallest separation h0", "separation")
     h0_max: float = setting(H0_MAX, "largest separation h0 (above: the paper's rules)",
                             "separation")
-    h0_count: int = setting(H0_COUNT, "h0 candidates, log-spaced (the paper: 100)", unit="-")
+    h0_count: int = setting(H0_COUNT, "h0 candidates, log-spaced (the paper: 100)", "samples")
     h0_tol: float = setting(0.01, "adaptive h0: solve the candidates the log-h0 "
                             "interpolant needs to read the others within this (0: all, the "
-                            "paper)", unit="fraction")
+                            "paper)", "adaptive_tolerance")
 
 
 @dataclass(frozen=True)
@@ -158,9 +170,9 @@ class MacroSpec(MacroSettings):
     pin and a ball's grid."""
 
     pin: str | int = setting("average", "the macro pin: the levelled set's average, or a "
-                             "pin number from 1", unit='"average" or a number')
+                             "pin number from 1", "pin_number")
     grid: int = setting(97, "nodes per side of a ball's grid over [-4a, 2a] x [-3a, 3a]",
-                        unit="-")
+                        "nodes")
 
 
 @dataclass(frozen=True)
@@ -170,14 +182,17 @@ class SweepSpec:
 
     speed_max: float = setting(2.0, "fastest sliding speed (the paper: 2 m/s)", "speed")
     speed_min: float = setting(0.01, "slowest sliding speed (the paper: 0.01 m/s)", "speed")
-    count: int = setting(25, "speeds, log-spaced from fast to slow", unit="-")
+    count: int = setting(25, "speeds, log-spaced from fast to slow", "samples")
     refine: int = setting(1, "passes adding midpoints where C_f jumps (0: off, at most 4)",
-                          unit="-")
+                          "passes")
     refine_step: float = setting(0.1, "... by more than this share of C_f,b",
-                                 unit="fraction")
+                                 "share")
     error_tolerance: float = setting(0.005, "warn where a point's estimated discretisation "
                                      "error of C_f exceeds this share of C_f,b",
-                                     unit="fraction")
+                                     "share")
+
+    def __post_init__(self):
+        check_ranges(self)
 
     @property
     def speeds(self):
@@ -190,7 +205,7 @@ class RunSpec:
     """``[run]``: where independent work runs, and whether the main job adds the patch
     scatter band."""
 
-    workers: int = setting(0, "local processes (0: all cores)", unit="-")
+    workers: int = setting(0, "local processes (0: all cores)", "workers")
     scheduler: str | None = setting(None, "a Dask scheduler's address instead, e.g. "
                                     '"tcp://10.0.0.1:8786", or "local": a Dask LocalCluster '
                                     "of `workers` processes (the cluster extra)",
@@ -209,7 +224,10 @@ class RunSpec:
     # error, in fewer Newton steps (benchmarks/README.md)
     band_tol: float = setting(1e-3, "coupling tolerance of the band's sweeps ([macro] tol "
                               "for the main curves, which carry the error estimates)",
-                              unit="-")
+                              "solver_tolerance")
+
+    def __post_init__(self):
+        check_ranges(self)
 
 
 #: each setting a stage's settings take from another section (declared with

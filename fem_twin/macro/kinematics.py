@@ -19,7 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..checks import arguments
+from ..checks import arguments, as_pair, plausible
 from ..errors import InputError
 
 
@@ -33,6 +33,7 @@ def disk_velocity(face, spacing, track_radius=None) -> np.ndarray | None:
         return None
     if not np.isfinite(track_radius) or track_radius <= 0:
         raise InputError(f"track radius must be positive [m], got {track_radius}")
+    spacing = plausible("disk_velocity: spacing [m]", as_pair("spacing", spacing), "pitch")
     face = np.asarray(face, bool)
     ny, nx = face.shape
     centre = face_centre(face if face.any() else np.ones_like(face), spacing)

@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .. import tables as T
-from ..checks import check_choices, setting
+from ..checks import check_choices, check_ranges, setting
 from ..errors import InputError
 from .cavitation import MODELS, cavitation_model
 from .contact_load import RULES
@@ -21,12 +21,12 @@ class MacroSettings:
     """Settings of the macro solver (Table 6 defaults, SI units)."""
 
     ambient_pressure: float = setting(T.AMBIENT_PRESSURE, "ambient pressure p_amb on the "
-                                      "edges of the pin (Table 6)", unit="Pa")
+                                      "edges of the pin (Table 6)", "pressure")
     cavitation_pressure: float = setting(T.CAVITATION_PRESSURE, "cavitation pressure p_cav "
-                                         "(Table 6)", unit="Pa")
-    e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", "reduced_modulus",
+                                         "(Table 6)", "pressure")
+    e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", "solver_modulus",
                                section="materials")
-    boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", unit="-",
+    boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", "friction",
                                        section="tribometer")
     track_radius: float | None = setting(
         None, "the disk's axis at this distance from the face's centre: the disk's velocity "
@@ -50,41 +50,35 @@ class MacroSettings:
                                       "a pixel), or the paper's p_con at the nodes",
                                       choices=RULES)
     relaxation_pcon: float = setting(T.RELAXATION_PCON, "under-relaxation alpha_pcon of "
-                                     "p_con, eq 26 (pid coupling)", unit="-")
+                                     "p_con, eq 26 (pid coupling)", "relaxation")
     relaxation_elastic: float = setting(0.1, "under-relaxation of h_el (pid coupling)",
-                                        unit="-")
+                                        "relaxation")
     gains: tuple = setting(T.MACRO_GAINS, "K_P, K_I, K_D of the PID on h_d, eq 29 (pid "
-                           "coupling)", unit="-")
-    anderson_depth: int = setting(8, "iterates the Anderson acceleration keeps", unit="-")
+                           "coupling)", "pid_gain")
+    anderson_depth: int = setting(8, "iterates the Anderson acceleration keeps",
+                                 "history")
     # 0.5: fewer coupling iterations than undamped, C_f the same to 3.3e-5 C_f,b
     # (benchmarks/README.md, "macro/settings")
     anderson_damping: float = setting(0.5, "damping beta of the Anderson step (1: undamped)",
-                                      unit="-")
+                                      "relaxation")
     inner_steps: int = setting(1, "Newton steps per Reynolds solve while far from the fixed "
-                               "point (0: every solve to convergence)", unit="-")
-    p_ref: float = setting(100e6, "pressure scale of the residuals and of theta", unit="Pa")
-    h_ref: float = setting(1e-6, "length scale of the residuals", unit="m")
+                               "point (0: every solve to convergence)", "newton_steps")
+    p_ref: float = setting(100e6, "pressure scale of the residuals and of theta",
+                           "pressure_scale")
+    h_ref: float = setting(1e-6, "length scale of the residuals", "separation")
     # 1e-4: C_f within 2.1e-5 C_f,b of 1e-6, far below the points' error estimates
     # (docs/accuracy.md)
     tol: float = setting(1e-4, "convergence tolerance of the coupling (scaled residuals)",
-                         unit="-")
-    max_iter: int = setting(300, "iterations of the coupling before it gives up", unit="-")
-    gap_floor: float = setting(1e-9, "smallest h0 passed to the flow factors", unit="m")
+                         "solver_tolerance")
+    max_iter: int = setting(300, "iterations of the coupling before it gives up",
+                           "iterations")
+    gap_floor: float = setting(1e-9, "smallest h0 passed to the flow factors", "gap_floor")
 
     def __post_init__(self):
         check_choices(self)
+        check_ranges(self)
         if self.ambient_pressure < self.cavitation_pressure:
             raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
         cavitation_model(self.complementarity)              # a registered model
-        if not (isinstance(self.inner_steps, int) and self.inner_steps >= 0):
-            raise InputError(f"inner_steps must be an integer >= 0, got {self.inner_steps!r}")
-        if not all(0 < getattr(self, k) <= 1 for k in
-                   ("relaxation_pcon", "relaxation_elastic", "anderson_damping")):
-            raise InputError("relaxation_pcon, relaxation_elastic and anderson_damping must be "
-                             "in (0, 1]")
-        scales = ("p_ref", "h_ref", "tol", "max_iter", "gap_floor", "anderson_depth",
-                  "e_reduced")
-        bad = [k for k in scales if not getattr(self, k) > 0]
-        if bad or len(self.gains) != 3:
-            raise InputError(f"{', '.join(bad) or 'gains'}: must be positive (gains: K_P, "
-                             "K_I, K_D)")
+        if len(self.gains) != 3:
+            raise InputError(f"gains: K_P, K_I, K_D (three numbers), got {self.gains!r}")

@@ -20,7 +20,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.fft as fft
 
-from ..checks import check_ranges, setting
+from ..checks import arguments, as_pair, check_ranges, plausible, setting
 from ..contact.elastic import love_rectangle
 from ..errors import InputError, NotConverged
 
@@ -53,17 +53,19 @@ class ThermalSettings:
                                  "spot_radius")
     tol: float = setting(0.01, "the film temperature's iteration stops when it moves by "
                          "less", "temperature_tol")
-    max_iter: int = setting(30, "iterations before the temperature gives up", unit="-")
-    grid: int = setting(64, "nodes a side of the face's heat-flux grid at most", unit="-")
+    max_iter: int = setting(30, "iterations before the temperature gives up",
+                           "iterations")
+    grid: int = setting(64, "nodes a side of the face's heat-flux grid at most",
+                       "nodes")
 
     def __post_init__(self):
         if self.model not in ("flash", "none"):
             raise InputError(f"model must be 'flash' or 'none', got {self.model!r}")
         check_ranges(self)
-        if int(self.max_iter) != self.max_iter or self.max_iter < 1 or self.grid < 8:
-            raise InputError("max_iter must be a positive integer and grid >= 8")
 
 
+@arguments(flux="field", spacing="pair", speed="number", conductivity="number",
+           diffusivity="number")
 def surface_temperature(flux, spacing, speed: float, conductivity: float,
                         diffusivity: float) -> np.ndarray:
     """The surface temperature rise [K] of a half-space under the surface heat ``flux``
@@ -74,8 +76,11 @@ def surface_temperature(flux, spacing, speed: float, conductivity: float,
     of sub-samples (:data:`SUBSAMPLES` a side)."""
     q = np.asarray(flux, float)
     ny, nx = q.shape
-    k_hat = _kernel_hat((ny, nx), tuple(float(v) for v in spacing), float(speed),
-                        float(diffusivity))
+    spacing = plausible("surface_temperature: spacing [m]", as_pair("spacing", spacing), "pitch")
+    plausible("surface_temperature: |speed| [m/s]", abs(speed) or 1.0, "speed")
+    plausible("surface_temperature: conductivity", conductivity, "conductivity")
+    plausible("surface_temperature: diffusivity", diffusivity, "diffusivity")
+    k_hat = _kernel_hat((ny, nx), spacing, float(speed), float(diffusivity))
     theta = fft.irfft2(fft.rfft2(q, s=(2 * ny, 2 * nx)) * k_hat, s=(2 * ny, 2 * nx))
     return theta[:ny, :nx] / conductivity
 
@@ -103,11 +108,16 @@ def _kernel_hat(shape, spacing, speed, diffusivity):
     return fft.rfft2(kernel / (2 * np.pi))
 
 
+@arguments(flux="field", face="field", spacing="pair", speeds="pair",
+           settings=ThermalSettings)
 def face_flash(flux, face, spacing, speeds, settings: ThermalSettings) -> tuple:
     """``(theta, pin_share)``: the face-mean flash temperature [K] of the heat ``flux``
     [W/m^2] over the ``face`` (bool grid), shared between the pin (or ball) and the disk
     whose surfaces pass the contact at ``speeds`` = (pin, disk) [m/s] so that both face
     means agree (Blok), and the pin's share of the heat."""
+    if np.shape(flux) != np.shape(face):
+        raise InputError(f"face_flash: flux {np.shape(flux)} and face {np.shape(face)} must "
+                         "share their grid")
     q, f, dx = _coarse(np.where(face, flux, 0.0), face, spacing, settings.grid)
     pin, disk = (surface_temperature(q, dx, abs(u), settings.conductivity,
                                      settings.diffusivity)[f].mean() for u in speeds)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import plausible
+from ..checks import check, plausible
 from ..errors import InputError
 
 #: 0 C in K
@@ -33,10 +33,10 @@ class WaltherLaw:
     def through(cls, temperatures, viscosities, density: float) -> "WaltherLaw":
         """The law through measured dynamic viscosities [Pa s] at temperatures [C] (two or
         more distinct ones)."""
-        t = np.asarray(temperatures, float)
-        mu = np.asarray(viscosities, float)
-        plausible("viscosities [Pa s]", mu, "viscosity")
+        plausible("temperatures [C]", temperatures, "temperature_C")
+        plausible("viscosities [Pa s]", viscosities, "viscosity")
         plausible("density [kg/m^3]", density, "density")
+        t, mu = np.asarray(temperatures, float), np.asarray(viscosities, float)
         if t.shape != mu.shape or np.unique(t).size < 2:
             raise InputError("the viscosity-temperature law needs viscosities at two or more "
                              f"distinct temperatures, got {t.tolist()} C")
@@ -49,12 +49,14 @@ class WaltherLaw:
         return cls(float(intercept), float(-slope), float(density))
 
     def viscosity(self, temperature):
-        """Dynamic viscosity [Pa s] at ``temperature`` [C]."""
+        """Dynamic viscosity [Pa s] at ``temperature`` [C] (finite numbers)."""
+        check("WaltherLaw.viscosity: temperature [C]", temperature, "numbers")
         x = np.log10(np.asarray(temperature, float) + KELVIN)
         nu = 10 ** 10 ** (self.a - self.b * x) - 0.7
         return nu * 1e-6 * self.density
 
     def temperature(self, viscosity):
         """Temperature [C] at which the oil has the dynamic ``viscosity`` [Pa s]."""
+        plausible("WaltherLaw.temperature: viscosity [Pa s]", viscosity, "viscosity")
         y = np.log10(np.log10(np.asarray(viscosity, float) / self.density * 1e6 + 0.7))
         return 10 ** ((self.a - y) / self.b) - KELVIN

@@ -118,8 +118,6 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
         raise InputError("fitting the thermal resistance needs every curve swept at two or "
                          "more resistances (FitModel.resistance_curves)")
     names, x0, lower, upper = _unknowns(model, params, len(measured), start_temperatures)
-    sigma = [_sigma(m) for m in measured]
-    weighted = all(s is not None for s in sigma)
 
     def unpack(x):
         """C_f,b, the viscosity [Pa s] of each curve, the face's load share and R_b."""
@@ -132,6 +130,10 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
         else:
             mus = [float(model.law.viscosity(t)) for t in temps]
         return cfb, mus, v.get("load_share"), v.get("bulk_resistance")
+
+    measured, dropped = _inside(model, measured, *unpack(x0))
+    sigma = [_sigma(m) for m in measured]
+    weighted = all(s is not None for s in sigma)
 
     def residuals(x):
         cfb, mus, share, resistance = unpack(x)
@@ -151,6 +153,9 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     if not sol.success:
         raise NotConverged(f"fit did not converge: {sol.message}", [float(sol.cost)])
     out = _summary(model, measured, names, sol, weighted, unpack, (lower, upper))
+    out["fit"]["points_not_counted"] = dropped
+    out["fit"]["warnings"] += [f"curve {k + 1}: {n} measured point(s) outside the simulated "
+                               "speeds not counted" for k, n in enumerate(dropped) if n]
     check_misfit(out, names, sol.x, lower, upper)
     return out
 
@@ -203,6 +208,23 @@ def check_misfit(result: dict, names, x, lower, upper) -> None:
                          + (f"; {', '.join(pinned)} at the bound of its range" if pinned
                             else "") + "; was it measured at the case's load, in m/s, with "
                          "the case's lubricant?")
+
+
+def _inside(model: FitModel, measured, cfb, mus, share, resistance) -> tuple:
+    """The ``measured`` curves cut to the points inside the simulated curves' Hersey range
+    at the start values (C_f there would be held at the ends), and how many each lost;
+    a curve with none inside is refused."""
+    kept, dropped = [], []
+    for k, m in enumerate(measured):
+        inside = model.friction(k, m.speed, cfb, mus[k], share, resistance)[1]
+        if not inside.any():
+            raise InputError(f"measured curve {k + 1}: all {m.speed.size} points lie outside "
+                             "the simulated speeds; sweep its speeds, or leave it out")
+        cut = lambda a: None if a is None else np.asarray(a)[inside]  # noqa: E731
+        kept.append(MeasuredCurve(m.speed[inside], m.friction_coefficient[inside],
+                                  cut(m.low), cut(m.high)))
+        dropped.append(int((~inside).sum()))
+    return kept, dropped
 
 
 def _sigma(m: MeasuredCurve):

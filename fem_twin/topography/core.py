@@ -18,16 +18,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..checks import as_pair
+from ..checks import as_pair, plausible
 from ..errors import InputError
 
 #: Largest peak-to-valley [m] accepted for a topography.  A pin-on-disk map spans a few
 #: millimetres at most (pin height 1 mm); anything larger almost surely is in um or nm.
 MAX_PEAK_TO_VALLEY = 0.05
-#: Largest pixel pitch [m] accepted (a grid finer than 1 m per pixel); larger means mm or um.
-MAX_SPACING = 1.0
-#: the smallest pixel pitch [m]: below an atomic distance, a unit slip
-MIN_SPACING = 1e-10
 #: the plausible extent of a map [m]: a pitch that makes it larger or smaller wants a unit
 EXTENT = (1e-6, 1.0)
 
@@ -57,6 +53,9 @@ class Topography:
     meta: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        if np.iscomplexobj(self.heights):
+            raise InputError("heights must be real numbers [m], got complex values (take the "
+                             "real part or the modulus at I/O)")
         try:
             h = np.array(self.heights, dtype=float)
         except (TypeError, ValueError):
@@ -69,10 +68,7 @@ class Topography:
         if not np.all(np.isfinite(spacing)) or np.any(spacing <= 0):
             raise InputError(f"spacing must be positive and finite [m], got ({spacing[0]:g}, "
                              f"{spacing[1]:g})")
-        if np.any(spacing > MAX_SPACING) or np.any(spacing < MIN_SPACING):
-            raise InputError(
-                f"spacing ({spacing[0]:g}, {spacing[1]:g}) m per pixel is implausible: give it "
-                "in metres (e.g. 16e-6 for a 16 um pitch)")
+        plausible("spacing [m]", spacing, "map_pitch")
         extent = np.array(h.shape[::-1]) * spacing
         if np.any(extent > EXTENT[1]) or np.any(extent < EXTENT[0]):
             raise InputError(

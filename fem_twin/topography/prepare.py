@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import setting
+from ..checks import check_choices, check_ranges, setting
 from ..errors import InputError
 from .core import Topography
 from .filling import fill_defects
@@ -23,18 +23,22 @@ class MacroOptions:
 
     fwhm_px: float = setting(9.0, "Gaussian filter FWHM in pixels of the measured map (0: "
                              "unfiltered; the paper's calibrated value is 9)", "fwhm_px")
-    clip: float = setting(20e-6, "heights clipped to +-clip", unit="m")
+    clip: float = setting(20e-6, "heights clipped to +-clip", "height")
     resolution: tuple[int, int] | None = setting(
-        (256, 256), "rows and columns of the virtual geometry (the macro grid)", unit="px")
+        (256, 256), "rows and columns of the virtual geometry (the macro grid)", "pixels")
     resample_method: str = setting("linear", "resampling interpolation",
                                    choices=("linear", "cubic"))
     truncation: float = setting(-20e-6, "below this height a pin pixel belongs to the "
-                                "holder", unit="m")
-    holder_height: float = setting(-1e-3, "the holder surface (pin height 1 mm)", unit="m")
+                                "holder", "depth")
+    holder_height: float = setting(-1e-3, "the holder surface (pin height 1 mm)", "depth")
     level_radius: float = setting(3e-3, "radius about the pin centre of the final "
-                                  "mean-plane fit", unit="m")
+                                  "mean-plane fit", "length")
     sliding_direction: str = setting("+x1", "measured axis along the disk velocity",
                                      choices=("+x1", "-x1", "+x2", "-x2"))
+
+    def __post_init__(self):
+        check_choices(self)
+        check_ranges(self)
 
 
 def pin_face_guess(topo: Topography) -> np.ndarray:
