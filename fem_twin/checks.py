@@ -43,7 +43,10 @@ QUANTITIES = {
     "separation": (1e-10, 1e-4, "m (0.1 um is 1e-7)"),
     "speed": (1e-6, 100.0, "m/s"),
     "pitch": (1e-9, 1e-2, "m (0.3 um is 3e-7, 31 um is 3.1e-5)"),
-    "map_pitch": (1e-9, 1e-3, "m per pixel of a measured map (16 um is 1.6e-5, not 0.016)"),
+    "map_pitch": (1e-9, 1e-3, "m per pixel of a measured map: give the pitch in metres "
+                  "(16 um is 1.6e-5, not 0.016)"),
+    "axis_distance": (1e-4, 1e3, "m, the disk's axis from the face's centre (30 mm is "
+                      "30e-3; far: uniform sliding)"),
     "fwhm_px": (0.0, 200.0, "pixels (0 or at least 1)"),
     "temperature_C": (-40.0, 300.0, "degrees Celsius, not kelvin (24 C is 24.0, not 297.15)"),
     "conductivity": (0.1, 500.0, "W/(m K) (steel: 46)"),

@@ -1057,7 +1057,8 @@ def test_fit_validate_and_from_fit_refuse_what_they_cannot_use(tmp_path, capsys)
     out = tmp_path / "o"
     assert main(["fit", str(case), str(far), "-o", str(out), "--params", "boundary_friction",
                  "--no-progress"]) == 2
-    assert "too few" in capsys.readouterr().err and not (out / "geometry").exists()
+    assert "no measured point lies inside" in capsys.readouterr().err
+    assert not (out / "geometry").exists()
     negative = tmp_path / "neg.csv"
     negative.write_text("speed,friction_coefficient\n0.1,-0.02\n0.2,0.01\n")
     assert main(["fit", str(case), str(negative), "-o", str(out), "--params",

@@ -31,7 +31,7 @@ class MacroSettings:
     track_radius: float | None = setting(
         None, "the disk's axis at this distance from the face's centre: the disk's velocity "
         "field over the face (fem_twin.macro.kinematics); none: uniform sliding along x1",
-        "length", section="tribometer")
+        "axis_distance", section="tribometer")
     friction: str = setting("pin", "friction law: the force on the pin (wall shear and "
                             "the film pressure on the asperity flanks and the face's slope), "
                             "or the paper's eq 31 (the pin's wall shear)", choices=LAWS)

@@ -78,8 +78,9 @@ def surface_temperature(flux, spacing, speed: float, conductivity: float,
     ny, nx = q.shape
     spacing = plausible("surface_temperature: spacing [m]", as_pair("spacing", spacing), "pitch")
     plausible("surface_temperature: |speed| [m/s]", abs(speed) or 1.0, "speed")
-    plausible("surface_temperature: conductivity", conductivity, "conductivity")
-    plausible("surface_temperature: diffusivity", diffusivity, "diffusivity")
+    if not (conductivity > 0 and diffusivity > 0):      # an ideal sink's 1e12 W/(m K) too
+        raise InputError(f"surface_temperature: conductivity {conductivity} W/(m K) and "
+                         f"diffusivity {diffusivity} m^2/s must be positive")
     k_hat = _kernel_hat((ny, nx), spacing, float(speed), float(diffusivity))
     theta = fft.irfft2(fft.rfft2(q, s=(2 * ny, 2 * nx)) * k_hat, s=(2 * ny, 2 * nx))
     return theta[:ny, :nx] / conductivity
