@@ -1,8 +1,8 @@
 """The ``defaults`` group: what cheaper micro settings cost and how far they move C_f.
 
 The paper case (``examples/paper.toml``) with its first patch pair and mu_0 = 0.066 Pa s
-(25 speeds, no refinement pass, no band, isothermal) on several cell grids and step counts, against a
-reference at twice the macro grid (512^2), the patches' own 256 px, 128 steps and every
+(25 speeds, no refinement pass, no band, isothermal) on several cell grids and step counts, against
+a reference at twice the macro grid (512^2), the patches' own 256 px, 128 steps and every
 one of the 100 h0 candidates (``h0_tol = 0``).  Per setting: its task graph's CPU time, the
 largest C_f error estimate and the largest change to the reference, both in % C_f,b, and
 the speed of the latter.  ``$FEM_TWIN_BENCH_DIR`` keeps the runs; a finished run there is

@@ -73,7 +73,8 @@ def bench_contact(sizes=(256, 512, 1024)):
         t_s, sep = best_of(lambda: contact.solve(shape, dx, e_red, separation=h0, periodic=True,
                                                  hardness=6.99e9), 1)
         t_sw, sepw = best_of(lambda: contact.solve(shape, dx, e_red, separation=h0, periodic=True,
-                                                   hardness=6.99e9, initial_pressure=el.pressure), 1)
+                                                   hardness=6.99e9,
+                                                   initial_pressure=el.pressure), 1)
         base = base or t_fft
         per = lambda t, it: f"{it} it, {t / it / t_fft:.2f} x (rfft2+irfft2) per it"  # noqa: E731
         assert np.abs(el.pressure - p_ref).max() < 1e-6 * p_ref.max()
@@ -161,7 +162,8 @@ def bench_contact_pk(sizes=(256, 1024)):
                                                           tol=1e-8, **kw), REPS)
                 l2 = lambda p: np.linalg.norm(p - ref) / np.linalg.norm(ref)  # noqa: E731
                 rows += [(f"{n}^2 {name}: pk_numpy", t_pk, f"{out['it']} it, "
-                          f"{K.nfft / REPS / 2 / out['it']:.2f} FFT pairs/it, L2 {l2(out['p']):.1e}"),
+                          f"{K.nfft / REPS / 2 / out['it']:.2f} FFT pairs/it, "
+                          f"L2 {l2(out['p']):.1e}"),
                          (f"{n}^2 {name}: fem_twin", t_ft, f"{res.iterations} it, "
                           f"{calls['n'] / REPS / res.iterations:.2f} + "
                           f"{calls['single'] / REPS / res.iterations:.2f} single FFT pairs/it, "
@@ -320,7 +322,8 @@ def bench_macro():
                 cf[method] = r.friction_coefficient
                 newton = int(r.history[:, 6].sum())
                 rows.append((f"{method.upper()} {n}^2, U = {speed} m/s", t,
-                             f"{r.iterations} it, {newton} Newton steps, C_f {r.friction_coefficient:.5f}"))
+                             f"{r.iterations} it, {newton} Newton steps, "
+                             f"C_f {r.friction_coefficient:.5f}"))
             rows.append(("  FE / FVM time; |C_f,dev|", rows[-1][1] / rows[-2][1],
                          f"{abs(cf['fe'] - cf['fvm']) / 0.19245:.2e}"))
             t0 = time.perf_counter()
@@ -368,7 +371,8 @@ def bench_stribeck():
                            lubricant=Lubricant(0.066), face=face))
     t = time.perf_counter() - t0
     rows.append(("paper-grade curve: 25 speeds at 256^2", t,
-                 f"{int(curve.iterations.sum())} iterations, C_f {curve.friction_coefficient[0]:.4f}"
+                 f"{int(curve.iterations.sum())} iterations, "
+                 f"C_f {curve.friction_coefficient[0]:.4f}"
                  f" -> {curve.friction_coefficient[-1]:.4f}; goal 600 s"))
     return base, rows
 
@@ -380,8 +384,8 @@ def bench_newton():
     stencil pattern (analysis once per grid) with exact inner solves, and by the default
     (PARDISO, one Newton step per inner solve while the coupling is far from converged).
     Baseline: the previous method at 128^2.  Goal of the paper-grade issue: 2x at 256^2."""
-    from fem_twin.numerics.linalg import _mkl_rt
     from fem_twin.macro import Lubricant, MacroSettings
+    from fem_twin.numerics.linalg import _mkl_rt
     from fem_twin.stribeck import SweepRequest, stribeck_sweep
 
     ff = macro_factors()
@@ -396,7 +400,8 @@ def bench_newton():
         for name, (sparse, steps) in methods.items():
             os.environ["FEM_TWIN_SPARSE"] = sparse
             t0 = time.perf_counter()
-            c = stribeck_sweep(SweepRequest(gap, spacing, ff, np.geomspace(2.0, 0.01, 8), load=150.0,
+            c = stribeck_sweep(SweepRequest(gap, spacing, ff, np.geomspace(2.0, 0.01, 8),
+                                            load=150.0,
                                lubricant=Lubricant(0.066), face=face,
                                settings=MacroSettings(inner_steps=steps)))
             times.append(time.perf_counter() - t0)
@@ -416,9 +421,9 @@ def bench_paper():
     viscosities x 25 speeds (+ refinement, ~37 points) at 256^2; patch band: 12 more
     sweeps at 64^2, the nested solves' coarsest grid; 2 cores).  Measured here: sample
     patch pair 3 at 256^2, adaptive h0 on 2 processes, and the previous method's cost of
-    one h0 (10 of the 100, serial); 8 consecutive speeds of the paper's 25 (0.53 -> 0.07 m/s) at 256^2 with the
-    macro groups' flow factors (patch 1 at 64^2, 30 h0), the first point cold, and the same
-    speeds on the band's grids (128^2, "coarse", the default before; 64^2, "coarsest").
+    one h0 (10 of the 100, serial); 8 consecutive speeds of the paper's 25 (0.53 -> 0.07 m/s) at
+    256^2 with the macro groups' flow factors (patch 1 at 64^2, 30 h0), the first point cold, and
+    the same speeds on the band's grids (128^2, "coarse", the default before; 64^2, "coarsest").
     Baseline: the measured micro time of one h0."""
     from fem_twin.case import load_case
     from fem_twin.macro import Lubricant
@@ -439,11 +444,13 @@ def bench_paper():
     speeds = np.geomspace(2.0, 0.01, case.sweep.count)[6:14]
     ff = macro_factors()          # smooth factors (30 h0): 10 h0 kink p_con, the sweep stalls
     t0 = time.perf_counter()
-    stribeck_sweep(SweepRequest(gap, spacing, ff, speeds[:1], load=150.0, lubricant=Lubricant(0.066),
+    stribeck_sweep(SweepRequest(gap, spacing, ff, speeds[:1], load=150.0,
+                                lubricant=Lubricant(0.066),
                    face=face))
     cold = time.perf_counter() - t0
     t0 = time.perf_counter()
-    curve = stribeck_sweep(SweepRequest(gap, spacing, ff, speeds, load=150.0, lubricant=Lubricant(0.066),
+    curve = stribeck_sweep(SweepRequest(gap, spacing, ff, speeds, load=150.0,
+                                        lubricant=Lubricant(0.066),
                            face=face))
     warm = (time.perf_counter() - t0 - cold) / (speeds.size - 1)
     band = []                                  # a point on each of the band's grids
@@ -451,7 +458,8 @@ def bench_paper():
     for _ in range(nested_levels(gap.shape)):
         grid = coarsened(*grid)
         t0 = time.perf_counter()
-        stribeck_sweep(SweepRequest(grid[0], grid[1], ff, speeds, load=150.0, lubricant=Lubricant(0.066),
+        stribeck_sweep(SweepRequest(grid[0], grid[1], ff, speeds, load=150.0,
+                                    lubricant=Lubricant(0.066),
                        face=grid[2]))
         band.append((time.perf_counter() - t0) / speeds.size)
     coarse, coarsest = band[0], band[-1]
@@ -578,7 +586,8 @@ def bench_estimate(case_file="pin_on_disk.toml", viscosity=0.066):
 
 
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
-          "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton, "paper": bench_paper, "stribeck": bench_stribeck,
+          "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton,
+          "paper": bench_paper, "stribeck": bench_stribeck,
           "estimate": bench_estimate, "scale": bench_scale, "cores": bench_cores,
           "estimate-paper": lambda: bench_estimate("paper.toml"),
           "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults,

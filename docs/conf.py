@@ -55,7 +55,8 @@ html_theme_options = {
 html_sidebars = {"index": [], "getting_started": [], "tutorial": []}
 
 SHARED = ROOT.parent / "shared" / "topographies"
-GALLERY_OUT = Path(os.environ.get("FEM_TWIN_DOCS_OUT") or tempfile.mkdtemp(prefix="fem_twin_gallery_"))
+GALLERY_OUT = Path(os.environ.get("FEM_TWIN_DOCS_OUT")
+                   or tempfile.mkdtemp(prefix="fem_twin_gallery_"))
 
 
 def example_argv(gallery_conf, script_vars):

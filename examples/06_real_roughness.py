@@ -28,9 +28,9 @@ import numpy as np
 
 from fem_twin import read_topography, write_topography
 from fem_twin.case import load_case
+from fem_twin.micro import FlowFactors
 from fem_twin.pipeline import run
 from fem_twin.stribeck import friction_deviation, read_stribeck_csv
-from fem_twin.micro import FlowFactors
 from fem_twin.topography import extract_patch, fill_defects
 
 HERE = Path(sys.argv[0]).resolve().parent
@@ -102,7 +102,8 @@ def report(results, cfb, path):
         sq = ", ".join(f"{a.rms_height() * 1e9:.0f}/{b.rms_height() * 1e9:.0f}"
                        for a, b in zip(pins[::2], pins[1::2]))
         turn = turning_speed(curve, cfb / 2)
-        print(f"{label:>9}: Sq pin/disk of the two pairs {sq} nm; A11 at 0.2 um {ff.at(0.2e-6).A[0, 0]:.3f}, "
+        print(f"{label:>9}: Sq pin/disk of the two pairs {sq} nm; "
+              f"A11 at 0.2 um {ff.at(0.2e-6).A[0, 0]:.3f}, "
               f"p_con at 0.1 um {ff.at(0.1e-6).p_con * 1e-6:.1f} MPa; C_f = C_f,b/2 at "
               f"U = {turn:.3g} m/s")
         a.semilogx(curve.speed, curve.friction_coefficient, "o-", ms=3,

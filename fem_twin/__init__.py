@@ -5,11 +5,12 @@ stribeck``, with ``fvm`` as the reference twin of the FE solvers and ``io`` for 
 meshes and VTK.  All quantities are SI (m, Pa, Pa s, m/s).
 """
 
-from .topography import Topography
 from .io.files import read_topography, write_topography
+from .topography import Topography
 
 try:
-    from importlib.metadata import PackageNotFoundError, version as _version
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as _version
     __version__ = _version("fem-twin")                  # one source: pyproject.toml
 except PackageNotFoundError:                            # a source tree never installed
     __version__ = "0.0.0+unknown"

@@ -24,14 +24,14 @@ from .io.layout import RunLayout
 from .io.table import write_csv
 from .macro import MixedResult
 from .micro import FlowFactors
-from .micro.flow_factors import ARRAYS
 from .micro.estimate import discrepancy, grid_separations
-from .stribeck import friction_deviation, stribeck_sweep
-from .stages.requests import macro_settings, sweep_request
+from .micro.flow_factors import ARRAYS
+from .numerics.threads import executor_for
 from .stages.factors import homogenise_patches
 from .stages.geometry import level_pins, reconstruct_geometry
+from .stages.requests import macro_settings, sweep_request
+from .stribeck import friction_deviation, stribeck_sweep
 from .stribeck.sweep import point_files
-from .numerics.threads import executor_for
 
 
 def flow_factor_differences(fe: FlowFactors, fvm: FlowFactors) -> dict:

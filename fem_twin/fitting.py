@@ -19,13 +19,21 @@ from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .io.table import write_csv
 from .macro.viscosity import WaltherLaw
+from .numerics.threads import executor_for
 from .stages.requests import per_viscosity, sweep_request
 from .stages.sweeps import run_sweeps
 from .stribeck import read_measured_csv
 from .stribeck.curve import read_stribeck_csv
-from .stribeck.fit import (LOAD_SHARES, PARAMETERS, RESISTANCES, FitModel, check_parameters,
-                           fit_curves, plot_fit, predict)
-from .numerics.threads import executor_for
+from .stribeck.fit import (
+    LOAD_SHARES,
+    PARAMETERS,
+    RESISTANCES,
+    FitModel,
+    check_parameters,
+    fit_curves,
+    plot_fit,
+    predict,
+)
 from .taskgraph import fit_scaling
 
 log = logging.getLogger("fem_twin")

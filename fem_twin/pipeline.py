@@ -24,14 +24,14 @@ import numpy as np
 from .case import Case
 from .errors import InputError, RunLocked
 from .io.atomic import atomic_path
-from .io.writers import Writers
 from .io.layout import RunLayout
+from .io.writers import Writers
+from .numerics.threads import executor_for, one_thread
 from .stages.curves import stribeck_curves
 from .stages.factors import homogenise_patches
 from .stages.geometry import level_pins, reconstruct_geometry
 from .stages.provenance import provenance, stage_keys
 from .stribeck import read_measured_csv
-from .numerics.threads import executor_for, one_thread
 
 log = logging.getLogger("fem_twin")
 

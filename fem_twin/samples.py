@@ -48,12 +48,15 @@ def generate(outdir) -> list[Path]:
     written = []
     for k in (1, 2, 3):
         name, seed = next(files)
-        written.append(write_topography(outdir / name, worn_pin(seed, k), height_scale=MACRO_QUANTUM))
+        written.append(write_topography(outdir / name, worn_pin(seed, k),
+                                        height_scale=MACRO_QUANTUM))
     for k in (1, 2, 3):
         name, seed = next(files)
-        written.append(write_topography(outdir / name, worn_disk(seed, k), height_scale=MACRO_QUANTUM))
+        written.append(write_topography(outdir / name, worn_disk(seed, k),
+                                        height_scale=MACRO_QUANTUM))
     for k in range(6):
-        for sq, (name, seed) in zip((TABLE5_SQ_LOW[k], TABLE5_SQ_UP[k]), (next(files), next(files))):
+        for sq, (name, seed) in zip((TABLE5_SQ_LOW[k], TABLE5_SQ_UP[k]),
+                                    (next(files), next(files))):
             patch = roughness_patch(seed, sq, f"{name[:-4]} (Table 5 patch {k + 1})")
             written.append(write_topography(outdir / name, patch, height_scale=PATCH_QUANTUM))
     return written
@@ -75,9 +78,11 @@ def worn_pin(seed: int, k: int) -> Topography:
     crown = rng.uniform(1.5e-6, 3.0e-6)               # face crown [m] over the radius
     roll = rng.uniform(3e-6, 6e-6)                    # extra edge roll-off [m]
     r_roll = rng.uniform(3.2e-3, 3.5e-3)              # where the roll-off starts [m]
-    face = -crown * (r / PIN_RADIUS) ** 2 - roll * np.clip((r - r_roll) / (PIN_RADIUS - r_roll), 0, None) ** 2
+    face = (-crown * (r / PIN_RADIUS) ** 2
+            - roll * np.clip((r - r_roll) / (PIN_RADIUS - r_roll), 0, None) ** 2)
     # running-in leaves a slightly asymmetric face: low-order waviness of ~0.3 um
-    face += 0.3e-6 * rng.uniform(0.5, 1) * np.cos(2 * np.pi * X1 / 9e-3 + rng.uniform(0, 2 * np.pi)) \
+    face += 0.3e-6 * rng.uniform(0.5, 1) \
+        * np.cos(2 * np.pi * X1 / 9e-3 + rng.uniform(0, 2 * np.pi)) \
         * np.cos(2 * np.pi * X2 / 11e-3 + rng.uniform(0, 2 * np.pi))
     rough = self_affine(MACRO_SHAPE, dx, 0.8, 0.25e-6, rolloff_wavelength=0.2e-3,
                         rng=rng).heights
@@ -92,7 +97,8 @@ def worn_pin(seed: int, k: int) -> Topography:
         c = rng.integers(100, 400, size=2)
         invalid[c[0]:c[0] + rng.integers(2, 6), c[1]:c[1] + rng.integers(2, 6)] = True
     z[invalid] = np.nan
-    meta = {"sample": f"worn pin {k}", "instrument": "FRT-like confocal, 500 x 500 px over 8 x 8 mm",
+    meta = {"sample": f"worn pin {k}",
+            "instrument": "FRT-like confocal, 500 x 500 px over 8 x 8 mm",
             "generator": "fem_twin.samples.worn_pin", "seed": int(seed), "unit": "m",
             "pin_radius": PIN_RADIUS, "crown": crown, "edge_roll_off": roll}
     return Topography(z, dx, origin=(x[0], x[0]), meta=meta)

@@ -1,4 +1,5 @@
-"""Shared fixtures: paths to the repository's sample twin and the shared instrument files."""
+"""Shared fixtures: paths to the repository's sample twin and the shared instrument files,
+and the sample patch's flow factors (computed once per session)."""
 
 from pathlib import Path
 
@@ -23,3 +24,10 @@ def shared_topographies():
     if not SHARED_TOPOGRAPHIES.is_dir():
         pytest.skip(f"shared instrument files not found at {SHARED_TOPOGRAPHIES}")
     return SHARED_TOPOGRAPHIES
+
+
+@pytest.fixture(scope="session")
+def factors():
+    """Flow factors of sample patch pair 1 (:func:`sample_cases.sample_factors`)."""
+    from sample_cases import sample_factors
+    return sample_factors()

@@ -53,7 +53,7 @@ def test_no_import_cycle_between_modules():
 
 
 def test_every_raise_is_a_fem_twin_error():
-    """Issue 30 item 2: every exception fem_twin raises on purpose derives from
+    """Every exception fem_twin raises on purpose derives from
     FemTwinError (and from the builtin a caller expects), so ``except FemTwinError`` catches
     all of them.  Walks every ``raise Name(...)`` of the package and resolves the name in
     its module; re-raises (``raise``, ``raise err``) are not new errors."""
@@ -74,7 +74,7 @@ def test_every_raise_is_a_fem_twin_error():
 
 
 def test_run_files_are_named_only_by_the_run_layout():
-    """Issue 31 item 2: the names of the files a run writes and reads appear once, in
+    """The names of the files a run writes and reads appear once, in
     fem_twin/io/layout.py (RunLayout); every other module asks it for the path.
     (samples.py names the bundled sample's input maps, which happen to share a pattern.)"""
     import re
@@ -96,7 +96,8 @@ def test_run_files_are_named_only_by_the_run_layout():
 LAYERS = {"topography": 1, "io.files": 1, "io": 1, "contact": 2, "micro": 3, "macro": 4,
           "fvm": 4, "stribeck": 5,
           "case": 6.0, "results": 6.1, "stages": 6.2, "taskgraph": 6.2, "pipeline": 6.3,
-          "compare": 6.4, "calibration": 6.4, "verification": 6.4, "fitting": 6.4, "report": 6.5, "samples": 6.5,
+          "compare": 6.4, "calibration": 6.4, "verification": 6.4, "fitting": 6.4,
+          "report": 6.5, "samples": 6.5,
           "cli": 7}
 
 
@@ -110,7 +111,7 @@ def _layer(module: str) -> float:
 
 
 def test_imports_run_down_the_pipeline():
-    """Issue 31 item 6: topography -> contact -> micro -> macro -> stribeck -> the workflow
+    """Topography -> contact -> micro -> macro -> stribeck -> the workflow
     (case, results, stages, pipeline, studies, report) -> the CLI: no stage imports a later
     one, and the workflow never imports from the CLI."""
     up = []
@@ -124,7 +125,7 @@ def test_imports_run_down_the_pipeline():
 
 
 def test_result_variables_are_declared_once():
-    """Issue 31 item 6: an output variable is declared in one place, so adding one touches
+    """An output variable is declared in one place, so adding one touches
     at most two files: an operating point's grid fields are MixedResult's arrays, each with
     its unit in macro/result.FIELDS (checkpoints, VTU, fields.nc and the docs read it); a
     Stribeck curve's are StribeckCurve's arrays, each a column of stribeck/curve.COLUMNS with
@@ -144,7 +145,7 @@ def test_result_variables_are_declared_once():
 
 
 def test_every_setting_another_section_sets_is_filled_from_it():
-    """Issue 63 item 2: a stage setting declared ``setting(..., section=...)`` (E' and the
+    """A stage setting declared ``setting(..., section=...)`` (E' and the
     hardness from [materials], C_f,b and the track radius from [tribometer], the cells'
     sliding kinematics) is filled from that section in one place, ``Case.filled``, which
     the stages' settings go through: a case's own values reach the cells and the macro

@@ -5,13 +5,12 @@ import json
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from fem_twin.case import CaseError, load_case
 from fem_twin.cli import main
 from fem_twin.macro import MixedResult
 from fem_twin.stages.geometry import ball_contact
-
-from conftest import ROOT
 
 
 def small_ball_case(tmp_path):
@@ -31,6 +30,7 @@ def small_ball_case(tmp_path):
     return path
 
 
+@pytest.mark.integration
 def test_ball_on_disk_stribeck_curve_from_ehl_to_boundary(tmp_path):
     """Full film at the fast end (central film within 20 % of Hamrock-Dowson for the smooth
     ball: the film is thicker than the roughness there; measured for the smooth ball with
@@ -74,6 +74,7 @@ def test_ball_case_keys_are_validated_with_units(tmp_path, old, new, key):
         load_case(tmp_path / "bad.toml")
 
 
+@pytest.mark.integration
 def test_traction_curve_of_the_ball(tmp_path, capsys):
     """``fem-twin traction``: C_f versus SRR at one entrainment speed per viscosity, from the
     micro stage of the same folder.  In the mixed regime (70-93 % of the load on the
@@ -114,10 +115,11 @@ def test_a_measured_ball_cap_is_the_macro_gap(tmp_path):
     the gap is the measured cap around its apex (the smooth ball's paraboloid plus the form
     error, to the sphere's r^4 / (8 R^3) term); a radius given as well, or a cap on a pin
     case, is refused."""
-    from fem_twin.io.files import write_topography
-    from fem_twin.stages.geometry import macro_geometry
-    from fem_twin.io.layout import RunLayout
     from test_topography import synthetic_cap
+
+    from fem_twin.io.files import write_topography
+    from fem_twin.io.layout import RunLayout
+    from fem_twin.stages.geometry import macro_geometry
     cap, _ = synthetic_cap(astig=50e-9)
     cap_file = write_topography(tmp_path / "cap.npz", cap)
     text = small_ball_case(tmp_path).read_text().replace(
@@ -137,7 +139,8 @@ def test_a_measured_ball_cap_is_the_macro_gap(tmp_path):
     quartic = np.hypot(X1, X2).max() ** 4 / (8 * 9.525e-3 ** 3)      # sphere - paraboloid
     assert np.ptp(gap - (smooth - form)) < quartic + 1e-9
     pin = (ROOT / "examples" / "pin_on_disk.toml").read_text().replace(
-        "[geometry]", f'[geometry]\nball = "{cap_file}"').replace("../meshes/", str(ROOT / "meshes") + "/")
+        "[geometry]", f'[geometry]\nball = "{cap_file}"').replace("../meshes/",
+                                                                str(ROOT / "meshes") + "/")
     (tmp_path / "pin.toml").write_text(pin)
     with pytest.raises(CaseError, match="ball-on-disk"):
         load_case(tmp_path / "pin.toml")

@@ -14,7 +14,7 @@ from fem_twin.stribeck.sweep import point_files
 from fem_twin.topography.synthetic import self_affine
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_macro import macro_case, smooth_factors  # noqa: E402
+from sample_cases import macro_case, smooth_factors  # noqa: E402
 
 
 def test_a_stribeck_point_copied_over_another_is_recomputed(tmp_path):
@@ -48,3 +48,69 @@ def test_an_h0_checkpoint_copied_over_another_is_recomputed(tmp_path):
     again = homogenise(pin, disk, [0.2e-6, 0.4e-6], **kw)
     assert low.with_name(low.name + ".corrupt").is_file()
     assert np.array_equal(again.A, first.A) and np.array_equal(again.h_m, first.h_m)
+
+
+def _changed(value):
+    """``value`` changed a little, whatever its kind (a number, an array, a dataclass's first
+    number, a string, None)."""
+    from dataclasses import fields, replace
+    if isinstance(value, bool):
+        return not value
+    if isinstance(value, int):
+        return value + 1
+    if isinstance(value, float):
+        return value * 1.01 + 1e-9
+    if isinstance(value, np.ndarray):
+        out = value.copy()
+        out.flat[0] = (not out.flat[0]) if out.dtype == bool else out.flat[0] * 1.01 + 1e-12
+        return out
+    if isinstance(value, tuple):
+        return (_changed(value[0]), *value[1:])
+    if isinstance(value, str):
+        return value + "x"
+    for f in fields(value):
+        if isinstance(getattr(value, f.name), (int, float)) and not isinstance(
+                getattr(value, f.name), bool):
+            return replace(value, **{f.name: _changed(getattr(value, f.name))})
+    raise AssertionError(f"no field to change in {value!r}")
+
+
+def test_the_sweep_key_changes_with_every_field_that_sets_the_points():
+    """A sweep's checkpoint key is derived from its request: changing any field outside the
+    declared exclusions (where points are written, the speeds, the Hersey length, the
+    starts), or any field of its settings, lubricant, thermal model or factors, changes the
+    key; changing an excluded one does not.  A new physics field can therefore not reuse
+    stale checkpoints."""
+    from dataclasses import fields, replace
+
+    from fem_twin.macro.thermal import ContactThermal, ThermalSettings
+    from fem_twin.macro.viscosity import WaltherLaw
+    from fem_twin.stribeck import request as rq
+    gap, dx, face = macro_case(16)
+    law = WaltherLaw.through([24.0, 50.0], [0.066, 0.024], 850.0)
+    base = SweepRequest(gap, dx, smooth_factors(), [1.0], load=150.0,
+                        lubricant=Lubricant(0.066), face=face,
+                        thermal=ContactThermal(ThermalSettings(), law, 0.15))
+    key = base.key
+    nested = {"settings": base.settings, "lubricant": base.lubricant,
+              "thermal": base.thermal, "factors": base.factors}
+    for f in fields(base):
+        value = getattr(base, f.name)
+        if f.name in rq.NOT_KEYED or f.name in nested or f.name == "motion":
+            continue
+        changed = _changed(value) if value is not None else "factors of a run"
+        assert replace(base, **{f.name: changed}).key != key, f.name
+    for name, value in nested.items():
+        for g in fields(value):
+            if g.name == "meta" or isinstance(getattr(value, g.name), str):
+                continue
+            inner = getattr(value, g.name)
+            if inner is None:
+                continue
+            moved = replace(value, **{g.name: _changed(inner)})
+            assert replace(base, **{name: moved}).key != key, (name, g.name)
+    from fem_twin.stribeck.request import RollingSliding
+    assert replace(base, motion=RollingSliding(1.0)).key != key
+    for name, value in (("speeds", [2.0]), ("hersey_length", 9e-3), ("origin", (1.0, 0.0)),
+                        ("error_estimate", True), ("keep_level", 1), ("guide", "abc")):
+        assert replace(base, **{name: value}).key == key, name

@@ -198,6 +198,7 @@ def test_split_fft_operator_matches_the_two_dimensional_transforms(periodic):
     (1e-13 of the peak), and its single-precision twin (used for CG search directions) to
     1e-5: float32 transforms carry about 1e-7 per element, summed over 2 x 96 terms."""
     import scipy.fft as fft
+
     from fem_twin.contact.elastic import elastic_operator
     ny, nx = 64, 96
     op = elastic_operator((ny, nx), (1e-6, 1.3e-6), 2.3e11, periodic)
@@ -241,7 +242,8 @@ def test_rough_contact_under_the_loaded_separation_returns_the_loaded_state(cap)
     load = 100e6 * size ** 2
     hardness = np.inf
     if cap is not None:
-        hardness = cap * contact.solve(shape, size / n, e_red, load=load, periodic=True).pressure.max()
+        peak = contact.solve(shape, size / n, e_red, load=load, periodic=True).pressure.max()
+        hardness = cap * peak
     by_load = contact.solve(shape, size / n, e_red, load=load, periodic=True, hardness=hardness)
     by_gap = contact.solve(shape, size / n, e_red, separation=by_load.separation, periodic=True,
                            hardness=hardness)

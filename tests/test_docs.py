@@ -7,10 +7,8 @@ one fresh process, from the repository root); blocks meant to be read, not run, 
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
-
 from conftest import ROOT
 
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]

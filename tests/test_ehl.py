@@ -144,6 +144,7 @@ def test_central_film_over_the_moes_range(M, L):
     assert abs(h_c / contact.hamrock_dowson()[0] - 1) < 0.15
 
 
+@pytest.mark.integration
 def test_elastic_film_converges_under_refinement():
     """Isoviscous-elastic ball (M = 10, incompressible): the film's successive differences
     shrink on 49 -> 97 -> 193 nodes with an observed order above 0.5 (measured 0.6-0.7:

@@ -173,7 +173,7 @@ def public_callables():
 
 
 def test_every_public_function_refuses_wrong_arguments_with_a_fem_twin_error():
-    """Issue 64 item 4: every callable of the public API (the subpackages' ``__all__``),
+    """Every callable of the public API (the subpackages' ``__all__``),
     its required arguments all wrong (types, empty and non-finite arrays, integers where
     metres go), raises a FemTwinError naming what is wrong, never a numpy, scipy or
     Python error from inside."""
@@ -218,7 +218,7 @@ def _declared_settings():
 
 
 def test_every_numeric_setting_declares_a_plausible_range():
-    """Issue 72 item 1: every setting of the case file and of the stages' settings objects
+    """Every setting of the case file and of the stages' settings objects
     either names a quantity of ``checks.QUANTITIES`` (its plausible range and unit, shown
     in the generated case-file reference) or is text, a switch or a file; its default lies
     inside that range, and an API object built with a value a thousand times outside it

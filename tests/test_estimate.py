@@ -28,7 +28,7 @@ from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import prepare_patch
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_macro import SAMPLE, macro_case  # noqa: E402
+from sample_cases import SAMPLE, macro_case  # noqa: E402
 
 
 def patch_factors(n, steps, count):
@@ -44,6 +44,7 @@ def runs():
             (macro_case(96), patch_factors(64, 32, 31)))
 
 
+@pytest.mark.integration
 @pytest.mark.parametrize("speed", [1.0, 0.1, 0.05, 0.03, 0.02, 0.01])
 def test_estimate_bounds_the_change_to_a_refined_run(runs, speed):
     ((gap, dx, face), factors), ((gap_r, dx_r, face_r), factors_r) = runs

@@ -12,14 +12,14 @@ import pytest
 
 from fem_twin.errors import InputError
 from fem_twin.macro import Lubricant, MacroSettings
+from fem_twin.macro.thermal import ContactThermal, ThermalSettings
 from fem_twin.macro.viscosity import WaltherLaw
 from fem_twin.stribeck import SweepRequest, stribeck_sweep
 from fem_twin.stribeck.curve import MeasuredCurve
-from fem_twin.macro.thermal import ContactThermal, ThermalSettings
 from fem_twin.stribeck.fit import LOAD_SHARES, RESISTANCES, FitModel, fit_curves, predict
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_macro import factors, macro_case  # noqa: E402,F401
+from sample_cases import macro_case  # noqa: E402
 
 LAW = WaltherLaw.through([24.0, 50.0], [0.066, 0.024], 850.0)
 CFB = MacroSettings().boundary_friction          # the C_f,b the curves are run with (eq 32)
@@ -32,7 +32,7 @@ SIMULATED = np.geomspace(2.0, 0.004, 20)
 
 
 @pytest.fixture(scope="module")
-def twin(factors):  # noqa: F811
+def twin(factors):
     """Simulated curves at 24 and 50 C, and the 'measured' ones run directly at 35 and 45 C
     with C_f,b = 0.15 (C_f only)."""
     gap, dx, face = macro_case(32)
@@ -74,7 +74,7 @@ def test_fit_recovers_boundary_friction_and_temperature(twin):
 
 
 def test_measured_points_outside_the_simulated_speeds_are_not_counted(twin):
-    """Issue 72 item 2: points beyond the simulated speeds (where C_f would be held at the
+    """Points beyond the simulated speeds (where C_f would be held at the
     ends) are left out of the fit, counted and named; the fit of the rest is the fit
     without them, to rounding; a curve wholly outside is refused."""
     sim, cf = twin
@@ -112,7 +112,7 @@ def test_prediction_at_another_temperature_holds_the_twin(twin):
 
 
 @pytest.fixture(scope="module")
-def shares(twin, factors):  # noqa: F811
+def shares(twin, factors):
     """The 24 C curve swept at each of LOAD_SHARES of 150 N (1.0: the twin's), and the
     'measured' curve run directly at 0.8 of it (between two swept shares), C_f over the
     imposed 150 N with C_f,b = 0.15."""
@@ -155,7 +155,7 @@ def test_fit_recovers_the_load_share(twin, shares):
     assert np.all(p["cf_high"] - p["cf_low"] > 0)
 
 
-def test_a_curve_no_parameters_fit_is_refused_naming_its_residual(twin, factors):  # noqa: F811
+def test_a_curve_no_parameters_fit_is_refused_naming_its_residual(twin, factors):
     """A curve rising with speed cannot be fitted by C_f,b and the temperature, nor one
     measured at 600 N (four times the case's load) with a +-2 % scatter band at the known
     temperature: InputError with the rms and the largest C_f,dev.  Without a band, the
@@ -183,7 +183,7 @@ def test_a_curve_no_parameters_fit_is_refused_naming_its_residual(twin, factors)
 
 
 def test_a_parameter_the_points_do_not_see_is_refused(twin):
-    """Issue 64 item 2: measured points only where the film carries the load (no contact,
+    """Measured points only where the film carries the load (no contact,
     so C_f does not depend on C_f,b) gave the starting value back with a zero-width 95 %
     interval; the fit now refuses, naming the parameter."""
     sim, cf = twin
@@ -198,7 +198,7 @@ def test_a_parameter_the_points_do_not_see_is_refused(twin):
 
 
 @pytest.fixture(scope="module")
-def resistances(factors):  # noqa: F811
+def resistances(factors):
     """The thermal twin (fem_twin.macro.thermal) at 24 and 50 C swept at each of
     RESISTANCES [K/W], and the 'measured' curves run directly at R_b = 1.5 (between two
     swept ones) with C_f,b = 0.15, all at the measured speeds (no interpolation in speed)."""
@@ -207,14 +207,15 @@ def resistances(factors):  # noqa: F811
 
     def sweep(mu, r, at=SPEEDS):
         thermal = ContactThermal(ThermalSettings(bulk_resistance=r), LAW, CFB)
-        return stribeck_sweep(SweepRequest(gap, dx, factors, at, lubricant=Lubricant(mu), thermal=thermal,
-                              **common))
+        return stribeck_sweep(SweepRequest(gap, dx, factors, at, lubricant=Lubricant(mu),
+                                           thermal=thermal, **common))
     grid = tuple(tuple((r, sweep(mu, r)) for r in RESISTANCES) for mu in (0.066, 0.024))
     direct = [sweep(mu, 1.5) for mu in (0.066, 0.024)]
     cf = [(r.hydrodynamic_friction + CFB_TRUE / CFB * r.boundary_friction) / 150 for r in direct]
     return grid, cf
 
 
+@pytest.mark.integration
 def test_fit_recovers_the_rigs_thermal_resistance(resistances):
     """C_f,b and R_b (1.5 K/W, between the swept 1 and 2) from the two curves at their known
     temperatures, the model's curves at R_b = 1 moved along the swept resistances.

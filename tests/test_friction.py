@@ -17,7 +17,7 @@ from fem_twin.micro.sliding import cell_solver, sliding_contacts, sliding_pass, 
 from fem_twin.topography.synthetic import self_affine
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_macro import SAMPLE, factors, macro_case  # noqa: E402,F401 (a fixture)
+from sample_cases import SAMPLE, macro_case  # noqa: E402
 
 L = 80e-6                                       # cell length [m]
 AMP, H0 = 0.08e-6, 0.15e-6                      # the striated case

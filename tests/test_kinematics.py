@@ -24,7 +24,7 @@ from fem_twin.macro.reynolds import fe_poiseuille, trapezoid_weights
 from fem_twin.micro.flow_factors import LocalFactors
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_macro import factors, macro_case  # noqa: E402,F401 (a fixture)
+from sample_cases import macro_case  # noqa: E402
 
 MU, OMEGA = 0.05, 100.0
 #: a sector pad: radii, angle, films (thick at the inlet, large polar angle)
@@ -47,7 +47,8 @@ def polar_sector(n):
     idx = np.arange(R.size).reshape(R.shape)
     i, c = idx[1:-1, 1:-1].ravel(), (slice(1, -1), slice(1, -1))
     Rc, Tc, h3 = R[c], T[c], sector_film(T[c]) ** 3
-    links = (((Rc + dr / 2) * h3 / dr ** 2, idx[2:, 1:-1]), ((Rc - dr / 2) * h3 / dr ** 2, idx[:-2, 1:-1]),
+    links = (((Rc + dr / 2) * h3 / dr ** 2, idx[2:, 1:-1]),
+             ((Rc - dr / 2) * h3 / dr ** 2, idx[:-2, 1:-1]),
              (sector_film(Tc + dt / 2) ** 3 / (Rc * dt ** 2), idx[1:-1, 2:]),
              (sector_film(Tc - dt / 2) ** 3 / (Rc * dt ** 2), idx[1:-1, :-2]))
     edge = np.setdiff1d(idx.ravel(), i)
@@ -161,8 +162,9 @@ def test_the_cell_frame_turns_into_the_grid():
     v = np.stack([1 + 0.1 * rng.random((3, 4)), 0.2 * rng.standard_normal((3, 4))], -1)
     A = rng.random((3, 4, 2, 2))
     loc = LocalFactors(h0=np.ones((3, 4)), h_m=np.ones((3, 4)), p_con=None,
-                       A=np.broadcast_to(2 * np.eye(2), (3, 4, 2, 2)), b=np.tile([1.0, 0.0], (3, 4, 1)),
-                       C=A, d=None, friction_factor=None, pressure_friction=None, contact_fraction=None)
+                       A=np.broadcast_to(2 * np.eye(2), (3, 4, 2, 2)),
+                       b=np.tile([1.0, 0.0], (3, 4, 1)), C=A, d=None, friction_factor=None,
+                       pressure_friction=None, contact_fraction=None)
     moved = in_grid_frame(loc, rotations(v))
     c, s, _ = rotations(v)
     assert np.allclose(moved.A, 2 * np.eye(2)) and np.allclose(moved.b, np.stack([c, s], -1))
@@ -206,21 +208,24 @@ def test_the_case_turns_the_disk_at_its_track_radius(tmp_path):
     root = Path(__file__).resolve().parents[1] / "examples"
     assert macro_settings(load_case(root / "pin_on_disk.toml")).track_radius == 30e-3
     assert macro_settings(load_case(root / "ball_on_disk.toml")).track_radius == 20e-3
-    text = (root / "pin_on_disk.toml").read_text().replace("../meshes/", str(root.parent / "meshes") + "/")
+    text = (root / "pin_on_disk.toml").read_text().replace("../meshes/",
+                                                           str(root.parent / "meshes") + "/")
     for value, expect in (('"uniform"', None), ('"spinning"', "kinematics")):
-        (tmp_path / "case.toml").write_text(text.replace('kinematics = "rotating"', f"kinematics = {value}"))
+        (tmp_path / "case.toml").write_text(text.replace('kinematics = "rotating"',
+                                                         f"kinematics = {value}"))
         if expect is None:
             assert macro_settings(load_case(tmp_path / "case.toml")).track_radius is None
         else:
             with pytest.raises(CaseError, match=expect):
                 load_case(tmp_path / "case.toml")
-    (tmp_path / "radius.toml").write_text(text.replace("[macro]", "[macro]\ntrack_radius = 0.03", 1))
+    (tmp_path / "radius.toml").write_text(text.replace("[macro]", "[macro]\ntrack_radius = 0.03",
+                                                       1))
     with pytest.raises(CaseError, match="set by"):
         load_case(tmp_path / "radius.toml")
 
 
 def test_a_disk_axis_under_the_ball_is_refused_when_the_case_is_read():
-    """Issue 72 item 2: a track radius inside the ball's grid (three Hertz radii, 322 um for
+    """A track radius inside the ball's grid (three Hertz radii, 322 um for
     the bundled ball: a = 107 um) is refused when the case is read, naming the key, rather
     than at the Stribeck stage after the micro stage."""
     import tomllib

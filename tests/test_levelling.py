@@ -2,12 +2,11 @@
 
 import numpy as np
 import pytest
+from conftest import SAMPLE
 
 from fem_twin import Topography, read_topography
 from fem_twin.contact.levelling import average_pins, level_pin, tilt_pin, torque_residuals
 from fem_twin.topography.prepare import MacroOptions, prepare_pin
-
-from conftest import SAMPLE
 
 
 def _flat_pin(n=64):
@@ -67,7 +66,8 @@ def test_a_fine_pin_is_levelled_on_every_other_pixel(tmp_path):
     from fem_twin.stages import geometry
     from fem_twin.topography.prepare import prepare_disk
     case = load_case(SAMPLE.parent.parent / "examples" / "pin_on_disk.toml")
-    pin_map, disk_map = read_topography(SAMPLE / "pin_1.npz"), read_topography(SAMPLE / "disk_1.npz")
+    pin_map = read_topography(SAMPLE / "pin_1.npz")
+    disk_map = read_topography(SAMPLE / "disk_1.npz")
 
     def levelled(n):
         opts = MacroOptions(resolution=(n, n))

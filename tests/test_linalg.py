@@ -9,12 +9,12 @@ import scipy.sparse.linalg as spla
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fem_twin.fvm import CellSolverFV
 from fem_twin.errors import InputError
-from fem_twin.numerics.linalg import SPDSolver, _mkl_rt, default_backend
+from fem_twin.fvm import CellSolverFV
 from fem_twin.macro.stencil_solver import _stencil_pattern
-from fem_twin.numerics.ordering import nested_dissection, subgrid_order
 from fem_twin.micro import CellSolver
+from fem_twin.numerics.linalg import SPDSolver, _mkl_rt, default_backend
+from fem_twin.numerics.ordering import nested_dissection, subgrid_order
 
 BACKENDS = ["superlu", pytest.param("pardiso", marks=pytest.mark.skipif(
     _mkl_rt() is None, reason="MKL not installed (pip install 'fem-twin[pardiso]')"))]

@@ -7,13 +7,12 @@ couplings agree to about 1e-5 (two independent 1e-6 stops); exact invariances ho
 """
 
 import pickle
-from pathlib import Path
 
 import numpy as np
 import pytest
+from sample_cases import macro_case, smooth_factors
 
 from fem_twin.fvm import fvm_poiseuille
-from fem_twin.io.files import read_topography
 from fem_twin.macro import (
     BOUNDARY_FRICTION,
     Lubricant,
@@ -24,11 +23,7 @@ from fem_twin.macro import (
     solve_reynolds,
 )
 from fem_twin.macro.reynolds import fe_poiseuille
-from fem_twin.micro import FlowFactors, homogenise
-from fem_twin.topography import resample_cell
-from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
-
-SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "sample"
+from fem_twin.micro import FlowFactors
 
 ISOVISCOUS = dict(roelands_alpha=0.0)
 
@@ -39,33 +34,11 @@ ISOVISCOUS = dict(roelands_alpha=0.0)
 TIGHT = 1e-6
 
 
-def macro_case(n):
-    opts = MacroOptions(resolution=(n, n))
-    pin = prepare_pin(read_topography(SAMPLE / "pin_1.npz"), opts)
-    disk = prepare_disk(read_topography(SAMPLE / "disk_1.npz"), opts)
-    return disk.heights - pin.heights, pin.spacing, pin.heights > opts.holder_height / 2
-
-
-@pytest.fixture(scope="module")
-def factors():
-    low = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_pin.npz")), (32, 32))
-    up = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"), upper=True),
-                  (32, 32))
-    return homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), n_steps=4)
-
-
 @pytest.fixture(scope="module")
 def case32():
     return macro_case(32)
 
 
-def smooth_factors():
-    h0 = np.geomspace(1e-9, 1e-3, 7)
-    n = h0.size
-    return FlowFactors(h0=h0, h_m=h0.copy(), p_con=np.zeros(n), A=np.tile(np.eye(2), (n, 1, 1)),
-                       b=np.tile([1.0, 0.0], (n, 1)), C=np.tile(np.eye(2), (n, 1, 1)),
-                       d=np.zeros((n, 2)), friction_factor=np.ones(n),
-                       pressure_friction=np.tile([1.0, 0.0], (n, 1)), contact_fraction=np.zeros(n))
 
 
 @pytest.mark.parametrize("assemble", [fe_poiseuille, fvm_poiseuille])
@@ -145,7 +118,7 @@ def test_paper_pid_coupling_reaches_the_same_state(case32, factors):
 
 def test_every_coupling_takes_its_cavitation_model_from_the_registry(case32, factors,
                                                                      monkeypatch):
-    """Issue 31 item 4: a cavitation model registered in macro/cavitation.MODELS is used by
+    """A cavitation model registered in macro/cavitation.MODELS is used by
     solve_reynolds, the fixed point and the Newton coupling (its inner solve, split and
     derivatives), so adding one touches that module and a test only.  A counting copy of
     the switch gives the switch's state."""
@@ -558,8 +531,8 @@ def test_the_patch_band_starts_from_the_main_points_nested_levels(tmp_path, fact
     calls = []
     monkeypatch.setattr("fem_twin.stribeck.sweep.solve_nested",
                         lambda *a, **k: calls.append(1) or nested.solve_nested(*a, **k))
-    coarse = stribeck_sweep(SweepRequest(gap2, dx2, factors, speeds, face=face2, checkpoint=tmp_path,
-                            factors_key="average", **kw))
+    coarse = stribeck_sweep(SweepRequest(gap2, dx2, factors, speeds, face=face2,
+                                         checkpoint=tmp_path, factors_key="average", **kw))
     assert not calls and np.array_equal(coarse.friction_coefficient,
                                         main.coarse_friction_coefficient[0])
     patch = moved(factors, p_con=1.3 * factors.p_con, A=0.9 * factors.A)
@@ -618,7 +591,7 @@ def test_contact_load_integrates_the_bilinear_film(block, monkeypatch):
 
 
 def test_contact_quadrature_converges_on_the_pin(factors):
-    """Issue 27: on sample pin 1 in the mixed regime (0.03 m/s, a fifth of the load on the
+    """On sample pin 1 in the mixed regime (0.03 m/s, a fifth of the load on the
     asperities) C_f from 48^2 to 96^2 (each prepared from the measured map) moves by
     0.26 % C_f,b with the "gauss" contact quadrature and by 2.1 % read at the nodes (64^2
     to 128^2: 0.28 and 2.4 %; 2026-11-25): asserted below a quarter; and the two rules
@@ -680,7 +653,7 @@ def test_the_newton_merit_of_an_overflowing_trial_step_is_inf():
 
 
 def test_a_sweeps_points_run_in_parallel_from_its_guide(factors, tmp_path):
-    """Issue 62 item 1: a checkpointed sweep runs as its guide (the same sweep on the
+    """A checkpointed sweep runs as its guide (the same sweep on the
     coarsest nested grid, one warm-started chain) and then every speed as a task of its
     own, started from the guide's point there.  Into the mixed regime (sample pin 1 at
     96^2, 0.1 -> 0.02 m/s) its C_f equals the chained sweep's within ten times the coupling

@@ -21,7 +21,8 @@ def test_nodes_are_pixels_row_major():
     assert np.array_equal(gm.to_grid(gm.to_nodes(f)), f)
 
 
-@pytest.mark.parametrize("kind,element", [("quad", skfem.ElementQuad1), ("tri", skfem.ElementTriP1)])
+@pytest.mark.parametrize("kind,element", [("quad", skfem.ElementQuad1),
+                                          ("tri", skfem.ElementTriP1)])
 @pytest.mark.parametrize("periodic", [False, True])
 def test_mesh_geometry_and_periodic_operator(kind, element, periodic):
     ny, nx, dx1, dx2 = 8, 10, 0.3, 0.2

@@ -410,7 +410,7 @@ def test_interpolation_rules(small_factors):
     assert loc.p_con[1, 1] > ff.p_con[0] and np.allclose(loc.A[1, 1], ff.A[0])
     with pytest.raises(ValueError):
         ff.at([-1e-7])
-    import pickle                         # to a worker after use: the interpolants stay
+    import pickle  # to a worker after use: the interpolants stay
     back = pickle.loads(pickle.dumps(ff))
     assert "_pchip" not in back.__dict__ and "_pchip" in ff.__dict__
     assert np.array_equal(back.contact_pressure(field), ff.contact_pressure(field))
@@ -485,9 +485,9 @@ def test_bad_input_is_refused():
 
 def test_adaptive_instants_reach_the_tolerance_where_contact_needs_them():
     """time_tol: at each h0 the midpoints are added while A11, b1 or d1 (relative to at
-    least 1/3) still change by more than the tolerance.  Without contact nothing is added; a refined h0 is the fixed run with
-    the doubled count (the same instants); in heavy contact (sample patch 3 at 64 px,
-    0.12 um, 20 % of the pixels touching) b1 comes within 1 % of every pixel translation
+    least 1/3) still change by more than the tolerance.  Without contact nothing is added; a refined
+    h0 is the fixed run with the doubled count (the same instants); in heavy contact (sample patch 3
+    at 64 px, 0.12 um, 20 % of the pixels touching) b1 comes within 1 % of every pixel translation
     (N_t = 64) where 8 fixed steps are 5.8 % off, and d1 too (measured: refined 8 -> 64
     instants, every pixel translation)."""
     from pathlib import Path
@@ -516,7 +516,7 @@ def test_adaptive_instants_reach_the_tolerance_where_contact_needs_them():
 
 
 def test_grid_convergence_on_a_fixed_measured_surface_is_nearly_second_order():
-    """Issue 13 item 3.  Sample patch 3 cut to 32 px, then held fixed as its periodic
+    """Sample patch 3 cut to 32 px, then held fixed as its periodic
     bilinear surface and sampled at 32, 64, 128, 256 px (4 exact-scheme steps).  A11 and
     p_con converge at orders 1.5-2.5 with contact (0.14 um: 15-18 % of the pixels, 0.3 um:
     2-3 %) and 2 without (1.5 um): measured 1.7-2.4.  The first order seen when a measured
@@ -653,7 +653,7 @@ def test_results_dataset_holds_patches_sampled_at_different_h0():
 
 
 def test_zero_tolerances_mean_off_as_in_the_case_file():
-    """Issue 31: h0_tol = 0 and time_tol = 0 are 'off' in the API as in the case file (every
+    """H0_tol = 0 and time_tol = 0 are 'off' in the API as in the case file (every
     h0, n_steps everywhere), with the same factors and checkpoint key as None."""
     pin, disk = rough_pair(16)
     h0 = [1e-7, 2e-7, 4e-7]
@@ -664,7 +664,7 @@ def test_zero_tolerances_mean_off_as_in_the_case_file():
 
 
 def test_a_separations_instants_run_as_two_halves():
-    """Issue 62: with the exact squeeze term the instants of a separation are independent,
+    """With the exact squeeze term the instants of a separation are independent,
     so its even and its odd instants run as two tasks, the even ones the half pass of the
     time-error estimate.  Joined, the moments equal one pass's to round-off (their sums
     are taken in another order; measured 1e-15 relative) and the half pass's exactly, each

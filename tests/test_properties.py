@@ -10,6 +10,7 @@ import tomllib
 
 import numpy as np
 import pytest
+from conftest import ROOT
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
@@ -18,8 +19,6 @@ from fem_twin.case import parse_case
 from fem_twin.cli import main
 from fem_twin.errors import InputError
 from fem_twin.topography import fill_defects, level
-
-from conftest import ROOT
 
 EXAMPLES = 400 if os.environ.get("FEM_TWIN_SLOW_PROPERTIES") else 40
 CASE = tomllib.loads((ROOT / "examples" / "pin_on_disk.toml").read_text())

@@ -214,8 +214,7 @@ def test_poiseuille_reassembly_equals_the_scikit_fem_form(block, monkeypatch):
     monkeypatch.setattr(reynolds, "BLOCK", block)
 
     from fem_twin.io.mesh import grid_mesh
-    from fem_twin.macro.reynolds import (fe_poiseuille, homogenised_poiseuille_form,
-                                         poiseuille_form)
+    from fem_twin.macro.reynolds import fe_poiseuille, homogenised_poiseuille_form, poiseuille_form
     rng = np.random.default_rng(0)
     shape, dx = (9, 12), (1.3e-5, 1.1e-5)
     g, A = rng.random(shape), rng.random(shape + (2, 2))
@@ -246,10 +245,10 @@ def test_a_newton_step_reuses_the_factors_of_its_inner_solve(monkeypatch, scale)
     node's, as on the 2048^2 pin where GMRES with the kept factors failed such steps."""
     import scipy.sparse as sp
 
-    from fem_twin.numerics.linalg import SPDSolver, default_backend
     from fem_twin.macro import stencil_solver as ss
     from fem_twin.macro.couette import couette_matrix
     from fem_twin.macro.reynolds import fe_poiseuille
+    from fem_twin.numerics.linalg import SPDSolver, default_backend
     if default_backend() != "pardiso":
         pytest.skip("the stencil solver needs MKL PARDISO")
     rng = np.random.default_rng(4)

@@ -2,12 +2,11 @@
 
 import numpy as np
 import pytest
+from conftest import SAMPLE
 
 from fem_twin import read_topography, samples
 from fem_twin import topography as tp
 from fem_twin.topography.prepare import prepare_pin
-
-from conftest import SAMPLE
 
 
 @pytest.mark.parametrize("k", range(6))

@@ -43,6 +43,7 @@ def small_sweep():
                 face=pin.heights > -0.5e-3)
 
 
+@pytest.mark.integration
 def test_dask_local_cluster_gives_the_serial_numbers(tmp_path):
     distributed = pytest.importorskip("distributed")
     common = small_sweep()
@@ -60,7 +61,7 @@ def test_dask_local_cluster_gives_the_serial_numbers(tmp_path):
 
 
 def test_a_local_cluster_computes_without_the_dask_profiler():
-    """Issue 28 item 4: [run] scheduler = "local" serves tasks from a LocalCluster of
+    """[run] scheduler = "local" serves tasks from a LocalCluster of
     [run] workers processes whose Dask settings keep background work out of the tasks'
     way (threads.DASK_CONFIG: a default worker's profiler and ticks made a task's wall time
     7-10 % longer than its CPU time on 2 cores)."""
@@ -82,7 +83,7 @@ def test_a_local_cluster_computes_without_the_dask_profiler():
 
 
 def test_micro_tasks_follow_the_cluster_size():
-    """Issue 17 item 5: with an executor served by W processes the h0 values go out as 4 W
+    """With an executor served by W processes the h0 values go out as 4 W
     tasks (at most one per h0), so a large Dask cluster is not left idle."""
     from concurrent.futures import Executor, Future
 
@@ -125,8 +126,9 @@ def test_the_schedule_of_a_task_graph():
         makespan([Task("x", 1.0, ("y",)), Task("y", 1.0, ("x",))], 2)
 
 
+@pytest.mark.integration
 def test_the_task_graph_of_a_finished_run(tmp_path):
-    """Issue 28 item 4: the graph read back from a run's checkpoints holds every h0 the
+    """The graph read back from a run's checkpoints holds every h0 the
     micro stage solved (round by round, the rounds replayed from the checkpoints; each h0
     its even and odd instants, issue 62), the coarse cells of the grid estimate, each
     sweep's guide and points, and the band's sweeps; on one worker it takes the
@@ -134,11 +136,12 @@ def test_the_task_graph_of_a_finished_run(tmp_path):
     run's wall time."""
     import json
 
+    from sample_cases import small_case
+
     from fem_twin.case import load_case
     from fem_twin.cli import main
     from fem_twin.micro.sampling import START
     from fem_twin.taskgraph import critical_path, makespan, run_task_graph
-    from test_cli import small_case
     path = small_case(tmp_path, workers=2, band=True)
     path.write_text(path.read_text().replace("h0_count = 6", "h0_count = 24").replace(
         "steps = 4", "steps = 8"))                                # 2+ rounds of the sampler
@@ -164,18 +167,20 @@ def test_the_task_graph_of_a_finished_run(tmp_path):
     assert graph["wall_s"]["2"] == pytest.approx(makespan(tasks, 2), abs=0.1)
 
 
+@pytest.mark.integration
 def test_the_band_runs_beside_the_main_points(tmp_path):
-    """Issue 62 item 2: on a grid with a coarser level (96^2: guides at 48^2) the band's
+    """On a grid with a coarser level (96^2: guides at 48^2) the band's
     grid is the guides', so its sweeps start after the guides' first passes, beside the
     main points, and each refined speed after the band's first pass and the guides' point
     there; the band then leaves the critical path (the same checkpoints scheduled with the
     band after the main points give a longer one), and a rerun of the finished run finds
     every band point checkpointed."""
+    from sample_cases import small_case
+
     from fem_twin.case import load_case
     from fem_twin.cli import main
     from fem_twin.stribeck.sweep import point_files
     from fem_twin.taskgraph import critical_path, run_task_graph, sweep_tasks
-    from test_cli import small_case
     path = small_case(tmp_path, workers=2, band=True)
     path.write_text(path.read_text().replace("resolution = [48, 48] #", "resolution = [96, 96] #")
                     .replace("refine = 0 ", "refine = 1 "))

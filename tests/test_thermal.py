@@ -33,7 +33,7 @@ from fem_twin.macro.thermal import (
 from fem_twin.macro.viscosity import WaltherLaw
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_macro import factors, macro_case  # noqa: E402,F401 (a fixture)
+from sample_cases import macro_case  # noqa: E402
 
 L, KAPPA = 4e-3, 1.2e-5                       # half-width [m], steel's diffusivity [m^2/s]
 SQUARE_AT_REST = 2 * (4 * np.log(1 + np.sqrt(2)) + 4 / 3 * (1 - np.sqrt(2))) / (2 * np.pi)

@@ -137,7 +137,8 @@ def test_gaussian_filter_fwhm_on_delta(fwhm):
 
 
 def test_gaussian_filter_zero_is_identity_and_masked_constant_stays_constant():
-    t = Topography(np.full((30, 30), 2e-6), 1e-6, mask=np.random.default_rng(4).random((30, 30)) > 0.2)
+    mask = np.random.default_rng(4).random((30, 30)) > 0.2
+    t = Topography(np.full((30, 30), 2e-6), 1e-6, mask=mask)
     assert tp.gaussian_filter(t, 0) is t
     out = tp.gaussian_filter(t, 7)
     assert np.array_equal(out.valid, t.valid)

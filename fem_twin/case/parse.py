@@ -13,9 +13,19 @@ from ..checks import arguments, check_choice, memory_shortfall, plausible
 from ..errors import InputError
 from ..macro.thermal import ThermalSettings
 from ..stribeck.request import RollingSliding
-from .sections import (SECTIONS, Case, Geometry, LubricantSpec, MacroSpec, Materials,
-                       MicroSpec, RunSpec, SweepSpec, Tribometer)
 from ..topography.prepare import MacroOptions
+from .sections import (
+    SECTIONS,
+    Case,
+    Geometry,
+    LubricantSpec,
+    MacroSpec,
+    Materials,
+    MicroSpec,
+    RunSpec,
+    SweepSpec,
+    Tribometer,
+)
 
 
 class CaseError(InputError):
@@ -93,7 +103,8 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     return Case(name=str(data.get("name", source.stem if source else "case")),
                 geometry=geometry, preprocessing=preprocessing, tribometer=tribometer,
                 lubricant=lubricant, materials=materials, micro=micro, macro=macro,
-                thermal=thermal, sweep=sweep, run=run, measured=measured, source=source, defaulted=defaulted)
+                thermal=thermal, sweep=sweep, run=run, measured=measured, source=source,
+                defaulted=defaulted)
 
 
 #: the keys a pin case has no use for, with what sets them (refused, not ignored)

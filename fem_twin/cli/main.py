@@ -9,14 +9,13 @@ import os
 import sys
 from pathlib import Path
 
-from . import runs
-from . import steps
-from ..errors import NotConverged, RunLocked, SchedulerUnreachable
 from .. import tables as T
 from ..case.sections import Geometry, LubricantSpec, MicroSpec, Tribometer
 from ..contact.levelling import level_pin
+from ..errors import NotConverged, RunLocked, SchedulerUnreachable
 from ..stribeck.fit import PARAMETERS
 from ..topography.prepare import MacroOptions
+from . import runs, steps
 
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
@@ -227,7 +226,8 @@ def _add_topography(sub):
 
 def _add_contact(sub):
     """contact level|average: dry contact of pins."""
-    c = sub.add_parser("contact", help="dry contact: pin levelling by torque balance, set averaging")
+    c = sub.add_parser("contact",
+                       help="dry contact: pin levelling by torque balance, set averaging")
     cs = c.add_subparsers(dest="step", required=True, metavar="STEP")
     lv = cs.add_parser("level", help="tilt a mounted pin until the contact torques vanish "
                        f"(Table 4: at {T.LEVELLING_LOAD:g} N)")

@@ -15,7 +15,6 @@ from ..checks import number
 from ..errors import InputError, MissingFile
 from ..io.layout import RunLayout
 
-
 #: the bundled case's estimate on 2 cores of the calibration machine [s]
 #: (``examples/pin_on_disk.toml``; tests/test_cli.py holds it to the estimate)
 BUNDLED_SECONDS = 80.2
@@ -196,9 +195,9 @@ def validate(args):
     from dataclasses import replace
 
     from ..case import load_case
+    from ..io.table import write_csv
     from ..macro.friction import BOUNDARY_FRICTION
     from ..stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
-    from ..io.table import write_csv
     from ..stribeck.curve import read_stribeck_csv
     if args.radius is not None:
         number("--radius [m]", args.radius, "length")

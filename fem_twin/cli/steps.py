@@ -132,7 +132,8 @@ def _write_factors(folder, ff, patches=()):
     ff.write_csv(out.flow_factors_csv)
     labels = [f.meta.get("patch_id") or f"patch {i + 1}" for i, f in enumerate(patches)]
     plot_flow_factors([*patches, ff], out.flow_factors_png,
-                      labels=[*labels, "average" if patches else ff.meta.get("patch_id") or "patch"])
+                      labels=[*labels, "average" if patches
+                              else ff.meta.get("patch_id") or "patch"])
     print(json.dumps({"h0_um": [ff.h0[0] * 1e6, ff.h0[-1] * 1e6], "points": len(ff),
                       "p_con_max_MPa": float(ff.p_con.max() * 1e-6),
                       "A11_range": [float(ff.A[:, 0, 0].min()), float(ff.A[:, 0, 0].max())],

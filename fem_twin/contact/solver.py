@@ -17,7 +17,6 @@ from ..checks import as_field, as_pair, plausible
 from ..errors import InputError, NotConverged
 from .elastic import elastic_operator
 
-
 _REFRESH = 16          # CG iterations between exact deformations K p (round-off drift)
 
 

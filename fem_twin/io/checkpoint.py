@@ -4,8 +4,8 @@ Every cached result (a micro h0 point, a Stribeck point, a pipeline stage) is fi
 :func:`input_key`, a hash of all its inputs and the fem_twin version: a change of any input
 or of the code's version makes a new key, so a stale file is never read (callers prune the
 files of keys they no longer use).  Every stage writes atomically
-(:func:`fem_twin.io.atomic.atomic_path`), so a file is either complete or absent after a crash; a file
-that still cannot be read (a disk error, a truncated copy, a hand edit) must not stop every
+(:func:`fem_twin.io.atomic.atomic_path`), so a file is either complete or absent after a crash; a
+file that still cannot be read (a disk error, a truncated copy, a hand edit) must not stop every
 later run.  :func:`load_or_none` returns the loaded result, or None after moving the bad file
 to ``NAME.corrupt`` with a warning in the log, and the caller recomputes it; so does a file
 whose metadata names another key or point than its own (:func:`check_made_for`).

@@ -11,8 +11,9 @@ separation, :func:`fem_twin.contact.solve`) and ``K`` the non-periodic half-spac
 Ambient and cavitation pressure 0 (gauge).  Each pass solves the contact against the shape
 deformed by the film pressure, then the film on the contact's gap (floored at ``gap_floor``,
 as in the cells); the film's deformation, viscosity and density are mixed (Anderson) until
-they settle; ``h_d`` balances the load (Brent on the log of the load).  Friction on the pin (:func:`pad_friction`) plus ``C_f,b``
-times the contact load (eq 32); integrals by the trapezoidal rule."""
+they settle; ``h_d`` balances the load (Brent on the log of the load).  Friction on the pin
+(:func:`pad_friction`) plus ``C_f,b`` times the contact load (eq 32); integrals by the trapezoidal
+rule."""
 
 from __future__ import annotations
 

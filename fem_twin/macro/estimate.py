@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import MixedNotConverged
-from .mixed import solve_mixed
 from ..micro.estimate import FILM_VARIANTS
+from .mixed import solve_mixed
 from .nested import coarsened
 from .result import friction_with
 

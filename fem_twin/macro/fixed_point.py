@@ -19,10 +19,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..numerics.anderson import Anderson
 from ..errors import MixedNotConverged
-from .couette import couette_matrix
+from ..numerics.anderson import Anderson
 from .cavitation import cavitation_model
+from .couette import couette_matrix
 from .evaluation import FixedPointEvaluation
 from .result import resampled
 from .reynolds import ReynoldsNotConverged

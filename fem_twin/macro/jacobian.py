@@ -27,7 +27,6 @@ from .evaluation import NewtonEvaluation
 from .kinematics import rotate_tensor, rotate_vector
 from .problem import MAX_COEFFICIENT_PRESSURE, Problem
 
-
 #: a node joins the dense elastic block when its elastic coupling exceeds this fraction of
 #: its pressure-flow coupling
 DENSE_THRESHOLD = 0.02
@@ -210,10 +209,11 @@ class Preconditioner:
 
 def _grid_lu(A, shape, nodes):
     """SuperLU of the sparse ``A`` whose unknowns are the grid ``shape``'s flat ``nodes``,
-    eliminated in the grid's nested-dissection order (:func:`~fem_twin.numerics.ordering.subgrid_order`)
-    with diagonal pivots preferred (faster and leaner than SuperLU's own COLAMD order);
-    ``solve(rhs)`` in ``A``'s numbering.  PARDISO's LU as :class:`~fem_twin.numerics.linalg.SPDSolver`
-    runs it (no matching, no scaling) misses these matrices by O(1): not used."""
+    eliminated in the grid's nested-dissection order
+    (:func:`~fem_twin.numerics.ordering.subgrid_order`) with diagonal pivots preferred (faster and
+    leaner than SuperLU's own COLAMD order); ``solve(rhs)`` in ``A``'s numbering.  PARDISO's LU as
+    :class:`~fem_twin.numerics.linalg.SPDSolver` runs it (no matching, no scaling) misses these
+    matrices by O(1): not used."""
     position = np.full(int(np.prod(shape)), -1)
     position[nodes] = np.arange(nodes.size)
     order = subgrid_order(shape, position)

@@ -31,8 +31,8 @@ from .fixed_point import Concentrated, solve_fixed_point
 from .kinematics import disk_velocity
 from .lubricant import Lubricant
 from .problem import macro_problem
-from .reynolds import check_closed
 from .result import MixedResult, mixed_result, on_grid
+from .reynolds import check_closed
 from .settings import MacroSettings
 
 __all__ = ["MacroSettings", "MixedNotConverged", "MixedResult", "solve_mixed"]

@@ -219,7 +219,8 @@ def continuation(P: Problem, load: float, *, tol: float, max_iter: int, progress
                  ratio: float = 0.3):
     """Cold start by load continuation: the rigid film of :func:`rigid_start`, then Newton
     solves at loads growing by a factor (x4, its logarithm halved after a failure and
-    doubled after a success) up to ``load``.  Returns what :func:`solve` returns, with the iterations of every stage."""
+    doubled after a success) up to ``load``.  Returns what :func:`solve` returns, with the
+    iterations of every stage."""
     x, F = rigid_start(P, load, ratio)
     total, history, factor, target = 0, [], 4.0, F
     while True:

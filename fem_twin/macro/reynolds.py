@@ -31,7 +31,6 @@ from .couette import SCHEMES, couette_matrix
 from .lubricant import Lubricant
 from .reynolds_fv import fvm_poiseuille
 
-
 #: Nodes whose gap exceeds this [m] are at ambient pressure (Dirichlet): the oil bath around
 #: a pin face, over the holder 1 mm below it.  Half a millimetre carries no hydrodynamic
 #: pressure: its ``h^3`` is at least 1e6 times that of any film (< 5 um) that does, and

@@ -18,7 +18,6 @@ from ..errors import ReynoldsNotConverged
 from ..numerics.ordering import subgrid_order
 from .stencil_solver import newton_solver
 
-
 #: relative mass residual at which Newton steps can no longer improve the solution
 ROUND_OFF = 1e3 * np.finfo(float).eps
 

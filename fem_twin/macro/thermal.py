@@ -194,8 +194,8 @@ def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
     the film's ``lubricant``, warm from ``previous`` (None first).  The film temperature
     ``T = T_oil + R_b Q + theta_face`` is iterated by secant steps on ``T - g(T)``, from the
     film temperature of ``near`` (a neighbouring point's record on the same oil; else the
-    oil's), until it moves by less than ``settings.tol``; returns ``(levels, lubricant, record)`` with the
-    record's temperatures [C] (``oil``, ``film``, ``asperity``), rises [K], power [W] and
+    oil's), until it moves by less than ``settings.tol``; returns ``(levels, lubricant, record)``
+    with the record's temperatures [C] (``oil``, ``film``, ``asperity``), rises [K], power [W] and
     iterations, or raises :class:`ThermalNotConverged` with the history."""
     s, law = thermal.settings, thermal.law
     oil = float(law.temperature(lubricant.viscosity))

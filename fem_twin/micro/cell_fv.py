@@ -18,9 +18,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..numerics.assembly import FixedPattern, periodic_unknowns
 from ..checks import arguments
 from ..errors import InputError
+from ..numerics.assembly import FixedPattern, periodic_unknowns
 from ..numerics.linalg import SPDSolver
 from .cell import CellSolution
 

@@ -10,8 +10,14 @@ from ..io.figure import save_figure
 from ..io.mesh import grid_mesh, write_pvd, write_vtu
 from .flow_factors import FlowFactors
 from .homogenisation import _check_patches
-from .sliding import (CellSettings, cell_solver, sliding_cells, sliding_contacts, sliding_pass,
-                      sliding_squeeze)
+from .sliding import (
+    CellSettings,
+    cell_solver,
+    sliding_cells,
+    sliding_contacts,
+    sliding_pass,
+    sliding_squeeze,
+)
 
 
 def plot_flow_factors(factors, path, labels=None) -> Path:

@@ -12,8 +12,15 @@ from pathlib import Path
 import numpy as np
 
 from ..numerics.threads import one_thread, process_pool, stop_pool, worker_heap
-from .sliding import (cell_solver, factors_from_moments, half_pass_moments, instants,
-                      refine_instants, sliding_pass, time_average)
+from .sliding import (
+    cell_solver,
+    factors_from_moments,
+    half_pass_moments,
+    instants,
+    refine_instants,
+    sliding_pass,
+    time_average,
+)
 from .store import cell_key, load_point, save_point
 
 

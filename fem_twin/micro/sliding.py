@@ -19,10 +19,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..contact import contact_rate
-from ..contact import solve as contact_solve
 from .. import tables as T
 from ..checks import arguments, check_choices, check_ranges, setting
+from ..contact import contact_rate
+from ..contact import solve as contact_solve
 from ..errors import InputError
 from .cell_fv import CellSolverFV
 from .film import mean_inverse_film

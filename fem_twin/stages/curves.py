@@ -12,17 +12,16 @@ from pathlib import Path
 import numpy as np
 
 from ..case import Case
-from ..io.writers import Writers
 from ..io.layout import RunLayout
+from ..io.writers import Writers
 from ..macro import MixedResult
 from ..macro.figures import plot_point_files
 from ..macro.point_contact import film_against_hamrock_dowson
 from ..micro import FlowFactors
 from ..stribeck import plot_stribeck, read_measured_csv, write_stribeck_csv
-from ..stribeck.curve import plot_temperatures
 from ..stribeck.accuracy import error_summary, range_summary
-from ..stribeck.analysis import (defect_corrected, hersey_collapse, patch_band,
-                                 transition_speeds)
+from ..stribeck.analysis import defect_corrected, hersey_collapse, patch_band, transition_speeds
+from ..stribeck.curve import plot_temperatures
 from ..stribeck.sweep import LOAD_BELOW, point_files, point_key, point_meta, point_speed
 from ..stribeck.validation import validate_curves
 from .geometry import ball_contact, hersey_length

@@ -13,9 +13,9 @@ from tqdm import tqdm
 
 from ..case import Case
 from ..io.checkpoint import load_or_none
-from ..io.writers import Writers
 from ..io.files import read_topography
 from ..io.layout import RunLayout
+from ..io.writers import Writers
 from ..micro import CellSettings, FlowFactors, average, homogenise
 from ..micro.output import plot_flow_factors
 from ..micro.store import prune_checkpoints

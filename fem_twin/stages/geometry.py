@@ -19,11 +19,11 @@ from ..io.files import read_topography, write_topography
 from ..io.layout import RunLayout
 from ..io.mesh import grid_mesh, write_vtu
 from ..macro.point_contact import PointContact
+from ..numerics.threads import run_jobs
 from ..topography.filling import fill_defects
 from ..topography.plausibility import check_patch, check_pin
-from ..topography.sphere import cap_gap, fit_sphere
 from ..topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
-from ..numerics.threads import run_jobs
+from ..topography.sphere import cap_gap, fit_sphere
 
 log = logging.getLogger("fem_twin")
 

@@ -10,10 +10,10 @@ import numpy as np
 from tqdm import tqdm
 
 from ..macro.nested import nested_levels
+from ..numerics.threads import worker_heap
 from ..stribeck import stribeck_sweep
 from ..stribeck.curve import joined
 from ..stribeck.sweep import point_file, point_files, point_key
-from ..numerics.threads import worker_heap
 
 #: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH (the resolution
 #: study's points grow as N^1.39 from 500^2 to 1997^2, benchmarks/README.md), so that the

@@ -8,8 +8,8 @@ import logging
 
 from ..case import Case
 from ..io.layout import RunLayout
-from ..stribeck.traction import plot_traction, traction_sweep, write_traction_csv
 from ..numerics.threads import worker_heap
+from ..stribeck.traction import plot_traction, traction_sweep, write_traction_csv
 from .curves import curve_labels
 from .requests import per_viscosity, sweep_request
 

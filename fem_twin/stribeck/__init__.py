@@ -1,8 +1,16 @@
 """Stribeck curves: speed sweeps of the macro solver, Hersey number, deviations (eqs 35, 46)."""
 
-from .curve import (MeasuredCurve, StribeckCurve, deviation_from_measured,
-                    friction_deviation, hersey_number, plot_stribeck, read_measured_csv,
-                    read_stribeck_csv, write_stribeck_csv)
+from .curve import (
+                    MeasuredCurve,
+                    StribeckCurve,
+                    deviation_from_measured,
+                    friction_deviation,
+                    hersey_number,
+                    plot_stribeck,
+                    read_measured_csv,
+                    read_stribeck_csv,
+                    write_stribeck_csv,
+)
 from .request import RollingSliding, Sliding, SweepRequest
 from .sweep import stribeck_sweep
 from .traction import TractionCurve, traction_sweep

@@ -46,8 +46,8 @@ def transition_speeds(curves, step: float) -> np.ndarray:
 
 
 def hersey_collapse(curves, boundary_friction: float = BOUNDARY_FRICTION) -> float:
-    """``max |C_f,dev|`` (eq 35, relative to ``boundary_friction`` = C_f,b) between the first curve and
-    the others over the Hersey numbers where they overlap (the others' points, interpolated
+    """``max |C_f,dev|`` (eq 35, relative to ``boundary_friction`` = C_f,b) between the first curve
+    and the others over the Hersey numbers where they overlap (the others' points, interpolated
     on the first curve)."""
     ref = curves[0]
     devs = []

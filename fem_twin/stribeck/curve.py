@@ -209,8 +209,8 @@ def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None
     ``(cf_min, cf_max)`` per curve, drawn as a shaded band (the patch scatter, Figure 13);
     ``measured``: optional :class:`MeasuredCurve` (or None) per curve, drawn on top in the
     curve's colour; a curve's ``friction_error`` is drawn as error bars (capped, distinct
-    from the shaded scatter band) (on the Hersey axis with ``diameter`` [m] and ``load`` [N] of eq 46).
-    ``speed_label``: the speed axis (a ball-on-disk sweep is over entrainment speeds).
+    from the shaded scatter band) (on the Hersey axis with ``diameter`` [m] and ``load`` [N] of eq
+    46). ``speed_label``: the speed axis (a ball-on-disk sweep is over entrainment speeds).
     """
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
@@ -333,5 +333,5 @@ def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve,
     u = np.log(measured.speed)
     inside = (u >= x[0]) & (u <= x[-1])
     sim = PchipInterpolator(x, curve.friction_coefficient[order])(np.clip(u, x[0], x[-1]))
-    return np.where(inside, friction_deviation(sim, measured.friction_coefficient, boundary_friction),
-                    np.nan)
+    deviation = friction_deviation(sim, measured.friction_coefficient, boundary_friction)
+    return np.where(inside, deviation, np.nan)

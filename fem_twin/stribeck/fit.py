@@ -147,7 +147,7 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     n = sum(m.speed.size for m in measured)
     if n <= x0.size:
         raise InputError(f"{n} measured points cannot fit {x0.size} parameters")
-    from scipy import optimize              # imported here: the CLI reads PARAMETERS
+    from scipy import optimize  # imported here: the CLI reads PARAMETERS
     sol = optimize.least_squares(residuals, x0, bounds=(lower, upper), x_scale="jac",
                                  verbose=2 if verbose else 0)
     if not sol.success:

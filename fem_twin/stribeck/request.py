@@ -7,7 +7,7 @@ names its point checkpoints (:func:`~fem_twin.stribeck.sweep.point_file`)."""
 
 from __future__ import annotations
 
-from dataclasses import KW_ONLY, dataclass, replace
+from dataclasses import KW_ONLY, dataclass, fields, is_dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -123,9 +123,12 @@ class SweepRequest:
 
     def key_with(self, motion_key) -> str:
         """:attr:`key` with ``motion_key`` for the motion's (a traction curve's)."""
-        factors = self.factors if self.factors_key is None else self.factors_key
-        return sweep_key(self.gap, self.spacing, factors, self.load, self.lubricant,
-                         self.settings, self.face, motion_key, self.thermal)
+        keyed = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in NOT_KEYED}
+        keyed["motion"] = motion_key
+        if self.factors_key is None:            # the factors' own values, not their meta
+            keyed["factors"] = {f.name: getattr(self.factors, f.name)
+                                for f in fields(self.factors) if f.name != "meta"}
+        return sweep_key(keyed)
 
     def level_key(self, level: int) -> str:
         """The :attr:`key` of this sweep on the grid coarsened ``level`` times
@@ -141,18 +144,34 @@ class SweepRequest:
         return replace(self, gap=gap, spacing=spacing, face=face)
 
 
-def sweep_key(gap, spacing, factors, load, lubricant, settings, face, motion_key=None,
-              thermal=None) -> str:
-    """Key of a sweep's checkpoints (``point_KEY_*.npz``): a hash of all its inputs, with
-    ``factors`` a :class:`FlowFactors` or a key string of their inputs."""
-    flow = ((factors.h0, factors.h_m, factors.p_con, factors.A, factors.b, factors.C,
-             factors.d, factors.friction_factor, factors.pressure_friction)
-            if isinstance(factors, FlowFactors) else (str(factors),))
-    inputs = [load, lubricant.__dict__, settings.__dict__]
-    if motion_key is not None:
-        inputs.append(motion_key)
-    if thermal is not None:
-        inputs.append([thermal.settings.__dict__, thermal.law.__dict__,
-                       thermal.boundary_friction])
-    return input_key(np.asarray(gap, float), np.asarray(spacing, float), *flow,
-                     None if face is None else np.asarray(face, bool), inputs, length=12)
+#: the request's fields that do not set its points' converged states: where the points
+#: are written and what is written beside them, the speeds (each point's own key), the
+#: Hersey length (applied to the curve), the starts (``guide``, ``keep_level``: iterations,
+#: not results) and the factors when ``factors_key`` names their inputs instead
+NOT_KEYED = frozenset({"checkpoint", "fields", "origin", "error_estimate", "speeds",
+                       "hersey_length", "keep_level", "guide", "factors"})
+
+
+def sweep_key(keyed: dict) -> str:
+    """Key of a sweep's checkpoints (``point_KEY_*.npz``): a hash of ``keyed``, the
+    request's fields that set its points (every field but :data:`NOT_KEYED`), dataclasses
+    by their fields and arrays by their bits."""
+    arrays = []
+    skeleton = _skeleton(keyed, arrays)
+    return input_key(*arrays, skeleton, length=12)
+
+
+def _skeleton(value, arrays: list):
+    """``value`` with its arrays moved to ``arrays`` (hashed by their bits) and dataclasses
+    as dicts of their fields: a JSON form that names every number."""
+    if isinstance(value, np.ndarray):
+        arrays.append(value)
+        return f"array {len(arrays)}"
+    if is_dataclass(value) and not isinstance(value, type):
+        return {"class": type(value).__name__,
+                **{f.name: _skeleton(getattr(value, f.name), arrays) for f in fields(value)}}
+    if isinstance(value, dict):
+        return {str(k): _skeleton(v, arrays) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_skeleton(v, arrays) for v in value]
+    return value

@@ -10,8 +10,8 @@ from .curve import deviation_from_measured, plot_stribeck, read_measured_csv
 
 
 def validate_curves(curves, measured, boundary_friction: float, labels, table, plot_of) -> list:
-    """C_f,dev (eq 35, relative to ``boundary_friction`` = C_f,b) of each simulated curve against its
-    measured CSV (``measured``: a path or None per curve); all rows into the CSV ``table``,
+    """C_f,dev (eq 35, relative to ``boundary_friction`` = C_f,b) of each simulated curve against
+    its measured CSV (``measured``: a path or None per curve); all rows into the CSV ``table``,
     one plot per curve at ``plot_of(viscosity)``.  Returns ``max |C_f,dev|`` per curve."""
     rows, result = [], []
     for curve, path, label in zip(curves, measured, labels):
@@ -23,7 +23,8 @@ def validate_curves(curves, measured, boundary_friction: float, labels, table, p
                  zip(m.speed, m.friction_coefficient, dev)]
         band = None if m.low is None else (m.low, m.high)
         plot_stribeck([curve], plot_of(curve.viscosity), labels=[label],
-                      reference=(m.speed, m.friction_coefficient, band), boundary_friction=boundary_friction)
+                      reference=(m.speed, m.friction_coefficient, band),
+                      boundary_friction=boundary_friction)
         result.append({"viscosity_Pa_s": curve.viscosity, "measured": str(path),
                        "max_abs_cf_dev": float(np.nanmax(np.abs(dev)))})
     write_csv(table, dict(zip(("viscosity_Pa_s", "speed_m_s", "measured_cf", "cf_dev"),

@@ -6,8 +6,15 @@ Each function takes a :class:`Topography` and returns a new one; nothing is chan
 from .core import Topography
 from .filling import fill_defects
 from .filtering import FWHM_PER_SIGMA, clip_heights, gaussian_filter
-from .geometry import (align_sliding, centre_on, extract_patch, flip_disk, mount_pin,
-                       pin_centre, pin_face)
+from .geometry import (
+                       align_sliding,
+                       centre_on,
+                       extract_patch,
+                       flip_disk,
+                       mount_pin,
+                       pin_centre,
+                       pin_face,
+)
 from .levelling import level, mean_plane, radial_mask, zero_mean
 from .resampling import refine, resample, resample_cell
 

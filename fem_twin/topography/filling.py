@@ -10,7 +10,6 @@ from ..checks import arguments
 from ..errors import InputError
 from .core import Topography
 
-
 #: the fraction of measured pixels below which a map is refused, not filled
 MIN_VALID = 0.01
 

@@ -109,7 +109,8 @@ def mount_pin(topo: Topography, truncation: float = -20e-6, holder_height: float
         raise InputError(f"no pin face: no valid pixel above the truncation {truncation} m")
     return topo.with_heights(np.where(face, topo.heights, holder_height), mask=None,
                              meta=topo.with_history(
-                                 f"mount_pin(truncation={truncation:.3g} m, holder={holder_height:.3g} m)"))
+                                 f"mount_pin(truncation={truncation:.3g} m, "
+                                 f"holder={holder_height:.3g} m)"))
 
 
 @arguments(topo=Topography, holder_height="number")

@@ -1,0 +1,129 @@
+"""`fem-twin fit`, `validate` and `run --from-fit` on the bundled case at reduced size."""
+
+
+import csv
+import json
+
+import pytest
+from sample_cases import small_case
+
+from fem_twin.cli import main
+from fem_twin.stribeck.curve import read_stribeck_csv
+
+
+def measured_from_run(out, folder, speeds):
+    """'Measured' CSVs made of a run's own curves at C_f,b = 0.15 (their force parts), at
+    the ``speeds`` slice of each curve; their paths."""
+    cfb = 1 / (3 * 3 ** 0.5)
+    files = []
+    for c in read_stribeck_csv(out / "stribeck.csv"):
+        cf = (c.hydrodynamic_friction + 0.15 / cfb * c.boundary_friction) / 150.0
+        path = folder / f"m{c.viscosity:g}.csv"
+        path.write_text("speed,friction_coefficient\n" + "".join(
+            f"{float(u)!r},{float(f)!r}\n" for u, f in zip(c.speed[speeds], cf[speeds])))
+        files.append(str(path))
+    return files
+
+
+@pytest.mark.integration
+def test_fit_a_case_to_measured_curves(tmp_path, capsys):
+    """Fem-twin fit CASE measured.csv -o OUT --params ... --predict T: the
+    'measured' curves are the run's own at C_f,b = 0.15 (its two viscosities, 24 and 50 C in
+    the case), so the fit returns C_f,b = 0.15 and the case's temperatures, writes fit.json,
+    fit.png and a predicted curve with its band, and refuses an unknown parameter before
+    any work."""
+    case = small_case(tmp_path)
+    out = tmp_path / "o"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    cfb = 1 / (3 * 3 ** 0.5)
+    files = measured_from_run(out, tmp_path, slice(1, -1))
+    assert main(["fit", str(case), *files, "-o", str(out), "--no-progress", "--predict", "37",
+                 "--params", "boundary_friction,temperature,load_share"]) == 0
+    fit = json.loads((out / "fit.json").read_text())
+    assert fit["boundary_friction"]["value"] == pytest.approx(0.15, rel=2e-3)
+    for k, t in ((1, 24.0), (2, 50.0)):
+        assert abs(fit[f"temperature_{k}"]["value"] - t) < 0.5
+    # the curves were made at load share 1, the upper bound of the fit (the case resumes;
+    # only the first viscosity's sweeps at the other shares are new)
+    assert fit["load_share"]["value"] == pytest.approx(1.0, abs=1e-3)
+    assert (out / "fit.png").is_file() and "boundary_friction = 0.15" in capsys.readouterr().out
+    pred = list(csv.DictReader(open(out / "prediction_37C.csv")))
+    assert all(float(r["cf_low"]) < float(r["friction_coefficient"]) < float(r["cf_high"])
+               for r in pred)
+    assert main(["fit", str(case), files[0], "-o", str(tmp_path / "x"), "--params",
+                 "load"]) == 2
+    assert main(["fit", str(case), files[0], "-o", str(tmp_path / "x"), "--predict",
+                 "323"]) == 2                                     # kelvin typed as C
+    assert not (tmp_path / "x").exists()
+    # the fitted twin run at 120 N: prediction.csv is the run's own curve with its band
+    case120 = tmp_path / "case120.toml"
+    case120.write_text(case.read_text().replace("load = 150.0 ", "load = 120.0 "))
+    assert main(["run", str(case120), "-o", str(tmp_path / "o120"), "--no-progress",
+                 "--from-fit", str(out / "fit.json")]) == 0
+    pred = list(csv.DictReader(open(tmp_path / "o120" / "prediction.csv")))
+    run120 = list(csv.DictReader(open(tmp_path / "o120" / "stribeck.csv")))
+    for p, r in zip(pred, run120, strict=True):       # the same points, solved from other
+        assert float(p["friction_coefficient"]) == pytest.approx(     # starts: equal to the
+            float(r["friction_coefficient"]), abs=5e-5 * cfb)  # coupling's 1.5e-5 C_f,b, x3
+        assert float(p["cf_low"]) < float(p["friction_coefficient"]) < float(p["cf_high"])
+    assert main(["run", str(case120), "-o", str(tmp_path / "y"), "--from-fit",
+                 str(files[0])]) == 2                                  # not a fit.json
+
+
+@pytest.mark.integration
+def test_fit_the_rigs_thermal_resistance(tmp_path, capsys):
+    """Fem-twin fit --params boundary_friction,bulk_resistance sweeps each
+    curve at the other RESISTANCES (checkpointed in OUT/fit) and recovers the case's own
+    R_b = 1 K/W and C_f,b = 0.15 from the thermal run's own curves; the isothermal twin
+    refuses the parameter before any work."""
+    case = small_case(tmp_path)
+    out = tmp_path / "o"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    files = measured_from_run(out, tmp_path, slice(None))
+    params = "boundary_friction,bulk_resistance"
+    assert main(["fit", str(case), *files, "-o", str(out), "--no-progress", "--params",
+                 params]) == 0
+    fit = json.loads((out / "fit.json").read_text())
+    assert fit["bulk_resistance"]["value"] == pytest.approx(1.0, abs=0.05)
+    assert fit["boundary_friction"]["value"] == pytest.approx(0.15, rel=2e-3)
+    assert "bulk_resistance" in capsys.readouterr().out
+    iso = tmp_path / "iso.toml"
+    iso.write_text(case.read_text().replace('model = "flash"', 'model = "none"'))
+    assert main(["fit", str(iso), *files, "-o", str(tmp_path / "x"), "--params", params]) == 2
+    assert not (tmp_path / "x").exists()
+
+
+def test_fit_validate_and_from_fit_refuse_what_they_cannot_use(tmp_path, capsys):
+    """Checked against the case before any work, exit 2 and one line:
+    a fit whose measured speeds lie outside the case's sweep (it returned the starting
+    values with a zero-width interval), a measured C_f below zero, a zero or negative
+    --radius, a fit.json with an implausible C_f,b (it ran and reported C_f up to 4.2)."""
+    case = small_case(tmp_path)
+    far = tmp_path / "far.csv"
+    far.write_text("speed,friction_coefficient\n" + "".join(
+        f"{u!r},0.05\n" for u in (10.0, 20.0, 30.0)))
+    out = tmp_path / "o"
+    assert main(["fit", str(case), str(far), "-o", str(out), "--params", "boundary_friction",
+                 "--no-progress"]) == 2
+    assert "no measured point lies inside" in capsys.readouterr().err
+    assert not (out / "geometry").exists()
+    negative = tmp_path / "neg.csv"
+    negative.write_text("speed,friction_coefficient\n0.1,-0.02\n0.2,0.01\n")
+    assert main(["fit", str(case), str(negative), "-o", str(out), "--params",
+                 "boundary_friction", "--no-progress"]) == 2
+    assert "[0, 1]" in capsys.readouterr().err
+    (out / "stribeck.csv").parent.mkdir(parents=True, exist_ok=True)
+    (out / "stribeck.csv").write_text("speed_m_s,hersey,friction_coefficient,viscosity_Pa_s\n"
+                                      "0.1,1e-7,0.01,0.066\n1.0,1e-6,0.02,0.066\n")
+    good = tmp_path / "good.csv"
+    good.write_text("speed,friction_coefficient\n10,0.01\n20,0.02\n")
+    for radius in ("0", "-0.03"):
+        assert main(["validate", str(out), str(good), "--rpm", "--radius", radius]) == 2
+        assert "--radius" in capsys.readouterr().err
+    fit = tmp_path / "fit.json"
+    fit.write_text(json.dumps({"fit": {"parameters": ["boundary_friction"]},
+                               "case": {"temperatures": [24.0, 50.0], "law": None},
+                               "boundary_friction": {"value": 5.0, "low": 4.0, "high": 6.0}}))
+    assert main(["run", str(case), "-o", str(tmp_path / "p"), "--from-fit", str(fit)]) == 2
+    assert "boundary_friction" in capsys.readouterr().err
+    assert not (tmp_path / "p" / "geometry").exists()
