@@ -85,7 +85,7 @@ def main(out="out/contact_temperature", quick=False):
     law = WaltherLaw.through((24.0, 50.0), (0.066, 0.024), 875.0)
     sweep = sample_sweep(48 if quick else 96, speeds)
     iso = stribeck_sweep(sweep)
-    hot = stribeck_sweep(replace(sweep, thermal=ContactThermal(STEEL, law, 0.1924500897)))
+    hot = stribeck_sweep(replace(sweep, thermal=ContactThermal(STEEL, law)))
     right.loglog(speeds, iso.friction_coefficient, "o-", label="isothermal (the paper)")
     right.loglog(speeds, hot.friction_coefficient, "s--", label="thermal, R_b = 1 K/W")
     right.set(xlabel="sliding speed U [m/s]", ylabel="C_f", title="sample pin at 24 C")

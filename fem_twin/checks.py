@@ -76,6 +76,10 @@ QUANTITIES = {
     "solver_tolerance": (1e-15, 0.1, "a relative tolerance (e.g. 1e-6)"),
     "adaptive_tolerance": (0.0, 0.5, "a fraction (1 % is 0.01; 0: off)"),
     "share": (1e-6, 0.999, "a fraction of C_f,b (0.5 % is 0.005)"),
+    "shear_strength": (0.0, 1e9, "Pa (a boundary film's tau_0, 10 MPa is 1e7)"),
+    "pressure_coefficient": (0.0, 1.0, "(Briscoe-Tabor's alpha, 0.1 is 0.1)"),
+    "speed_coefficient": (-0.5, 0.5, "per decade of sliding speed (5 % is 0.05)"),
+    "temperature_coefficient": (0.0, 0.1, "1/K (0.2 % per kelvin is 0.002)"),
 }
 
 

@@ -69,6 +69,10 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     if "bulk_resistance" in params and case.thermal.model == "none":
         raise InputError("bulk_resistance is the thermal twin's: set [thermal] model = "
                          "\"flash\" to fit it")
+    if "boundary_friction" in params and case.boundary.law != "constant":
+        raise InputError("boundary_friction is eq 32's constant C_f,b; the case's [boundary] "
+                         "law = \"shear\" does not read it: fit the other parameters, or "
+                         "set law = \"constant\"")
     _check_coverage(case, paths, curves_measured, params)
     law = (WaltherLaw.through(lb.temperatures, lb.viscosities, lb.density)
            if len(set(lb.temperatures)) > 1 else None)
@@ -168,6 +172,9 @@ def apply_fit(case: Case, result: dict) -> Case:
     if "bulk_resistance" in params and case.thermal.model == "none":
         raise InputError("the fit's bulk_resistance is a thermal model's: the case has "
                          '[thermal] model = "none"; set model = "flash" or fit without it')
+    if "boundary_friction" in params and case.boundary.law != "constant":
+        raise InputError("the fit's boundary_friction is eq 32's constant C_f,b; this case's "
+                         '[boundary] law = "shear" does not read it; set law = "constant"')
     if made.get("kind", tr.kind) != tr.kind:
         raise InputError(f"the fit was made on a {made['kind']} case and this is a {tr.kind} "
                          "case: its contact and kinematics differ; fit this tribometer's curves")

@@ -90,7 +90,7 @@ def test_the_sweep_key_changes_with_every_field_that_sets_the_points():
     law = WaltherLaw.through([24.0, 50.0], [0.066, 0.024], 850.0)
     base = SweepRequest(gap, dx, smooth_factors(), [1.0], load=150.0,
                         lubricant=Lubricant(0.066), face=face,
-                        thermal=ContactThermal(ThermalSettings(), law, 0.15))
+                        thermal=ContactThermal(ThermalSettings(), law))
     key = base.key
     nested = {"settings": base.settings, "lubricant": base.lubricant,
               "thermal": base.thermal, "factors": base.factors}

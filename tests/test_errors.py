@@ -200,9 +200,10 @@ def test_every_public_function_refuses_wrong_arguments_with_a_fem_twin_error():
     assert not escaped, "\n".join(escaped)
 
 
-#: settings that carry no number: file paths, switches, text and addresses
+#: settings that carry no number of their own: file paths, switches, text, addresses and a
+#: section filled in whole (its own keys are walked as that section's)
 UNRANGED_UNITS = {"file path", "file paths", "file path pairs", "true or false", "address",
-                  "a registered model"}
+                  "a registered model", "a section"}
 
 
 def _declared_settings():

@@ -206,7 +206,7 @@ def resistances(factors):
     common = dict(load=150.0, face=face, settings=MacroSettings())
 
     def sweep(mu, r, at=SPEEDS):
-        thermal = ContactThermal(ThermalSettings(bulk_resistance=r), LAW, CFB)
+        thermal = ContactThermal(ThermalSettings(bulk_resistance=r), LAW)
         return stribeck_sweep(SweepRequest(gap, dx, factors, at, lubricant=Lubricant(mu),
                                            thermal=thermal, **common))
     grid = tuple(tuple((r, sweep(mu, r)) for r in RESISTANCES) for mu in (0.066, 0.024))

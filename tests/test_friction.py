@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 
 from fem_twin import Topography
-from fem_twin.macro import Lubricant, MacroSettings, hydrodynamic_shear, solve_mixed, solve_reynolds
+from fem_twin.macro import (
+    BoundaryLaw,
+    Lubricant,
+    MacroSettings,
+    hydrodynamic_shear,
+    solve_mixed,
+    solve_reynolds,
+)
 from fem_twin.macro.reynolds import trapezoid_weights
 from fem_twin.micro import CellSettings, FlowFactors, homogenise
 from fem_twin.micro.film import mean_inverse_film
@@ -295,11 +302,11 @@ def test_friction_on_a_face_that_fills_the_grid_converges_at_second_order():
 
 
 def test_the_boundary_friction_is_cfb_times_the_contact_load():
-    """With a constant C_f,b the boundary friction is C_f,b times the contact load, to
-    rounding, on a face that fills the grid: a rigid plane pad (5 mm x 40 mm) with ridges
-    along the sliding that touch near the outlet (E' 4e12 Pa, hardness 1 GPa, 400 N, 33 %
-    of it on asperities).  With every node weighted as a full cell it was 29 %, 15 %,
-    7.7 % high at 81^2 .. 321^2."""
+    """With a constant C_f,b the boundary friction is C_f,b times the asperities' load
+    (p_con + p a_r; the contact load p_con alone with the paper's eq 32), to rounding, on a face
+    that fills the grid: a rigid plane pad (5 mm x 40 mm) with ridges along the sliding that touch
+    near the outlet (E' 4e12 Pa, hardness 1 GPa, 400 N, 33 % of it on asperities).  With every node
+    weighted as a full cell it was 29 %, 15 %, 7.7 % high at 81^2 .. 321^2."""
     n = 64
     z = np.tile(0.5e-6 * np.cos(2 * np.pi * np.arange(n) / n)[:, None], (1, 4))
     dx = 20e-6 / n
@@ -313,8 +320,15 @@ def test_the_boundary_friction_is_cfb_times_the_contact_load():
                       settings=MacroSettings(e_reduced=4e12, ambient_pressure=0.0,
                                              cavitation_pressure=0.0))
     assert 0.05 < res.contact_load / res.normal_load < 0.95
-    assert res.boundary_friction == pytest.approx(
-        res.meta["settings"]["boundary_friction"] * res.contact_load, rel=1e-12)
+    cfb = res.meta["settings"]["boundary_friction"]
+    assert res.boundary_friction == pytest.approx(cfb * res.asperity_load, rel=1e-12)
+    assert res.asperity_load > res.contact_load                 # p a_r on the spots
+    paper = solve_mixed(gap, (5e-3 / 80, 40e-3 / 80), ff, load=400.0, speed=0.01,
+                        lubricant=Lubricant(0.066, roelands_alpha=0.0, dh_c2=1.0),
+                        settings=MacroSettings(e_reduced=4e12, ambient_pressure=0.0,
+                                               cavitation_pressure=0.0,
+                                               boundary=BoundaryLaw(film_on_contacts=False)))
+    assert paper.boundary_friction == pytest.approx(cfb * paper.contact_load, rel=1e-12)
 
 
 def test_the_friction_factor_converges_through_contact_onset():

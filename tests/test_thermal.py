@@ -109,7 +109,7 @@ def test_the_film_temperature_settles_and_its_heat_is_the_frictional_power(point
     """At 1 m/s on the sample pin: the converged film temperature is the oil's plus R_b Q
     plus the face's flash (to the tolerance), Q = F_T U, and the film's viscosity is the
     Walther law's at that temperature."""
-    thermal = ContactThermal(ThermalSettings(bulk_resistance=2.0), LAW, 0.19245)
+    thermal = ContactThermal(ThermalSettings(bulk_resistance=2.0), LAW)
     (res,), film, record = thermal_point(point, Lubricant(0.066), thermal, factors, (0.0, 1.0))
     assert record["power_W"] == pytest.approx(res.friction_force * 1.0, rel=1e-12)
     assert abs(record["oil_C"] + 2.0 * record["power_W"] + record["face_flash_K"]
@@ -125,7 +125,7 @@ def test_ideal_heat_sinks_recover_the_isothermal_twin(point, factors):
     plausible conductivities ThermalSettings accepts, so it is set past the check.)"""
     s = ThermalSettings(bulk_resistance=0.0, spot_radius=0.0)
     object.__setattr__(s, "conductivity", 46e9)
-    (res,), film, record = thermal_point(point, Lubricant(0.066), ContactThermal(s, LAW, 0.2),
+    (res,), film, record = thermal_point(point, Lubricant(0.066), ContactThermal(s, LAW),
                                          factors, (0.0, 1.0))
     iso = point(Lubricant(0.066), None)[0]
     assert record["iterations"] == 1
@@ -138,7 +138,7 @@ def test_a_temperature_that_does_not_settle_raises_with_its_history(point, facto
     documented exit 3, not an internal error)."""
     s = ThermalSettings(bulk_resistance=20.0, max_iter=1)
     with pytest.raises(ThermalNotConverged) as err:
-        thermal_point(point, Lubricant(0.066), ContactThermal(s, LAW, 0.2), factors, (0.0, 1.0))
+        thermal_point(point, Lubricant(0.066), ContactThermal(s, LAW), factors, (0.0, 1.0))
     assert len(err.value.history) == 1 and err.value.history[0] > 10
     again = pickle.loads(pickle.dumps(err.value))
     assert again.history == err.value.history and str(again) == str(err.value)

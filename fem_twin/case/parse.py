@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..checks import arguments, check_choice, memory_shortfall, plausible
 from ..errors import InputError
+from ..macro.boundary import BoundaryLaw
 from ..macro.thermal import ThermalSettings
 from ..stribeck.request import RollingSliding
 from ..topography.prepare import MacroOptions
@@ -75,6 +76,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     macro = _macro(data, where, tribometer, geometry)
     sweep = _sweep(data, where)
     thermal = _thermal(data, where, lubricant)
+    boundary = _boundary(data, where, thermal, sweep)
     _disk_axis(tribometer, materials, geometry, where)
     run = _section(data, "run", RunSpec, where)
     if run.workers < 0:
@@ -103,8 +105,8 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     return Case(name=str(data.get("name", source.stem if source else "case")),
                 geometry=geometry, preprocessing=preprocessing, tribometer=tribometer,
                 lubricant=lubricant, materials=materials, micro=micro, macro=macro,
-                thermal=thermal, sweep=sweep, run=run, measured=measured, source=source,
-                defaulted=defaulted)
+                thermal=thermal, boundary=boundary, sweep=sweep, run=run, measured=measured,
+                source=source, defaulted=defaulted)
 
 
 #: the keys a pin case has no use for, with what sets them (refused, not ignored)
@@ -273,6 +275,26 @@ def _thermal(data, where, lubricant) -> ThermalSettings:
                         f"{list(lubricant.temperatures)} C rise (swapped?); the thermal model's "
                         "Walther law needs them in order")
     return thermal
+
+
+def _boundary(data, where, thermal, sweep) -> BoundaryLaw:
+    """[boundary]: the shear law's keys only with ``law = "shear"``, a temperature term only
+    with the thermal model, a speed factor positive over the sweep's speeds."""
+    boundary = _section(data, "boundary", BoundaryLaw, where)
+    given = set(data.get("boundary", {})) - {"law", "film_on_contacts"}
+    if boundary.law == "constant" and given:
+        raise CaseError(f"{where} [boundary] {', '.join(sorted(given))}: the shear law's, unused "
+                        "by law = \"constant\" (eq 32 with [tribometer] boundary_friction); set "
+                        "law = \"shear\" or remove them")
+    if boundary.temperature_coefficient and thermal.model == "none":
+        raise CaseError(f"{where} [boundary] temperature_coefficient: the asperity spots' "
+                        "flash rise comes from the thermal model; set [thermal] model = "
+                        "\"flash\" or remove it")
+    try:
+        boundary.check_speeds(sweep.speed_min, sweep.speed_max)
+    except InputError as err:
+        raise CaseError(f"{where} {err}") from None
+    return boundary
 
 
 def _sweep(data, where) -> SweepSpec:

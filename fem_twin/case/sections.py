@@ -11,6 +11,7 @@ from pathlib import Path
 
 from .. import tables as T
 from ..checks import check_ranges, setting
+from ..macro.boundary import BoundaryLaw
 from ..macro.settings import MacroSettings
 from ..macro.thermal import ThermalSettings
 from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN
@@ -238,15 +239,16 @@ FILLED = {"e_reduced": ("materials", lambda case: case.materials.e_reduced),
           "hardness": ("materials", lambda case: case.materials.hardness),
           "boundary_friction": ("tribometer", lambda case: case.tribometer.boundary_friction),
           "track_radius": ("tribometer", lambda case: case.tribometer.disk_radius),
-          "slide_to_roll": ("tribometer", lambda case: SLIDING)}
+          "slide_to_roll": ("tribometer", lambda case: SLIDING),
+          "boundary": ("boundary", lambda case: case.boundary)}
 
 
 #: the case file's sections and the dataclass that declares each one's keys
 #: (``[validation]`` has one key, ``measured``; ``name`` is top-level)
 SECTIONS = {"geometry": Geometry, "preprocessing": MacroOptions, "tribometer": Tribometer,
             "lubricant": LubricantSpec, "materials": Materials, "micro": MicroSpec,
-            "macro": MacroSpec, "thermal": ThermalSettings, "sweep": SweepSpec,
-            "run": RunSpec}
+            "macro": MacroSpec, "thermal": ThermalSettings, "boundary": BoundaryLaw,
+            "sweep": SweepSpec, "run": RunSpec}
 
 
 @dataclass(frozen=True)
@@ -262,6 +264,7 @@ class Case:
     micro: MicroSpec = field(default_factory=MicroSpec)
     macro: MacroSpec = field(default_factory=MacroSpec)
     thermal: ThermalSettings = field(default_factory=ThermalSettings)
+    boundary: BoundaryLaw = field(default_factory=BoundaryLaw)
     sweep: SweepSpec = field(default_factory=SweepSpec)
     run: RunSpec = field(default_factory=RunSpec)
     measured: tuple[Path | None, ...] = ()   # [validation] measured curves per viscosity

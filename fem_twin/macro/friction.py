@@ -1,5 +1,5 @@
-"""Friction on the pin: the tangential force of the film (eqs 31, 33-34) and of the contacts
-(eq 32).
+"""Friction on the pin: the tangential force of the film (eqs 31, 33-34); the contacts'
+(eq 32) is :mod:`.boundary`'s.
 
 The default law (``"pin"``) is the force a load cell on the pin holder reads: the wall
 shear plus the film pressure on the pin's asperity flanks (the micro scale's friction
@@ -14,10 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..checks import arguments
-from ..tables import BOUNDARY_FRICTION
 from .kinematics import rotate_tensor, rotations
 
-#: Boundary friction coefficient C_f,b of eq 32 (Bowden and Tabor, pure shearing).
 #: the friction laws: the force on the pin, or the paper's eq 31
 LAWS = ("pin", "paper")
 
@@ -78,12 +76,3 @@ def face_slope(gap, face, dx1: float) -> np.ndarray:
     both = left & right
     slope = np.where(both, (back + ahead) / 2, np.where(left, back, np.where(right, ahead, 0.0)))
     return np.where(face, slope / dx1, 0.0)
-
-
-@arguments(contact_pressure="numbers", boundary_friction="number")
-def boundary_shear(contact_pressure, boundary_friction: float = BOUNDARY_FRICTION) -> np.ndarray:
-    """tau_con = C_f,b p_con of eq 32 [Pa], where the surfaces slide (u_r > 0): a pure
-    rolling contact has none (the operating point applies it only then; the creep of
-    partial slip at small slide-to-roll ratios is not modelled, so any sliding gives the
-    whole of it)."""
-    return boundary_friction * np.asarray(contact_pressure, float)

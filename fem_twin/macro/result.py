@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields, is_dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from ..io.atomic import atomic_path
 from ..micro.rolling import at_slide_to_roll
-from .friction import boundary_shear, hydrodynamic_shear
+from .boundary import asperity_load, boundary_traction
+from .friction import hydrodynamic_shear
 from .kinematics import disk_velocity, rotations
 from .reynolds import trapezoid_weights
 
@@ -18,7 +19,7 @@ from .reynolds import trapezoid_weights
 #: checkpoints, VTU files and ``fields.nc`` (:func:`fem_twin.results.fields_dataset`)
 FIELDS = {"pressure": "Pa", "contact_pressure": "Pa", "cavity_fraction": "1", "h0": "m",
           "mean_gap": "m", "elastic_deformation": "m", "viscosity": "Pa s",
-          "density_ratio": "1", "shear_stress": "Pa", "face": "1"}
+          "density_ratio": "1", "shear_stress": "Pa", "boundary_shear": "Pa", "face": "1"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -28,10 +29,13 @@ class MixedResult:
     Scalars: ``speed`` U [m/s], ``imposed_load`` F_N,imp and ``normal_load`` F_N (eq 28) [N],
     ``h_d`` [m], ``friction_force`` F_T (eq 33) with its ``hydrodynamic_friction`` and
     ``boundary_friction`` parts [N], ``friction_coefficient`` C_f (eq 34),
-    ``contact_load`` (integral of p_con) [N].
+    ``contact_load`` (integral of p_con) [N], the asperities' ``asperity_load`` (integral
+    of p_con + p a_r, :func:`.boundary.asperity_load`) [N] and ``real_contact_area`` (of
+    a_r) [m^2] over the face.
     Fields (ny, nx): ``pressure`` p_hd, ``contact_pressure`` p_con [Pa], ``cavity_fraction``,
     ``h0``, ``mean_gap`` h_m, ``elastic_deformation`` h_el [m], ``viscosity`` [Pa s],
-    ``density_ratio`` rho/rho_0, ``shear_stress`` tau_tot [Pa], ``face`` (pin face mask).
+    ``density_ratio`` rho/rho_0, ``shear_stress`` tau_tot and its ``boundary_shear`` part
+    (x1, :mod:`.boundary`) [Pa], ``face`` (pin face mask).
     ``history``: rows (iteration, r_hel, r_pcon, r_p, r_F, h_d, newton steps).
     """
 
@@ -44,6 +48,8 @@ class MixedResult:
     boundary_friction: float
     friction_coefficient: float
     contact_load: float
+    asperity_load: float
+    real_contact_area: float
     spacing: tuple
     pressure: np.ndarray
     contact_pressure: np.ndarray
@@ -54,6 +60,7 @@ class MixedResult:
     viscosity: np.ndarray
     density_ratio: np.ndarray
     shear_stress: np.ndarray
+    boundary_shear: np.ndarray
     face: np.ndarray
     iterations: int = 0
     history: np.ndarray = field(default_factory=lambda: np.zeros((0, 7)))
@@ -115,9 +122,9 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
     s, dx, area, speed, lubricant = P.settings, P.spacing, P.area, P.speed, P.lubricant
     loc = ev.loc
     p_hd = ev.p + s.cavitation_pressure
-    tau_hd, tau_con = pin_friction(p_hd, ev.theta, ev.mu, ev.h0, loc.h_m, ev.p_con, dx,
-                                   P.factors, s, lubricant, speed, P.entrainment, face,
-                                   P.velocity)
+    tau_hd, tau_con, asperity, a_r = pin_friction(
+        p_hd, ev.theta, ev.mu, ev.h0, loc.h_m, ev.p_con, dx, P.factors, s, lubricant, speed,
+        P.entrainment, face, P.velocity)
     weights = area * face                         # the load's trapezoidal rule on the face
     F_hd = float(np.sum(weights * tau_hd))
     F_con = float(np.sum(weights * tau_con))
@@ -126,16 +133,23 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
         speed=float(speed), imposed_load=float(load), normal_load=F_N, h_d=float(h_d),
         friction_force=F_hd + F_con, hydrodynamic_friction=F_hd, boundary_friction=F_con,
         friction_coefficient=(F_hd + F_con) / F_N,
-        contact_load=float(np.sum(area * ev.p_con)), spacing=dx,
+        contact_load=float(np.sum(area * ev.p_con)),
+        asperity_load=float(np.sum(weights * asperity)),
+        real_contact_area=float(np.sum(weights * a_r)), spacing=dx,
         pressure=p_hd, contact_pressure=ev.p_con, cavity_fraction=ev.theta,
         h0=ev.h0, mean_gap=loc.h_m, elastic_deformation=h_el,
         viscosity=ev.mu, density_ratio=ev.rho, shear_stress=tau_hd + tau_con,
-        face=face, iterations=it, history=np.array(history),
-        meta={"settings": {k: (list(v) if isinstance(v, tuple) else v)
-                           for k, v in s.__dict__.items()},
+        boundary_shear=tau_con * face, face=face, iterations=it, history=np.array(history),
+        meta={"settings": _plain(s),
               "lubricant": lubricant.__dict__.copy(), "seconds": seconds,
               "coupling": coupling or ("anderson" if s.coupling == "auto" else s.coupling),
               "entrainment": P.entrainment})
+
+
+def _plain(settings) -> dict:
+    """``settings`` as JSON-ready values (tuples as lists, nested settings as dicts)."""
+    return {f.name: (_plain(v) if is_dataclass(v) else list(v) if isinstance(v, tuple) else v)
+            for f in fields(settings) for v in [getattr(settings, f.name)]}
 
 
 def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubricant, speed,
@@ -144,16 +158,21 @@ def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubrica
     31-32, or the force on the pin: ``settings.friction``,
     :func:`.friction.hydrodynamic_shear`) of a converged state, with ``factors`` at its
     slide-to-roll ratio, on the pin ``face``, the disk moving at ``velocity``
-    (:func:`.kinematics.disk_velocity`; None: along x1)."""
+    (:func:`.kinematics.disk_velocity`; None: along x1); and the asperities' load field
+    (:func:`.boundary.asperity_load`) [Pa] and contact fraction a_r [-] the law reads."""
     shear = factors.at(h0)              # the shear factors (the iterations read none)
     tau_hd = hydrodynamic_shear(p_hd, h_m, theta, mu, shear, dx, speed,
                                 entrainment=entrainment, eyring_stress=lubricant.eyring_stress,
                                 law=settings.friction, face=face,
                                 ambient_pressure=settings.ambient_pressure, velocity=velocity)
-    tau_con = boundary_shear(p_con, settings.boundary_friction) * (speed > 0)  # 0: no sliding
-    if velocity is not None:
-        tau_con = tau_con * rotations(velocity)[0]          # along the sliding, x1 part
-    return tau_hd, tau_con
+    cos, local = ((rotations(velocity)[0], rotations(velocity)[2]) if velocity is not None
+                  else (1.0, 1.0))
+    film = np.maximum(np.asarray(p_hd, float) - settings.ambient_pressure, 0.0)
+    a_r = shear.contact_fraction
+    tau_con = boundary_traction(p_con, film, a_r, speed * local, settings.boundary,
+                                settings.boundary_friction)
+    return (tau_hd, tau_con * cos * (speed > 0),     # along the sliding, x1; 0: no sliding
+            asperity_load(p_con, film, a_r, settings.boundary), a_r)
 
 
 def friction_with(result: MixedResult, factors, settings, lubricant) -> float:
@@ -163,7 +182,7 @@ def friction_with(result: MixedResult, factors, settings, lubricant) -> float:
     does not read (the friction factors)."""
     u_m = result.meta.get("entrainment") or result.speed / 2
     moved = at_slide_to_roll(factors, result.speed / u_m)
-    tau_hd, tau_con = pin_friction(result.pressure, result.cavity_fraction, result.viscosity,
+    tau_hd, tau_con, *_ = pin_friction(result.pressure, result.cavity_fraction, result.viscosity,
                                    result.h0, result.mean_gap, result.contact_pressure,
                                    result.spacing, moved, settings, lubricant, result.speed,
                                    result.meta.get("entrainment"), result.face,

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from .. import tables as T
 from ..checks import check_choices, check_ranges, setting
 from ..errors import InputError
+from .boundary import BoundaryLaw
 from .cavitation import MODELS, cavitation_model
 from .contact_load import RULES
 from .couette import SCHEMES
@@ -28,6 +29,9 @@ class MacroSettings:
                                section="materials")
     boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", "friction",
                                        section="tribometer")
+    boundary: BoundaryLaw = setting(BoundaryLaw(), "the boundary shear's law (eq 32 or the "
+                                    "shear law, fem_twin.macro.boundary)", unit="a section",
+                                    section="boundary")
     track_radius: float | None = setting(
         None, "the disk's axis at this distance from the face's centre: the disk's velocity "
         "field over the face (fem_twin.macro.kinematics); none: uniform sliding along x1",

@@ -23,6 +23,7 @@ import scipy.fft as fft
 from ..checks import arguments, as_pair, check_ranges, plausible, setting
 from ..contact.elastic import love_rectangle
 from ..errors import InputError, NotConverged
+from .boundary import BoundaryLaw, spot_temperature_factor
 
 #: sub-samples a side of a cell for the moving part of the kernel (it varies over 2 kappa / U)
 SUBSAMPLES = 8
@@ -157,11 +158,11 @@ def _coarse(flux, face, spacing, most: int):
 class ContactThermal:
     """A run's thermal model: its ``settings``, the oil's viscosity-temperature ``law``
     (:class:`~.viscosity.WaltherLaw`; a curve's oil is at the temperature where the law
-    gives the curve's mu_0) and C_f,b (eq 32), which sets the asperity spots' flux."""
+    gives the curve's mu_0); a point's boundary law (its settings') reads the asperity
+    spots' flash in its temperature term (:meth:`tempered`)."""
 
     settings: ThermalSettings
     law: object
-    boundary_friction: float
 
     def heat(self, result, speeds) -> dict:
         """The heat of a converged point ``result``: ``power`` F_T U [W], the face's
@@ -176,14 +177,30 @@ class ContactThermal:
         return {"power": power, "flash": flash, "pin_share": share}
 
     def spot(self, result, factors, speeds) -> float:
-        """An asperity spot's flash temperature [K] at the point ``result``: the boundary
-        shear's flux at the contacts' mean pressure (``factors``: the point's flow factors,
-        for the contact fraction)."""
+        """An asperity spot's flash temperature [K] at the point ``result``: the flux of the
+        boundary shear over the real contact area (``factors``: the point's flow factors,
+        for the contact fraction) at the sliding speed."""
         face = np.asarray(result.face, bool)
         fraction = factors.at(result.h0).contact_fraction[face].sum()
-        flux = (self.boundary_friction * result.contact_pressure[face].sum() / fraction
-                * abs(result.speed) if fraction > 0 else 0.0)
+        flux = (max(result.boundary_shear[face].sum(), 0.0) / fraction * abs(result.speed)
+                if fraction > 0 else 0.0)
         return spot_flash(flux, speeds, self.settings)
+
+    def tempered(self, result, factors, speeds):
+        """``result`` with its boundary shear times its shear law's temperature factor at
+        the spots' flash rise (:func:`~.boundary.spot_temperature_factor`; unchanged
+        without a temperature term)."""
+        law = BoundaryLaw(**result.meta.get("settings", {}).get("boundary", {}))
+        t = spot_temperature_factor(law, self.spot(result, factors, speeds))
+        if t == 1.0:
+            return result
+        lost = (1 - t) * result.boundary_friction
+        return replace(result, boundary_friction=t * result.boundary_friction,
+                       friction_force=result.friction_force - lost,
+                       friction_coefficient=(result.friction_force - lost) / result.normal_load,
+                       shear_stress=result.shear_stress - (1 - t) * result.boundary_shear,
+                       boundary_shear=t * result.boundary_shear,
+                       meta={**result.meta, "boundary_temperature_factor": t})
 
 
 def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
@@ -204,6 +221,7 @@ def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
     for _ in range(s.max_iter):
         film = replace(lubricant, viscosity=float(law.viscosity(T)))
         levels = solve(film, previous)
+        levels = (thermal.tempered(levels[0], factors, speeds), *levels[1:])
         heat = thermal.heat(levels[0], speeds)
         target = oil + s.bulk_resistance * heat["power"] + heat["flash"]
         history.append(abs(target - T))

@@ -62,11 +62,10 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
 
 
 def contact_thermal(case: Case) -> ContactThermal | None:
-    """The run's thermal model (``[thermal]``, the Walther law of ``[lubricant]``, C_f,b),
+    """The run's thermal model (``[thermal]``, the Walther law of ``[lubricant]``),
     or None for the isothermal twin (``model = "none"``)."""
     if case.thermal.model == "none":
         return None
     lb = case.lubricant
     return ContactThermal(case.thermal, WaltherLaw.through(lb.temperatures, lb.viscosities,
-                                                           lb.density),
-                          case.tribometer.boundary_friction)
+                                                           lb.density))

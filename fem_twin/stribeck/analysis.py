@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..macro.friction import BOUNDARY_FRICTION
+from ..macro.boundary import BOUNDARY_FRICTION
 from .curve import friction_deviation
 
 

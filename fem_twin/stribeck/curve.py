@@ -12,7 +12,7 @@ from ..checks import arguments
 from ..errors import InputError, MissingFile
 from ..io.figure import save_figure
 from ..io.table import write_csv
-from ..macro.friction import BOUNDARY_FRICTION
+from ..macro.boundary import BOUNDARY_FRICTION
 
 COLUMNS = ("speed", "hersey", "friction_coefficient", "viscosity", "hydrodynamic_friction",
            "boundary_friction", "contact_load_fraction", "h_d", "iterations")

@@ -1,0 +1,111 @@
+"""The boundary shear of the asperity contacts (eq 32 and its generalisation).
+
+The cell's dry contact at imposed h0 gives the asperities' pressure above the film's: a
+film pressure uniform over a cell leaves the cell's gap unchanged, so the contact spots,
+a fraction a_r of the area, carry ``p_con + p a_r`` (p the film's gauge pressure).  Both
+laws act on that load:
+
+- ``"constant"`` (eq 32): ``tau_b = C_f,b (p_con + p a_r)``;
+- ``"shear"`` (Briscoe and Tabor's ``tau = tau_0 + alpha p`` on the real contact area,
+  activated in the sliding speed): ``tau_b = (tau_0 a_r + alpha (p_con + p a_r)) s(u)``
+  with ``s(u) = 1 + c_u log10(u / u_ref)``; its temperature factor ``1 - c_T dT`` follows
+  the asperity spots' flash rise dT, :func:`spot_temperature_factor`.
+
+``tau_0 = 0``, ``alpha = C_f,b`` and ``c_u = c_T = 0`` give the constant law exactly
+(docs/model.md, "Boundary friction").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..checks import arguments, check_choices, check_ranges, setting
+from ..errors import InputError
+from ..tables import BOUNDARY_FRICTION
+
+#: the boundary laws: eq 32's constant C_f,b, or the shear strength of a boundary film
+LAWS = ("constant", "shear")
+
+
+@dataclass(frozen=True)
+class BoundaryLaw:
+    """``[boundary]``: the boundary shear on the real contact area (module docstring);
+    ``law = "constant"`` reads ``[tribometer] boundary_friction`` (eq 32)."""
+
+    law: str = setting("constant", "eq 32's C_f,b times the asperities' load, or the shear "
+                       "law tau_0 a_r + alpha (p_con + p a_r), in the sliding speed and the "
+                       "spots' temperature", choices=LAWS)
+    shear_strength: float = setting(0.0, "tau_0, the boundary film's shear strength at no "
+                                    "pressure", "shear_strength")
+    pressure_coefficient: float = setting(BOUNDARY_FRICTION, "alpha, the shear's growth "
+                                          "with the contact pressure", "pressure_coefficient")
+    speed_coefficient: float = setting(0.0, "c_u, the shear's relative change per decade of "
+                                       "sliding speed about reference_speed",
+                                       "speed_coefficient")
+    reference_speed: float = setting(1.0, "u_ref of the speed factor", "speed")
+    temperature_coefficient: float = setting(0.0, "c_T, the shear's relative fall per kelvin "
+                                             "of the asperity spots' flash rise (the thermal "
+                                             "model's)", "temperature_coefficient")
+    film_on_contacts: bool = setting(True, "the film's pressure on the contact spots joins "
+                                     "the asperities' load, p_con + p a_r (false: the "
+                                     "paper's p_con alone)", unit="true or false")
+
+    def __post_init__(self):
+        check_choices(self)
+        check_ranges(self)
+
+    def speed_factor(self, speed) -> np.ndarray:
+        """``s(u) = 1 + c_u log10(u / u_ref)`` at the sliding ``speed`` [m/s] (1 where it
+        is 0, and for the constant law)."""
+        u = np.asarray(speed, float)
+        if self.law == "constant" or self.speed_coefficient == 0:
+            return np.ones_like(u)
+        ratio = np.where(u > 0, u, self.reference_speed) / self.reference_speed
+        return 1 + self.speed_coefficient * np.log10(ratio)
+
+    def check_speeds(self, low: float, high: float) -> None:
+        """Refuse a speed factor that is not positive over the speeds ``low`` to ``high``
+        [m/s] (a shear that changes sign with the speed)."""
+        worst = float(np.min(self.speed_factor([low, high])))
+        if worst <= 0:
+            raise InputError(f"[boundary] speed_coefficient = {self.speed_coefficient:g}: the "
+                             f"speed factor falls to {worst:.3g} between {low:g} and {high:g} "
+                             "m/s; it must stay positive (a relative change per decade, "
+                             "0.05 is 5 %)")
+
+
+def asperity_load(contact_pressure, film_pressure, contact_fraction,
+                  law: BoundaryLaw) -> np.ndarray:
+    """The asperities' mean normal stress ``p_con + p a_r`` [Pa]: the dry contact's pressure
+    over the film's gauge pressure ``film_pressure`` on the contact spots' fraction (p_con
+    alone without ``law.film_on_contacts``, the paper's eq 32)."""
+    p_con = np.asarray(contact_pressure, float)
+    if not law.film_on_contacts:
+        return p_con
+    return p_con + np.asarray(film_pressure, float) * np.asarray(contact_fraction, float)
+
+
+@arguments(contact_pressure="numbers", film_pressure="numbers", contact_fraction="numbers",
+           sliding_speed="numbers", law=BoundaryLaw, boundary_friction="number")
+def boundary_traction(contact_pressure, film_pressure, contact_fraction, sliding_speed,
+                      law: BoundaryLaw, boundary_friction: float) -> np.ndarray:
+    """The boundary shear ``tau_b`` [Pa] of ``law`` (module docstring) at each node, its
+    temperature factor apart (:func:`spot_temperature_factor`); ``boundary_friction``:
+    the constant law's C_f,b."""
+    load = asperity_load(contact_pressure, film_pressure, contact_fraction, law)
+    if law.law == "constant":
+        return boundary_friction * load
+    shear = law.shear_strength * np.asarray(contact_fraction, float)
+    return (shear + law.pressure_coefficient * load) * law.speed_factor(sliding_speed)
+
+
+def spot_temperature_factor(law: BoundaryLaw, rise_per_shear: float) -> float:
+    """The shear law's temperature factor ``t = 1 - c_T dT`` where the spots' flash rise
+    dT is itself the flash of the tempered shear: ``dT = G tau t`` (the flash is linear in
+    the flux), so ``t = 1 / (1 + c_T G tau)``; ``rise_per_shear`` is ``G tau`` [K], the
+    rise of the untempered shear (1 for the constant law)."""
+    if law.law == "constant" or law.temperature_coefficient == 0:
+        return 1.0
+    return 1.0 / (1.0 + law.temperature_coefficient * max(rise_per_shear, 0.0))

@@ -1,0 +1,147 @@
+"""The boundary shear law (fem_twin.macro.boundary, docs/model.md "Boundary friction"):
+its constant limit bit for bit, a single Hertzian asperity, one decade of speed, and the
+case file's [boundary] section."""
+
+import numpy as np
+import pytest
+from sample_cases import macro_case
+
+from fem_twin import Topography
+from fem_twin.case import CaseError
+from fem_twin.errors import InputError
+from fem_twin.macro import BOUNDARY_FRICTION, BoundaryLaw, Lubricant, MacroSettings, solve_mixed
+from fem_twin.macro.boundary import boundary_traction
+from fem_twin.micro import homogenise
+
+SHEAR = BoundaryLaw(law="shear", shear_strength=50e6, pressure_coefficient=0.1,
+                    speed_coefficient=0.05, reference_speed=0.1)
+
+
+def test_the_shear_law_with_the_constant_coefficient_is_the_constant_law(factors):
+    """tau_0 = 0, alpha = C_f,b and no speed or temperature term: the same operating point,
+    friction and shear field bit for bit as eq 32's constant law."""
+    gap, dx, face = macro_case(32)
+    run = lambda law: solve_mixed(gap, dx, factors, load=150.0, speed=0.02,  # noqa: E731
+                                  face=face, lubricant=Lubricant(0.066),
+                                  settings=MacroSettings(boundary=law))
+    constant = run(BoundaryLaw())
+    shear = run(BoundaryLaw(law="shear", shear_strength=0.0,
+                            pressure_coefficient=BOUNDARY_FRICTION))
+    assert shear.boundary_friction == constant.boundary_friction > 0
+    assert shear.friction_coefficient == constant.friction_coefficient
+    assert np.array_equal(shear.shear_stress, constant.shear_stress)
+
+
+def test_one_decade_of_speed_multiplies_the_shear_by_one_plus_the_coefficient():
+    """s(10 u) / s(u) = 1 + c_u at u = u_ref, and the constant law has no speed term."""
+    p, a = np.array([1e8, 2e8]), np.array([0.1, 0.3])
+    at = lambda law, u: boundary_traction(p, 1e6, a, u, law, 0.15)  # noqa: E731
+    assert at(SHEAR, 1.0) / at(SHEAR, 0.1) == pytest.approx(1.05, rel=1e-14)
+    assert np.array_equal(at(BoundaryLaw(), 1.0), at(BoundaryLaw(), 0.01))
+
+
+def test_a_single_hertzian_asperity_carries_tau0_times_its_area_plus_alpha_times_its_load():
+    """A paraboloid asperity (R = 20 um) in a 40 um periodic cell of 256^2 pixels against a
+    flat at interferences of 0.1 and 0.2 um: the cell's real contact area lies within 5 % of Hertz's
+    pi a^2 for its load (a = (3 W R / (2 E'))^(1/3); measured +2.1 % and +3.4 %: the area
+    is counted in whole pixels), and the law's force over the cell is tau_0 A + alpha W
+    exactly, so within 2 % of tau_0 pi a^2 + alpha W."""
+    n, size, radius, e_red = 256, 40e-6, 20e-6, 231e9
+    x = (np.arange(n) - n / 2 + 0.5) * size / n
+    z = -(x[None, :] ** 2 + x[:, None] ** 2) / (2 * radius)
+    z -= z.mean()
+    flat = Topography(np.zeros_like(z), size / n)
+    ff = homogenise(Topography(z, size / n), flat, z.max() - np.array([0.2e-6, 0.1e-6]),
+                    n_steps=1, e_reduced=e_red, hardness=1e11, error_estimate=False)
+    load, area = ff.p_con * size ** 2, ff.contact_fraction * size ** 2
+    hertz = np.pi * (3 * load * radius / (2 * e_red)) ** (2 / 3)
+    assert np.all(np.abs(area / hertz - 1) < 0.05), area / hertz
+    at_ref = BoundaryLaw(**{**SHEAR.__dict__, "speed_coefficient": 0.0})
+    force = boundary_traction(ff.p_con, 0.0, ff.contact_fraction, 1.0, at_ref, 0.0) * size ** 2
+    assert force == pytest.approx(50e6 * area + 0.1 * load, rel=1e-12)
+    assert force == pytest.approx(50e6 * hertz + 0.1 * load, rel=0.02)
+
+
+def test_the_boundary_section_is_checked_before_any_work(tmp_path):
+    """The shear law's keys need law = "shear"; its speed factor stays positive over the
+    sweep; its temperature term needs the thermal model; a slip is refused with its key."""
+    from conftest import ROOT
+
+    from fem_twin.case import load_case
+    text = (ROOT / "examples" / "pin_on_disk.toml").read_text().replace(
+        "../meshes/", str(ROOT / "meshes") + "/")
+    cases = {'[boundary]\nshear_strength = 1e7\n': "unused by law",
+             '[boundary]\nlaw = "shear"\nspeed_coefficient = 0.5\n': "speed factor falls",
+             '[boundary]\nlaw = "shear"\nshear_strength = 10\npressure_coefficient = 12\n':
+                 "pressure_coefficient = 12: implausible",
+             '[boundary]\nlaw = "stick"\n': "law: one of"}
+    for section, words in cases.items():
+        (tmp_path / "case.toml").write_text(text + "\n" + section)
+        with pytest.raises(CaseError, match=words):
+            load_case(tmp_path / "case.toml")
+    cold = text.replace('model = "flash"', 'model = "none"')
+    (tmp_path / "case.toml").write_text(
+        cold + '\n[boundary]\nlaw = "shear"\ntemperature_coefficient = 0.002\n')
+    with pytest.raises(CaseError, match="thermal model"):
+        load_case(tmp_path / "case.toml")
+    (tmp_path / "case.toml").write_text(text + '\n[boundary]\nlaw = "shear"\n'
+                                        'shear_strength = 2e7\npressure_coefficient = 0.1\n')
+    case = load_case(tmp_path / "case.toml")
+    assert case.boundary.shear_strength == 2e7
+    from fem_twin.stages.requests import macro_settings
+    assert macro_settings(case).boundary == case.boundary
+    with pytest.raises(InputError, match="speed_coefficient"):
+        BoundaryLaw(speed_coefficient=5.0)
+
+
+def test_the_temperature_term_reads_the_flash_of_the_tempered_shear(factors):
+    """With the thermal model, the shear law's temperature factor t and the asperity spots'
+    flash rise dT of the tempered shear satisfy t = 1 - c_T dT to rounding (the flash is
+    linear in the flux, so t = 1 / (1 + c_T G tau) is exact, no iteration), and the
+    point's boundary friction is t times the untempered one's at the same film."""
+    from fem_twin.macro.thermal import ContactThermal, ThermalSettings, thermal_point
+    from fem_twin.macro.viscosity import WaltherLaw
+    gap, dx, face = macro_case(32)
+    law = BoundaryLaw(law="shear", shear_strength=20e6, pressure_coefficient=0.1,
+                      temperature_coefficient=0.01)
+
+    def solve(lubricant, previous):
+        return (solve_mixed(gap, dx, factors, load=150.0, speed=0.05, face=face,
+                            lubricant=lubricant, settings=MacroSettings(boundary=law)),)
+    thermal = ContactThermal(ThermalSettings(), WaltherLaw.through((24.0, 50.0),
+                                                                   (0.066, 0.024), 875.0))
+    (res,), film, record = thermal_point(solve, Lubricant(0.066), thermal, factors,
+                                         (0.0, 0.05))
+    t = res.meta["boundary_temperature_factor"]
+    assert 0.5 < t < 0.999
+    assert t == pytest.approx(1 - 0.01 * record["spot_flash_K"], rel=1e-9)
+    (cold,) = solve(film, None)
+    assert res.boundary_friction == pytest.approx(t * cold.boundary_friction, rel=1e-9)
+
+
+def test_a_constant_coefficient_fit_is_refused_on_a_shear_law_case(tmp_path):
+    """``fit --params boundary_friction`` and ``run --from-fit`` with a fitted C_f,b on a
+    case whose [boundary] law is "shear" (which does not read C_f,b) are refused before any
+    work rather than silently ignored."""
+    import json
+    from dataclasses import replace
+
+    from conftest import ROOT
+
+    from fem_twin.case import load_case
+    from fem_twin.fitting import apply_fit, fit_case
+    case = load_case(ROOT / "examples" / "pin_on_disk.toml")
+    case = replace(case, boundary=SHEAR)
+    fit = {"fit": {"parameters": ["boundary_friction"]}, "case": {"temperatures": [24.0]},
+           "boundary_friction": {"value": 0.12}}
+    with pytest.raises(InputError, match="does not read it"):
+        apply_fit(case, json.loads(json.dumps(fit)))
+    measured = tmp_path / "m.csv"
+    measured.write_text("speed,friction_coefficient\n" + "".join(
+        f"{u},{0.05}\n" for u in (0.01, 0.1, 1.0)))
+
+    def run(*args, **kwargs):
+        raise AssertionError("the run started")
+    with pytest.raises(InputError, match="does not read it"):
+        fit_case(case, [measured], tmp_path / "o", ["boundary_friction"], progress=False,
+                 run=run)
