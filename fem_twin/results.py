@@ -20,7 +20,7 @@ from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .macro.estimate import PARTS
 from .macro.result import FIELDS
-from .stribeck.curve import TEMPERATURES, UNITS
+from .stribeck.curve import OPTIONAL, UNITS
 
 ENGINE = "h5netcdf"
 #: ``fields.nc``'s variables and units: an operating point's fields
@@ -104,13 +104,13 @@ def stribeck_dataset(curves, patch_curves=None):
     if patch_curves:
         ds["patch_friction_coefficient"] = (("patch", "viscosity", "speed"), cf, {
             "units": "1", "long_name": "C_f with one patch's flow factors"})
-    for name, (_, meaning) in TEMPERATURES.items():
+    for name, (_, unit, meaning) in OPTIONAL.items():
         if any(getattr(c, name) is not None for c in curves):
             v = np.full((mu.size, speed.size), np.nan)
             for i, c in enumerate(curves):
                 if getattr(c, name) is not None:
                     v[i, np.searchsorted(speed, c.speed)] = getattr(c, name)
-            ds[name] = (("viscosity", "speed"), v, {"units": "degC", "long_name": meaning})
+            ds[name] = (("viscosity", "speed"), v, {"units": unit, "long_name": meaning})
     if any(c.friction_error is not None for c in curves):
         parts = {"cf_err": "total"} | {f"cf_err_{p}": p for p in PARTS}
         for name, part in parts.items():

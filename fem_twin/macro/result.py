@@ -29,9 +29,10 @@ class MixedResult:
     Scalars: ``speed`` U [m/s], ``imposed_load`` F_N,imp and ``normal_load`` F_N (eq 28) [N],
     ``h_d`` [m], ``friction_force`` F_T (eq 33) with its ``hydrodynamic_friction`` and
     ``boundary_friction`` parts [N], ``friction_coefficient`` C_f (eq 34),
-    ``contact_load`` (integral of p_con) [N], the asperities' ``asperity_load`` (integral
-    of p_con + p a_r, :func:`.boundary.asperity_load`) [N] and ``real_contact_area`` (of
-    a_r) [m^2] over the face.
+    ``contact_load`` (integral of p_con) [N]; the asperities' ``asperity_load`` (of
+    p_con + p a_r, :func:`.boundary.asperity_load`) [N] and ``real_contact_area`` (of a_r)
+    [m^2] over the face, each node weighted by the x1 share of its sliding direction (1
+    under uniform sliding): the integrals the boundary law reads along the load cell.
     Fields (ny, nx): ``pressure`` p_hd, ``contact_pressure`` p_con [Pa], ``cavity_fraction``,
     ``h0``, ``mean_gap`` h_m, ``elastic_deformation`` h_el [m], ``viscosity`` [Pa s],
     ``density_ratio`` rho/rho_0, ``shear_stress`` tau_tot and its ``boundary_shear`` part
@@ -159,7 +160,8 @@ def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubrica
     :func:`.friction.hydrodynamic_shear`) of a converged state, with ``factors`` at its
     slide-to-roll ratio, on the pin ``face``, the disk moving at ``velocity``
     (:func:`.kinematics.disk_velocity`; None: along x1); and the asperities' load field
-    (:func:`.boundary.asperity_load`) [Pa] and contact fraction a_r [-] the law reads."""
+    (:func:`.boundary.asperity_load`) [Pa] and contact fraction a_r [-] the law reads, each
+    times the x1 share of the local sliding direction."""
     shear = factors.at(h0)              # the shear factors (the iterations read none)
     tau_hd = hydrodynamic_shear(p_hd, h_m, theta, mu, shear, dx, speed,
                                 entrainment=entrainment, eyring_stress=lubricant.eyring_stress,
@@ -172,7 +174,7 @@ def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubrica
     tau_con = boundary_traction(p_con, film, a_r, speed * local, settings.boundary,
                                 settings.boundary_friction)
     return (tau_hd, tau_con * cos * (speed > 0),     # along the sliding, x1; 0: no sliding
-            asperity_load(p_con, film, a_r, settings.boundary), a_r)
+            asperity_load(p_con, film, a_r, settings.boundary) * cos, a_r * cos)
 
 
 def friction_with(result: MixedResult, factors, settings, lubricant) -> float:

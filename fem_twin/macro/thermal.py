@@ -231,6 +231,7 @@ def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
                       "bulk_rise_K": s.bulk_resistance * heat["power"],
                       "face_flash_K": heat["flash"], "spot_flash_K": spot,
                       "power_W": heat["power"], "pin_share": heat["pin_share"],
+                      "spot_rise_K_Pa": spot_flash(abs(levels[0].speed), speeds, s),
                       "iterations": len(history)}
             return levels, film, record
         pairs.append((T, target - T))

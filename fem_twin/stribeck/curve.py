@@ -20,12 +20,20 @@ COLUMNS = ("speed", "hersey", "friction_coefficient", "viscosity", "hydrodynamic
 HEADERS = dict(zip(COLUMNS, ("speed_m_s", "hersey", "friction_coefficient", "viscosity_Pa_s",
                              "hydrodynamic_friction_N", "boundary_friction_N",
                              "contact_load_fraction", "h_d_m", "iterations")))
-#: a thermal run's temperatures per point [C] (:mod:`fem_twin.macro.thermal`): their CSV
-#: header and ``results.nc`` long name
-TEMPERATURES = {"contact_temperature": ("contact_temperature_C", "the film's temperature: oil, "
-                                        "bulk rise and the face's flash temperature"),
-                "asperity_temperature": ("asperity_temperature_C", "an asperity contact's "
-                                         "temperature: the film's and its flash")}
+#: the columns a curve has when its run gives them: a thermal run's temperatures [C] and
+#: spots' flash per pascal of boundary shear [K/Pa] (:mod:`fem_twin.macro.thermal`), the
+#: boundary law's integrals (:mod:`fem_twin.macro.boundary`): their CSV header, unit in
+#: ``results.nc`` and long name
+OPTIONAL = {"contact_temperature": ("contact_temperature_C", "degC", "the film's temperature: "
+                                    "oil, bulk rise and the face's flash temperature"),
+            "asperity_temperature": ("asperity_temperature_C", "degC", "an asperity "
+                                     "contact's temperature: the film's and its flash"),
+            "asperity_load": ("asperity_load_N", "N", "the asperities' load p_con + p a_r "
+                              "along the sliding (the constant law's F_b over C_f,b)"),
+            "real_contact_area": ("real_contact_area_m2", "m2", "the real contact area "
+                                  "along the sliding"),
+            "spot_rise": ("spot_rise_K_Pa", "K/Pa", "an asperity spot's flash per pascal "
+                          "of boundary shear")}
 #: the unit and meaning of each variable over (viscosity, speed) in ``results.nc``
 #: (:func:`fem_twin.results.stribeck_dataset`; speed and viscosity are its coordinates)
 UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
@@ -65,8 +73,9 @@ class StribeckCurve:
     sweep estimated them (None otherwise); coarse_friction_coefficient: C_f of the same
     points on the macro grid coarsened by two, four, ..., as ``(levels, points)`` (the
     nested solves' coarse points, finest first; NaN where none was solved), when the sweep
-    kept them; contact_temperature and asperity_temperature [C]: a thermal run's
-    (:data:`TEMPERATURES`; None when isothermal).
+    kept them; the :data:`OPTIONAL` columns where the run gives them (temperatures [C]
+    and the spots' flash per shear [K/Pa] of a thermal run, the boundary law's asperity
+    load [N] and real contact area [m^2]; None otherwise).
     """
 
     speed: np.ndarray
@@ -83,6 +92,9 @@ class StribeckCurve:
     coarse_friction_coefficient: np.ndarray | None = None
     contact_temperature: np.ndarray | None = None
     asperity_temperature: np.ndarray | None = None
+    asperity_load: np.ndarray | None = None
+    real_contact_area: np.ndarray | None = None
+    spot_rise: np.ndarray | None = None
 
     def with_load_share(self, share: float) -> "StribeckCurve":
         """This curve, swept at ``share`` F_N,imp on the pin face, referred to the imposed
@@ -122,7 +134,7 @@ def joined(curves) -> StribeckCurve:
     if any(c.viscosity != first.viscosity for c in curves):
         raise InputError("joined: the pieces of a curve share one viscosity")
     arrays = {name: np.concatenate([getattr(c, name) for c in curves])
-              for name in (*COLUMNS, *TEMPERATURES) if name != "viscosity"
+              for name in (*COLUMNS, *OPTIONAL) if name != "viscosity"
               and getattr(first, name) is not None}
     error = None if first.friction_error is None else np.concatenate(
         [c.friction_error for c in curves])
@@ -153,7 +165,7 @@ def write_stribeck_csv(path, curves, band=None) -> Path:
         columns["cf_err"] = np.concatenate([np.full(c.speed.shape, np.nan)
                                             if c.friction_error is None else c.friction_error
                                             for c in curves])
-    for name, (header, _) in TEMPERATURES.items():
+    for name, (header, *_) in OPTIONAL.items():
         if any(getattr(c, name) is not None for c in curves):
             columns[header] = np.concatenate([np.full(c.speed.shape, np.nan)
                                               if getattr(c, name) is None else getattr(c, name)
@@ -174,7 +186,8 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
         rows = list(csv.DictReader(f))
     if rows and set(HEADERS.values()) <= set(rows[0]):
         rows = [{**{k: r[HEADERS[k]] for k in COLUMNS},
-                 **({"cf_err": r["cf_err"]} if "cf_err" in r else {})} for r in rows]
+                 **({"cf_err": r["cf_err"]} if "cf_err" in r else {}),
+                 **{k: r[h] for k, (h, *_) in OPTIONAL.items() if h in r}} for r in rows]
     if not rows or set(COLUMNS) - set(rows[0]):
         raise InputError(f"{path}: not a Stribeck CSV with columns {tuple(HEADERS.values())}")
     try:
@@ -193,6 +206,7 @@ def _curves(rows) -> list[StribeckCurve]:
         col["iterations"] = col["iterations"].astype(int)
         if "cf_err" in sel[0]:
             col["friction_error"] = np.array([float(r["cf_err"]) for r in sel])
+        col.update({k: np.array([float(r[k]) for r in sel]) for k in OPTIONAL if k in sel[0]})
         out.append(StribeckCurve(viscosity=mu, **col))
     return out
 

@@ -165,11 +165,12 @@ def _curve(records, request: SweepRequest) -> StribeckCurve:
     get = lambda name: np.array([r[name] for r in records])  # noqa: E731
     errors = ({part: np.array([r["error_estimate"][part] for r in records])
                for part in (*PARTS, "total")} if request.error_estimate else None)
-    temperature = ({k: get(k) for k in ("contact_temperature", "asperity_temperature")}
-                   if request.thermal is not None else {})
+    thermal = ({k: get(k) for k in ("contact_temperature", "asperity_temperature",
+                                    "spot_rise")} if request.thermal is not None else {})
     speeds, mu, load = request.speeds, request.lubricant.viscosity, request.load
     return StribeckCurve(
-        speed=speeds.copy(), **temperature,
+        speed=speeds.copy(), **thermal, asperity_load=get("asperity_load"),
+        real_contact_area=get("real_contact_area"),
         hersey=hersey_number(mu, speeds, request.hersey_length, load),
         friction_coefficient=get("friction_coefficient"), viscosity=mu,
         hydrodynamic_friction=get("hydrodynamic_friction"),
@@ -260,8 +261,10 @@ def _record(res: MixedResult) -> dict:
         "friction_coefficient", "hydrodynamic_friction", "boundary_friction", "contact_load",
         "h_d", "iterations")}, COARSE_CF: np.atleast_1d(res.meta.get(COARSE_CF, np.nan)),
         "error_estimate": res.meta.get("error_estimate"),
+        "asperity_load": res.asperity_load, "real_contact_area": res.real_contact_area,
         "contact_temperature": res.meta.get("thermal", {}).get("film_C", np.nan),
-        "asperity_temperature": res.meta.get("thermal", {}).get("asperity_C", np.nan)}
+        "asperity_temperature": res.meta.get("thermal", {}).get("asperity_C", np.nan),
+        "spot_rise": res.meta.get("thermal", {}).get("spot_rise_K_Pa", np.nan)}
 
 
 def _levels(rows) -> np.ndarray:
