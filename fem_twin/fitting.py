@@ -18,6 +18,7 @@ from .errors import InputError
 from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .io.table import write_csv
+from .macro.boundary import BoundaryLaw
 from .macro.viscosity import WaltherLaw
 from .numerics.threads import executor_for
 from .stages.requests import per_viscosity, sweep_request
@@ -28,12 +29,12 @@ from .stribeck.fit import (
     LOAD_SHARES,
     PARAMETERS,
     RESISTANCES,
+    SHEAR,
     FitModel,
     check_parameters,
     fit_curves,
-    plot_fit,
-    predict,
 )
+from .stribeck.prediction import plot_fit, predict
 from .taskgraph import fit_scaling
 
 log = logging.getLogger("fem_twin")
@@ -44,7 +45,7 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     """Fit ``params`` (case-file keys, :data:`~fem_twin.stribeck.fit.PARAMETERS`) of
     ``case`` to the ``measured`` CSV files, the K-th against the case's K-th viscosity;
     ``predict_at``: oil temperatures [C] of predicted curves (``OUT/prediction_T.csv``,
-    C_f with its 95 % band, :func:`~fem_twin.stribeck.fit.predict`).
+    C_f with its 95 % band, :func:`~fem_twin.stribeck.prediction.predict`).
     ``run``: the pipeline's ``run`` (runs or resumes the case into ``outdir``); a
     ``load_share`` fit then sweeps the first viscosity at :data:`LOAD_SHARES`
     (checkpointed in ``OUT/fit/``, so a rerun resumes)."""
@@ -86,7 +87,7 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
         RESISTANCES if "bulk_resistance" in params else (), progress)
     model = FitModel(tuple(simulated), case.tribometer.boundary_friction, case.tribometer.load,
                      law, case.tribometer.load_share, shares, case.thermal.bulk_resistance,
-                     resistances)
+                     resistances, _shear_base(case))
     nominal = list(lb.temperatures[:len(paths)])
     result = fit_curves(model, curves_measured, params, verbose=progress,
                         start_temperatures=nominal if "temperature" in params else None)
@@ -186,12 +187,24 @@ def apply_fit(case: Case, result: dict) -> Case:
                  load_share=get("load_share", tr.load_share))
     thermal = replace(case.thermal, bulk_resistance=get("bulk_resistance",
                                                         case.thermal.bulk_resistance))
+    shear = {k: result[k]["value"] for k in SHEAR if k in result}
+    boundary = (replace(_shear_base(case), law="shear", **shear) if shear
+                else case.boundary)
     offset = temperature_offset(result)
     if offset is not None:
         law = WaltherLaw(**result["case"]["law"])
         lb = replace(lb, viscosities=tuple(float(law.viscosity(t + offset))
                                            for t in lb.temperatures))
-    return replace(case, tribometer=tr, lubricant=lb, thermal=thermal)
+    return replace(case, tribometer=tr, lubricant=lb, thermal=thermal, boundary=boundary)
+
+
+def _shear_base(case: Case) -> BoundaryLaw:
+    """The shear law whose unfitted values a fit of the law's parameters keeps: the case's
+    own, or eq 32's constant C_f,b as a shear law (tau_0 = 0, alpha = C_f,b)."""
+    if case.boundary.law == "shear":
+        return case.boundary
+    return BoundaryLaw(law="shear", shear_strength=0.0,
+                       pressure_coefficient=case.tribometer.boundary_friction)
 
 
 def temperature_offset(result: dict) -> float | None:
@@ -223,7 +236,8 @@ def check_fit(result, where: str = "fit") -> dict:
         unknown = [k for k in result["fit"]["parameters"] if k not in PARAMETERS
                    and not re.fullmatch(r"temperature_[1-9][0-9]*", k)]
         values = {k: float(result[k]["value"]) for k in ("boundary_friction", "load_share",
-                                                         "bulk_resistance") if k in result}
+                                                         "bulk_resistance", *SHEAR)
+                  if k in result}
         offset = temperature_offset(result)
         law = None if offset is None else WaltherLaw(**result["case"]["law"])
         law is None or float(law.viscosity(20.0))
@@ -233,7 +247,7 @@ def check_fit(result, where: str = "fit") -> dict:
         raise InputError(f"{where}: unknown fitted parameter(s) {unknown}; fem-twin fit writes "
                          f"{', '.join(PARAMETERS)} and temperature_K")
     quantity = {"boundary_friction": "friction", "load_share": "load_share",
-                "bulk_resistance": "thermal_resistance"}
+                "bulk_resistance": "thermal_resistance", **{k: k for k in SHEAR}}
     for name, value in values.items():          # the case parser's ranges
         plausible(f"{where} {name}", value, quantity[name])
         result[name]["value"] = value           # a number, whatever the file spelled
@@ -271,7 +285,7 @@ def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=Non
     shares = shares if len(shares) > 1 else ()                # a zero-width interval
     resistances = resistances if resistances and len(resistances[0]) > 1 else ()
     model = FitModel(tuple(curves), tr.boundary_friction, tr.load, law, tr.load_share, shares,
-                     fitted.thermal.bulk_resistance, resistances)
+                     fitted.thermal.bulk_resistance, resistances, _shear_base(fitted))
     offset = temperature_offset(result)
     rows = [predict(model, result, c.speed, None if offset is None else t,
                     result["case"]["temperatures"], curve=k)

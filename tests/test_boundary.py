@@ -145,3 +145,41 @@ def test_a_constant_coefficient_fit_is_refused_on_a_shear_law_case(tmp_path):
     with pytest.raises(InputError, match="does not read it"):
         fit_case(case, [measured], tmp_path / "o", ["boundary_friction"], progress=False,
                  run=run)
+
+
+def test_a_fit_recovers_the_shear_laws_pressure_and_speed_coefficients(factors):
+    """Synthetic truth: the twin run with the shear law (alpha = 0.12, c_u = 0.03 about
+    0.1 m/s) at 9 speeds is fitted by the constant-law twin's curve (its real contact area
+    and asperity load, 20 speeds, PCHIP in log speed): noiseless, alpha and c_u within
+    1 % and 0.003; with 1 % noise inside their 95 % intervals.  tau_0 with alpha from one
+    load, and C_f,b beside the shear law, are refused as unidentifiable."""
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
+    from fem_twin.stribeck.curve import MeasuredCurve
+    from fem_twin.stribeck.fit import FitModel, fit_curves
+    gap, dx, face = macro_case(32)
+    truth = BoundaryLaw(law="shear", pressure_coefficient=0.12, speed_coefficient=0.03,
+                        reference_speed=0.1)
+    common = dict(load=150.0, face=face, lubricant=Lubricant(0.066))
+    sim = stribeck_sweep(SweepRequest(gap, dx, factors, np.geomspace(2.0, 0.004, 20),
+                                      **common))
+    speeds = np.geomspace(1.0, 0.01, 9)
+    measured = stribeck_sweep(SweepRequest(gap, dx, factors, speeds, **common,
+                                           settings=MacroSettings(boundary=truth)))
+    model = FitModel((sim,), BOUNDARY_FRICTION, 150.0, None,
+                     boundary=BoundaryLaw(law="shear", pressure_coefficient=0.15,
+                                          reference_speed=0.1))
+    params = ["pressure_coefficient", "speed_coefficient"]
+    exact = fit_curves(model, [MeasuredCurve(speeds, measured.friction_coefficient)], params,
+                       start_temperatures=None)
+    assert exact["pressure_coefficient"]["value"] == pytest.approx(0.12, rel=0.01)
+    assert exact["speed_coefficient"]["value"] == pytest.approx(0.03, abs=0.003)
+    noisy = measured.friction_coefficient * (
+        1 + 0.01 * np.random.default_rng(5).standard_normal(speeds.size))
+    out = fit_curves(model, [MeasuredCurve(speeds, noisy)], params, start_temperatures=None)
+    for name, value in (("pressure_coefficient", 0.12), ("speed_coefficient", 0.03)):
+        assert out[name]["low"] < value < out[name]["high"], (name, out[name])
+    for bad, words in ((["shear_strength", "pressure_coefficient"], "one load"),
+                       (["boundary_friction", "speed_coefficient"], "fit one law"),
+                       (["temperature_coefficient"], "spot_rise")):
+        with pytest.raises(InputError, match=words):
+            fit_curves(model, [MeasuredCurve(speeds, noisy)], bad, start_temperatures=None)

@@ -16,7 +16,8 @@ from fem_twin.macro.thermal import ContactThermal, ThermalSettings
 from fem_twin.macro.viscosity import WaltherLaw
 from fem_twin.stribeck import SweepRequest, stribeck_sweep
 from fem_twin.stribeck.curve import MeasuredCurve
-from fem_twin.stribeck.fit import LOAD_SHARES, RESISTANCES, FitModel, fit_curves, predict
+from fem_twin.stribeck.fit import LOAD_SHARES, RESISTANCES, FitModel, fit_curves
+from fem_twin.stribeck.prediction import predict
 
 sys.path.insert(0, str(Path(__file__).parent))
 from sample_cases import macro_case  # noqa: E402

@@ -15,17 +15,21 @@ its diagonal's root."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from ..errors import InputError, NotConverged
+from ..macro.boundary import BoundaryLaw
 from ..macro.viscosity import WaltherLaw
 from .curve import MeasuredCurve, StribeckCurve
 
+#: the shear law's parameters a fit can identify (``[boundary]`` keys), with their bounds
+SHEAR = {"shear_strength": (0.0, 5e8), "pressure_coefficient": (0.0, 1.0),
+         "speed_coefficient": (-0.3, 0.3), "temperature_coefficient": (0.0, 0.05)}
 #: the parameters :func:`fit_curves` can fit (case-file keys)
-PARAMETERS = ("boundary_friction", "temperature", "load_share", "bulk_resistance")
+PARAMETERS = ("boundary_friction", "temperature", "load_share", "bulk_resistance", *SHEAR)
 #: the face's shares of the imposed load swept for a ``load_share`` fit (its bounds)
 LOAD_SHARES = (0.5, 0.625, 0.75, 0.875, 1.0)
 #: the rig's thermal resistances [K/W] swept for a ``bulk_resistance`` fit (its bounds)
@@ -44,7 +48,9 @@ class FitModel:
     without temperatures); ``share_curves``: ``((share, StribeckCurve), ...)`` swept at one
     viscosity, ascending, that bracket ``load_share`` (empty: the share is not a parameter);
     ``resistance_curves``: per curve, ``((R_b, StribeckCurve), ...)`` ascending around the
-    curves' own ``bulk_resistance`` [K/W] (empty: not a parameter).
+    curves' own ``bulk_resistance`` [K/W] (empty: not a parameter); ``boundary``: the
+    shear law whose unfitted values a fit of its parameters keeps (None: eq 32's constant
+    C_f,b as a shear law, tau_0 = 0 and alpha = ``boundary_friction``).
     """
 
     curves: tuple
@@ -55,14 +61,17 @@ class FitModel:
     share_curves: tuple = ()
     bulk_resistance: float = 0.0
     resistance_curves: tuple = ()
+    boundary: BoundaryLaw | None = None
 
     def friction(self, k: int, speed, boundary_friction: float, viscosity: float,
-                 share: float | None = None, resistance: float | None = None):
+                 share: float | None = None, resistance: float | None = None,
+                 shear: dict | None = None):
         """C_f of curve ``k`` at ``speed`` [m/s] for C_f,b, mu_0 [Pa s], the face's
         ``share`` of the load and the rig's thermal ``resistance`` [K/W] (None: the curves'
-        own); and the mask of speeds whose Hersey number lies inside the simulated range
-        (ends held outside)."""
-        at = lambda c: self._at(c, speed, boundary_friction, viscosity)  # noqa: E731
+        own), the boundary shear by the shear law with the values ``shear`` (None: C_f,b);
+        and the mask of speeds whose Hersey number lies inside the simulated range (ends
+        held outside)."""
+        at = lambda c: self._at(c, speed, boundary_friction, viscosity, shear)  # noqa: E731
         cf, inside = at(self.curves[k])
         for value, own, swept in ((share, self.load_share, self.share_curves),
                                   (resistance, self.bulk_resistance,
@@ -77,23 +86,54 @@ class FitModel:
             inside = inside & np.all([v[1] for v in values], axis=0)
         return cf, inside
 
-    def _at(self, c: StribeckCurve, speed, boundary_friction: float, viscosity: float):
+    def _at(self, c: StribeckCurve, speed, boundary_friction: float, viscosity: float,
+            shear: dict | None = None):
         order = np.argsort(c.speed)
         x = np.log(c.speed[order])
         u = np.log(np.asarray(speed, float) * viscosity / c.viscosity)
         inside = (u >= x[0]) & (u <= x[-1])
-        u = np.clip(u, x[0], x[-1])
-        hd = PchipInterpolator(x, c.hydrodynamic_friction[order])(u)
-        con = PchipInterpolator(x, c.boundary_friction[order])(u) / self.boundary_friction
-        return (hd + boundary_friction * con) / self.load, inside
+        at = lambda a: PchipInterpolator(x, a[order])(np.clip(u, x[0], x[-1]))  # noqa: E731
+        hd = at(c.hydrodynamic_friction)
+        if shear is None:
+            return (hd + boundary_friction * at(c.boundary_friction)
+                    / self.boundary_friction) / self.load, inside
+        return (hd + self._law_force(c, at, speed, shear)) / self.load, inside
+
+    def _law_force(self, c: StribeckCurve, at, speed, shear: dict):
+        """The shear law's boundary force [N] (:mod:`fem_twin.macro.boundary`) from the
+        curve's real contact area and asperity load, its spots' flash for the temperature
+        factor (``t = 1 / (1 + c_T dT)``, dT the untempered shear's flash)."""
+        base = self.boundary or BoundaryLaw(law="shear", shear_strength=0.0,
+                                            pressure_coefficient=self.boundary_friction)
+        law = replace(base, law="shear", **shear)
+        area, load = at(c.real_contact_area), at(c.asperity_load)
+        force = (law.shear_strength * area + law.pressure_coefficient * load) * \
+            law.speed_factor(speed)
+        if law.temperature_coefficient:
+            rise = at(c.spot_rise) * np.divide(force, area, out=np.zeros_like(force),
+                                               where=area > 0)
+            force = force / (1 + law.temperature_coefficient * np.maximum(rise, 0.0))
+        return force
 
 
 def check_parameters(params) -> None:
-    """Refuse an empty list or a name outside :data:`PARAMETERS`."""
+    """Refuse an empty list, a name outside :data:`PARAMETERS`, and a set the data cannot
+    identify: C_f,b beside the shear law's parameters (two boundary laws), or tau_0 with
+    alpha from curves at one load (the real area and the asperity load grow together
+    along a curve, so one load does not separate them)."""
     unknown = set(params) - set(PARAMETERS)
     if unknown or not params:
         raise InputError(f"unknown fit parameter(s) {sorted(unknown)}; choose from "
                          f"{list(PARAMETERS)}")
+    if "boundary_friction" in params and set(params) & set(SHEAR):
+        raise InputError("boundary_friction is eq 32's constant law; the shear law's "
+                         f"{', '.join(sorted(set(params) & set(SHEAR)))} replace it: fit one "
+                         "law")
+    if {"shear_strength", "pressure_coefficient"} <= set(params):
+        raise InputError("shear_strength and pressure_coefficient cannot both be fitted to "
+                         "curves at one load: along a curve the real contact area and the "
+                         "asperity load grow together; fit one of them (the other keeps its "
+                         "[boundary] value)")
 
 
 def fit_curves(model: FitModel, measured, params, *, start_temperatures,
@@ -117,6 +157,7 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     if "bulk_resistance" in params and len(model.resistance_curves) != len(model.curves):
         raise InputError("fitting the thermal resistance needs every curve swept at two or "
                          "more resistances (FitModel.resistance_curves)")
+    _check_columns(model, params)
     names, x0, lower, upper = _unknowns(model, params, len(measured), start_temperatures)
 
     def unpack(x):
@@ -129,17 +170,18 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
                    else [float(model.law.viscosity(t)) for t in start_temperatures])
         else:
             mus = [float(model.law.viscosity(t)) for t in temps]
-        return cfb, mus, v.get("load_share"), v.get("bulk_resistance")
+        shear = {k: v[k] for k in SHEAR if k in v} or None
+        return cfb, mus, v.get("load_share"), v.get("bulk_resistance"), shear
 
     measured, dropped = _inside(model, measured, *unpack(x0))
     sigma = [_sigma(m) for m in measured]
     weighted = all(s is not None for s in sigma)
 
     def residuals(x):
-        cfb, mus, share, resistance = unpack(x)
+        cfb, mus, share, resistance, shear = unpack(x)
         out = []
         for k, m in enumerate(measured):
-            cf, _ = model.friction(k, m.speed, cfb, mus[k], share, resistance)
+            cf, _ = model.friction(k, m.speed, cfb, mus[k], share, resistance, shear)
             r = (cf - m.friction_coefficient) / model.boundary_friction
             out.append(r / (sigma[k] / model.boundary_friction) if weighted else r)
         return np.concatenate(out)
@@ -175,6 +217,10 @@ def _unknowns(model, params, n_curves, start_temperatures):
     if "bulk_resistance" in params:
         lo, hi = model.resistance_curves[0][0][0], model.resistance_curves[0][-1][0]
         rows.append(("bulk_resistance", min(max(model.bulk_resistance, lo), hi), lo, hi))
+    base = model.boundary or BoundaryLaw(law="shear", pressure_coefficient=min(
+        model.boundary_friction, SHEAR["pressure_coefficient"][1]))
+    rows += [(name, min(max(getattr(base, name), lo), hi), lo, hi)
+             for name, (lo, hi) in SHEAR.items() if name in params]
     names, x0, lower, upper = zip(*rows)
     return list(names), np.array(x0, float), list(lower), list(upper)
 
@@ -196,7 +242,7 @@ def check_misfit(result: dict, names, x, lower, upper) -> None:
     where = (f"rms C_f,dev {f['rms_cf_dev']:.1%} of C_f,b, largest {worst[3]:+.1%} at "
              f"{worst[2]:.3g} m/s on curve {worst[1]}")
     pinned = [n for n, v, lo, hi in zip(names, x, lower, upper)
-              if n not in ("load_share", "bulk_resistance")
+              if n not in ("load_share", "bulk_resistance", *SHEAR)
               and min(v - lo, hi - v) <= 1e-6 * (hi - lo)]
     if f["weights"] == "equal":
         bad = f["rms_cf_dev"] > MISFIT_RMS
@@ -210,13 +256,13 @@ def check_misfit(result: dict, names, x, lower, upper) -> None:
                          "the case's lubricant?")
 
 
-def _inside(model: FitModel, measured, cfb, mus, share, resistance) -> tuple:
+def _inside(model: FitModel, measured, cfb, mus, share, resistance, shear) -> tuple:
     """The ``measured`` curves cut to the points inside the simulated curves' Hersey range
     at the start values (C_f there would be held at the ends), and how many each lost;
     a curve with none inside is refused."""
     kept, dropped = [], []
     for k, m in enumerate(measured):
-        inside = model.friction(k, m.speed, cfb, mus[k], share, resistance)[1]
+        inside = model.friction(k, m.speed, cfb, mus[k], share, resistance, shear)[1]
         if not inside.any():
             raise InputError(f"measured curve {k + 1}: all {m.speed.size} points lie outside "
                              "the simulated speeds; sweep its speeds, or leave it out")
@@ -225,6 +271,19 @@ def _inside(model: FitModel, measured, cfb, mus, share, resistance) -> tuple:
                                   cut(m.low), cut(m.high)))
         dropped.append(int((~inside).sum()))
     return kept, dropped
+
+
+def _check_columns(model: FitModel, params) -> None:
+    """Refuse a shear-law fit on curves without the law's integrals (a run of an older
+    fem_twin) or, for its temperature term, without the spots' flash (an isothermal run)."""
+    needs = (("real_contact_area", "asperity_load") if set(params) & set(SHEAR) else ()) + (
+        ("spot_rise",) if "temperature_coefficient" in params else ())
+    for name in needs:
+        if any(getattr(c, name) is None for c in model.curves):
+            raise InputError(f"fitting {', '.join(p for p in params if p in SHEAR)} needs each "
+                             f"simulated curve's {name} (" + (
+                                 "a run with [thermal] model = \"flash\")" if name ==
+                                 "spot_rise" else "run the case again with this fem_twin)"))
 
 
 def _sigma(m: MeasuredCurve):
@@ -260,7 +319,7 @@ def _summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
     half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
     out = {name: interval(v, h, lo, hi)
            for name, v, h, lo, hi in zip(names, sol.x, half, *bounds)}
-    cfb, mus, share, resistance = unpack(sol.x)
+    cfb, mus, share, resistance, shear = unpack(sol.x)
     for k in range(len(measured)):
         t = out.get(f"temperature_{k + 1}")
         if t is not None:                       # viscosity falls as temperature rises
@@ -269,7 +328,7 @@ def _summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
                                          "high": float(mu[2])}
     rows, outside = [], 0
     for k, m in enumerate(measured):
-        cf, inside = model.friction(k, m.speed, cfb, mus[k], share, resistance)
+        cf, inside = model.friction(k, m.speed, cfb, mus[k], share, resistance, shear)
         outside += int((~inside).sum())
         rows.append({"curve": k + 1, "speed_m_s": m.speed.tolist(),
                      "measured_cf": m.friction_coefficient.tolist(), "fitted_cf": cf.tolist(),
@@ -303,70 +362,6 @@ def _temperature_warnings(model: FitModel, out: dict, n: int) -> list[str]:
     return warnings
 
 
-def predict(model: FitModel, result: dict, speeds, temperature: float | None,
-            nominal=None, *, curve: int | None = None) -> dict:
-    """C_f at ``speeds`` [m/s] for the oil at ``temperature`` [C] with the fitted parameters
-    of ``result`` (:func:`fit_curves`), and its 95 % band from their covariance.
-
-    With fitted temperatures and the ``nominal`` oil temperatures of the measured curves
-    [C], the contact runs at ``temperature`` plus their mean offset (fitted minus nominal,
-    e.g. frictional heating), whose uncertainty joins the band; without, at
-    ``temperature`` (None: at the viscosity of the simulated ``curve``).  The simulated
-    curve of the nearest viscosity, or ``curve``, is rescaled (Hersey); without ``curve``
-    the band adds the spread of all the simulated curves so rescaled (the Hersey collapse's
-    own error, when there are two or more); it adds their C_f error estimates
-    (``cf_err``).  A fitted load share and thermal resistance move C_f along
-    ``model.share_curves`` and ``model.resistance_curves``."""
-    names = result["fit"]["parameters"]
-    x = np.array([result[n]["value"] for n in names])
-    cov = np.asarray(result["fit"]["covariance"])
-    temps = [i for i, n in enumerate(names) if n.startswith("temperature_")]
-
-    def cf(x, k=curve):
-        v = dict(zip(names, x))
-        offset = (np.mean([x[i] - t for i, t in zip(temps, nominal)])
-                  if temps and nominal is not None else 0.0)
-        mu = (model.curves[k].viscosity if temperature is None
-              else float(model.law.viscosity(temperature + offset)))
-        if k is None:
-            k = int(np.argmin([abs(np.log(c.viscosity / mu)) for c in model.curves]))
-        return model.friction(k, speeds, v.get("boundary_friction", model.boundary_friction),
-                              mu, v.get("load_share"), v.get("bulk_resistance"))
-
-    value, inside = cf(x)
-    discretisation = _error_at(model, speeds) + (_collapse_error(model, cf, x)
-                                                 if curve is None else 0.0)
-    grad = np.stack([(cf(x + step)[0] - value) / step[i]
-                     for i, step in enumerate(np.diag(np.maximum(1e-6 * np.abs(x), 1e-6)))],
-                    axis=1)
-    half = result["fit"]["t_factor"] * np.sqrt(np.einsum("ij,jk,ik->i", grad, cov, grad))
-    half = half + discretisation                  # the twin's own error (cf_err), when known
-    return {"speed_m_s": np.asarray(speeds, float), "cf": value, "cf_low": value - half,
-            "cf_high": value + half, "cf_err": discretisation,
-            "inside_simulated_range": inside}
-
-
-def _collapse_error(model: FitModel, cf, x) -> np.ndarray:
-    """Largest spread of the simulated curves rescaled to the same viscosity (eq 46)."""
-    if len(model.curves) < 2:
-        return 0.0
-    values = np.array([cf(x, k)[0] for k in range(len(model.curves))])
-    return values.max(axis=0) - values.min(axis=0)
-
-
-def _error_at(model: FitModel, speeds) -> np.ndarray:
-    """The simulated curves' C_f error estimate at ``speeds`` (the largest over the curves;
-    0 without estimates)."""
-    curves = [c for c in model.curves if c.friction_error is not None]
-    if not curves:
-        return np.zeros(np.shape(speeds))
-    out = []
-    for c in curves:
-        order = np.argsort(c.speed)
-        out.append(np.interp(np.log(speeds), np.log(c.speed[order]), c.friction_error[order]))
-    return np.max(out, axis=0)
-
-
 def _covariance(jac, res, weighted: bool):
     """Covariance of the fitted parameters: ``(J^T J)^-1`` for residuals weighted by the
     measured scatter; without it, the heteroscedasticity-consistent sandwich estimator HC3
@@ -386,25 +381,3 @@ def _correlation(cov):
     d = np.sqrt(np.diag(cov))
     outer = np.outer(d, d)
     return np.divide(cov, outer, out=np.zeros_like(cov), where=outer > 0)
-
-
-def plot_fit(result: dict, path, labels=None):
-    """Measured and fitted C_f against speed, one colour per curve."""
-    import matplotlib.pyplot as plt
-
-    from ..io.figure import save_figure
-    fig, ax = plt.subplots(figsize=(6.5, 4.2))
-    for i, row in enumerate(result["residuals"]):
-        label = labels[i] if labels else f"curve {row['curve']}"
-        (line,) = ax.loglog(row["speed_m_s"], row["fitted_cf"], "-", label=f"fitted, {label}")
-        ax.loglog(row["speed_m_s"], row["measured_cf"], "s", color=line.get_color(), ms=4,
-                  label=f"measured, {label}")
-    fitted = ", ".join(f"{k} = {v['value']:.4g} [{v['low']:.4g}, {v['high']:.4g}]"
-                       for k, v in result.items() if k in result["fit"]["parameters"])
-    ax.set_title(fitted, fontsize="small")
-    ax.set_xlabel("sliding speed $U$ [m/s]")
-    ax.set_ylabel("$C_f$ [-]")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize="x-small")
-    fig.tight_layout()
-    return save_figure(fig, path, dpi=110)

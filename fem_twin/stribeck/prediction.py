@@ -1,0 +1,95 @@
+"""A fitted twin's predictions: C_f at other speeds, temperatures or cases with the 95 %
+band of the fitted parameters (:func:`predict`), and the fit's figure (:func:`plot_fit`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .fit import SHEAR, FitModel
+
+
+def predict(model: FitModel, result: dict, speeds, temperature: float | None,
+            nominal=None, *, curve: int | None = None) -> dict:
+    """C_f at ``speeds`` [m/s] for the oil at ``temperature`` [C] with the fitted parameters
+    of ``result`` (:func:`fit_curves`), and its 95 % band from their covariance.
+
+    With fitted temperatures and the ``nominal`` oil temperatures of the measured curves
+    [C], the contact runs at ``temperature`` plus their mean offset (fitted minus nominal,
+    e.g. frictional heating), whose uncertainty joins the band; without, at
+    ``temperature`` (None: at the viscosity of the simulated ``curve``).  The simulated
+    curve of the nearest viscosity, or ``curve``, is rescaled (Hersey); without ``curve``
+    the band adds the spread of all the simulated curves so rescaled (the Hersey collapse's
+    own error, when there are two or more); it adds their C_f error estimates
+    (``cf_err``).  A fitted load share and thermal resistance move C_f along
+    ``model.share_curves`` and ``model.resistance_curves``."""
+    names = result["fit"]["parameters"]
+    x = np.array([result[n]["value"] for n in names])
+    cov = np.asarray(result["fit"]["covariance"])
+    temps = [i for i, n in enumerate(names) if n.startswith("temperature_")]
+
+    def cf(x, k=curve):
+        v = dict(zip(names, x))
+        offset = (np.mean([x[i] - t for i, t in zip(temps, nominal)])
+                  if temps and nominal is not None else 0.0)
+        mu = (model.curves[k].viscosity if temperature is None
+              else float(model.law.viscosity(temperature + offset)))
+        if k is None:
+            k = int(np.argmin([abs(np.log(c.viscosity / mu)) for c in model.curves]))
+        return model.friction(k, speeds, v.get("boundary_friction", model.boundary_friction),
+                              mu, v.get("load_share"), v.get("bulk_resistance"),
+                              {n: v[n] for n in SHEAR if n in v} or None)
+
+    value, inside = cf(x)
+    discretisation = _error_at(model, speeds) + (_collapse_error(model, cf, x)
+                                                 if curve is None else 0.0)
+    grad = np.stack([(cf(x + step)[0] - value) / step[i]
+                     for i, step in enumerate(np.diag(np.maximum(1e-6 * np.abs(x), 1e-6)))],
+                    axis=1)
+    half = result["fit"]["t_factor"] * np.sqrt(np.einsum("ij,jk,ik->i", grad, cov, grad))
+    half = half + discretisation                  # the twin's own error (cf_err), when known
+    return {"speed_m_s": np.asarray(speeds, float), "cf": value, "cf_low": value - half,
+            "cf_high": value + half, "cf_err": discretisation,
+            "inside_simulated_range": inside}
+
+
+def _collapse_error(model: FitModel, cf, x) -> np.ndarray:
+    """Largest spread of the simulated curves rescaled to the same viscosity (eq 46)."""
+    if len(model.curves) < 2:
+        return 0.0
+    values = np.array([cf(x, k)[0] for k in range(len(model.curves))])
+    return values.max(axis=0) - values.min(axis=0)
+
+
+def _error_at(model: FitModel, speeds) -> np.ndarray:
+    """The simulated curves' C_f error estimate at ``speeds`` (the largest over the curves;
+    0 without estimates)."""
+    curves = [c for c in model.curves if c.friction_error is not None]
+    if not curves:
+        return np.zeros(np.shape(speeds))
+    out = []
+    for c in curves:
+        order = np.argsort(c.speed)
+        out.append(np.interp(np.log(speeds), np.log(c.speed[order]), c.friction_error[order]))
+    return np.max(out, axis=0)
+
+
+def plot_fit(result: dict, path, labels=None):
+    """Measured and fitted C_f against speed, one colour per curve."""
+    import matplotlib.pyplot as plt
+
+    from ..io.figure import save_figure
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for i, row in enumerate(result["residuals"]):
+        label = labels[i] if labels else f"curve {row['curve']}"
+        (line,) = ax.loglog(row["speed_m_s"], row["fitted_cf"], "-", label=f"fitted, {label}")
+        ax.loglog(row["speed_m_s"], row["measured_cf"], "s", color=line.get_color(), ms=4,
+                  label=f"measured, {label}")
+    fitted = ", ".join(f"{k} = {v['value']:.4g} [{v['low']:.4g}, {v['high']:.4g}]"
+                       for k, v in result.items() if k in result["fit"]["parameters"])
+    ax.set_title(fitted, fontsize="small")
+    ax.set_xlabel("sliding speed $U$ [m/s]")
+    ax.set_ylabel("$C_f$ [-]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="x-small")
+    fig.tight_layout()
+    return save_figure(fig, path, dpi=110)
