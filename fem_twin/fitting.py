@@ -70,6 +70,9 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: b
     if "bulk_resistance" in params and case.thermal.model == "none":
         raise InputError("bulk_resistance is the thermal twin's: set [thermal] model = "
                          "\"flash\" to fit it")
+    if "temperature_coefficient" in params and case.thermal.model == "none":
+        raise InputError("temperature_coefficient reads the asperity spots' flash of the "
+                         "thermal twin: set [thermal] model = \"flash\" to fit it")
     if "boundary_friction" in params and case.boundary.law != "constant":
         raise InputError("boundary_friction is eq 32's constant C_f,b; the case's [boundary] "
                          "law = \"shear\" does not read it: fit the other parameters, or "
