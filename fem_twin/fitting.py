@@ -31,6 +31,7 @@ from .stribeck.fit import (
     RESISTANCES,
     SHEAR,
     FitModel,
+    check_loads,
     check_parameters,
     fit_curves,
 )
@@ -40,72 +41,129 @@ from .taskgraph import fit_scaling
 log = logging.getLogger("fem_twin")
 
 
-def fit_case(case: Case, measured, outdir, params, *, predict_at=(), progress: bool = True,
-             run=None) -> dict:
+def fit_case(case: Case, measured, outdir, params, *, predict_at=(), predict_loads=(),
+             progress: bool = True, run=None) -> dict:
     """Fit ``params`` (case-file keys, :data:`~fem_twin.stribeck.fit.PARAMETERS`) of
-    ``case`` to the ``measured`` CSV files, the K-th against the case's K-th viscosity;
-    ``predict_at``: oil temperatures [C] of predicted curves (``OUT/prediction_T.csv``,
-    C_f with its 95 % band, :func:`~fem_twin.stribeck.prediction.predict`).
-    ``run``: the pipeline's ``run`` (runs or resumes the case into ``outdir``); a
-    ``load_share`` fit then sweeps the first viscosity at :data:`LOAD_SHARES`
-    (checkpointed in ``OUT/fit/``, so a rerun resumes)."""
+    ``case`` to the ``measured`` CSV files: the K-th against the case's K-th viscosity at
+    the case's load, or at the ``load_N`` and ``viscosity_Pa_s`` its file gives (the twin
+    swept there, checkpointed in ``OUT/fit/``); ``predict_at``: oil temperatures [C] and
+    ``predict_loads``: loads [N] of predicted curves (``OUT/prediction_TC.csv``,
+    ``OUT/prediction_LN.csv``, C_f with its 95 % band,
+    :func:`~fem_twin.stribeck.prediction.predict`).  ``run``: the pipeline's ``run`` (runs
+    or resumes the case into ``outdir``); a ``load_share`` fit then sweeps the first
+    viscosity at :data:`LOAD_SHARES` (so a rerun resumes)."""
     params = list(params)
-    check_parameters(params)                                      # before the run
     paths = [Path(p) for p in measured]
     curves_measured = [read_measured_csv(p) for p in paths]      # checked before any work
+    tests = _tests(case, curves_measured)
+    _check_request(case, params, paths, curves_measured, tests, predict_at, predict_loads)
     lb = case.lubricant
-    if not 1 <= len(paths) <= len(lb.viscosities):
-        raise InputError(f"{len(paths)} measured curves for the case's {len(lb.viscosities)} "
-                         "viscosities ([lubricant] viscosities): give one CSV per viscosity, "
-                         "in their order")
-    bad = [t for t in predict_at if not -30.0 <= float(t) <= 250.0]
-    if bad:
-        raise InputError(f"--predict {bad}: oil temperatures in C, from -30 to 250 (the range "
-                         "of the fitted contact temperatures)")
-    if (predict_at or "temperature" in params) and len(set(lb.temperatures)) < 2:
-        raise InputError("fitting or predicting a temperature needs viscosities at two "
-                         "temperatures in [lubricant] (the Walther law of ASTM D341)")
-    if "load_share" in params and case.tribometer.ball:
-        raise InputError("load_share is a pin face's share of the load; a ball carries it all")
-    if "bulk_resistance" in params and case.thermal.model == "none":
-        raise InputError("bulk_resistance is the thermal twin's: set [thermal] model = "
-                         "\"flash\" to fit it")
-    if "temperature_coefficient" in params and case.thermal.model == "none":
-        raise InputError("temperature_coefficient reads the asperity spots' flash of the "
-                         "thermal twin: set [thermal] model = \"flash\" to fit it")
-    if "boundary_friction" in params and case.boundary.law != "constant":
-        raise InputError("boundary_friction is eq 32's constant C_f,b; the case's [boundary] "
-                         "law = \"shear\" does not read it: fit the other parameters, or "
-                         "set law = \"constant\"")
-    _check_coverage(case, paths, curves_measured, params)
     law = (WaltherLaw.through(lb.temperatures, lb.viscosities, lb.density)
            if len(set(lb.temperatures)) > 1 else None)
     if run is None:
         from .pipeline import run
     run(case, outdir, progress=progress)
     out = RunLayout(outdir)
-    simulated = read_stribeck_csv(out.stribeck_csv)[:len(paths)]
+    simulated = _simulated(case, out, tests, progress)
     shares, resistances = extra_curves(
         case, out, simulated, LOAD_SHARES if "load_share" in params else (),
         RESISTANCES if "bulk_resistance" in params else (), progress)
     model = FitModel(tuple(simulated), case.tribometer.boundary_friction, case.tribometer.load,
                      law, case.tribometer.load_share, shares, case.thermal.bulk_resistance,
-                     resistances, _shear_base(case))
-    nominal = list(lb.temperatures[:len(paths)])
+                     resistances, _shear_base(case), loads=tuple(load for load, _ in tests))
+    nominal = [lb.temperatures[k] if c.viscosity is None else
+               None if law is None else float(law.temperature(c.viscosity))
+               for k, c in enumerate(curves_measured)]
     result = fit_curves(model, curves_measured, params, verbose=progress,
                         start_temperatures=nominal if "temperature" in params else None)
     result["measured"] = [str(p) for p in paths]
     if shares or resistances:
         result["task_graph"] = fit_scaling(case, outdir)
     result["case"] = {"temperatures": nominal, "load_N": case.tribometer.load,
-                      "kind": case.tribometer.kind, "law": None if law is None else vars(law)}
+                      "loads_N": [load for load, _ in tests], "kind": case.tribometer.kind,
+                      "law": None if law is None else vars(law)}
     with atomic_path(out.fit) as tmp:
         tmp.write_text(json.dumps(result, indent=2))
-    plot_fit(result, out.fit_png, labels=[f"{t:g} C in the case" for t in lb.temperatures])
+    plot_fit(result, out.fit_png, labels=[f"{mu:g} Pa s, {load:g} N" for load, mu in tests])
     for t in predict_at:
         _write_prediction(out.prediction(t), [predict(model, result, simulated[0].speed,
                                                       float(t), nominal=nominal)])
+    for load in predict_loads:
+        _predict_load(case, out, result, float(load), progress)
     return result
+
+
+def _tests(case: Case, curves) -> list[tuple[float, float]]:
+    """Each measured curve's ``(load [N], viscosity [Pa s])``: its file's, else the case's
+    load and K-th viscosity."""
+    mus = case.lubricant.viscosities
+    out = []
+    for k, c in enumerate(curves):
+        if c.viscosity is None and k >= len(mus):
+            raise InputError(f"measured curve {k + 1} of {len(curves)}: the case has "
+                             f"{len(mus)} viscosities ([lubricant] viscosities); give one CSV "
+                             "per viscosity, in their order, or a viscosity_Pa_s column")
+        out.append((c.load or case.tribometer.load, c.viscosity or mus[k]))
+    return out
+
+
+def _check_request(case: Case, params, paths, curves, tests, predict_at, predict_loads):
+    """Everything a fit can be refused for, before the run."""
+    check_parameters(params)
+    check_loads(params, [load for load, _ in tests])
+    lb, tr = case.lubricant, case.tribometer
+    own = [(tr.load, mu) for mu in lb.viscosities]
+    if any(t not in own for t in tests) and {"load_share", "bulk_resistance"} & set(params):
+        raise InputError("load_share and bulk_resistance are fitted on the case's own load and "
+                         "viscosities; leave out the load_N and viscosity_Pa_s columns")
+    bad = [t for t in predict_at if not -30.0 <= float(t) <= 250.0]
+    if bad:
+        raise InputError(f"--predict {bad}: oil temperatures in C, from -30 to 250 (the range "
+                         "of the fitted contact temperatures)")
+    for load in predict_loads:
+        plausible("--predict-load [N]", load, "load")
+    if (predict_at or "temperature" in params) and len(set(lb.temperatures)) < 2:
+        raise InputError("fitting or predicting a temperature needs viscosities at two "
+                         "temperatures in [lubricant] (the Walther law of ASTM D341)")
+    if "load_share" in params and tr.ball:
+        raise InputError("load_share is a pin face's share of the load; a ball carries it all")
+    for name in ("bulk_resistance", "temperature_coefficient"):
+        if name in params and case.thermal.model == "none":
+            raise InputError(f"{name} needs the thermal twin: set [thermal] model = "
+                             "\"flash\" to fit it")
+    if "boundary_friction" in params and case.boundary.law != "constant":
+        raise InputError("boundary_friction is eq 32's constant C_f,b; the case's [boundary] "
+                         "law = \"shear\" does not read it: fit the other parameters, or "
+                         "set law = \"constant\"")
+    _check_coverage(case, paths, curves, params)
+
+
+def _simulated(case: Case, out: RunLayout, tests, progress: bool) -> list:
+    """The twin's curve for each measured one: the run's at the case's load and viscosity,
+    else a sweep of its own at the test's load and viscosity (``OUT/fit/checkpoints``)."""
+    tr, mus = case.tribometer, case.lubricant.viscosities
+    run = read_stribeck_csv(out.stribeck_csv)
+    own = [run[mus.index(mu)] if load == tr.load and mu in mus else None
+           for load, mu in tests]
+    first = _fit_sweep(case, out)                   # its load is the face's share of it
+    tasks = [replace(first, load=load * tr.load_share,
+                     lubricant=replace(first.lubricant, viscosity=mu))
+             for (load, mu), c in zip(tests, own) if c is None]
+    with executor_for(case.run.workers, case.run.scheduler) as executor:
+        swept = iter(run_sweeps(tasks, executor, progress, desc="fit loads")
+                     if tasks else [])
+    return [c if c is not None else next(swept).with_load_share(tr.load_share) for c in own]
+
+
+def _predict_load(case: Case, out: RunLayout, result: dict, load: float, progress: bool):
+    """``OUT/prediction_LN.csv``: the fitted twin at ``load`` [N], each case viscosity
+    swept there, with the 95 % band of the fitted parameters."""
+    tests = [(load, mu) for mu in case.lubricant.viscosities]
+    curves = _simulated(case, out, tests, progress)
+    model = FitModel(tuple(curves), case.tribometer.boundary_friction, load, None,
+                     boundary=_shear_base(case))
+    rows = [predict(model, result, c.speed, None, curve=k) for k, c in enumerate(curves)]
+    _write_prediction(out.prediction_at_load(load), rows, [c.viscosity for c in curves])
 
 
 def _check_coverage(case: Case, paths, curves, params) -> None:

@@ -127,3 +127,39 @@ def test_fit_validate_and_from_fit_refuse_what_they_cannot_use(tmp_path, capsys)
     assert main(["run", str(case), "-o", str(tmp_path / "p"), "--from-fit", str(fit)]) == 2
     assert "boundary_friction" in capsys.readouterr().err
     assert not (tmp_path / "p" / "geometry").exists()
+
+
+@pytest.mark.integration
+def test_measured_curves_at_two_loads_and_a_prediction_at_a_third(tmp_path, capsys):
+    """A measured CSV with ``load_N`` and ``viscosity_Pa_s`` columns is fitted against the
+    twin swept at that load and oil (checkpointed in OUT/fit/): the run's own curve at
+    150 N and the twin's at 300 N, both at C_f,b = 0.15, return C_f,b = 0.15 with the
+    loads in fit.json; ``--predict-load 225`` writes the fitted twin at 225 N with its
+    band; tau_0 with alpha from one load is refused before any work."""
+    case = small_case(tmp_path)
+    out, heavy = tmp_path / "o", tmp_path / "heavy"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    light = measured_from_run(out, tmp_path, slice(1, -1))[0]
+    (tmp_path / "heavy.toml").write_text(case.read_text().replace("load = 150.0",
+                                                                  "load = 300.0"))
+    assert main(["run", str(tmp_path / "heavy.toml"), "-o", str(heavy), "--no-progress"]) == 0
+    cfb = 1 / (3 * 3 ** 0.5)
+    c = read_stribeck_csv(heavy / "stribeck.csv")[0]
+    cf = (c.hydrodynamic_friction + 0.15 / cfb * c.boundary_friction) / 300.0
+    (tmp_path / "m300.csv").write_text("speed,friction_coefficient,load_N,viscosity_Pa_s\n"
+                                       + "".join(f"{float(u)!r},{float(f)!r},300,"
+                                                 f"{float(c.viscosity)!r}\n"
+                                                 for u, f in zip(c.speed[1:-1], cf[1:-1])))
+    args = ["fit", str(case), light, str(tmp_path / "m300.csv"), "-o", str(out),
+            "--no-progress"]
+    assert main([*args, "--params", "boundary_friction", "--predict-load", "225"]) == 0
+    fit = json.loads((out / "fit.json").read_text())
+    assert fit["boundary_friction"]["value"] == pytest.approx(0.15, rel=2e-3)
+    assert fit["case"]["loads_N"] == [150.0, 300.0]
+    rows = list(csv.DictReader(open(out / "prediction_225N.csv")))
+    assert {"speed_m_s", "friction_coefficient", "cf_low", "cf_high"} <= set(rows[0])
+    assert all(float(r["cf_low"]) <= float(r["friction_coefficient"]) <= float(r["cf_high"])
+               for r in rows)
+    assert main(["fit", str(case), light, "-o", str(out), "--no-progress", "--params",
+                 "shear_strength,pressure_coefficient"]) == 2
+    assert "two or more loads" in capsys.readouterr().err

@@ -158,19 +158,24 @@ def _add_case_commands(sub):
     cb = _case_command(sub, "calibrate", "calibration study of a case (paper 3.2): C_f,dev "
                                          "of variants against a reference curve",
                        "calibration", runs.calibrate)
-    ft = sub.add_parser("fit", help="fit C_f,b, the oil temperature, the load share and the "
-                                    "rig's thermal resistance of a case to measured Stribeck "
-                                    "curves (runs or resumes the case first)")
+    ft = sub.add_parser("fit", help="fit C_f,b or the boundary shear law, the oil "
+                                    "temperature, the load share and the rig's thermal "
+                                    "resistance of a case to measured Stribeck curves (runs or "
+                                    "resumes the case first)")
     ft.add_argument("case", type=Path, help="case file")
     ft.add_argument("measured", type=Path, nargs="+",
                     help="measured CSV per viscosity of the case (speed [m/s], "
-                         "friction_coefficient, optional cf_min/cf_max)")
+                         "friction_coefficient, optional cf_min/cf_max; load_N and "
+                         "viscosity_Pa_s: the test's own, the twin swept there)")
     ft.add_argument("-o", "--output", type=Path, default=Path("out"), help="output folder")
     ft.add_argument("--params", default="boundary_friction,temperature",
                     help="comma-separated case keys to fit: " + ", ".join(PARAMETERS))
     ft.add_argument("--predict", type=float, nargs="+", default=[], metavar="T",
                     help="oil temperatures [C] of predicted curves with their 95 %% band "
                          "(OUT/prediction_TC.csv)")
+    ft.add_argument("--predict-load", type=float, nargs="+", default=[], metavar="L",
+                    help="loads [N] of predicted curves, each case viscosity swept there, "
+                         "with their 95 %% band (OUT/prediction_LN.csv)")
     ft.add_argument("--no-progress", action="store_true", help="no progress bars")
     ft.add_argument("--yes", action="store_true", help="start even if the run is long")
     ft.set_defaults(func=runs.fit)

@@ -160,7 +160,8 @@ def fit(args):
         return 2
     result = fit_case(case, args.measured, args.output,
                       [p.strip() for p in args.params.split(",") if p.strip()],
-                      predict_at=args.predict, progress=not args.no_progress)
+                      predict_at=args.predict, predict_loads=args.predict_load,
+                      progress=not args.no_progress)
     for name in result["fit"]["parameters"] + [k for k in result if k.startswith("viscosity_")]:
         v = result[name]
         print(f"fem-twin fit: {name} = {v['value']:.5g} (95 %: {v['low']:.5g} to "

@@ -197,6 +197,10 @@ class RunLayout:
         name = "prediction.csv" if temperature is None else f"prediction_{temperature:g}C.csv"
         return self.root / name
 
+    def prediction_at_load(self, load: float) -> Path:
+        """``fem-twin fit --predict-load L``: the curves predicted at the load ``L`` [N]."""
+        return self.root / f"prediction_{load:g}N.csv"
+
     @property
     def fit_points(self) -> Path:
         """The checkpoints of the sweeps at other load shares (``load_share`` fits)."""

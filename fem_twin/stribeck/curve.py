@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..checks import arguments
+from ..checks import arguments, number
 from ..errors import InputError, MissingFile
 from ..io.figure import save_figure
 from ..io.table import write_csv
@@ -282,19 +282,24 @@ def plot_temperatures(curves, path, *, labels=None,
 
 @dataclass(frozen=True, eq=False)
 class MeasuredCurve:
-    """A measured Stribeck curve: speed [m/s], C_f, optional scatter band (low, high)."""
+    """A measured Stribeck curve: speed [m/s], C_f, optional scatter band (low, high), and
+    the normal ``load`` [N] and oil ``viscosity`` mu_0 [Pa s] it was measured at when the
+    file says (None: the case's)."""
 
     speed: np.ndarray
     friction_coefficient: np.ndarray
     low: np.ndarray | None = None
     high: np.ndarray | None = None
+    load: float | None = None
+    viscosity: float | None = None
 
 
 @arguments(path="path")
 def read_measured_csv(path, unit: str = "m/s") -> MeasuredCurve:
     """CSV with a header: ``speed`` [m/s, or rpm with ``unit="rpm"``, converted by the
     caller] and ``friction_coefficient`` (or ``cf``), and optionally ``cf_min``/``cf_max``
-    (the scatter band of a test set)."""
+    (the scatter band of a test set) and ``load_N`` and ``viscosity_Pa_s`` (the test's
+    load and oil, each one value throughout the file)."""
     if not Path(path).is_file():
         raise MissingFile(f"{path}: no such measured curve (a CSV with speed and "
                           "friction_coefficient)")
@@ -333,7 +338,16 @@ def read_measured_csv(path, unit: str = "m/s") -> MeasuredCurve:
                          f"{min(low.min(), cf.min()):.3g} to {max(high.max(), cf.max()):.3g})")
     if np.any(low > cf) or np.any(cf > high):
         raise InputError(f"{path}: cf_min <= friction_coefficient <= cf_max in every row")
-    return MeasuredCurve(speed, cf, low if band else None, high if band else None)
+    test = {}
+    for key, header, quantity in (("load", "load_N", "load"),
+                                  ("viscosity", "viscosity_Pa_s", "viscosity")):
+        if header in cols:
+            values = col(header)
+            if np.ptp(values) > 0:
+                raise InputError(f"{path}: column {header!r} must hold one value (one test per "
+                                 f"file), found {values.min():g} to {values.max():g}")
+            test[key] = number(f"{path}: {header}", float(values[0]), quantity)
+    return MeasuredCurve(speed, cf, low if band else None, high if band else None, **test)
 
 
 @arguments(curve=StribeckCurve, measured=MeasuredCurve, boundary_friction="number")

@@ -48,7 +48,8 @@ class FitModel:
     without temperatures); ``share_curves``: ``((share, StribeckCurve), ...)`` swept at one
     viscosity, ascending, that bracket ``load_share`` (empty: the share is not a parameter);
     ``resistance_curves``: per curve, ``((R_b, StribeckCurve), ...)`` ascending around the
-    curves' own ``bulk_resistance`` [K/W] (empty: not a parameter); ``boundary``: the
+    curves' own ``bulk_resistance`` [K/W] (empty: not a parameter); ``loads``: each
+    curve's imposed load [N] (empty: ``load`` for all); ``boundary``: the
     shear law whose unfitted values a fit of its parameters keeps (None: eq 32's constant
     C_f,b as a shear law, tau_0 = 0 and alpha = ``boundary_friction``).
     """
@@ -62,6 +63,7 @@ class FitModel:
     bulk_resistance: float = 0.0
     resistance_curves: tuple = ()
     boundary: BoundaryLaw | None = None
+    loads: tuple = ()
 
     def friction(self, k: int, speed, boundary_friction: float, viscosity: float,
                  share: float | None = None, resistance: float | None = None,
@@ -71,7 +73,9 @@ class FitModel:
         own), the boundary shear by the shear law with the values ``shear`` (None: C_f,b);
         and the mask of speeds whose Hersey number lies inside the simulated range (ends
         held outside)."""
-        at = lambda c: self._at(c, speed, boundary_friction, viscosity, shear)  # noqa: E731
+        load = self.loads[k] if self.loads else self.load
+        at = lambda c: self._at(c, speed, boundary_friction, viscosity, shear,  # noqa: E731
+                                load)
         cf, inside = at(self.curves[k])
         for value, own, swept in ((share, self.load_share, self.share_curves),
                                   (resistance, self.bulk_resistance,
@@ -87,7 +91,7 @@ class FitModel:
         return cf, inside
 
     def _at(self, c: StribeckCurve, speed, boundary_friction: float, viscosity: float,
-            shear: dict | None = None):
+            shear: dict | None, load: float):
         order = np.argsort(c.speed)
         x = np.log(c.speed[order])
         u = np.log(np.asarray(speed, float) * viscosity / c.viscosity)
@@ -96,8 +100,8 @@ class FitModel:
         hd = at(c.hydrodynamic_friction)
         if shear is None:
             return (hd + boundary_friction * at(c.boundary_friction)
-                    / self.boundary_friction) / self.load, inside
-        return (hd + self._law_force(c, at, speed, shear)) / self.load, inside
+                    / self.boundary_friction) / load, inside
+        return (hd + self._law_force(c, at, speed, shear)) / load, inside
 
     def _law_force(self, c: StribeckCurve, at, speed, shear: dict):
         """The shear law's boundary force [N] (:mod:`fem_twin.macro.boundary`) from the
@@ -129,11 +133,17 @@ def check_parameters(params) -> None:
         raise InputError("boundary_friction is eq 32's constant law; the shear law's "
                          f"{', '.join(sorted(set(params) & set(SHEAR)))} replace it: fit one "
                          "law")
-    if {"shear_strength", "pressure_coefficient"} <= set(params):
-        raise InputError("shear_strength and pressure_coefficient cannot both be fitted to "
-                         "curves at one load: along a curve the real contact area and the "
-                         "asperity load grow together; fit one of them (the other keeps its "
-                         "[boundary] value)")
+
+
+def check_loads(params, loads) -> None:
+    """Refuse tau_0 with alpha from curves at fewer than two ``loads`` [N]: along a curve
+    the real contact area and the asperity load grow together, so one load does not
+    separate them."""
+    if {"shear_strength", "pressure_coefficient"} <= set(params) and len(set(loads)) < 2:
+        raise InputError("shear_strength and pressure_coefficient need measured curves at two "
+                         "or more loads (a load_N column in each CSV): along a curve the "
+                         "real contact area and the asperity load grow together; or fit one "
+                         "of them (the other keeps its [boundary] value)")
 
 
 def fit_curves(model: FitModel, measured, params, *, start_temperatures,
@@ -158,6 +168,7 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
         raise InputError("fitting the thermal resistance needs every curve swept at two or "
                          "more resistances (FitModel.resistance_curves)")
     _check_columns(model, params)
+    check_loads(params, model.loads or (model.load,))
     names, x0, lower, upper = _unknowns(model, params, len(measured), start_temperatures)
 
     def unpack(x):
@@ -190,10 +201,14 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     if n <= x0.size:
         raise InputError(f"{n} measured points cannot fit {x0.size} parameters")
     from scipy import optimize  # imported here: the CLI reads PARAMETERS
-    sol = optimize.least_squares(residuals, x0, bounds=(lower, upper), x_scale="jac",
-                                 verbose=2 if verbose else 0)
+    # solved over each unknown's range mapped to [0, 1]: the difference steps then suit
+    # C_f,b, a temperature [C] and tau_0 [Pa] alike (tau_0 starts at 0)
+    low, span = np.array(lower), np.array(upper) - np.array(lower)
+    sol = optimize.least_squares(lambda z: residuals(low + z * span), (x0 - low) / span,
+                                 bounds=(0.0, 1.0), x_scale="jac", verbose=2 if verbose else 0)
     if not sol.success:
         raise NotConverged(f"fit did not converge: {sol.message}", [float(sol.cost)])
+    sol.x, sol.jac = low + sol.x * span, sol.jac / span
     out = _summary(model, measured, names, sol, weighted, unpack, (lower, upper))
     out["fit"]["points_not_counted"] = dropped
     out["fit"]["warnings"] += [f"curve {k + 1}: {n} measured point(s) outside the simulated "
@@ -307,14 +322,16 @@ def interval(value: float, half: float, lower: float, upper: float) -> dict:
 def _summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
     n, p = sol.fun.size, sol.x.size
     dof = n - p
-    size = np.linalg.norm(sol.jac, axis=0)
+    # each column over its parameter's range: C_f,b and tau_0 [Pa] differ by 1e9 in units
+    size = np.linalg.norm(sol.jac * (np.array(bounds[1]) - np.array(bounds[0])), axis=0)
     blind = [name for name, s in zip(names, size) if not s > 1e-9 * max(size.max(), 1e-300)]
     if blind or dof < 1:
         raise InputError(f"the measured points do not constrain {', '.join(blind) or 'the fit'}"
                          f" ({n} residuals for {p} unknowns): they lie where C_f does not "
                          "depend on it (C_f,b in full film), or are too few; measure the "
                          "speeds where it acts")
-    cov = _covariance(sol.jac, sol.fun, weighted)
+    scale = np.array(bounds[1]) - np.array(bounds[0])      # unknowns of like size
+    cov = _covariance(sol.jac * scale, sol.fun, weighted) * np.outer(scale, scale)
     from scipy import stats
     half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
     out = {name: interval(v, h, lo, hi)
