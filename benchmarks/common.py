@@ -10,6 +10,7 @@ import numpy as np
 
 from fem_twin import read_topography
 from fem_twin import topography as tp
+from fem_twin.topography import pin_face
 from fem_twin.topography.prepare import prepare_pin
 
 SAMPLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "meshes", "sample")
@@ -42,4 +43,4 @@ def macro_gap(n):
     opts = MacroOptions(resolution=(n, n))
     pin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
     disk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
-    return disk.heights - pin.heights, pin.spacing, pin.heights > opts.holder_height / 2
+    return disk.heights - pin.heights, pin.spacing, pin_face(pin, opts.holder_height)

@@ -27,7 +27,7 @@ import numpy as np
 from fem_twin import read_topography
 from fem_twin.macro import Lubricant, MacroSettings, disk_velocity, solve_mixed
 from fem_twin.micro import homogenise
-from fem_twin.topography import resample_cell
+from fem_twin.topography import pin_face, resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 
 HERE = Path(sys.argv[0]).resolve().parent
@@ -40,7 +40,7 @@ def geometry(n):
     opts = MacroOptions(resolution=(n, n))
     pin = prepare_pin(read_topography(SAMPLE / "pin_1.npz"), opts)
     disk = prepare_disk(read_topography(SAMPLE / "disk_1.npz"), opts)
-    return disk.heights - pin.heights, pin.spacing, pin.heights > opts.holder_height / 2
+    return disk.heights - pin.heights, pin.spacing, pin_face(pin, opts.holder_height)
 
 
 def sweep(gap, dx, face, factors, speeds, radius):

@@ -30,7 +30,7 @@ from fem_twin.macro.thermal import ContactThermal, ThermalSettings, surface_temp
 from fem_twin.macro.viscosity import WaltherLaw
 from fem_twin.micro import homogenise
 from fem_twin.stribeck import SweepRequest, stribeck_sweep
-from fem_twin.topography import resample_cell
+from fem_twin.topography import pin_face, resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 
 HERE = Path(sys.argv[0]).resolve().parent
@@ -63,7 +63,7 @@ def sample_sweep(n, speeds):
                        (32, 32))
     factors = homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), n_steps=4)
     return SweepRequest(disk.heights - pin.heights, pin.spacing, factors, speeds, load=150.0,
-                        lubricant=Lubricant(0.066), face=pin.heights > opts.holder_height / 2,
+                        lubricant=Lubricant(0.066), face=pin_face(pin, opts.holder_height),
                         settings=MacroSettings(track_radius=30e-3))
 
 

@@ -42,7 +42,7 @@ from fem_twin.stribeck import SweepRequest, stribeck_sweep
 from fem_twin.stribeck.curve import MeasuredCurve
 from fem_twin.stribeck.fit import FitModel, fit_curves
 from fem_twin.stribeck.prediction import predict
-from fem_twin.topography import resample_cell
+from fem_twin.topography import pin_face, resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 
 SAMPLE = Path(sys.argv[0]).resolve().parents[1] / "meshes" / "sample"
@@ -59,7 +59,7 @@ def sample_pin():
     up = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"),
                                      upper=True), (32, 32))
     factors = homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), n_steps=4)
-    return disk.heights - pin.heights, pin.spacing, pin.heights > opts.holder_height / 2, factors
+    return disk.heights - pin.heights, pin.spacing, pin_face(pin, opts.holder_height), factors
 
 
 def main(out="out/boundary_law", quick=False):

@@ -9,7 +9,7 @@ import numpy as np
 
 from fem_twin.io.files import read_topography
 from fem_twin.micro import FlowFactors, homogenise
-from fem_twin.topography import resample_cell
+from fem_twin.topography import pin_face, resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -21,7 +21,7 @@ def macro_case(n):
     opts = MacroOptions(resolution=(n, n))
     pin = prepare_pin(read_topography(SAMPLE / "pin_1.npz"), opts)
     disk = prepare_disk(read_topography(SAMPLE / "disk_1.npz"), opts)
-    return disk.heights - pin.heights, pin.spacing, pin.heights > opts.holder_height / 2
+    return disk.heights - pin.heights, pin.spacing, pin_face(pin, opts.holder_height)
 
 
 def sample_factors():

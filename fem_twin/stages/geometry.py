@@ -21,6 +21,7 @@ from ..io.mesh import grid_mesh, write_vtu
 from ..macro.point_contact import PointContact
 from ..numerics.threads import run_jobs
 from ..topography.filling import fill_defects
+from ..topography.geometry import pin_face
 from ..topography.plausibility import check_patch, check_pin
 from ..topography.prepare import flat_disk, prepare_disk, prepare_patch, prepare_pin
 from ..topography.sphere import cap_gap, fit_sphere
@@ -68,11 +69,11 @@ def _pin_geometry(case: Case, out: RunLayout, i: int) -> tuple[dict, list[str]]:
                              f"{pin.shape} vs {disk.shape}")
         write_vtu(out.macro_vtu(i + 1), grid_mesh(pin.shape, pin.spacing, pin.origin),
                   {"x3_low": pin.heights, "x3_up": disk.heights,
-                   "pin_face": (pin.heights > opts.holder_height).astype(float)})
+                   "pin_face": pin_face(pin, opts.holder_height).astype(float)})
         write_topography(disk_out, disk)
         write_topography(pin_out, pin)
     pin = read_topography(pin_out)
-    face = pin.heights > opts.holder_height
+    face = pin_face(pin, opts.holder_height)
     return {"file": pin_out.name, "grid": list(pin.shape), "spacing_m": list(pin.spacing),
             "face_fraction": float(face.mean()),
             "face_range_m": [float(pin.heights[face].min()),
@@ -225,7 +226,7 @@ def macro_geometry(case: Case, out: RunLayout):
     pin = read_topography(macro_pin_file(case, out))
     k = macro_pin_number(case)
     disk = read_topography(out.disk(1 if k == "average" else k))
-    face = pin.heights > case.preprocessing.holder_height / 2
+    face = pin_face(pin, case.preprocessing.holder_height)
     return disk.heights - pin.heights, pin.spacing, face, pin.origin
 
 

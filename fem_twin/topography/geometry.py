@@ -115,5 +115,7 @@ def mount_pin(topo: Topography, truncation: float = -20e-6, holder_height: float
 
 @arguments(topo=Topography, holder_height="number")
 def pin_face(topo: Topography, holder_height: float = -1e-3) -> np.ndarray:
-    """Boolean mask of the pin face of a mounted pin (pixels above the holder)."""
-    return topo.heights > holder_height
+    """Boolean mask of the pin face of a mounted pin: pixels above half the holder's depth
+    ``holder_height`` [m] (a rim pixel that resampling left between face and holder counts
+    with the side it is nearer).  The one rule of the face, for every stage."""
+    return topo.heights > holder_height / 2
