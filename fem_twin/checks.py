@@ -31,6 +31,9 @@ QUANTITIES = {
     "thermal_resistance": (0.0, 100.0, "K/W (a rig's contact to its oil bath: about 1)"),
     "slide_to_roll": (-2.0, 2.0, "u_r / u_m in [-2, 2] (50 % is 0.5; 0: pure rolling; 2: "
                       "the pin or ball at rest)"),
+    "ball_slide_to_roll": (1e-3, 2.0, "u_r / u_m of a ball's Stribeck curve, in (0, 2] (50 % "
+                           "is 0.5; 2: the ball at rest; pure rolling, 0, is fem-twin "
+                           "traction's SRR 0)"),
     "viscosity": (1e-5, 10.0, "Pa s (66 mPa s is 0.066)"),
     "density": (100.0, 2e4, "kg/m^3"),
     "pressure_viscosity": (0.0, 1e-7, "1/Pa (22 GPa^-1 is 22e-9)"),

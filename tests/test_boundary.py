@@ -70,6 +70,7 @@ def test_the_boundary_section_is_checked_before_any_work(tmp_path):
     from fem_twin.case import load_case
     text = (ROOT / "examples" / "pin_on_disk.toml").read_text().replace(
         "../meshes/", str(ROOT / "meshes") + "/")
+    text = text[:text.index("[boundary]")] + text[text.index("[sweep]"):]  # its own below
     cases = {'[boundary]\nshear_strength = 1e7\n': "unused by law",
              '[boundary]\nlaw = "shear"\nspeed_coefficient = 0.5\n': "speed factor falls",
              '[boundary]\nlaw = "shear"\nshear_strength = 10\npressure_coefficient = 12\n':

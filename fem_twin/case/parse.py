@@ -13,7 +13,6 @@ from ..checks import arguments, check_choice, memory_shortfall, plausible
 from ..errors import InputError
 from ..macro.boundary import BoundaryLaw
 from ..macro.thermal import ThermalSettings
-from ..stribeck.request import RollingSliding
 from ..topography.prepare import MacroOptions
 from .sections import (
     SECTIONS,
@@ -118,12 +117,6 @@ BALL_ONLY = {("tribometer", "slide_to_roll"): 'kind = "ball-on-disk"',
 
 
 def _tribometer(data, where) -> Tribometer:
-    srr = data.get("tribometer", {}).get("slide_to_roll")
-    if isinstance(srr, (int, float)) and not isinstance(srr, bool):
-        try:
-            RollingSliding(srr)                     # the ball's Stribeck curve: its rule
-        except InputError as err:
-            raise CaseError(f"{where} [tribometer] {err}") from None
     tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
     if tribometer.ball and "sliding_radius" in data.get("tribometer", {}):
         raise CaseError(f"{where} [tribometer] sliding_radius: a pin's track, unused by a ball; "

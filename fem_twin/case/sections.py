@@ -15,7 +15,6 @@ from ..macro.boundary import BoundaryLaw
 from ..macro.settings import MacroSettings
 from ..macro.thermal import ThermalSettings
 from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN
-from ..micro.rolling import SLIDING
 from ..micro.sliding import CellSettings
 from ..topography.prepare import MacroOptions
 from .cost import estimated_seconds
@@ -71,8 +70,8 @@ class Tribometer:
     kind: str = setting("pin-on-disk", "the tribometer", choices=("pin-on-disk",
                                                                   "ball-on-disk"))
     ball_radius: float = setting(12.5e-3, "radius of a ball-on-disk's ball", "length")
-    slide_to_roll: float = setting(0.5, "slide-to-roll ratio u_r / u_m of a ball, in [0, 2] "
-                                   "(0: pure rolling; 2: a stationary ball)", "slide_to_roll")
+    slide_to_roll: float = setting(0.5, "slide-to-roll ratio u_r / u_m of a ball's Stribeck "
+                                   "curve (2: a stationary ball)", "ball_slide_to_roll")
     track_radius: float = setting(20e-3, "radius of a ball's track on the disk (its "
                                   "contact's centre's)", "length")
 
@@ -233,13 +232,13 @@ class RunSpec:
 
 #: each setting a stage's settings take from another section (declared with
 #: ``setting(..., section=...)``): its section and how the case gives it.  The cells slide
-#: (the pin at rest, SRR 2) in every case: a ball's ratio reaches the flow factors by the
-#: frame change of :func:`fem_twin.micro.at_slide_to_roll` in ``solve_mixed``.
+#: at ``CellSettings``' own SRR 2 (the pin at rest) in every case, no case key sets it: a
+#: ball's ratio reaches the flow factors by the frame change of
+#: :func:`fem_twin.micro.at_slide_to_roll` in ``solve_mixed``.
 FILLED = {"e_reduced": ("materials", lambda case: case.materials.e_reduced),
           "hardness": ("materials", lambda case: case.materials.hardness),
           "boundary_friction": ("tribometer", lambda case: case.tribometer.boundary_friction),
           "track_radius": ("tribometer", lambda case: case.tribometer.disk_radius),
-          "slide_to_roll": ("tribometer", lambda case: SLIDING),
           "boundary": ("boundary", lambda case: case.boundary)}
 
 

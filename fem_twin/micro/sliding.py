@@ -55,7 +55,7 @@ class CellSettings:
     slide_to_roll: float = setting(SLIDING, "SRR = u_r / u_m of the cell's kinematics: the pin or "
                                    "ball at u_m (1 - SRR/2), the disk at u_m (1 + SRR/2) "
                                    "(2: the pin at rest; exact squeeze term only)",
-                                   "slide_to_roll", section="tribometer")
+                                   "slide_to_roll")
     first_step: str = setting("steady", "backward scheme only: no time term at the first "
                               "step (the paper), or the last instant before the first",
                               choices=("steady", "periodic"))

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..checks import QUANTITIES, as_field, as_pair, check, number
+from ..checks import as_field, as_pair, check, number
 from ..errors import InputError
 from ..io.checkpoint import input_key
 from ..macro import Lubricant, MacroSettings
@@ -48,12 +48,7 @@ class RollingSliding:
     slide_to_roll: float
 
     def __post_init__(self):
-        top = QUANTITIES["slide_to_roll"][1]
-        srr = self.slide_to_roll
-        if isinstance(srr, bool) or not isinstance(srr, (int, float)) or not 0 < srr <= top:
-            raise InputError(f"slide_to_roll = {srr}: a ball's Stribeck curve slides at "
-                             f"u_r / u_m in (0, {top:g}] ({top:g}: the ball at rest); pure "
-                             "rolling (0) is fem-twin traction's SRR 0")
+        number("slide_to_roll", self.slide_to_roll, "ball_slide_to_roll")
 
     @property
     def key(self) -> float:
