@@ -248,6 +248,9 @@ def _macro(data, where, tribometer, geometry) -> MacroSpec:
     if not 9 <= macro.grid <= 1025:
         raise CaseError(f"{where} [macro] grid: nodes per side of the ball's grid, 9 to 1025 "
                         f"(e.g. 97), got {macro.grid}")
+    if tribometer.reading == "torque" and macro.friction != "pin":
+        raise CaseError(f"{where} [tribometer] reading = \"torque\": the disk's drag is the "
+                        "force law's; it needs [macro] friction = \"pin\"")
     if macro.pin != "average" and not tribometer.ball and not (isinstance(macro.pin, int)
                                        and 1 <= macro.pin <= len(geometry.pins)):
         raise CaseError(f"{where} [macro] pin: 'average' or a pin number 1..{len(geometry.pins)}")

@@ -12,6 +12,7 @@ from pathlib import Path
 from .. import tables as T
 from ..checks import check_ranges, setting
 from ..macro.boundary import BoundaryLaw
+from ..macro.friction import READINGS
 from ..macro.settings import MacroSettings
 from ..macro.thermal import ThermalSettings
 from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN
@@ -69,6 +70,9 @@ class Tribometer:
         "the friction force over the imposed load (1: the paper)", "load_share")
     kind: str = setting("pin-on-disk", "the tribometer", choices=("pin-on-disk",
                                                                   "ball-on-disk"))
+    reading: str = setting("force", "what the rig reads, C_f's numerator: the tangential "
+                           "force on the pin holder (a load cell), or the disk's reaction "
+                           "torque over the track radius", choices=READINGS)
     ball_radius: float = setting(12.5e-3, "radius of a ball-on-disk's ball", "length")
     slide_to_roll: float = setting(0.5, "slide-to-roll ratio u_r / u_m of a ball's Stribeck "
                                    "curve (2: a stationary ball)", "ball_slide_to_roll")
@@ -239,6 +243,7 @@ FILLED = {"e_reduced": ("materials", lambda case: case.materials.e_reduced),
           "hardness": ("materials", lambda case: case.materials.hardness),
           "boundary_friction": ("tribometer", lambda case: case.tribometer.boundary_friction),
           "track_radius": ("tribometer", lambda case: case.tribometer.disk_radius),
+          "reading": ("tribometer", lambda case: case.tribometer.reading),
           "boundary": ("boundary", lambda case: case.boundary)}
 
 

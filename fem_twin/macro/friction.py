@@ -18,6 +18,9 @@ from .kinematics import rotate_tensor, rotations
 
 #: the friction laws: the force on the pin, or the paper's eq 31
 LAWS = ("pin", "paper")
+#: what a rig reads: a tangential load cell on the pin holder, or the disk's reaction
+#: torque over the track radius
+READINGS = ("force", "torque")
 
 
 @arguments(pressure="field", mean_gap="field", spacing="pair", speed="number")
@@ -62,6 +65,26 @@ def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, sp
     if law == "paper":
         return poiseuille + couette
     return poiseuille + couette - (p - ambient_pressure) * face_slope(mean_gap, face, spacing[0])
+
+
+@arguments(pressure="field", mean_gap="field", spacing="pair", speed="number")
+def disk_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing, speed, *,
+               eyring_stress=None, velocity=None) -> np.ndarray:
+    """The film's traction on the disk along its local sliding [Pa] (its drag):
+    ``(mu u_r |v| / h_m) s_C (1 - theta) + (h_m / 2) b . grad p`` with ``b = 2 e1 - (2 e1 -
+    b)`` from the shear factors and ``grad p`` in the sliding frame, the disk at ``speed``
+    times ``velocity`` (None: along x1; Eyring as :func:`hydrodynamic_shear`'s).  Its
+    integral along x1 under uniform sliding is the force on the pin (docs/model.md,
+    "Friction on the pin"); times ``|v|`` it is the disk's torque over the track radius."""
+    p = np.asarray(pressure, float)
+    dp2, dp1 = np.gradient(p, spacing[1], spacing[0])
+    c, s, v = (1.0, 0.0, 1.0) if velocity is None else rotations(velocity)
+    f = shear.pressure_friction                                 # 2 e1 - b
+    couette = viscosity / mean_gap * speed * v * shear.friction_factor * (1 - cavity_fraction)
+    if eyring_stress is not None:
+        couette = eyring_stress * np.arcsinh(couette / eyring_stress)
+    return couette + mean_gap / 2 * ((2 - f[..., 0]) * (c * dp1 + s * dp2)
+                                     - f[..., 1] * (c * dp2 - s * dp1))
 
 
 def face_slope(gap, face, dx1: float) -> np.ndarray:

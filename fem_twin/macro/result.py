@@ -11,7 +11,7 @@ import numpy as np
 from ..io.atomic import atomic_path
 from ..micro.rolling import at_slide_to_roll
 from .boundary import asperity_load, boundary_traction
-from .friction import hydrodynamic_shear
+from .friction import disk_shear, hydrodynamic_shear
 from .kinematics import disk_velocity, rotations
 from .reynolds import trapezoid_weights
 
@@ -155,26 +155,35 @@ def _plain(settings) -> dict:
 
 def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubricant, speed,
                  entrainment, face=None, velocity=None):
-    """The film's and the contacts' tangential tractions on the pin along x1 [Pa] (eqs
-    31-32, or the force on the pin: ``settings.friction``,
-    :func:`.friction.hydrodynamic_shear`) of a converged state, with ``factors`` at its
-    slide-to-roll ratio, on the pin ``face``, the disk moving at ``velocity``
-    (:func:`.kinematics.disk_velocity`; None: along x1); and the asperities' load field
-    (:func:`.boundary.asperity_load`) [Pa] and contact fraction a_r [-] the law reads, each
-    times the x1 share of the local sliding direction."""
+    """The film's and the contacts' tangential tractions [Pa] of a converged state as the
+    rig reads them (``settings.reading``): on the pin along x1 (eqs 31-32, or the force on
+    the pin: ``settings.friction``, :func:`.friction.hydrodynamic_shear`), or the disk's
+    drag times ``|v|`` (its torque over the track radius, :func:`.friction.disk_shear`);
+    ``factors`` at the state's slide-to-roll ratio, on the pin ``face``, the disk moving at
+    ``velocity`` (:func:`.kinematics.disk_velocity`; None: along x1); and the asperities'
+    load field (:func:`.boundary.asperity_load`) [Pa] and contact fraction a_r [-] the law
+    reads, each weighted alike (the x1 share of the sliding, or ``|v|``)."""
     shear = factors.at(h0)              # the shear factors (the iterations read none)
-    tau_hd = hydrodynamic_shear(p_hd, h_m, theta, mu, shear, dx, speed,
-                                entrainment=entrainment, eyring_stress=lubricant.eyring_stress,
-                                law=settings.friction, face=face,
-                                ambient_pressure=settings.ambient_pressure, velocity=velocity)
     cos, local = ((rotations(velocity)[0], rotations(velocity)[2]) if velocity is not None
                   else (1.0, 1.0))
+    if settings.reading == "torque":    # the disk's drag times |v| = r / R (its lever)
+        along = local
+        tau_hd = disk_shear(p_hd, h_m, theta, mu, shear, dx, speed,
+                            eyring_stress=lubricant.eyring_stress, velocity=velocity) * local
+    else:                               # the load cell on the pin: the x1 component
+        along = cos
+        tau_hd = hydrodynamic_shear(p_hd, h_m, theta, mu, shear, dx, speed,
+                                    entrainment=entrainment,
+                                    eyring_stress=lubricant.eyring_stress,
+                                    law=settings.friction, face=face,
+                                    ambient_pressure=settings.ambient_pressure,
+                                    velocity=velocity)
     film = np.maximum(np.asarray(p_hd, float) - settings.ambient_pressure, 0.0)
     a_r = shear.contact_fraction
     tau_con = boundary_traction(p_con, film, a_r, speed * local, settings.boundary,
                                 settings.boundary_friction)
-    return (tau_hd, tau_con * cos * (speed > 0),     # along the sliding, x1; 0: no sliding
-            asperity_load(p_con, film, a_r, settings.boundary) * cos, a_r * cos)
+    return (tau_hd, tau_con * along * (speed > 0),   # along the reading; 0: no sliding
+            asperity_load(p_con, film, a_r, settings.boundary) * along, a_r * along)
 
 
 def friction_with(result: MixedResult, factors, settings, lubricant) -> float:

@@ -14,7 +14,7 @@ from .boundary import BoundaryLaw
 from .cavitation import MODELS, cavitation_model
 from .contact_load import RULES
 from .couette import SCHEMES
-from .friction import LAWS
+from .friction import LAWS, READINGS
 
 
 @dataclass(frozen=True)
@@ -32,6 +32,9 @@ class MacroSettings:
     boundary: BoundaryLaw = setting(BoundaryLaw(), "the boundary shear's law (eq 32 or the "
                                     "shear law, fem_twin.macro.boundary)", unit="a section",
                                     section="boundary")
+    reading: str = setting("force", "what the rig reads: the tangential force on the pin "
+                           "holder, or the disk's reaction torque over the track radius",
+                           choices=READINGS, section="tribometer")
     track_radius: float | None = setting(
         None, "the disk's axis at this distance from the face's centre: the disk's velocity "
         "field over the face (fem_twin.macro.kinematics); none: uniform sliding along x1",
@@ -84,5 +87,8 @@ class MacroSettings:
         if self.ambient_pressure < self.cavitation_pressure:
             raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
         cavitation_model(self.complementarity)              # a registered model
+        if self.reading == "torque" and self.friction != "pin":
+            raise InputError("reading = \"torque\" reads the disk's drag, the force law's; "
+                             "it needs friction = \"pin\" (eq 31 is the pin's wall shear)")
         if len(self.gains) != 3:
             raise InputError(f"gains: K_P, K_I, K_D (three numbers), got {self.gains!r}")
