@@ -324,3 +324,15 @@ def test_a_cold_oil_is_a_valid_temperature(temperatures):
     data["lubricant"]["temperatures"] = temperatures
     assert parse_case(data, base=example.parent, source=example).lubricant.temperatures == (
         tuple(temperatures))
+
+
+def test_a_torque_reading_needs_the_force_law(tmp_path):
+    """[tribometer] reading = "torque" reads the disk's drag, which only the force law
+    gives: with [macro] friction = "paper" (eq 31, the pin's wall shear) the case is
+    refused when it is read, naming both keys."""
+    text = small_case(tmp_path).read_text().replace('reading = "force"', 'reading = "torque"')
+    (tmp_path / "torque.toml").write_text(text)
+    assert load_case(tmp_path / "torque.toml").tribometer.reading == "torque"
+    (tmp_path / "paper.toml").write_text(text.replace('friction = "pin"', 'friction = "paper"'))
+    with pytest.raises(CaseError, match=r"reading = \"torque\".*friction = \"pin\""):
+        load_case(tmp_path / "paper.toml")
