@@ -1,5 +1,8 @@
-"""The paper's Tables 4 and 6 (and its constants of eqs 22-32) in SI units: the one source
-of every default taken from them (case file defaults, solver settings, levelling)."""
+"""The paper's Tables 1, 4 and 6 (and its constants of eqs 22-32) in SI units: the one
+source of every default taken from them (case file defaults, solver settings, levelling)."""
+
+#: Table 1: the tribometer
+PIN_DIAMETER = 8e-3                   # D of the Hersey number, eq 46 [m]
 
 #: Table 4: pin levelling and dry contact
 E_STEEL = 210e9                       # Young's modulus of pin and disk [Pa]

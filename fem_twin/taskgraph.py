@@ -45,7 +45,7 @@ def patch_tasks(case: Case, out: RunLayout, k: int) -> list[Task]:
     ff = FlowFactors.load(out.patch_factors(k))
     folder, keys = out.patch_checkpoints(k), ff.meta["checkpoint_keys"]
     mc = case.micro
-    h0 = np.geomspace(mc.h0_min, mc.h0_max, ff.meta.get("h0_candidates", mc.h0_count))
+    h0 = mc.h0_candidates(ff.meta.get("h0_candidates"))
     rounds = _rounds(h0, folder, keys[0], ff.meta.get("h0_tol"))
     tasks, before = [], ()
     for r, indices in enumerate(rounds):

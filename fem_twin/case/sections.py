@@ -15,7 +15,7 @@ from ..macro.boundary import BoundaryLaw
 from ..macro.friction import READINGS
 from ..macro.settings import MacroSettings
 from ..macro.thermal import ThermalSettings
-from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN
+from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN, h0_candidates
 from ..micro.sliding import CellSettings
 from ..topography.prepare import MacroOptions
 from .cost import estimated_seconds
@@ -54,7 +54,7 @@ class Tribometer:
     are then entrainment speeds u_m)."""
 
     load: float = setting(T.LOAD, "imposed normal load F_N,imp (Table 6)", "load")
-    pin_diameter: float = setting(8e-3, "pin diameter D of the Hersey number (eq 46)",
+    pin_diameter: float = setting(T.PIN_DIAMETER, "pin diameter D of the Hersey number (eq 46)",
                                   "pin_diameter")
     sliding_radius: float = setting(30e-3, "radius of the pin's track on the disk (its "
                                     "centre's; the sweep's speeds are the sliding speeds there)",
@@ -165,6 +165,11 @@ class MicroSpec(CellSettings):
     h0_tol: float = setting(0.01, "adaptive h0: solve the candidates the log-h0 "
                             "interpolant needs to read the others within this (0: all, the "
                             "paper)", "adaptive_tolerance")
+
+    def h0_candidates(self, count: int | None = None):
+        """The h0 candidates [m] of ``[micro]`` (``count`` of them; default ``h0_count``):
+        :func:`fem_twin.micro.homogenisation.h0_candidates`."""
+        return h0_candidates(self.h0_min, self.h0_max, count or self.h0_count)
 
 
 @dataclass(frozen=True)

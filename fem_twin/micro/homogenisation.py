@@ -31,7 +31,16 @@ from .store import cell_key
 
 #: the paper's separations: 100 values geometrically spaced in [0.1, 1] um
 H0_MIN, H0_MAX, H0_COUNT = 1e-7, 1e-6, 100
-DEFAULT_H0 = np.geomspace(H0_MIN, H0_MAX, H0_COUNT)
+
+
+def h0_candidates(h0_min: float = H0_MIN, h0_max: float = H0_MAX,
+                  count: int = H0_COUNT) -> np.ndarray:
+    """The separations h0 [m] a micro stage may solve: ``count`` values geometrically
+    spaced from ``h0_min`` to ``h0_max`` (the paper's 100 in [0.1, 1] um by default)."""
+    return np.geomspace(h0_min, h0_max, count)
+
+
+DEFAULT_H0 = h0_candidates()
 
 
 @one_thread

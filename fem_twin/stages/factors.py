@@ -34,7 +34,7 @@ def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool
     once."""
     out.micro.mkdir(parents=True, exist_ok=True)
     mc = case.micro
-    h0 = np.geomspace(mc.h0_min, mc.h0_max, mc.h0_count) if h0 is None else np.asarray(h0)
+    h0 = mc.h0_candidates() if h0 is None else np.asarray(h0)
     n = len(case.geometry.patches)
     bar = tqdm(total=n * len(h0), desc="flow factors", unit="h0", disable=not progress
                or os.environ.get("FEM_TWIN_NO_PROGRESS") == "1")

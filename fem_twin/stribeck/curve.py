@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import tables as T
 from ..checks import arguments, number
 from ..errors import InputError, MissingFile
 from ..io.figure import save_figure
@@ -214,7 +215,7 @@ def _curves(rows) -> list[StribeckCurve]:
 @arguments(curves=[StribeckCurve], path="path")
 def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None,
                   boundary_friction: float = BOUNDARY_FRICTION, bands=None, measured=None,
-                  diameter: float = 8e-3, load: float = 150.0,
+                  diameter: float = T.PIN_DIAMETER, load: float = 150.0,
                   speed_label: str = "sliding speed $U$ [m/s]") -> Path:
     """C_f versus sliding speed (``x="speed"``) or Hersey number (``"hersey"``), log x.
 

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import tables as T
 from ..checks import as_field, as_pair, check, number
 from ..errors import InputError
 from ..io.checkpoint import input_key
@@ -84,7 +85,7 @@ class SweepRequest:
     load: float
     lubricant: Lubricant
     motion: Sliding | RollingSliding = Sliding()
-    hersey_length: float = 8e-3
+    hersey_length: float = T.PIN_DIAMETER
     face: np.ndarray | None = None
     settings: MacroSettings = MacroSettings()
     thermal: object = None
