@@ -136,11 +136,13 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
     curves = {label: c.with_load_share(variant.tribometer.load_share)
               for (label, (variant, _, _)), c in zip(cases.items(), swept)}
     ref = curves[ref_label]
-    dev = {k: friction_deviation(c.friction_coefficient, _at(ref, c.speed))
+    cfb = case.tribometer.boundary_friction
+    dev = {k: friction_deviation(c.friction_coefficient, _at(ref, c.speed), cfb)
            for k, c in curves.items()}
     labels = list(curves)
     write_stribeck_csv(out.stribeck_csv, curves.values())
-    plot_stribeck(list(curves.values()), out.stribeck_png("speed"), labels=labels)
+    plot_stribeck(list(curves.values()), out.stribeck_png("speed"), labels=labels,
+                  boundary_friction=cfb)
     _plot_deviation(out.deviation_png, {k: c.speed for k, c in curves.items()}, dev,
                     ref_label, study)
     summary = {"study": study, "reference": ref_label, "viscosity_Pa_s": lub.viscosity,

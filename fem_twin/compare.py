@@ -110,7 +110,7 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
                                 key=lambda r: -r.speed)            # as the curve: fast first
     lub = request.lubricant
     dev = friction_deviation(curves["fe"].friction_coefficient,
-                             curves["fvm"].friction_coefficient)
+                             curves["fvm"].friction_coefficient, case.tribometer.boundary_friction)
     fields = [field_differences(a, b) for a, b in zip(points["fe"], points["fvm"])]
     write_csv(out.compare_factors_csv, {"h0_m" if k == "h0" else k: v
                                                      for k, v in ffd.items()})

@@ -7,7 +7,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..macro.boundary import BOUNDARY_FRICTION
 from .curve import friction_deviation
 
 
@@ -45,7 +44,7 @@ def transition_speeds(curves, step: float) -> np.ndarray:
     return np.unique(np.round(extra, 12))
 
 
-def hersey_collapse(curves, boundary_friction: float = BOUNDARY_FRICTION) -> float:
+def hersey_collapse(curves, boundary_friction: float) -> float:
     """``max |C_f,dev|`` (eq 35, relative to ``boundary_friction`` = C_f,b) between the first curve
     and the others over the Hersey numbers where they overlap (the others' points, interpolated
     on the first curve)."""

@@ -13,7 +13,6 @@ from ..checks import arguments, number
 from ..errors import InputError, MissingFile
 from ..io.figure import save_figure
 from ..io.table import write_csv
-from ..macro.boundary import BOUNDARY_FRICTION
 
 COLUMNS = ("speed", "hersey", "friction_coefficient", "viscosity", "hydrodynamic_friction",
            "boundary_friction", "contact_load_fraction", "h_d", "iterations")
@@ -56,7 +55,7 @@ def hersey_number(viscosity, speed, diameter: float, load: float):
 
 
 @arguments(cf="numbers", cf_ref="numbers", boundary_friction="number")
-def friction_deviation(cf, cf_ref, boundary_friction: float = BOUNDARY_FRICTION):
+def friction_deviation(cf, cf_ref, boundary_friction: float):
     """C_f,dev = (C_f - C_f,ref) / C_f,b of eq 35 [-]."""
     return (np.asarray(cf) - np.asarray(cf_ref)) / boundary_friction
 
@@ -214,7 +213,7 @@ def _curves(rows) -> list[StribeckCurve]:
 
 @arguments(curves=[StribeckCurve], path="path")
 def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None,
-                  boundary_friction: float = BOUNDARY_FRICTION, bands=None, measured=None,
+                  boundary_friction: float, bands=None, measured=None,
                   diameter: float = T.PIN_DIAMETER, load: float = 150.0,
                   speed_label: str = "sliding speed $U$ [m/s]") -> Path:
     """C_f versus sliding speed (``x="speed"``) or Hersey number (``"hersey"``), log x.
@@ -353,7 +352,7 @@ def read_measured_csv(path, unit: str = "m/s") -> MeasuredCurve:
 
 @arguments(curve=StribeckCurve, measured=MeasuredCurve, boundary_friction="number")
 def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve,
-                            boundary_friction: float = BOUNDARY_FRICTION):
+                            boundary_friction: float):
     """C_f,dev (eq 35) of the simulated curve against the measured one, at the measured
     speeds inside the simulated range (PCHIP in log speed); NaN outside it."""
     from scipy.interpolate import PchipInterpolator
