@@ -230,3 +230,22 @@ def test_two_loads_separate_the_shear_strength_from_the_pressure_coefficient(fac
                      None, curve=0)
     miss = np.abs(at_300["cf"] - measured[300.0]).max() / BOUNDARY_FRICTION
     assert 0.01 < miss < 0.04
+
+
+def test_the_error_estimate_carries_the_real_contact_fractions_error(factors):
+    """Each variant of the flow factors (time steps, cell grid, h0 spacing) carries its own
+    contact fraction, and the law reads it: under a law that rests on the real area
+    (tau_0 = 100 MPa, alpha = 0.02) the point's grid part differs from the constant law's
+    (measured at 0.02 m/s: 0.0093 against 0.0041), while the film part, which no contact
+    fraction enters, is the same."""
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
+    gap, dx, face = macro_case(32)
+    parts = {}
+    for law in (BoundaryLaw(), BoundaryLaw(law="shear", shear_strength=100e6,
+                                           pressure_coefficient=0.02)):
+        curve = stribeck_sweep(SweepRequest(gap, dx, factors, [0.02], load=150.0, face=face,
+                                            lubricant=Lubricant(0.066), error_estimate=True,
+                                            settings=MacroSettings(boundary=law)))
+        parts[law.law] = {k: float(v[0]) for k, v in curve.friction_error_parts.items()}
+    assert abs(parts["shear"]["grid"] / parts["constant"]["grid"] - 1) > 0.1
+    assert parts["shear"]["film"] == pytest.approx(parts["constant"]["film"], rel=1e-9)
