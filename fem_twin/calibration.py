@@ -133,8 +133,7 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
         tasks = [_sweep(variant, folder, out, patch, speeds)
                  for folder, (variant, patch, speeds) in zip(folders, cases.values())]
         swept = run_sweeps(tasks, executor, progress, desc="calibration points")
-    curves = {label: c.with_load_share(variant.tribometer.load_share)
-              for (label, (variant, _, _)), c in zip(cases.items(), swept)}
+    curves = dict(zip(cases, swept))
     ref = curves[ref_label]
     cfb = case.tribometer.boundary_friction
     dev = {k: friction_deviation(c.friction_coefficient, _at(ref, c.speed), cfb)

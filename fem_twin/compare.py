@@ -104,8 +104,7 @@ def compare(case: Case, outdir, *, progress: bool = True) -> dict:
     for method in ("fe", "fvm"):                  # isothermal: the methods, not the heat
         request = replace(common, factors=factors[method], settings=macro_settings(
             case, method), checkpoint=out.sub(method).points)
-        curves[method] = stribeck_sweep(request, progress).with_load_share(
-            case.tribometer.load_share)
+        curves[method] = stribeck_sweep(request, progress)
         points[method] = sorted((MixedResult.load(p) for p in point_files(request.checkpoint)),
                                 key=lambda r: -r.speed)            # as the curve: fast first
     lub = request.lubricant

@@ -145,14 +145,13 @@ def _simulated(case: Case, out: RunLayout, tests, progress: bool) -> list:
     run = read_stribeck_csv(out.stribeck_csv)
     own = [run[mus.index(mu)] if load == tr.load and mu in mus else None
            for load, mu in tests]
-    first = _fit_sweep(case, out)                   # its load is the face's share of it
-    tasks = [replace(first, load=load * tr.load_share,
-                     lubricant=replace(first.lubricant, viscosity=mu))
+    first = _fit_sweep(case, out)
+    tasks = [replace(first, load=load, lubricant=replace(first.lubricant, viscosity=mu))
              for (load, mu), c in zip(tests, own) if c is None]
     with executor_for(case.run.workers, case.run.scheduler) as executor:
         swept = iter(run_sweeps(tasks, executor, progress, desc="fit loads")
                      if tasks else [])
-    return [c if c is not None else next(swept).with_load_share(tr.load_share) for c in own]
+    return [c if c is not None else next(swept) for c in own]
 
 
 def _predict_load(case: Case, out: RunLayout, result: dict, load: float, progress: bool):
@@ -200,7 +199,7 @@ def extra_curves(case: Case, out: RunLayout, curves, shares=(), resistances=(),
     at_resistances = sorted(r for r in resistances
                             if not np.isclose(r, own, rtol=1e-9, atol=1e-12))
     first = _fit_sweep(case, out, speeds=np.sort(curves[0].speed)[::-1])
-    tasks = [replace(first, load=tr.load * s) for s in at_shares] + [
+    tasks = [replace(first, load_share=s) for s in at_shares] + [
         replace(request, speeds=np.sort(c.speed)[::-1], thermal=replace(
             request.thermal, settings=replace(request.thermal.settings, bulk_resistance=r)))
         for c, request in zip(curves, per_viscosity(case, _fit_sweep(case, out)))
@@ -208,7 +207,6 @@ def extra_curves(case: Case, out: RunLayout, curves, shares=(), resistances=(),
     with executor_for(case.run.workers, case.run.scheduler) as executor:
         swept = run_sweeps(tasks, executor, progress, desc="fit points")
     by_share, rest = swept[:len(at_shares)], swept[len(at_shares):]
-    rest = [c.with_load_share(tr.load_share) for c in rest]
     ascending = lambda pairs: tuple(sorted(pairs, key=lambda p: p[0]))  # noqa: E731
     n = len(at_resistances)
     return (ascending([*zip(at_shares, by_share), (tr.load_share, curves[0])])

@@ -83,7 +83,7 @@ def refined_curves(case: Case, out: RunLayout, request, executor=None,
     on the band's grid (``keep_level``), which the band's sweeps start from; where that
     grid is the guides' (:meth:`~fem_twin.case.Case.band_after_guides`), each pass of the
     band runs beside the main points."""
-    tr, step = case.tribometer, case.sweep.refine_step * case.tribometer.boundary_friction
+    step = case.sweep.refine_step * case.tribometer.boundary_friction
     speeds = request.speeds
     keep = case.band_coarsening(request.gap.shape) if case.run.patch_band else 0
     band = (band_tasks(case, out, request) if case.band_after_guides(request.gap.shape)
@@ -94,8 +94,7 @@ def refined_curves(case: Case, out: RunLayout, request, executor=None,
                                             keep_level=keep,
                                             fields=out.fields if final else None))
         followers = [replace(b, speeds=speeds) for b in band]
-        return [c.with_load_share(tr.load_share)
-                for c in run_sweeps(tasks, executor, progress, followers=followers)]
+        return run_sweeps(tasks, executor, progress, followers=followers)
 
     for level in range(case.sweep.refine + 1):
         final = level == case.sweep.refine
@@ -136,7 +135,6 @@ def band_curves(case: Case, request, curves, tasks, swept, executor=None,
     solve that failed, checkpoints of an earlier version), the average factors are swept
     on the band's grid too."""
     n = len(case.lubricant.lubricants())
-    swept = [c.with_load_share(case.tribometer.load_share) for c in swept]
     per_patch = [swept[i:i + n] for i in range(0, len(swept), n)]
     level = case.band_coarsening(request.gap.shape)
     if not per_patch or level == 0:
@@ -148,8 +146,7 @@ def band_curves(case: Case, request, curves, tasks, swept, executor=None,
             replace(c, friction_coefficient=cf[level - 1])
             for c, cf in zip(curves, coarse)]), tasks
     average = per_viscosity(case, request.coarsened(level))
-    coarse = [c.with_load_share(case.tribometer.load_share)
-              for c in run_sweeps(average, executor, progress, desc="patch band points")]
+    coarse = run_sweeps(average, executor, progress, desc="patch band points")
     return defect_corrected(per_patch, curves, coarse), tasks + average
 
 

@@ -230,12 +230,6 @@ def macro_geometry(case: Case, out: RunLayout):
     return disk.heights - pin.heights, pin.spacing, face, pin.origin
 
 
-def face_load(case: Case) -> float:
-    """The load the macro scale balances (eq 28) [N]: ``[tribometer] load_share`` of the
-    imposed load (C_f is referred to the imposed load, ``StribeckCurve.with_load_share``)."""
-    return case.tribometer.load * case.tribometer.load_share
-
-
 def ball_contact(case: Case) -> PointContact:
     """The smooth ball of a ball-on-disk case (Hertz radius, Hamrock-Dowson films) at the
     first viscosity and the sweep's fastest entrainment speed; of a measured cap's fitted

@@ -13,7 +13,7 @@ from ..macro.thermal import ContactThermal
 from ..macro.viscosity import WaltherLaw
 from ..micro import FlowFactors
 from ..stribeck.request import RollingSliding, Sliding, SweepRequest
-from .geometry import face_load, hersey_length, macro_geometry
+from .geometry import hersey_length, macro_geometry
 from .provenance import stage_keys
 
 
@@ -27,7 +27,8 @@ def sweep_request(case: Case, out: RunLayout, *, factors: FlowFactors | None = N
     if factors is None:
         factors, factors_key = FlowFactors.load(out.flow_factors), stage_keys(case)["micro"]
     request = SweepRequest(
-        gap, spacing, factors, case.sweep.speeds, load=face_load(case),
+        gap, spacing, factors, case.sweep.speeds, load=case.tribometer.load,
+        load_share=case.tribometer.load_share,
         lubricant=case.lubricant.lubricants()[0], motion=motion(case),
         hersey_length=hersey_length(case), face=face, origin=origin,
         settings=macro_settings(case), thermal=contact_thermal(case),

@@ -96,22 +96,6 @@ class StribeckCurve:
     real_contact_area: np.ndarray | None = None
     spot_rise: np.ndarray | None = None
 
-    def with_load_share(self, share: float) -> "StribeckCurve":
-        """This curve, swept at ``share`` F_N,imp on the pin face, referred to the imposed
-        load F_N,imp: C_f, its error estimates and the Hersey number (eq 46) times ``share``
-        (the friction forces and the contact's share of the face load stay)."""
-        if share == 1.0:
-            return self
-        parts = (None if self.friction_error_parts is None else
-                 {k: share * v for k, v in self.friction_error_parts.items()})
-        coarse = self.coarse_friction_coefficient
-        return replace(self, hersey=share * self.hersey,
-                       friction_coefficient=share * self.friction_coefficient,
-                       coarse_friction_coefficient=None if coarse is None else share * coarse,
-                       friction_error=(None if self.friction_error is None
-                                       else share * self.friction_error),
-                       friction_error_parts=parts)
-
     def at_hersey(self, hersey):
         """C_f interpolated (monotone cubic, PCHIP, in log H) at Hersey numbers inside this
         curve's range; NaN outside it."""

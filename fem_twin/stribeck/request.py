@@ -68,11 +68,12 @@ class RollingSliding:
 @dataclass(frozen=True, eq=False)
 class SweepRequest:
     """One viscosity's sweep: the macro ``gap`` [m] on a grid of ``spacing`` [m], the flow
-    ``factors``, the ``speeds`` [m/s] (fast to slow), the face's ``load`` [N] (eq 28),
-    the ``lubricant``, the ``motion``, D of the Hersey number ``hersey_length`` [m] (eq
-    46), the pin ``face`` (None: the whole grid), the macro ``settings`` and a ``thermal``
-    model (None: isothermal).  ``factors_key``: a key of the factors' inputs, hashed
-    instead of their bits; ``checkpoint``: the points' folder; ``fields``: a VTU per
+    ``factors``, the ``speeds`` [m/s] (fast to slow), the imposed ``load`` F_N,imp [N] of
+    which the face carries ``load_share`` (eq 28 balances their product; C_f and the
+    Hersey number refer to ``load``), the ``lubricant``, the ``motion``, D of the Hersey number
+    ``hersey_length`` [m] (eq 46), the pin ``face`` (None: the whole grid), the macro ``settings``
+    and a ``thermal`` model (None: isothermal).  ``factors_key``: a key of the factors' inputs,
+    hashed instead of their bits; ``checkpoint``: the points' folder; ``fields``: a VTU per
     speed there (``origin`` [m]); ``error_estimate``: each point's C_f error;
     ``keep_level``: keep each point's nested solve that many coarsenings down, which a
     sweep with ``guide`` (that level's key, :meth:`level_key`) starts from."""
@@ -84,6 +85,7 @@ class SweepRequest:
     _: KW_ONLY
     load: float
     lubricant: Lubricant
+    load_share: float = 1.0
     motion: Sliding | RollingSliding = Sliding()
     hersey_length: float = T.PIN_DIAMETER
     face: np.ndarray | None = None
@@ -111,6 +113,12 @@ class SweepRequest:
         object.__setattr__(self, "spacing", as_pair(f"{name}: spacing", self.spacing))
         object.__setattr__(self, "speeds", speeds)
         object.__setattr__(self, "load", number(f"{name}: load", self.load, "load"))
+        number(f"{name}: load_share", self.load_share, "load_share")
+
+    @property
+    def face_load(self) -> float:
+        """The load the face carries, ``load`` times ``load_share`` [N] (eq 28)."""
+        return self.load * self.load_share
 
     @property
     def key(self) -> str:

@@ -149,7 +149,7 @@ class _Point:
     def estimated(self, res, coarser, path):
         """``res`` with its C_f error estimate in ``meta`` (saved at ``path``)."""
         t0, r = time.perf_counter(), self.request
-        estimate = friction_error(res, r.gap, r.spacing, r.factors, load=r.load,
+        estimate = friction_error(res, r.gap, r.spacing, r.factors, load=r.face_load,
                                   lubricant=film_lubricant(res, r.lubricant), face=r.face,
                                   settings=r.settings, entrainment=res.meta.get("entrainment"),
                                   levels=coarser)
@@ -161,9 +161,12 @@ class _Point:
 
 
 def _curve(records, request: SweepRequest) -> StribeckCurve:
-    """The :class:`StribeckCurve` of a sweep's point ``records`` (:func:`_record`)."""
+    """The :class:`StribeckCurve` of a sweep's point ``records`` (:func:`_record`), C_f,
+    its error estimates and the Hersey number referred to the imposed load (each point's
+    C_f is its face's, ``load_share`` of it)."""
     get = lambda name: np.array([r[name] for r in records])  # noqa: E731
-    errors = ({part: np.array([r["error_estimate"][part] for r in records])
+    share = request.load_share
+    errors = ({part: share * np.array([r["error_estimate"][part] for r in records])
                for part in (*PARTS, "total")} if request.error_estimate else None)
     thermal = ({k: get(k) for k in ("contact_temperature", "asperity_temperature",
                                     "spot_rise")} if request.thermal is not None else {})
@@ -172,14 +175,14 @@ def _curve(records, request: SweepRequest) -> StribeckCurve:
         speed=speeds.copy(), **thermal, asperity_load=get("asperity_load"),
         real_contact_area=get("real_contact_area"),
         hersey=hersey_number(mu, speeds, request.hersey_length, load),
-        friction_coefficient=get("friction_coefficient"), viscosity=mu,
+        friction_coefficient=share * get("friction_coefficient"), viscosity=mu,
         hydrodynamic_friction=get("hydrodynamic_friction"),
         boundary_friction=get("boundary_friction"),
-        contact_load_fraction=get("contact_load") / load, h_d=get("h_d"),
+        contact_load_fraction=get("contact_load") / request.face_load, h_d=get("h_d"),
         iterations=get("iterations"),
         friction_error=None if errors is None else errors.pop("total"),
         friction_error_parts=errors,
-        coarse_friction_coefficient=_levels([r[COARSE_CF] for r in records]))
+        coarse_friction_coefficient=share * _levels([r[COARSE_CF] for r in records]))
 
 
 class _Guide:
@@ -228,7 +231,7 @@ def _solve_point(request: SweepRequest, speed: float, previous):
     sliding = r.motion.speeds(speed)
 
     def solve(lub, start):
-        return solve_nested(r.gap, r.spacing, r.factors, load=r.load, **sliding,
+        return solve_nested(r.gap, r.spacing, r.factors, load=r.face_load, **sliding,
                             lubricant=lub, face=r.face, settings=r.settings,
                             previous=start or previous)
 

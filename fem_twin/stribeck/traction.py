@@ -85,7 +85,7 @@ def traction_sweep(request: SweepRequest, slide_to_roll=DEFAULT_RATIOS,
     folder = None if r.checkpoint is None else Path(r.checkpoint)
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
-    common = dict(load=r.load, entrainment=entrainment, lubricant=r.lubricant, face=r.face,
+    common = dict(load=r.face_load, entrainment=entrainment, lubricant=r.lubricant, face=r.face,
                   settings=r.settings)
     results, previous = {}, None
     for srr in tqdm(ratios[::-1], desc=f"traction mu0={r.lubricant.viscosity:g}",
@@ -101,7 +101,7 @@ def traction_sweep(request: SweepRequest, slide_to_roll=DEFAULT_RATIOS,
             if path is not None:
                 res.save(path)
         results[srr] = previous = res
-    load, lubricant = r.load, r.lubricant
+    load, lubricant = r.face_load, r.lubricant
     get = lambda name: np.array([getattr(results[s], name) for s in ratios])  # noqa: E731
     return TractionCurve(
         slide_to_roll=ratios, entrainment=float(entrainment), viscosity=lubricant.viscosity,
