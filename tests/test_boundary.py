@@ -187,12 +187,12 @@ def test_a_fit_recovers_the_shear_laws_pressure_and_speed_coefficients(factors):
 
 
 def test_two_loads_separate_the_shear_strength_from_the_pressure_coefficient(factors):
-    """Synthetic truth at 150 and 300 N: the twin with tau_0 = 30 MPa and alpha = 0.08,
-    fitted by the constant-law twin's curves at both loads (20 speeds each): noiseless
-    within 2 % and 1 % (measured 29.45 MPa, 0.0804; the two 0.99 correlated); with 1 %
-    noise the intervals hold the truth in at least 75 % of 20 seeds (measured over 40:
-    92 % and 88 %).  From 150 N alone a law cannot separate them: its C_f,b-like fit
-    misses the 300 N curve by up to 2.2 % C_f,b, outside its band at 6 of 9 speeds."""
+    """Synthetic truth at 150 and 300 N with both oils (0.066 and 0.024 Pa s): the twin
+    with tau_0 = 30 MPa and alpha = 0.08, fitted by the constant-law twin's four curves (20
+    speeds each): noiseless within 2 % and 1 % (measured 30.28 MPa, 0.0798; the two 0.999
+    correlated); with 1 % noise the intervals hold the truth in at least 16 of 20 seeds
+    (measured over 40: 95 % for both).  From 150 N alone a law cannot separate them: a
+    constant C_f,b fitted there misses the 300 N curve by 2.2 % C_f,b (1 to 4 %)."""
     from fem_twin.stribeck import SweepRequest, stribeck_sweep
     from fem_twin.stribeck.curve import MeasuredCurve
     from fem_twin.stribeck.fit import FitModel, fit_curves
@@ -200,35 +200,36 @@ def test_two_loads_separate_the_shear_strength_from_the_pressure_coefficient(fac
     gap, dx, face = macro_case(32)
     truth = BoundaryLaw(law="shear", shear_strength=30e6, pressure_coefficient=0.08)
     speeds, sim, measured = np.geomspace(1.0, 0.01, 9), {}, {}
-    for load in (150.0, 300.0):
-        common = dict(load=load, face=face, lubricant=Lubricant(0.066))
-        sim[load] = stribeck_sweep(SweepRequest(gap, dx, factors,
-                                                np.geomspace(2.0, 0.004, 20), **common))
-        measured[load] = stribeck_sweep(SweepRequest(
+    tests = [(load, mu) for load in (150.0, 300.0) for mu in (0.066, 0.024)]
+    for load, mu in tests:
+        common = dict(load=load, face=face, lubricant=Lubricant(mu))
+        sim[load, mu] = stribeck_sweep(SweepRequest(gap, dx, factors,
+                                                    np.geomspace(2.0, 0.004, 20), **common))
+        measured[load, mu] = stribeck_sweep(SweepRequest(
             gap, dx, factors, speeds, **common,
             settings=MacroSettings(boundary=truth))).friction_coefficient
-    model = FitModel((sim[150.0], sim[300.0]), BOUNDARY_FRICTION, 150.0, None,
-                     loads=(150.0, 300.0))
+    model = FitModel(tuple(sim[t] for t in tests), BOUNDARY_FRICTION, 150.0, None,
+                     loads=tuple(load for load, _ in tests))
     params = ["shear_strength", "pressure_coefficient"]
-    exact = fit_curves(model, [MeasuredCurve(speeds, measured[150.0]),
-                               MeasuredCurve(speeds, measured[300.0])], params,
+    exact = fit_curves(model, [MeasuredCurve(speeds, measured[t]) for t in tests], params,
                        start_temperatures=None)
     assert exact["shear_strength"]["value"] == pytest.approx(30e6, rel=0.02)
     assert exact["pressure_coefficient"]["value"] == pytest.approx(0.08, rel=0.01)
     hits = np.zeros(2)
     for seed in range(20):
         rng = np.random.default_rng(seed)
-        noisy = [MeasuredCurve(speeds, measured[load] * (1 + 0.01 * rng.standard_normal(9)))
-                 for load in (150.0, 300.0)]
+        noisy = [MeasuredCurve(speeds, measured[t] * (1 + 0.01 * rng.standard_normal(9)))
+                 for t in tests]
         out = fit_curves(model, noisy, params, start_temperatures=None)
         hits += [out[n]["low"] < getattr(truth, n) < out[n]["high"] for n in params]
-    assert np.all(hits >= 15), hits
-    one = fit_curves(FitModel((sim[150.0],), BOUNDARY_FRICTION, 150.0, None),
-                     [MeasuredCurve(speeds, measured[150.0])], ["boundary_friction"],
+    assert np.all(hits >= 16), hits
+    light, heavy = (150.0, 0.066), (300.0, 0.066)
+    one = fit_curves(FitModel((sim[light],), BOUNDARY_FRICTION, 150.0, None),
+                     [MeasuredCurve(speeds, measured[light])], ["boundary_friction"],
                      start_temperatures=None)
-    at_300 = predict(FitModel((sim[300.0],), BOUNDARY_FRICTION, 300.0, None), one, speeds,
+    at_300 = predict(FitModel((sim[heavy],), BOUNDARY_FRICTION, 300.0, None), one, speeds,
                      None, curve=0)
-    miss = np.abs(at_300["cf"] - measured[300.0]).max() / BOUNDARY_FRICTION
+    miss = np.abs(at_300["cf"] - measured[heavy]).max() / BOUNDARY_FRICTION
     assert 0.01 < miss < 0.04
 
 
