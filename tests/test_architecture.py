@@ -87,18 +87,16 @@ def test_run_files_are_named_only_by_the_run_layout():
     assert not elsewhere, elsewhere
 
 
-#: the pipeline's order: a module imports only from its own layer or an earlier one.
-#: Shared plumbing (errors, checks, tables, numerics/, io/ ...) is layer 0; io.files reads
-#: and writes the Topography value, so it sits with the topography stage; fvm/ gathers the
-#: FV siblings of micro/ and macro/.  Inside the workflow (6.x): the case, the run's data
-#: files, the stages on a case and the task graph, the pipeline that orders them, the
-#: studies that run it, and the report of a finished run.
-LAYERS = {"topography": 1, "io.files": 1, "io": 1, "contact": 2, "micro": 3, "macro": 4,
-          "fvm": 4, "stribeck": 5,
-          "case": 6.0, "results": 6.1, "stages": 6.2, "taskgraph": 6.2, "pipeline": 6.3,
-          "compare": 6.4, "calibration": 6.4, "verification": 6.4, "fitting": 6.4,
-          "report": 6.5, "samples": 6.5,
-          "cli": 7}
+def _layers() -> dict:
+    """The layer of each package or module, from the table in fem_twin's docstring."""
+    import re
+
+    import fem_twin
+    rows = re.findall(r"^ {4}(\d+(?:\.\d+)?) +([\w., ]+)$", fem_twin.__doc__, re.M)
+    return {name.strip(): float(layer) for layer, names in rows for name in names.split(",")}
+
+
+LAYERS = _layers()
 
 
 def _layer(module: str) -> float:
