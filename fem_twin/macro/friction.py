@@ -70,12 +70,14 @@ def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, sp
 @arguments(pressure="field", mean_gap="field", spacing="pair", speed="number")
 def disk_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing, speed, *,
                eyring_stress=None, velocity=None) -> np.ndarray:
-    """The film's traction on the disk along its local sliding [Pa] (its drag):
-    ``(mu u_r |v| / h_m) s_C (1 - theta) + (h_m / 2) b . grad p`` with ``b = 2 e1 - (2 e1 -
-    b)`` from the shear factors and ``grad p`` in the sliding frame, the disk at ``speed``
-    times ``velocity`` (None: along x1; Eyring as :func:`hydrodynamic_shear`'s).  Its
-    integral along x1 under uniform sliding is the force on the pin (docs/model.md,
-    "Friction on the pin"); times ``|v|`` it is the disk's torque over the track radius."""
+    """The film's drag on the disk along its local sliding [Pa].
+
+    ``(mu u_r s / h_m) s_C (1 - theta) + (h_m / 2) b . grad p``, with ``s`` the local speed
+    over u_r, ``b`` from the shear factors' ``2 e1 - b`` and ``grad p`` in the sliding
+    frame; the disk at ``speed`` times ``velocity`` (None: along x1; Eyring as in
+    :func:`hydrodynamic_shear`).  Under uniform sliding its integral along x1 is the force
+    on the pin (docs/model.md, "Friction on the pin"); times ``s`` it is the disk's torque
+    over the track radius."""
     p = np.asarray(pressure, float)
     dp2, dp1 = np.gradient(p, spacing[1], spacing[0])
     c, s, v = (1.0, 0.0, 1.0) if velocity is None else rotations(velocity)
