@@ -1,5 +1,6 @@
 """The case file: its sections (:mod:`~fem_twin.case.sections`, every key declared once),
-the parser that validates a TOML file into a :class:`Case` (:mod:`~fem_twin.case.parse`),
+the parser that validates a TOML file into a :class:`Case` (:mod:`~fem_twin.case.parse`,
+each table read by :mod:`~fem_twin.case.table`),
 and what a run will cost before it starts (:mod:`~fem_twin.case.cost`, scaled to this
 machine by :mod:`~fem_twin.case.machine`)."""
 

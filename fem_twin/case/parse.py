@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import math
 import os
 import tomllib
-from dataclasses import MISSING, fields
 from itertools import pairwise
 from pathlib import Path
 
-from ..checks import arguments, check_choice, memory_shortfall, plausible
+from ..checks import arguments, memory_shortfall
 from ..errors import InputError
 from ..macro.boundary import BoundaryLaw
 from ..macro.thermal import ThermalSettings
@@ -26,11 +24,7 @@ from .sections import (
     SweepSpec,
     Tribometer,
 )
-
-
-class CaseError(InputError):
-    """A case file that is missing, malformed or inconsistent."""
-
+from .table import CaseError, int_pair, only, read_table
 
 #: local worker processes a case may ask for per core (``[run] workers``): more only add
 #: memory and switching
@@ -60,7 +54,7 @@ def load_case(path) -> Case:
 def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -> Case:
     """Validate a case given as a dict (as read from TOML); file paths relative to ``base``."""
     where = str(source or "case")
-    _only(data, {"name", "validation", *SECTIONS}, where)
+    only(data, {"name", "validation", *SECTIONS}, where)
     if "geometry" not in data:
         raise CaseError(f"{where}: missing [geometry] section")
     tribometer = _tribometer(data, where)
@@ -70,14 +64,14 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
                         "gives the radius ([geometry] ball); remove one of the two")
     preprocessing = _preprocessing(data, where)
     lubricant = _lubricant(data, where)
-    materials = _section(data, "materials", Materials, where, positive=True)
+    materials = read_table(data, "materials", Materials, where, positive=True)
     micro = _micro(data, where)
     macro = _macro(data, where, tribometer, geometry)
     sweep = _sweep(data, where)
     thermal = _thermal(data, where, lubricant)
     boundary = _boundary(data, where, thermal, sweep)
     _disk_axis(tribometer, materials, geometry, where)
-    run = _section(data, "run", RunSpec, where)
+    run = read_table(data, "run", RunSpec, where)
     if run.workers < 0:
         raise CaseError(f"{where} [run] workers: a number of processes >= 0 (0: all cores), "
                         f"got {run.workers}")
@@ -117,7 +111,7 @@ BALL_ONLY = {("tribometer", "slide_to_roll"): 'kind = "ball-on-disk"',
 
 
 def _tribometer(data, where) -> Tribometer:
-    tribometer = _section(data, "tribometer", Tribometer, where, positive=True)
+    tribometer = read_table(data, "tribometer", Tribometer, where, positive=True)
     if tribometer.ball and "sliding_radius" in data.get("tribometer", {}):
         raise CaseError(f"{where} [tribometer] sliding_radius: a pin's track, unused by a ball; "
                         "a ball's is track_radius")
@@ -158,9 +152,9 @@ def _geometry(data, base, where, ball) -> Geometry:
                         "kind = \"ball-on-disk\"")
     if isinstance(g, dict) and not ball and not g.get("pins"):
         raise CaseError(f"{where} [geometry]: at least one pin file is required in 'pins'")
-    geometry = _section(data, "geometry", Geometry, where, files=_files(base, where))
-    _int_pair(list(geometry.patch_shape), f"{where} [geometry] patch_shape")
-    _int_pair(list(geometry.patch_start), f"{where} [geometry] patch_start", 0)
+    geometry = read_table(data, "geometry", Geometry, where, files=_files(base, where))
+    int_pair(list(geometry.patch_shape), f"{where} [geometry] patch_shape")
+    int_pair(list(geometry.patch_start), f"{where} [geometry] patch_start", 0)
     if geometry.disks and len(geometry.disks) != len(geometry.pins):
         raise CaseError(f"{where} [geometry]: {len(geometry.pins)} pins but "
                         f"{len(geometry.disks)} disks (give one disk per pin, or none for flat)")
@@ -193,8 +187,8 @@ def _files(base: Path, where: str):
 
 def _preprocessing(data, where) -> MacroOptions:
     """[preprocessing]: the macro geometry's options, lengths in metres."""
-    opts = _section(data, "preprocessing", MacroOptions, where)
-    rows, cols = _int_pair(list(opts.resolution), f"{where} [preprocessing] resolution")
+    opts = read_table(data, "preprocessing", MacroOptions, where)
+    rows, cols = int_pair(list(opts.resolution), f"{where} [preprocessing] resolution")
     short = memory_shortfall(rows * cols, "macro")
     if short:
         raise CaseError(f"{where} [preprocessing] resolution: {short}")
@@ -209,7 +203,7 @@ def _preprocessing(data, where) -> MacroOptions:
 
 
 def _lubricant(data, where) -> LubricantSpec:
-    lubricant = _section(data, "lubricant", LubricantSpec, where, positive=True,
+    lubricant = read_table(data, "lubricant", LubricantSpec, where, positive=True,
                          zero_ok=("eyring_stress",))
     if not lubricant.viscosities:
         raise CaseError(f"{where} [lubricant] viscosities: give at least one mu_0 [Pa s]")
@@ -223,7 +217,7 @@ def _micro(data, where) -> MicroSpec:
         raise CaseError(f"{where} [micro] error_tolerance: moved to [sweep] error_tolerance, "
                         "the estimated error of C_f as a fraction of C_f,b (e.g. 0.005); the "
                         "flow factors' own estimates are in summary.json")
-    micro = _section(data, "micro", MicroSpec, where)
+    micro = read_table(data, "micro", MicroSpec, where)
     if not 0 <= micro.h0_tol < 1:
         raise CaseError(f"{where} [micro] h0_tol: 0 (every h0) or a fraction in (0, 1), "
                         "e.g. 0.005")
@@ -244,7 +238,7 @@ def _micro(data, where) -> MicroSpec:
 
 
 def _macro(data, where, tribometer, geometry) -> MacroSpec:
-    macro = _section(data, "macro", MacroSpec, where)       # MacroSettings' own rules too
+    macro = read_table(data, "macro", MacroSpec, where)       # MacroSettings' own rules too
     if not 9 <= macro.grid <= 1025:
         raise CaseError(f"{where} [macro] grid: nodes per side of the ball's grid, 9 to 1025 "
                         f"(e.g. 97), got {macro.grid}")
@@ -259,7 +253,7 @@ def _macro(data, where, tribometer, geometry) -> MacroSpec:
 
 def _thermal(data, where, lubricant) -> ThermalSettings:
     """[thermal]: the flash model needs the oil's viscosity at two temperatures."""
-    thermal = _section(data, "thermal", ThermalSettings, where)
+    thermal = read_table(data, "thermal", ThermalSettings, where)
     if thermal.model != "none" and len(set(lubricant.temperatures)) < 2:
         raise CaseError(f"{where} [thermal] model = \"{thermal.model}\": the film's viscosity "
                         "at its temperature needs [lubricant] viscosities at two temperatures "
@@ -276,7 +270,7 @@ def _thermal(data, where, lubricant) -> ThermalSettings:
 def _boundary(data, where, thermal, sweep) -> BoundaryLaw:
     """[boundary]: the shear law's keys only with ``law = "shear"``, a temperature term only
     with the thermal model, a speed factor positive over the sweep's speeds."""
-    boundary = _section(data, "boundary", BoundaryLaw, where)
+    boundary = read_table(data, "boundary", BoundaryLaw, where)
     given = set(data.get("boundary", {})) - {"law", "film_on_contacts"}
     if boundary.law == "constant" and given:
         raise CaseError(f"{where} [boundary] {', '.join(sorted(given))}: the shear law's, unused "
@@ -294,7 +288,7 @@ def _boundary(data, where, thermal, sweep) -> BoundaryLaw:
 
 
 def _sweep(data, where) -> SweepSpec:
-    sweep = _section(data, "sweep", SweepSpec, where, positive=True, zero_ok=("refine",))
+    sweep = read_table(data, "sweep", SweepSpec, where, positive=True, zero_ok=("refine",))
     if not 0 <= sweep.refine <= 4 or not 0 < sweep.refine_step < 1:
         raise CaseError(f"{where} [sweep]: refine is 0-4 passes, refine_step a fraction of "
                         "C_f,b in (0, 1)")
@@ -308,7 +302,7 @@ def _sweep(data, where) -> SweepSpec:
 
 def _measured(val, base, where, lubricant) -> tuple:
     """[validation] measured: one CSV file (or "") per viscosity, resolved."""
-    _only(val, {"measured"}, f"{where} [validation]")
+    only(val, {"measured"}, f"{where} [validation]")
     measured = val.get("measured", [])
     if (not isinstance(measured, list) or len(measured) > len(lubricant.viscosities)
             or not all(isinstance(m, str) for m in measured)):
@@ -319,96 +313,3 @@ def _measured(val, base, where, lubricant) -> tuple:
         if m is not None and not m.is_file():
             raise CaseError(f"{where} [validation] measured: file not found: {m}")
     return measured
-
-
-def _section(data, name, cls, where, positive=False, zero_ok=(), files=None):
-    """A table of scalars/lists into the dataclass ``cls`` (lists become tuples); the
-    settings declared with a file unit read by ``files(key, value, unit)``."""
-    table = data.get(name, {})
-    _only(table, {f.name for f in fields(cls)}, f"{where} [{name}]")
-    values = {}
-    for f in fields(cls):
-        if f.name not in table:
-            continue
-        if f.metadata.get("section"):
-            raise CaseError(f"{where} [{name}] {f.name}: set by [{f.metadata['section']}], "
-                            "not here")
-        _plausible(name, f, table[f.name], where)
-        _choice(name, f, table[f.name], where)
-        v = table[f.name]
-        if files is not None and f.metadata.get("unit", "").startswith("file path"):
-            values[f.name] = files(f.name, v, f.metadata["unit"])
-            continue
-        ranged = f.metadata.get("quantity") is not None     # its range replaces "positive"
-        # the declared default: an instance's may be normalised (time_tol 0 -> None)
-        default = f.default if f.default is not MISSING else getattr(cls(), f.name)
-        if isinstance(default, tuple):
-            if not isinstance(v, list) or not all(isinstance(x, (int, float)) for x in v):
-                raise CaseError(f"{where} [{name}] {f.name}: expected a list of numbers")
-            if default and isinstance(default[0], int) and not all(isinstance(x, int)
-                                                                    for x in v):
-                raise CaseError(f"{where} [{name}] {f.name}: expected whole numbers, got {v}")
-            v = tuple(type(default[0])(x) if default else x for x in v)
-            if not all(math.isfinite(x) for x in v):
-                raise CaseError(f"{where} [{name}] {f.name}: values must be finite numbers")
-            if positive and not ranged and any(x <= 0 for x in v):
-                raise CaseError(f"{where} [{name}] {f.name}: values must be positive (SI units)")
-        elif isinstance(default, bool):
-            if not isinstance(v, bool):
-                raise CaseError(f"{where} [{name}] {f.name}: expected true or false")
-        elif default is None or isinstance(default, str):
-            if not isinstance(v, (str, int)) or isinstance(v, bool):
-                raise CaseError(f"{where} [{name}] {f.name}: expected a string")
-        elif isinstance(default, (int, float)):
-            if not isinstance(v, (int, float)) or isinstance(v, bool):
-                raise CaseError(f"{where} [{name}] {f.name}: expected a number (SI units)")
-            if isinstance(default, int) and not isinstance(v, int):
-                raise CaseError(f"{where} [{name}] {f.name}: expected a whole number, got {v}")
-            if not math.isfinite(v):
-                raise CaseError(f"{where} [{name}] {f.name}: must be a finite number, got {v}")
-            if positive and not ranged and (v < 0 if f.name in zero_ok else v <= 0):
-                raise CaseError(f"{where} [{name}] {f.name}: must be positive (SI units)")
-            v = type(default)(v) if isinstance(default, float) else v
-        values[f.name] = v
-    try:
-        return cls(**values)
-    except CaseError:
-        raise
-    except InputError as err:            # a rule of the settings themselves (__post_init__)
-        raise CaseError(f"{where} [{name}]: {err}") from err
-
-
-def _plausible(section: str, f, value, where):
-    """Refuse a number outside the plausible SI range its declaration names
-    (:func:`fem_twin.checks.plausible`), naming the key; other values are the type checks'."""
-    quantity = f.metadata.get("quantity")
-    values = value if isinstance(value, list) else [value]
-    if quantity and values and all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                                   and math.isfinite(v) for v in values):
-        try:
-            plausible(f"{where} [{section}] {f.name}", values, quantity)
-        except InputError as err:
-            raise CaseError(str(err)) from None
-
-
-def _choice(section: str, f, value, where):
-    """Refuse a text setting outside its declared choices (:func:`fem_twin.checks.check_choice`)."""
-    try:
-        check_choice(f"{where} [{section}] {f.name}", value, f.metadata.get("choices"))
-    except InputError as err:
-        raise CaseError(str(err)) from None
-
-
-def _only(section, allowed: set, where: str):
-    if not isinstance(section, dict):
-        raise CaseError(f"{where}: expected a table")
-    unknown = set(section) - allowed
-    if unknown:
-        raise CaseError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
-
-
-def _int_pair(value, where: str, minimum: int = 2) -> tuple[int, int]:
-    if (not isinstance(value, list) or len(value) != 2
-            or not all(isinstance(v, int) and v >= minimum for v in value)):
-        raise CaseError(f"{where}: expected two integers >= {minimum}, got {value!r}")
-    return (value[0], value[1])
