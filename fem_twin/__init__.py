@@ -1,16 +1,9 @@
 """fem_twin: finite-element digital twin of a pin-on-disk tribometer in mixed lubrication.
 
-Pipeline: ``topography -> contact -> micro (homogenisation) -> macro (reynolds) ->
-stribeck``, with ``fvm`` as the reference twin of the FE solvers and ``io`` for files,
-meshes and VTK.  All quantities are SI (m, Pa, Pa s, m/s).
-
-The layers, in the pipeline's order: a module imports only from its own layer or an
-earlier one (``tests/test_architecture.py`` reads this table).  Shared plumbing (errors,
-checks, tables, numerics ...) is layer 0; ``io.files`` reads and writes the Topography
-value, so ``io`` sits with the topography stage; ``fvm`` gathers the FV siblings of micro
-and macro.  The workflow (6.x): the case, the run's data files, the stages on a case and
-the task graph, the pipeline that orders them, the studies that run it, and the report
-of a finished run::
+Pipeline ``topography -> contact -> micro -> macro -> stribeck`` (``fvm``: the FE solvers'
+reference twin; ``io``: files, meshes, VTK), SI units throughout.  A module imports only
+from its own layer or an earlier one (0: shared plumbing; tests/test_architecture.py
+reads this table; docs: ARCHITECTURE.md)::
 
     1    topography, io
     2    contact

@@ -127,15 +127,22 @@ def _check_request(case: Case, params, paths, curves, tests, predict_at, predict
                          "temperatures in [lubricant] (the Walther law of ASTM D341)")
     if "load_share" in params and tr.ball:
         raise InputError("load_share is a pin face's share of the load; a ball carries it all")
+    _check_models(case, params)
+    _check_coverage(case, paths, curves, params)
+
+
+def _check_models(case: Case, params) -> None:
+    """Refuse (fitted) parameters the case's models do not read: a thermal one on an
+    isothermal case, C_f,b on a shear-law case; for a fit before its run and for
+    ``--from-fit`` alike."""
     for name in ("bulk_resistance", "temperature_coefficient"):
         if name in params and case.thermal.model == "none":
-            raise InputError(f"{name} needs the thermal twin: set [thermal] model = "
-                             "\"flash\" to fit it")
+            raise InputError(f"{name} needs the thermal twin and the case has [thermal] model "
+                             "= \"none\": set model = \"flash\", or fit without it")
     if "boundary_friction" in params and case.boundary.law != "constant":
         raise InputError("boundary_friction is eq 32's constant C_f,b; the case's [boundary] "
                          "law = \"shear\" does not read it: fit the other parameters, or "
                          "set law = \"constant\"")
-    _check_coverage(case, paths, curves, params)
 
 
 def _simulated(case: Case, out: RunLayout, tests, progress: bool) -> list:
@@ -229,12 +236,7 @@ def apply_fit(case: Case, result: dict) -> Case:
     result = check_fit(result)
     tr, lb = case.tribometer, case.lubricant
     params, made = result["fit"]["parameters"], result["case"]
-    if "bulk_resistance" in params and case.thermal.model == "none":
-        raise InputError("the fit's bulk_resistance is a thermal model's: the case has "
-                         '[thermal] model = "none"; set model = "flash" or fit without it')
-    if "boundary_friction" in params and case.boundary.law != "constant":
-        raise InputError("the fit's boundary_friction is eq 32's constant C_f,b; this case's "
-                         '[boundary] law = "shear" does not read it; set law = "constant"')
+    _check_models(case, params)
     if made.get("kind", tr.kind) != tr.kind:
         raise InputError(f"the fit was made on a {made['kind']} case and this is a {tr.kind} "
                          "case: its contact and kinematics differ; fit this tribometer's curves")

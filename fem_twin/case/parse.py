@@ -102,24 +102,24 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
                 source=source, defaulted=defaulted)
 
 
-#: the keys a pin case has no use for, with what sets them (refused, not ignored)
-BALL_ONLY = {("tribometer", "slide_to_roll"): 'kind = "ball-on-disk"',
-             ("tribometer", "ball_radius"): 'kind = "ball-on-disk"',
-             ("tribometer", "track_radius"): 'kind = "ball-on-disk"',
-             ("macro", "grid"): '[tribometer] kind = "ball-on-disk" (a pin\'s grid is '
-                                '[preprocessing] resolution)'}
+#: the keys each kind of tribometer has no use for (refused, not ignored): what they are,
+#: and how to fix the case
+UNUSED = {"pin-on-disk": {
+    ("tribometer", key): "a ball-on-disk setting, unused in a pin case; remove it, or set "
+                         'kind = "ball-on-disk"'
+    for key in ("slide_to_roll", "ball_radius", "track_radius")} | {
+    ("macro", "grid"): "a ball-on-disk setting, unused in a pin case; remove it, or set "
+                       '[tribometer] kind = "ball-on-disk" (a pin\'s grid is [preprocessing] '
+                       "resolution)"},
+    "ball-on-disk": {("tribometer", "sliding_radius"): "a pin's track, unused by a ball; a "
+                                                       "ball's is track_radius"}}
 
 
 def _tribometer(data, where) -> Tribometer:
     tribometer = read_table(data, "tribometer", Tribometer, where, positive=True)
-    if tribometer.ball and "sliding_radius" in data.get("tribometer", {}):
-        raise CaseError(f"{where} [tribometer] sliding_radius: a pin's track, unused by a ball; "
-                        "a ball's is track_radius")
-    if not tribometer.ball:
-        for (section, key), needs in BALL_ONLY.items():
-            if key in data.get(section, {}):
-                raise CaseError(f"{where} [{section}] {key}: a ball-on-disk setting, unused in "
-                                f"a pin case; remove it, or set {needs}")
+    for (section, key), why in UNUSED[tribometer.kind].items():
+        if key in data.get(section, {}):
+            raise CaseError(f"{where} [{section}] {key}: {why}")
     if tribometer.ball and tribometer.load_share != 1.0:
         raise CaseError(f"{where} [tribometer] load_share: a ball carries the whole load "
                         "(load_share = 1); it is a pin face's share")

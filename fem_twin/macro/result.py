@@ -164,8 +164,7 @@ def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubrica
     load field (:func:`.boundary.asperity_load`) [Pa] and contact fraction a_r [-] the law
     reads, each weighted alike (the x1 share of the sliding, or ``|v|``)."""
     shear = factors.at(h0)              # the shear factors (the iterations read none)
-    cos, local = ((rotations(velocity)[0], rotations(velocity)[2]) if velocity is not None
-                  else (1.0, 1.0))
+    cos, _, local = (1.0, 0.0, 1.0) if velocity is None else rotations(velocity)
     if settings.reading == "torque":    # the disk's drag times |v| = r / R (its lever)
         along = local
         tau_hd = disk_shear(p_hd, h_m, theta, mu, shear, dx, speed,

@@ -156,19 +156,7 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     its ``viscosity_K`` per curve K from 1) with the residuals and the fit's statistics.
     ``verbose``: a line per iteration (scipy's).  Raises :class:`~fem_twin.errors.InputError`
     when no parameter set fits (:func:`check_misfit`)."""
-    check_parameters(params)
-    if len(measured) != len(model.curves):
-        raise InputError(f"{len(measured)} measured curves for {len(model.curves)} simulated")
-    if "temperature" in params and start_temperatures is None:
-        raise InputError("fitting the temperature needs start temperatures [C]")
-    if "load_share" in params and len(model.share_curves) < 2:
-        raise InputError("fitting the load share needs sweeps at two or more load shares "
-                         "(FitModel.share_curves)")
-    if "bulk_resistance" in params and len(model.resistance_curves) != len(model.curves):
-        raise InputError("fitting the thermal resistance needs every curve swept at two or "
-                         "more resistances (FitModel.resistance_curves)")
-    _check_columns(model, params)
-    check_loads(params, model.loads or (model.load,))
+    _check_model(model, measured, params, start_temperatures)
     names, x0, lower, upper = _unknowns(model, params, len(measured), start_temperatures)
 
     def unpack(x):
@@ -286,6 +274,24 @@ def _inside(model: FitModel, measured, cfb, mus, share, resistance, shear) -> tu
                                   cut(m.low), cut(m.high)))
         dropped.append(int((~inside).sum()))
     return kept, dropped
+
+
+def _check_model(model: FitModel, measured, params, start_temperatures) -> None:
+    """Refuse ``params`` the ``model``'s curves cannot fit to ``measured``, before any
+    least squares."""
+    check_parameters(params)
+    if len(measured) != len(model.curves):
+        raise InputError(f"{len(measured)} measured curves for {len(model.curves)} simulated")
+    if "temperature" in params and start_temperatures is None:
+        raise InputError("fitting the temperature needs start temperatures [C]")
+    if "load_share" in params and len(model.share_curves) < 2:
+        raise InputError("fitting the load share needs sweeps at two or more load shares "
+                         "(FitModel.share_curves)")
+    if "bulk_resistance" in params and len(model.resistance_curves) != len(model.curves):
+        raise InputError("fitting the thermal resistance needs every curve swept at two or "
+                         "more resistances (FitModel.resistance_curves)")
+    _check_columns(model, params)
+    check_loads(params, model.loads or (model.load,))
 
 
 def _check_columns(model: FitModel, params) -> None:
