@@ -29,6 +29,8 @@ from ..errors import InputError
 from ..io.mesh import GridMesh, grid_mesh
 from ..numerics.assembly import FixedPattern, element_entries, periodic_unknowns, unit_element
 from ..numerics.linalg import SPDSolver
+from .pockets import fluid_regions
+from .pockets import sealed as seal
 
 
 @skfem.BilinearForm
@@ -152,25 +154,31 @@ class CellSolver:
         """Pixel index of each unknown of the reduced system."""
         return self._free
 
-    def _scatter(self, local: np.ndarray) -> np.ndarray:
-        """Element vectors ``(nelems, 4)`` -> reduced global vector."""
+    def _scatter(self, local: np.ndarray, regions=None) -> np.ndarray:
+        """Element vectors ``(nelems, 4)`` -> reduced global vector (``regions``: each
+        sealed region's net load removed, :func:`.pockets.sealed`)."""
         n = self.shape[0] * self.shape[1]
-        return np.bincount(self._pix.T.ravel(), weights=local.ravel(), minlength=n)[self._free]
+        full = np.bincount(self._pix.T.ravel(), weights=local.ravel(), minlength=n)
+        if regions is not None:
+            full = seal(full.reshape(self.shape), regions).ravel()
+        return full[self._free]
 
     def right_hand_sides(self, h_q: np.ndarray, a_q: np.ndarray, tau_q=None,
-                         couette: bool = True) -> np.ndarray:
-        """Load vectors of eqs 8, 9, 10 as columns ``(n - 1, 3)`` (``couette=False``: eq 8
-        without its Couette term, the mean-speed frame)."""
+                         couette: bool = True, regions=(None,)) -> np.ndarray:
+        """Load vectors of eqs 8, 9, 10 as columns ``(n - 1, 2 + len(regions))``: eq 8's
+        sealed in each of ``regions`` (None: not sealed; :mod:`.pockets`), then eqs 9 and
+        10 (``couette=False``: eq 8 without its Couette term, the mean-speed frame)."""
         f1 = h_q @ self._g[0] if couette else np.zeros_like(h_q @ self._m)
         if tau_q is not None:
             f1 = f1 - tau_q @ self._m
         f2 = -(a_q @ self._g[0])
         f3 = -(a_q @ self._g[1])
-        return np.column_stack([self._scatter(f1), self._scatter(f2), self._scatter(f3)])
+        return np.column_stack([self._scatter(f1, r) for r in regions]
+                               + [self._scatter(f2), self._scatter(f3)])
 
     # -- solve ---------------------------------------------------------------------------
     def solve(self, gap: np.ndarray, squeeze: np.ndarray | None = None,
-              couette: bool = True, film=(0.0,)) -> CellSolution:
+              couette: bool = True, film=(0.0,), sealed: bool = False) -> CellSolution:
         """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady).
 
         ``squeeze`` is ``(1/u_m) dh/dt`` on the grid, already discretised in time; its cell
@@ -178,6 +186,9 @@ class CellSolver:
         removed, as the periodic problem requires.  ``couette=False``: eq 8 without its
         Couette term (the mean-speed frame, :mod:`fem_twin.micro.sliding`).  ``film``: the
         thinnest film [m] whose dissipation of chi_1 counts, one moment per value.
+        ``sealed``: each value of ``film`` also walls in the regions of its own chi_1
+        (:mod:`.pockets`; the first is the solution's), one more right-hand side each;
+        False: the paper's source, which leaks through the contact spots.
         """
         h = np.asarray(gap, float)
         if h.shape != self.shape:
@@ -193,22 +204,25 @@ class CellSolver:
             tau_q = self.at_quadrature(squeeze)
             tau_q = tau_q - tau_q.mean()
         K = self.operator(a_q)
-        F = self.right_hand_sides(h_q, a_q, tau_q, couette)
+        regions = [fluid_regions(h, w, connectivity=8) for w in film] if sealed else [None]
+        F = self.right_hand_sides(h_q, a_q, tau_q, couette, regions)
         scale = a_q.mean()
         X = self._factor.factor(K.data / scale).solve(F / scale)
         n = self.shape[0] * self.shape[1]
-        chi = np.zeros((3, n))
-        chi[:, self._free] = X.T
-        chi = chi.reshape(3, *self.shape)
-        return CellSolution(chi, self.moments(h_q, chi, film))
+        fields = np.zeros((X.shape[1], n))
+        fields[:, self._free] = X.T
+        fields = fields.reshape(-1, *self.shape)
+        chi = fields[[0, -2, -1]]
+        return CellSolution(chi, self.moments(h_q, chi, film, fields[:-2]))
 
-    def moments(self, h_q: np.ndarray, chi: np.ndarray, film=(0.0,)) -> dict:
+    def moments(self, h_q: np.ndarray, chi: np.ndarray, film=(0.0,), chi_1=None) -> dict:
         """Cell averages of one time step, unnormalised (eqs 12-16 divide by h_m later).
 
         h : <h> [m];  h3_grad : <h^3 (I + G)> [m^3], G[i, j] = d chi_{j+2} / dx_i;
         h3_g1 : <h^3 grad chi_1> [m];  h_grad : <h (I + G)> [m];  h_g1 : <h grad chi_1> [1/m];
         h3_g1g1 : ``<h^3 |grad chi_1|^2>`` where ``h`` exceeds each value of ``film`` [1/m]
-        (the dissipation of the sliding flow in the film, :func:`.sliding.film_moments`)
+        (the dissipation of the sliding flow in the film, :func:`.sliding.film_moments`),
+        of the matching one of ``chi_1`` (sealed at each value) if given
         """
         a_q = h_q ** 3
         n = a_q.size
@@ -218,11 +232,13 @@ class CellSolver:
                            for j in (1, 2)], axis=2)            # <w G[i, j]>: (w, i, j)
         w_mean = weights.mean(axis=1)
         eye = np.eye(2)
-        density = weights[0] * (g1 * g1).sum(axis=0)
+        grads = ([g1] * len(film) if chi_1 is None or len(chi_1) == 1
+                 else [self.gradient(c).reshape(2, n) for c in chi_1])
+        density = [weights[0] * (g * g).sum(axis=0) for g in grads]
         return {"h": float(w_mean[1]),
                 "h3_grad": w_mean[0] * eye + g_mean[0],
                 "h3_g1": g1 @ weights[0] / n,
                 "h_grad": w_mean[1] * eye + g_mean[1],
                 "h_g1": g1 @ weights[1] / n,
-                "h3_g1g1": np.array([np.mean(np.where(weights[1] > cut, density, 0.0))
-                                     for cut in film])}
+                "h3_g1g1": np.array([np.mean(np.where(weights[1] > cut, d, 0.0))
+                                     for cut, d in zip(film, density)])}

@@ -23,6 +23,8 @@ from ..errors import InputError
 from ..numerics.assembly import FixedPattern, periodic_unknowns
 from ..numerics.linalg import SPDSolver
 from .cell import CellSolution
+from .pockets import fluid_regions
+from .pockets import sealed as seal
 
 
 def _cube_mean(a, b):
@@ -106,10 +108,11 @@ class CellSolverFV:
         out += (flux[1] - np.roll(flux[1], 1, axis=0)) * dx1
         return out
 
-    def solve(self, gap, squeeze=None, couette: bool = True, film=(0.0,)) -> CellSolution:
+    def solve(self, gap, squeeze=None, couette: bool = True, film=(0.0,),
+              sealed: bool = False) -> CellSolution:
         """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady);
-        ``couette=False``: eq 8 without its Couette term (the mean-speed frame); ``film``:
-        the thinnest films whose dissipation counts, as in :meth:`CellSolver.solve`."""
+        ``couette=False``: eq 8 without its Couette term (the mean-speed frame); ``film``
+        and ``sealed``: as in :meth:`CellSolver.solve` (the regions joined through faces)."""
         h = np.asarray(gap, float)
         if h.shape != self.shape:
             raise InputError(f"gap shape {h.shape} does not match the cell {self.shape}")
@@ -123,20 +126,24 @@ class CellSolverFV:
         if squeeze is not None:                   # mean removed: see the FE CellSolver
             tau = np.asarray(squeeze, float)
             f1 = f1 - (tau - tau.mean()) * dx1 * dx2
+        f1 = ([seal(f1, fluid_regions(h, w, connectivity=4)) for w in film] if sealed
+              else [f1])
         f2 = self._divergence(np.stack([cf[0], zero]))
         f3 = self._divergence(np.stack([zero, cf[1]]))
-        F = np.column_stack([f.ravel()[self._free] for f in (f1, f2, f3)])
+        F = np.column_stack([f.ravel()[self._free] for f in (*f1, f2, f3)])
         K = self.operator(cf)
         scale = cf.mean()
         X = self._factor.factor(K.data / scale).solve(F / scale)
-        chi = np.zeros((3, h.size))
-        chi[:, self._free] = X.T
-        chi = chi.reshape(3, *self.shape)
-        return CellSolution(chi, self.moments(h, hf, cf, chi, film))
+        fields = np.zeros((X.shape[1], h.size))
+        fields[:, self._free] = X.T
+        fields = fields.reshape(-1, *self.shape)
+        chi = fields[[0, -2, -1]]
+        return CellSolution(chi, self.moments(h, hf, cf, chi, film, fields[:-2]))
 
-    def moments(self, h, hf, cf, chi, film=(0.0,)) -> dict:
+    def moments(self, h, hf, cf, chi, film=(0.0,), chi_1=None) -> dict:
         """Cell averages of one step as face averages of the fluxes (same keys as FE; the
-        dissipation over the faces whose mean gap exceeds each value of ``film``)."""
+        dissipation over the faces whose mean gap exceeds each value of ``film``, of the
+        matching one of ``chi_1`` if given)."""
         dx = self.spacing
 
         def grad(f):                              # D_i f on the faces normal to x_i
@@ -144,6 +151,7 @@ class CellSolverFV:
                              (np.roll(f, -1, axis=0) - f) / dx[1]])
 
         g1 = grad(chi[0])
+        grads = [g1] * len(film) if chi_1 is None or len(chi_1) == 1 else map(grad, chi_1)
         G = np.stack([grad(chi[1]), grad(chi[2])], axis=1)      # (i, j, ny, nx): D_i chi_{j+2}
         eye = np.eye(2)[:, :, None, None]
         return {"h": float(h.mean()),
@@ -151,5 +159,5 @@ class CellSolverFV:
                 "h3_g1": (cf * g1).mean(axis=(1, 2)),
                 "h_grad": (hf[:, None] * (eye + G)).mean(axis=(2, 3)),
                 "h_g1": (hf * g1).mean(axis=(1, 2)),
-                "h3_g1g1": np.array([np.where(hf > cut, cf * g1 * g1, 0.0).mean(axis=(1, 2)).sum()
-                                     for cut in film])}
+                "h3_g1g1": np.array([np.where(hf > cut, cf * g * g, 0.0).mean(axis=(1, 2)).sum()
+                                     for cut, g in zip(film, grads)])}

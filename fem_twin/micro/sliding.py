@@ -46,6 +46,10 @@ class CellSettings:
     boundary_film: float = setting(10e-9, "films thinner than this carry no film friction "
                                    "(contact spots carry the boundary shear, eq 32)",
                                    "boundary_film")
+    pockets: str = setting("sealed", "fluid regions that contact spots and boundary films "
+                           "wall in keep their volume (their net squeeze removed), or leak it "
+                           "through the contact spots at the gap floor (the paper)",
+                           choices=("sealed", "leaking"))
     method: str = setting("fe", "cell problems by Q1 finite elements or the paper's finite "
                           "volumes", choices=("fe", "fvm"))
     moving: str = setting("both", "the cell's frame: the disk at +U/2 and the pin at -U/2 "
@@ -227,10 +231,12 @@ FILM_CUTS = (1.0, 0.5, 2.0)
 
 def sliding_cells(contacts, squeezes, solver, settings: CellSettings, couette: bool = True):
     """Cell solutions of each step for its contact's gap and squeeze term (``couette``:
-    with eq 8's Couette term), with the film dissipation above each of :data:`FILM_CUTS`."""
+    with eq 8's Couette term), with the film dissipation above each of :data:`FILM_CUTS`,
+    each sealed at its own film unless ``settings.pockets`` is ``"leaking"``."""
     film = tuple(c * settings.boundary_film for c in FILM_CUTS)
     for r, tau in zip(contacts, squeezes):
-        yield solver.solve(r.gap, tau, couette=couette, film=film)
+        yield solver.solve(r.gap, tau, couette=couette, film=film,
+                           sealed=settings.pockets == "sealed")
 
 
 def film_moments(contact, cell: dict, settings: CellSettings) -> dict:
