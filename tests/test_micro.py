@@ -349,10 +349,11 @@ def test_variants_carry_each_estimated_error():
     v = ff.variants()
     assert sorted(v) == ["film_thick", "film_thin", "grid", "h0", "time"]
     est = ff.meta["error_estimate"]
-    # the films: only the friction factor moves; a thinner boundary film counts more film
+    # the films: only the friction factors move; a thinner boundary film counts more film
     for kind in ("film_thin", "film_thick"):
         assert all(np.array_equal(getattr(v[kind], k), getattr(ff, k)) for k in ARRAYS
-                   if k != "friction_factor")
+                   if k not in ("friction_factor", "film_fraction", "log_friction"))
+    assert np.all(v["film_thin"].film_fraction >= ff.film_fraction)
     assert np.all(v["film_thin"].friction_factor >= ff.friction_factor)
     assert np.all(v["film_thick"].friction_factor <= ff.friction_factor)
     assert max(np.abs(v[k].friction_factor - ff.friction_factor).max() for k in (

@@ -29,6 +29,7 @@ from ..errors import InputError
 from ..io.mesh import GridMesh, grid_mesh
 from ..numerics.assembly import FixedPattern, element_entries, periodic_unknowns, unit_element
 from ..numerics.linalg import SPDSolver
+from .film import shear_spread
 from .pockets import fluid_regions
 from .pockets import sealed as seal
 
@@ -178,7 +179,8 @@ class CellSolver:
 
     # -- solve ---------------------------------------------------------------------------
     def solve(self, gap: np.ndarray, squeeze: np.ndarray | None = None,
-              couette: bool = True, film=(0.0,), sealed: bool = False) -> CellSolution:
+              couette: bool = True, film=(0.0,), sealed: bool = False,
+              shear_weight: float | None = None) -> CellSolution:
         """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady).
 
         ``squeeze`` is ``(1/u_m) dh/dt`` on the grid, already discretised in time; its cell
@@ -189,6 +191,7 @@ class CellSolver:
         ``sealed``: each value of ``film`` also walls in the regions of its own chi_1
         (:mod:`.pockets`; the first is the solution's), one more right-hand side each;
         False: the paper's source, which leaks through the contact spots.
+        ``shear_weight``: adds the moments of the local shear's spread (see :meth:`moments`).
         """
         h = np.asarray(gap, float)
         if h.shape != self.shape:
@@ -213,16 +216,20 @@ class CellSolver:
         fields[:, self._free] = X.T
         fields = fields.reshape(-1, *self.shape)
         chi = fields[[0, -2, -1]]
-        return CellSolution(chi, self.moments(h_q, chi, film, fields[:-2]))
+        return CellSolution(chi, self.moments(h_q, chi, film, fields[:-2], shear_weight))
 
-    def moments(self, h_q: np.ndarray, chi: np.ndarray, film=(0.0,), chi_1=None) -> dict:
+    def moments(self, h_q: np.ndarray, chi: np.ndarray, film=(0.0,), chi_1=None,
+                shear_weight: float | None = None) -> dict:
         """Cell averages of one time step, unnormalised (eqs 12-16 divide by h_m later).
 
         h : <h> [m];  h3_grad : <h^3 (I + G)> [m^3], G[i, j] = d chi_{j+2} / dx_i;
         h3_g1 : <h^3 grad chi_1> [m];  h_grad : <h (I + G)> [m];  h_g1 : <h grad chi_1> [1/m];
         h3_g1g1 : ``<h^3 |grad chi_1|^2>`` where ``h`` exceeds each value of ``film`` [1/m]
         (the dissipation of the sliding flow in the film, :func:`.sliding.film_moments`),
-        of the matching one of ``chi_1`` (sealed at each value) if given
+        of the matching one of ``chi_1`` (sealed at each value) if given;
+        with ``shear_weight`` ``w``, per value of ``film``: film_area, the fraction of the
+        cell above it [-], and log_shear, ``<ln s>`` over it (zero elsewhere) of the local
+        dissipation ``s = 1/h + w h^3 |grad chi_1|^2`` [1/m] at the quadrature points
         """
         a_q = h_q ** 3
         n = a_q.size
@@ -235,10 +242,13 @@ class CellSolver:
         grads = ([g1] * len(film) if chi_1 is None or len(chi_1) == 1
                  else [self.gradient(c).reshape(2, n) for c in chi_1])
         density = [weights[0] * (g * g).sum(axis=0) for g in grads]
-        return {"h": float(w_mean[1]),
+        out = ({} if shear_weight is None
+               else shear_spread(weights[1], density, film, shear_weight))
+        return {**out, "h": float(w_mean[1]),
                 "h3_grad": w_mean[0] * eye + g_mean[0],
                 "h3_g1": g1 @ weights[0] / n,
                 "h_grad": w_mean[1] * eye + g_mean[1],
                 "h_g1": g1 @ weights[1] / n,
                 "h3_g1g1": np.array([np.mean(np.where(weights[1] > cut, d, 0.0))
                                      for cut, d in zip(film, density)])}
+

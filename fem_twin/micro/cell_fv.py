@@ -23,6 +23,7 @@ from ..errors import InputError
 from ..numerics.assembly import FixedPattern, periodic_unknowns
 from ..numerics.linalg import SPDSolver
 from .cell import CellSolution
+from .film import shear_spread
 from .pockets import fluid_regions
 from .pockets import sealed as seal
 
@@ -109,10 +110,11 @@ class CellSolverFV:
         return out
 
     def solve(self, gap, squeeze=None, couette: bool = True, film=(0.0,),
-              sealed: bool = False) -> CellSolution:
+              sealed: bool = False, shear_weight: float | None = None) -> CellSolution:
         """Cell solutions for the gap ``h`` [m] and the squeeze term ``tau`` [-] (or steady);
         ``couette=False``: eq 8 without its Couette term (the mean-speed frame); ``film``
-        and ``sealed``: as in :meth:`CellSolver.solve` (the regions joined through faces)."""
+        ``sealed`` and ``shear_weight``: as in :meth:`CellSolver.solve` (the regions joined
+        through faces; the local shear per pixel, its dissipation on its two upper faces)."""
         h = np.asarray(gap, float)
         if h.shape != self.shape:
             raise InputError(f"gap shape {h.shape} does not match the cell {self.shape}")
@@ -138,9 +140,10 @@ class CellSolverFV:
         fields[:, self._free] = X.T
         fields = fields.reshape(-1, *self.shape)
         chi = fields[[0, -2, -1]]
-        return CellSolution(chi, self.moments(h, hf, cf, chi, film, fields[:-2]))
+        return CellSolution(chi, self.moments(h, hf, cf, chi, film, fields[:-2], shear_weight))
 
-    def moments(self, h, hf, cf, chi, film=(0.0,), chi_1=None) -> dict:
+    def moments(self, h, hf, cf, chi, film=(0.0,), chi_1=None,
+                shear_weight: float | None = None) -> dict:
         """Cell averages of one step as face averages of the fluxes (same keys as FE; the
         dissipation over the faces whose mean gap exceeds each value of ``film``, of the
         matching one of ``chi_1`` if given)."""
@@ -151,10 +154,13 @@ class CellSolverFV:
                              (np.roll(f, -1, axis=0) - f) / dx[1]])
 
         g1 = grad(chi[0])
-        grads = [g1] * len(film) if chi_1 is None or len(chi_1) == 1 else map(grad, chi_1)
+        grads = [g1] * len(film) if chi_1 is None or len(chi_1) == 1 else [
+            grad(c) for c in chi_1]
         G = np.stack([grad(chi[1]), grad(chi[2])], axis=1)      # (i, j, ny, nx): D_i chi_{j+2}
         eye = np.eye(2)[:, :, None, None]
-        return {"h": float(h.mean()),
+        out = {} if shear_weight is None else shear_spread(
+            h.ravel(), [(cf * g * g).sum(axis=0).ravel() for g in grads], film, shear_weight)
+        return {**out, "h": float(h.mean()),
                 "h3_grad": (cf[:, None] * (eye + G)).mean(axis=(2, 3)),
                 "h3_g1": (cf * g1).mean(axis=(1, 2)),
                 "h_grad": (hf[:, None] * (eye + G)).mean(axis=(2, 3)),

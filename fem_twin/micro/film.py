@@ -56,3 +56,15 @@ def mean_inverse_film(gap, cut: float) -> float:
     h11 = np.roll(h10, -1, axis=0)
     total = _triangle_means(h00, h10, h11, cut) + _triangle_means(h00, h11, h01, cut)
     return float(np.mean(total))
+
+
+def shear_spread(h, density, film, shear_weight) -> dict:
+    """The moments of the local shear's spread over the films thicker than each of
+    ``film`` [m]: ``film_area`` [-], and ``log_shear``, the area mean of ``ln s`` there (zero
+    elsewhere) of ``s = 1/h + shear_weight density`` [1/m], from the films ``h`` [m] and the
+    sliding flow's ``h^3 |grad chi_1|^2`` (``density``, one array per film) [1/m] at points
+    of equal weight."""
+    above = [h > cut for cut in film]
+    local = [np.log(1 / h + shear_weight * d) for d in density]
+    return {"film_area": np.array([a.mean() for a in above]),
+            "log_shear": np.array([np.where(a, v, 0.0).mean() for a, v in zip(above, local)])}

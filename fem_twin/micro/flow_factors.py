@@ -27,14 +27,17 @@ from .estimate import combine
 
 #: the arrays of a FlowFactors value, in the order of its fields
 ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "friction_factor", "pressure_friction",
-          "contact_fraction")
+          "contact_fraction", "film_fraction", "log_friction")
+#: the arrays of the local shear's spread, which files written without them take as none
+SPREAD = ("film_fraction", "log_friction")
 #: p_con is interpolated as ``log(p_con + P_CON_FLOOR max p_con)``: it falls by a factor of
 #: about 3 per 40 nm of h0, so its logarithm interpolates seven times closer than p_con
 #: itself (benchmarks/README.md); the floor keeps the log finite where the surfaces
 #: separate (p_con = 0)
 P_CON_FLOOR = 1e-6
 #: what the friction needs beyond the Reynolds equation (eqs 31-32, the force on the pin)
-SHEAR = ("C", "d", "friction_factor", "pressure_friction", "contact_fraction")
+SHEAR = ("C", "d", "friction_factor", "pressure_friction", "contact_fraction", "film_fraction",
+         "log_friction")
 #: relative step of the central differences in h0 (:meth:`FlowFactors.slopes`)
 REL_STEP = 1e-6
 
@@ -54,6 +57,12 @@ class FlowFactors:
     pressure_friction : (n, 2) ``2 e1 - b`` (pin at rest), Poiseuille friction on the pin
     ``-(h_m / 2) pressure_friction . grad p`` [-]; eq 31: ``1 - 3 d1`` and ``C``'s first row
     contact_fraction : (n,) space-time mean fraction of pixels in contact [-]
+    film_fraction : (n,) w, the fraction of the cell whose film carries film friction
+    (thicker than the boundary film) [-]; default 1
+    log_friction : (n,) ``<ln(h_m s)>`` over that film, zero elsewhere, with ``s`` the local
+    dissipation per ``mu u_r^2`` [1/m], whose cell mean is ``s_C / h_m`` [-]; default
+    ``ln s_C``.  With ``film_fraction``, the spread of the local shear that an Eyring film
+    averages (:func:`fem_twin.macro.friction.eyring_shear`)
     meta : JSON-able description (patch ids, grid, materials, method, version, ...)
     """
 
@@ -67,13 +76,20 @@ class FlowFactors:
     friction_factor: np.ndarray
     pressure_friction: np.ndarray
     contact_fraction: np.ndarray
+    film_fraction: np.ndarray | None = None
+    log_friction: np.ndarray | None = None
     meta: dict = field(default_factory=dict)
 
     def __post_init__(self):
         n = np.shape(self.h0)
+        if self.film_fraction is None or self.log_friction is None:   # no spread known
+            object.__setattr__(self, "film_fraction", np.ones(n))
+            object.__setattr__(self, "log_friction", np.log(np.maximum(
+                np.asarray(self.friction_factor, float), 1e-300)))
         expect = {"h0": n, "h_m": n, "p_con": n, "A": n + (2, 2), "b": n + (2,),
                   "C": n + (2, 2), "d": n + (2,), "friction_factor": n,
-                  "pressure_friction": n + (2,), "contact_fraction": n}
+                  "pressure_friction": n + (2,), "contact_fraction": n, "film_fraction": n,
+                  "log_friction": n}
         for name, shape in expect.items():
             try:
                 v = np.asarray(getattr(self, name), dtype=float)
@@ -133,10 +149,11 @@ class FlowFactors:
         path = Path(path)
         try:
             with np.load(path, allow_pickle=False) as z:
-                missing = [k for k in ARRAYS if k not in z]
+                missing = [k for k in ARRAYS if k not in z and k not in SPREAD]
                 if missing:
                     raise InputError(f"missing {missing}")
-                return cls(**{k: z[k] for k in ARRAYS}, meta=json.loads(str(z["meta"])))
+                return cls(**{k: z[k] for k in ARRAYS if k in z},
+                           meta=json.loads(str(z["meta"])))
         except (OSError, EOFError, ValueError, KeyError) as err:
             raise InputError(f"{path}: cannot read flow factors ({err})") from err
 
@@ -150,7 +167,8 @@ class FlowFactors:
                 "C22": self.C[:, 1, 1], "d1": self.d[:, 0], "d2": self.d[:, 1],
                 "sC": self.friction_factor, "fP1": self.pressure_friction[:, 0],
                 "fP2": self.pressure_friction[:, 1],
-                "contact_fraction": self.contact_fraction}
+                "contact_fraction": self.contact_fraction, "film_fraction": self.film_fraction,
+                "log_sC": self.log_friction}
         return write_csv(path, cols)
 
     # -- interpolation -------------------------------------------------------------------
@@ -292,6 +310,8 @@ class LocalFactors:
     friction_factor: np.ndarray | None
     pressure_friction: np.ndarray | None
     contact_fraction: np.ndarray | None
+    film_fraction: np.ndarray | None = None
+    log_friction: np.ndarray | None = None
 
 
 @arguments(factors=[FlowFactors])

@@ -186,11 +186,22 @@ def estimate_errors(factors, moments, coarse, settings) -> dict:
         grid = replace(factors, meta={}, **{k: getattr(factors, k) + getattr(other, k)
                                             - getattr(same, k) for k in ARRAYS[1:]})
         out["checkpoint_keys"] = [key]
-    films = [replace(factors, meta={}, friction_factor=np.array([m["s_c"][k] for m in moments])
-                     * factors.h_m) for k in (1, 2)]
+    films = [_film_variant(factors, moments, k) for k in (1, 2)]
     out["film"] = {q: max(discrepancy(factors, f)[q] for f in films) for q in QUANTITIES}
     out["variants"] = variants(factors, half, grid, films)
     return out
+
+
+def _film_variant(factors, moments, k) -> FlowFactors:
+    """``factors`` with the friction factors of film cut ``k`` (:data:`.sliding.FILM_CUTS`)."""
+    def get(key):
+        return np.array([m[key][k] for m in moments])
+
+    h_m, out = factors.h_m, {"friction_factor": get("s_c") * factors.h_m}
+    if all("film_area" in m for m in moments):
+        out["film_fraction"] = get("film_area")
+        out["log_friction"] = get("log_shear") + out["film_fraction"] * np.log(h_m)
+    return replace(factors, meta={}, **out)
 
 
 def _check_patches(pin, disk):

@@ -232,11 +232,13 @@ FILM_CUTS = (1.0, 0.5, 2.0)
 def sliding_cells(contacts, squeezes, solver, settings: CellSettings, couette: bool = True):
     """Cell solutions of each step for its contact's gap and squeeze term (``couette``:
     with eq 8's Couette term), with the film dissipation above each of :data:`FILM_CUTS`,
-    each sealed at its own film unless ``settings.pockets`` is ``"leaking"``."""
+    each sealed at its own film unless ``settings.pockets`` is ``"leaking"``, and the
+    spread of the local shear there (:func:`.film.shear_spread`)."""
     film = tuple(c * settings.boundary_film for c in FILM_CUTS)
+    weight = 3 * (2 * frame_speed_ratio(settings)) ** 2          # 3 k^2 of film_moments
     for r, tau in zip(contacts, squeezes):
         yield solver.solve(r.gap, tau, couette=couette, film=film,
-                           sealed=settings.pockets == "sealed")
+                           sealed=settings.pockets == "sealed", shear_weight=weight)
 
 
 def film_moments(contact, cell: dict, settings: CellSettings) -> dict:
@@ -346,7 +348,12 @@ def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
         return np.array([m[prefix + key] for m in moments])
 
     h_m = get("h")
-    return FlowFactors(h0=np.asarray(h0, float), h_m=h_m, p_con=get("p_con"),
+    spread = {}
+    if all(prefix + "film_area" in m for m in moments):
+        area = get("film_area")[:, 0]
+        spread = {"film_fraction": area,
+                  "log_friction": get("log_shear")[:, 0] + area * np.log(h_m)}
+    return FlowFactors(h0=np.asarray(h0, float), h_m=h_m, p_con=get("p_con"), **spread,
                        A=get("h3_grad") / h_m[:, None, None] ** 3,
                        b=np.array([1.0, 0.0]) - get("h3_g1") / h_m[:, None],
                        C=get("h_grad") / h_m[:, None, None], d=get("h_g1") * h_m[:, None],
