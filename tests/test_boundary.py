@@ -10,7 +10,7 @@ from fem_twin import Topography
 from fem_twin.case import CaseError
 from fem_twin.errors import InputError
 from fem_twin.macro import BOUNDARY_FRICTION, BoundaryLaw, Lubricant, MacroSettings, solve_mixed
-from fem_twin.macro.boundary import boundary_traction
+from fem_twin.macro.boundary import boundary_area, boundary_traction
 from fem_twin.micro import homogenise
 
 SHEAR = BoundaryLaw(law="shear", shear_strength=50e6, pressure_coefficient=0.1,
@@ -238,15 +238,41 @@ def test_the_error_estimate_carries_the_real_contact_fractions_error(factors):
     contact fraction, and the law reads it: under a law that rests on the real area
     (tau_0 = 100 MPa, alpha = 0.02) the point's grid part differs from the constant law's
     (measured at 0.02 m/s: 0.0093 against 0.0041), while the film part, which no contact
-    fraction enters, is the same."""
+    fraction enters when the films below the cut carry no shear, is the same."""
     from fem_twin.stribeck import SweepRequest, stribeck_sweep
     gap, dx, face = macro_case(32)
     parts = {}
-    for law in (BoundaryLaw(), BoundaryLaw(law="shear", shear_strength=100e6,
-                                           pressure_coefficient=0.02)):
+    for law in (BoundaryLaw(thin_films=False),
+                BoundaryLaw(law="shear", shear_strength=100e6, pressure_coefficient=0.02,
+                            thin_films=False)):
         curve = stribeck_sweep(SweepRequest(gap, dx, factors, [0.02], load=150.0, face=face,
                                             lubricant=Lubricant(0.066), error_estimate=True,
                                             settings=MacroSettings(boundary=law)))
         parts[law.law] = {k: float(v[0]) for k, v in curve.friction_error_parts.items()}
     assert abs(parts["shear"]["grid"] / parts["constant"]["grid"] - 1) > 0.1
     assert parts["shear"]["film"] == pytest.approx(parts["constant"]["film"], rel=1e-9)
+
+
+def test_films_below_the_boundary_film_join_the_boundary_area():
+    """a_r is the contact spots' fraction and, with ``thin_films`` (the default), the films
+    thinner than the boundary film (1 - film_fraction): they carry the boundary shear, not
+    none.  Off, the spots alone; factors without a spread (film_fraction 1) read the spots
+    either way.  A cell in contact has films below the cut beside its spots (counted at
+    the quadrature points, so a lone contact pixel's neighbourhood can read as film: the
+    larger of the two areas is taken)."""
+    from types import SimpleNamespace
+    shear = SimpleNamespace(contact_fraction=np.array([0.1, 0.3, 0.2]),
+                            film_fraction=np.array([0.8, 0.75, 1.0]))
+    assert np.allclose(boundary_area(shear, BoundaryLaw()), [0.2, 0.3, 0.2])
+    assert np.allclose(boundary_area(shear, BoundaryLaw(thin_films=False)), [0.1, 0.3, 0.2])
+    n, dx = 32, 85e-6 / 32
+    pin = Topography(self_affine_patch(n, dx, 1), (dx, dx))
+    disk = Topography(self_affine_patch(n, dx, 2), (dx, dx))
+    ff = homogenise(pin, disk, [0.08e-6, 0.15e-6, 0.3e-6], steps=4, error_estimate=False)
+    assert np.all(ff.contact_fraction > 0) and np.all(ff.film_fraction < 1)
+    assert ff.film_fraction[0] < 1 - ff.contact_fraction[0]     # heavy contact: thin films
+
+
+def self_affine_patch(n, dx, seed):
+    from fem_twin.topography.synthetic import self_affine
+    return self_affine((n, n), (dx, dx), 0.8, 100e-9, rng=seed).heights

@@ -12,7 +12,8 @@ laws act on that load:
   the asperity spots' flash rise dT, :func:`spot_temperature_factor`.
 
 ``tau_0 = 0``, ``alpha = C_f,b`` and ``c_u = c_T = 0`` give the constant law exactly
-(docs/model.md, "Boundary friction").
+(docs/model.md, "Boundary friction").  a_r covers the films thinner than the cell's
+boundary film too (``thin_films``, :func:`boundary_area`): they are boundary films.
 """
 
 from __future__ import annotations
@@ -51,6 +52,9 @@ class BoundaryLaw:
     film_on_contacts: bool = setting(True, "the film's pressure on the contact spots joins "
                                      "the asperities' load, p_con + p a_r (false: the "
                                      "paper's p_con alone)", unit="true or false")
+    thin_films: bool = setting(True, "films thinner than [micro] boundary_film join the "
+                               "contact spots' area a_r (they carry no film friction); "
+                               "false: they carry no shear at all", unit="true or false")
 
     def __post_init__(self):
         check_choices(self)
@@ -74,6 +78,14 @@ class BoundaryLaw:
                              f"speed factor falls to {worst:.3g} between {low:g} and {high:g} "
                              "m/s; it must stay positive (a relative change per decade, "
                              "0.05 is 5 %)")
+
+
+def boundary_area(shear, law: BoundaryLaw) -> np.ndarray:
+    """a_r [-] from the shear factors ``shear`` (LocalFactors): the contact fraction, and
+    with ``law.thin_films`` the films below the boundary film too, ``1 - film_fraction``."""
+    if not law.thin_films or shear.film_fraction is None:
+        return shear.contact_fraction
+    return np.maximum(shear.contact_fraction, 1 - shear.film_fraction)
 
 
 def asperity_load(contact_pressure, film_pressure, contact_fraction,

@@ -82,14 +82,11 @@ class FlowFactors:
 
     def __post_init__(self):
         n = np.shape(self.h0)
-        if self.film_fraction is None or self.log_friction is None:   # no spread known
-            object.__setattr__(self, "film_fraction", np.ones(n))
-            object.__setattr__(self, "log_friction", np.log(np.maximum(
-                np.asarray(self.friction_factor, float), 1e-300)))
+        spread = self.film_fraction is not None and self.log_friction is not None
         expect = {"h0": n, "h_m": n, "p_con": n, "A": n + (2, 2), "b": n + (2,),
                   "C": n + (2, 2), "d": n + (2,), "friction_factor": n,
-                  "pressure_friction": n + (2,), "contact_fraction": n, "film_fraction": n,
-                  "log_friction": n}
+                  "pressure_friction": n + (2,), "contact_fraction": n,
+                  **({"film_fraction": n, "log_friction": n} if spread else {})}
         for name, shape in expect.items():
             try:
                 v = np.asarray(getattr(self, name), dtype=float)
@@ -103,6 +100,10 @@ class FlowFactors:
             object.__setattr__(self, name, v)
         if len(n) != 1 or n[0] < 1 or np.any(np.diff(self.h0) <= 0) or self.h0[0] <= 0:
             raise InputError("h0 must be a positive, strictly increasing 1D array [m]")
+        if not spread:                                    # no spread known: none
+            object.__setattr__(self, "film_fraction", np.ones(n))
+            object.__setattr__(self, "log_friction",
+                               np.log(np.maximum(self.friction_factor, 1e-300)))
 
     def __len__(self) -> int:
         return self.h0.size
