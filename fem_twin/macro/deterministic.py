@@ -12,8 +12,9 @@ Ambient and cavitation pressure 0 (gauge).  Each pass solves the contact against
 deformed by the film pressure, then the film on the contact's gap (floored at ``gap_floor``,
 as in the cells); the film's deformation, viscosity and density are mixed (Anderson) until
 they settle; ``h_d`` balances the load (Brent on the log of the load).  Friction on the pin
-(:func:`pad_friction`) plus ``C_f,b`` times the contact load (eq 32); integrals by the trapezoidal
-rule."""
+(:func:`pad_friction`) plus ``C_f,b`` times the boundary's load (eq 32): the contact load
+and the film's where the gap is at most the boundary film (the twin's ``p a_r``); integrals
+by the trapezoidal rule."""
 
 from __future__ import annotations
 
@@ -59,6 +60,10 @@ class DeterministicSettings:
                                    "carry no wall shear (the cells' default)", unit="m")
     gap_floor: float = setting(CellSettings.gap_floor, "the film in a contact spot (the "
                                "cells' default)", unit="m")
+    film_on_boundary: bool = setting(True, "the film's pressure where the gap is at most "
+                                     "boundary_film (spots and boundary films) joins the "
+                                     "boundary's load (the twin's [boundary] "
+                                     "film_on_contacts and thin_films)", unit="-")
     film_deforms: bool = setting(True, "the film pressure deforms the surfaces (False: the "
                                  "asperities feel their contact pressure alone)", unit="-")
     tol: float = setting(1e-7, "log load residual; the film's deformation per micrometre, "
@@ -81,7 +86,8 @@ class DeterministicSettings:
 class DeterministicResult:
     """A converged deterministic point (SI units): ``separation`` h_d [m]; ``film_load``,
     ``contact_load``, ``load`` [N]; ``film_friction`` (wall shear and film pressure on the
-    pin), ``boundary_force`` (C_f,b times the contact load) [N]; fields ``pressure``,
+    pin), ``boundary_force`` (C_f,b times the contact load and, with ``film_on_boundary``,
+    the film's load where the gap is at most the boundary film) [N]; fields ``pressure``,
     ``contact_pressure`` [Pa], ``cavity_fraction`` [-], ``gap`` [m]; ``history``: the log
     load residual of each evaluation."""
 
@@ -235,8 +241,12 @@ def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant:
     st = states[h_d]
     film = pad_friction(st["p"], st["gap"], st["theta"], st["mu"], dx, speed,
                         settings.boundary_film)
+    boundary_load = st["contact_load"]
+    if settings.film_on_boundary:
+        thin = st["gap"] <= settings.boundary_film
+        boundary_load += float(np.sum(pad.area * np.where(thin, np.maximum(st["p"], 0), 0)))
     return DeterministicResult(speed, load, float(h_d), st["film_load"], st["contact_load"],
-                               film, settings.boundary_friction * st["contact_load"], dx,
+                               film, settings.boundary_friction * boundary_load, dx,
                                st["p"], st["p_con"], st["theta"], st["gap"], tuple(history))
 
 
