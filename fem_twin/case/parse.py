@@ -271,7 +271,7 @@ def _boundary(data, where, thermal, sweep) -> BoundaryLaw:
     """[boundary]: the shear law's keys only with ``law = "shear"``, a temperature term only
     with the thermal model, a speed factor positive over the sweep's speeds."""
     boundary = read_table(data, "boundary", BoundaryLaw, where)
-    given = set(data.get("boundary", {})) - {"law", "film_on_contacts"}
+    given = set(data.get("boundary", {})) - {"law", "film_on_contacts", "thin_films"}
     if boundary.law == "constant" and given:
         raise CaseError(f"{where} [boundary] {', '.join(sorted(given))}: the shear law's, unused "
                         "by law = \"constant\" (eq 32 with [tribometer] boundary_friction); set "
