@@ -64,7 +64,7 @@ def test_fit_a_case_to_measured_curves(tmp_path, capsys):
     run120 = list(csv.DictReader(open(tmp_path / "o120" / "stribeck.csv")))
     for p, r in zip(pred, run120, strict=True):       # the same points, solved from other
         assert float(p["friction_coefficient"]) == pytest.approx(     # starts: equal to the
-            float(r["friction_coefficient"]), abs=5e-5 * cfb)  # coupling's 1.5e-5 C_f,b, x3
+            float(r["friction_coefficient"]), abs=2e-4 * cfb)  # coupling's 6.8e-5 C_f,b, x3
         assert float(p["cf_low"]) < float(p["friction_coefficient"]) < float(p["cf_high"])
     assert main(["run", str(case120), "-o", str(tmp_path / "y"), "--from-fit",
                  str(files[0])]) == 2                                  # not a fit.json
