@@ -20,7 +20,7 @@ from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .macro.estimate import PARTS
 from .macro.result import FIELDS
-from .stribeck.curve import OPTIONAL, UNITS
+from .stribeck.curve import LEGACY, OPTIONAL, UNITS
 
 ENGINE = "h5netcdf"
 #: ``fields.nc``'s variables and units: an operating point's fields
@@ -177,4 +177,6 @@ def open_run(outdir) -> RunResults:
     fields = (xr.open_dataset(out.fields_nc, engine=ENGINE) if out.fields_nc.is_file()
               else None)
     summary = json.loads(out.summary.read_text()) if out.summary.is_file() else {}
-    return RunResults(load("flow_factors"), load("stribeck"), fields, summary)
+    stribeck = load("stribeck")
+    stribeck = stribeck.rename({k: v for k, v in LEGACY.items() if k in stribeck.data_vars})
+    return RunResults(load("flow_factors"), stribeck, fields, summary)

@@ -93,7 +93,7 @@ def test_traction_curve_of_the_ball(tmp_path, capsys):
         srr = [float(x["slide_to_roll"]) for x in r]
         cf = [float(x["friction_coefficient"]) for x in r]
         assert srr == [0.0, 0.5, 2.0] and abs(cf[0]) < 0.01 * min(cf[1:])
-        assert float(r[0]["boundary_friction_N"]) == 0.0 < float(r[1]["boundary_friction_N"])
+        assert float(r[0]["boundary_force_N"]) == 0.0 < float(r[1]["boundary_force_N"])
         assert float(r[1]["sliding_speed_m_s"]) == pytest.approx(0.05)
         assert all(0 < float(x["cf_err"]) < 0.1 * cf[2] for x in r)
     points = sorted((out / "traction" / "checkpoints").glob("point_*.npz"))

@@ -27,7 +27,7 @@ def test_the_shear_law_with_the_constant_coefficient_is_the_constant_law(factors
     constant = run(BoundaryLaw())
     shear = run(BoundaryLaw(law="shear", shear_strength=0.0,
                             pressure_coefficient=BOUNDARY_FRICTION))
-    assert shear.boundary_friction == constant.boundary_friction > 0
+    assert shear.boundary_force == constant.boundary_force > 0
     assert shear.friction_coefficient == constant.friction_coefficient
     assert np.array_equal(shear.shear_stress, constant.shear_stress)
 
@@ -117,7 +117,7 @@ def test_the_temperature_term_reads_the_flash_of_the_tempered_shear(factors):
     assert 0.5 < t < 0.999
     assert t == pytest.approx(1 - 0.01 * record["spot_flash_K"], rel=1e-9)
     (cold,) = solve(film, None)
-    assert res.boundary_friction == pytest.approx(t * cold.boundary_friction, rel=1e-9)
+    assert res.boundary_force == pytest.approx(t * cold.boundary_force, rel=1e-9)
 
 
 def test_a_constant_coefficient_fit_is_refused_on_a_shear_law_case(tmp_path):

@@ -17,7 +17,7 @@ def measured_from_run(out, folder, speeds):
     cfb = 1 / (3 * 3 ** 0.5)
     files = []
     for c in read_stribeck_csv(out / "stribeck.csv"):
-        cf = (c.hydrodynamic_friction + 0.15 / cfb * c.boundary_friction) / 150.0
+        cf = (c.hydrodynamic_friction + 0.15 / cfb * c.boundary_force) / 150.0
         path = folder / f"m{c.viscosity:g}.csv"
         path.write_text("speed,friction_coefficient\n" + "".join(
             f"{float(u)!r},{float(f)!r}\n" for u, f in zip(c.speed[speeds], cf[speeds])))
@@ -145,7 +145,7 @@ def test_measured_curves_at_two_loads_and_a_prediction_at_a_third(tmp_path, caps
     assert main(["run", str(tmp_path / "heavy.toml"), "-o", str(heavy), "--no-progress"]) == 0
     cfb = 1 / (3 * 3 ** 0.5)
     c = read_stribeck_csv(heavy / "stribeck.csv")[0]
-    cf = (c.hydrodynamic_friction + 0.15 / cfb * c.boundary_friction) / 300.0
+    cf = (c.hydrodynamic_friction + 0.15 / cfb * c.boundary_force) / 300.0
     (tmp_path / "m300.csv").write_text("speed,friction_coefficient,load_N,viscosity_Pa_s\n"
                                        + "".join(f"{float(u)!r},{float(f)!r},300,"
                                                  f"{float(c.viscosity)!r}\n"

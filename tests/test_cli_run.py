@@ -268,7 +268,7 @@ def test_boundary_friction_is_set_from_the_case(tmp_path):
     assert main(["run", str(tmp_path / "cfb.toml"), "-o", str(out), "--no-progress"]) == 0
     rows = list(csv.DictReader(open(out / "stribeck.csv")))
     share = np.array([float(r["contact_load_fraction"]) for r in rows])
-    force = np.array([float(r["boundary_friction_N"]) for r in rows])
+    force = np.array([float(r["boundary_force_N"]) for r in rows])
     asperities = np.array([float(r["asperity_load_N"]) for r in rows])
     assert share.max() > 0.5
     assert np.allclose(force, 0.12 * asperities, rtol=1e-6, atol=1e-9)

@@ -42,7 +42,7 @@ def twin(factors):
                               lubricant=Lubricant(mu), **common)) for mu in (0.066, 0.024)}
     direct = {t: stribeck_sweep(SweepRequest(gap, dx, factors, SPEEDS, lubricant=Lubricant(
         float(LAW.viscosity(t))), **common)) for t in (35.0, 45.0)}
-    cf = {t: (r.hydrodynamic_friction + CFB_TRUE / CFB * r.boundary_friction) / 150
+    cf = {t: (r.hydrodynamic_friction + CFB_TRUE / CFB * r.boundary_force) / 150
           for t, r in direct.items()}
     return sim, cf
 
@@ -124,7 +124,7 @@ def shares(twin, factors):
                                     **common)) if s != 1.0 else sim[0.066])
                  for s in LOAD_SHARES)
     direct = stribeck_sweep(SweepRequest(gap, dx, factors, SPEEDS, load=120.0, **common))
-    return grid, (direct.hydrodynamic_friction + CFB_TRUE / CFB * direct.boundary_friction) / 150
+    return grid, (direct.hydrodynamic_friction + CFB_TRUE / CFB * direct.boundary_force) / 150
 
 
 def test_fit_recovers_the_load_share(twin, shares):
@@ -173,7 +173,7 @@ def test_a_curve_no_parameters_fit_is_refused_naming_its_residual(twin, factors)
     gap, dx, face = macro_case(32)
     heavy = stribeck_sweep(SweepRequest(gap, dx, factors, SPEEDS, load=600.0, face=face,
                            settings=MacroSettings(), lubricant=Lubricant(0.066)))
-    cf600 = (heavy.hydrodynamic_friction + CFB_TRUE / CFB * heavy.boundary_friction) / 600
+    cf600 = (heavy.hydrodynamic_friction + CFB_TRUE / CFB * heavy.boundary_force) / 600
     banded = MeasuredCurve(SPEEDS, cf600, 0.98 * cf600, 1.02 * cf600)
     with pytest.raises(InputError, match="no parameter set fits"):
         fit_curves(model, [banded], ["boundary_friction"], start_temperatures=[24.0])
@@ -189,7 +189,7 @@ def test_a_parameter_the_points_do_not_see_is_refused(twin):
     interval; the fit now refuses, naming the parameter."""
     sim, cf = twin
     curve = sim[0.066]
-    full_film = curve.speed[curve.boundary_friction == 0][:4]
+    full_film = curve.speed[curve.boundary_force == 0][:4]
     assert full_film.size == 4
     measured = MeasuredCurve(full_film, np.interp(np.log(full_film), np.log(curve.speed[::-1]),
                                                   curve.friction_coefficient[::-1]))
@@ -212,7 +212,7 @@ def resistances(factors):
                                            thermal=thermal, **common))
     grid = tuple(tuple((r, sweep(mu, r)) for r in RESISTANCES) for mu in (0.066, 0.024))
     direct = [sweep(mu, 1.5) for mu in (0.066, 0.024)]
-    cf = [(r.hydrodynamic_friction + CFB_TRUE / CFB * r.boundary_friction) / 150 for r in direct]
+    cf = [(r.hydrodynamic_friction + CFB_TRUE / CFB * r.boundary_force) / 150 for r in direct]
     return grid, cf
 
 

@@ -321,14 +321,14 @@ def test_the_boundary_friction_is_cfb_times_the_contact_load():
                                              cavitation_pressure=0.0))
     assert 0.05 < res.contact_load / res.normal_load < 0.95
     cfb = res.meta["settings"]["boundary_friction"]
-    assert res.boundary_friction == pytest.approx(cfb * res.asperity_load, rel=1e-12)
+    assert res.boundary_force == pytest.approx(cfb * res.asperity_load, rel=1e-12)
     assert res.asperity_load > res.contact_load                 # p a_r on the spots
     paper = solve_mixed(gap, (5e-3 / 80, 40e-3 / 80), ff, load=400.0, speed=0.01,
                         lubricant=Lubricant(0.066, roelands_alpha=0.0, dh_c2=1.0),
                         settings=MacroSettings(e_reduced=4e12, ambient_pressure=0.0,
                                                cavitation_pressure=0.0,
                                                boundary=BoundaryLaw(film_on_contacts=False)))
-    assert paper.boundary_friction == pytest.approx(cfb * paper.contact_load, rel=1e-12)
+    assert paper.boundary_force == pytest.approx(cfb * paper.contact_load, rel=1e-12)
 
 
 def test_the_friction_factor_converges_through_contact_onset():

@@ -127,3 +127,17 @@ def test_files_are_written_on_worker_processes(tmp_path):
         with pytest.raises(AttributeError):
             writers.wait()
     assert not (tmp_path / "bad.png").exists() and writers.pending == []
+
+
+def test_a_stribeck_csv_of_before_the_boundary_force_rename_reads(tmp_path):
+    """``boundary_friction_N`` (the boundary part of F_T, named like the case file's C_f,b
+    before 2026-11-29) reads as ``boundary_force``, the same numbers."""
+    from fem_twin.stribeck.curve import StribeckCurve, read_stribeck_csv, write_stribeck_csv
+    u = np.geomspace(1.0, 0.01, 4)
+    curve = StribeckCurve(speed=u, hersey=u * 3.5e-6, friction_coefficient=0.01 / u ** 0.5,
+                          viscosity=0.066, hydrodynamic_friction=u, boundary_force=1 - u,
+                          contact_load_fraction=0 * u, h_d=1e-6 * u, iterations=1 + 0 * u)
+    path = write_stribeck_csv(tmp_path / "stribeck.csv", [curve])
+    path.write_text(path.read_text().replace("boundary_force_N", "boundary_friction_N"))
+    old, = read_stribeck_csv(path)
+    assert np.array_equal(old.boundary_force, curve.boundary_force)

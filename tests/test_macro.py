@@ -100,7 +100,7 @@ def test_converged_state_balances_load_and_is_consistent(case32, factors):
     assert 0 < res.contact_load < 150
     # friction parts add up (eqs 32-34)
     assert res.friction_force == pytest.approx(res.hydrodynamic_friction
-                                               + res.boundary_friction)
+                                               + res.boundary_force)
     assert res.friction_coefficient == pytest.approx(res.friction_force / res.normal_load)
 
 

@@ -79,7 +79,7 @@ def finished_run(tmp_path_factory):
     ones = np.ones_like(u)
     write_stribeck_csv(out / "stribeck.csv", [StribeckCurve(
         speed=u, hersey=0.066 * u * 8e-3 / 150, friction_coefficient=0.01 / u ** 0.5,
-        viscosity=0.066, hydrodynamic_friction=ones, boundary_friction=ones,
+        viscosity=0.066, hydrodynamic_friction=ones, boundary_force=ones,
         contact_load_fraction=0 * u, h_d=1e-6 * ones, iterations=ones)])
     return out
 

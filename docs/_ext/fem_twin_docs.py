@@ -72,7 +72,7 @@ def outputs() -> str:
     with their units, from the writers' own tables."""
     from fem_twin.macro.estimate import PARTS
     from fem_twin.results import FIELD_UNITS
-    from fem_twin.stribeck.curve import HEADERS, OPTIONAL, UNITS
+    from fem_twin.stribeck.curve import HEADERS, LEGACY, OPTIONAL, UNITS
     lines = ["## `stribeck.csv`", "", "One row per point, curves one after another.", "",
              "| column | meaning |", "|---|---|"]
     for key, header in HEADERS.items():
@@ -102,6 +102,9 @@ def outputs() -> str:
               "## `fields.nc`", "", "Over (viscosity, speed, x2 [m], x1 [m]):", "",
               "| variable | unit |", "|---|---|"]
     lines += [f"| `{k}` | {u} |" for k, u in FIELD_UNITS.items()]
+    lines += ["", "## Older names", "", "Files written before 2026-11-29 are read with "
+              "today's names:", "", "| then | now |", "|---|---|"]
+    lines += [f"| `{old}` | `{new}` |" for old, new in LEGACY.items()]
     return "\n".join(lines) + "\n"
 
 

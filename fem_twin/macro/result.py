@@ -28,7 +28,7 @@ class MixedResult:
 
     Scalars: ``speed`` U [m/s], ``imposed_load`` F_N,imp and ``normal_load`` F_N (eq 28) [N],
     ``h_d`` [m], ``friction_force`` F_T (eq 33) with its ``hydrodynamic_friction`` and
-    ``boundary_friction`` parts [N], ``friction_coefficient`` C_f (eq 34),
+    ``boundary_force`` parts [N], ``friction_coefficient`` C_f (eq 34),
     ``contact_load`` (integral of p_con) [N]; the asperities' ``asperity_load`` (of
     p_con + p a_r, :func:`.boundary.asperity_load`) [N] and ``real_contact_area`` (of a_r)
     [m^2] over the face, each node weighted by the x1 share of its sliding direction (1
@@ -46,7 +46,7 @@ class MixedResult:
     h_d: float
     friction_force: float
     hydrodynamic_friction: float
-    boundary_friction: float
+    boundary_force: float
     friction_coefficient: float
     contact_load: float
     asperity_load: float
@@ -132,7 +132,7 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
     F_N = ev.F
     return MixedResult(
         speed=float(speed), imposed_load=float(load), normal_load=F_N, h_d=float(h_d),
-        friction_force=F_hd + F_con, hydrodynamic_friction=F_hd, boundary_friction=F_con,
+        friction_force=F_hd + F_con, hydrodynamic_friction=F_hd, boundary_force=F_con,
         friction_coefficient=(F_hd + F_con) / F_N,
         contact_load=float(np.sum(area * ev.p_con)),
         asperity_load=float(np.sum(weights * asperity)),

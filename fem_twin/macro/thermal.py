@@ -194,8 +194,8 @@ class ContactThermal:
         t = spot_temperature_factor(law, self.spot(result, factors, speeds))
         if t == 1.0:
             return result
-        lost = (1 - t) * result.boundary_friction
-        return replace(result, boundary_friction=t * result.boundary_friction,
+        lost = (1 - t) * result.boundary_force
+        return replace(result, boundary_force=t * result.boundary_force,
                        friction_force=result.friction_force - lost,
                        friction_coefficient=(result.friction_force - lost) / result.normal_load,
                        shear_stress=result.shear_stress - (1 - t) * result.boundary_shear,

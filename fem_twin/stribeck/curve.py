@@ -15,11 +15,14 @@ from ..io.figure import save_figure
 from ..io.table import write_csv
 
 COLUMNS = ("speed", "hersey", "friction_coefficient", "viscosity", "hydrodynamic_friction",
-           "boundary_friction", "contact_load_fraction", "h_d", "iterations")
+           "boundary_force", "contact_load_fraction", "h_d", "iterations")
 #: the CSV header of each column: its name with the SI unit (:mod:`fem_twin.io.table`)
 HEADERS = dict(zip(COLUMNS, ("speed_m_s", "hersey", "friction_coefficient", "viscosity_Pa_s",
-                             "hydrodynamic_friction_N", "boundary_friction_N",
+                             "hydrodynamic_friction_N", "boundary_force_N",
                              "contact_load_fraction", "h_d_m", "iterations")))
+#: the names of fem_twin before 2026-11-29, read as today's (the boundary part of F_T was
+#: ``boundary_friction``, the case file's coefficient C_f,b): CSV headers and variables
+LEGACY = {"boundary_friction_N": "boundary_force_N", "boundary_friction": "boundary_force"}
 #: the columns a curve has when its run gives them: a thermal run's temperatures [C] and
 #: spots' flash per pascal of boundary shear [K/Pa] (:mod:`fem_twin.macro.thermal`), the
 #: boundary law's integrals (:mod:`fem_twin.macro.boundary`): their CSV header, unit in
@@ -39,7 +42,7 @@ OPTIONAL = {"contact_temperature": ("contact_temperature_C", "degC", "the film's
 UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
          "friction_coefficient": ("1", "C_f (eq 34)"),
          "hydrodynamic_friction": ("N", "hydrodynamic part of F_T (eq 33)"),
-         "boundary_friction": ("N", "boundary part of F_T (eq 33)"),
+         "boundary_force": ("N", "boundary part of F_T (eq 33)"),
          "contact_load_fraction": ("1", "share of the face load (F_N times load_share) "
                                         "carried by p_con"),
          "h_d": ("m", "rigid-body separation h_d"),
@@ -65,7 +68,7 @@ class StribeckCurve:
     """C_f versus sliding speed at one viscosity; arrays ordered as computed (fast first).
 
     speed [m/s], hersey [-], friction_coefficient [-], viscosity mu_0 [Pa s] (scalar),
-    hydrodynamic_friction and boundary_friction: F_T parts [N], contact_load_fraction:
+    hydrodynamic_friction and boundary_force: F_T parts [N], contact_load_fraction:
     share of the face's load (F_N times ``load_share``) carried by p_con, h_d [m],
     iterations of the macro solver;
     friction_error: the estimated discretisation error of C_f [-] (absolute, both scales,
@@ -83,7 +86,7 @@ class StribeckCurve:
     friction_coefficient: np.ndarray
     viscosity: float
     hydrodynamic_friction: np.ndarray
-    boundary_friction: np.ndarray
+    boundary_force: np.ndarray
     contact_load_fraction: np.ndarray
     h_d: np.ndarray
     iterations: np.ndarray
@@ -167,7 +170,7 @@ def read_stribeck_csv(path) -> list[StribeckCurve]:
     if not Path(path).is_file():
         raise MissingFile(f"{path}: no such Stribeck CSV (fem-twin run writes stribeck.csv)")
     with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
+        rows = [{LEGACY.get(k, k): v for k, v in r.items()} for r in csv.DictReader(f)]
     if rows and set(HEADERS.values()) <= set(rows[0]):
         rows = [{**{k: r[HEADERS[k]] for k in COLUMNS},
                  **({"cf_err": r["cf_err"]} if "cf_err" in r else {}),

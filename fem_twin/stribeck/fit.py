@@ -99,7 +99,7 @@ class FitModel:
         at = lambda a: PchipInterpolator(x, a[order])(np.clip(u, x[0], x[-1]))  # noqa: E731
         hd = at(c.hydrodynamic_friction)
         if shear is None:
-            return (hd + boundary_friction * at(c.boundary_friction)
+            return (hd + boundary_friction * at(c.boundary_force)
                     / self.boundary_friction) / load, inside
         return (hd + self._law_force(c, at, speed, shear)) / load, inside
 

@@ -177,7 +177,7 @@ def _curve(records, request: SweepRequest) -> StribeckCurve:
         hersey=hersey_number(mu, speeds, request.hersey_length, load),
         friction_coefficient=share * get("friction_coefficient"), viscosity=mu,
         hydrodynamic_friction=get("hydrodynamic_friction"),
-        boundary_friction=get("boundary_friction"),
+        boundary_force=get("boundary_force"),
         contact_load_fraction=get("contact_load") / request.face_load, h_d=get("h_d"),
         iterations=get("iterations"),
         friction_error=None if errors is None else errors.pop("total"),
@@ -261,7 +261,7 @@ def film_lubricant(res: MixedResult, lubricant):
 def _record(res: MixedResult) -> dict:
     """The numbers of a point the curve keeps (no fields)."""
     return {**{name: getattr(res, name) for name in (
-        "friction_coefficient", "hydrodynamic_friction", "boundary_friction", "contact_load",
+        "friction_coefficient", "hydrodynamic_friction", "boundary_force", "contact_load",
         "h_d", "iterations")}, COARSE_CF: np.atleast_1d(res.meta.get(COARSE_CF, np.nan)),
         "error_estimate": res.meta.get("error_estimate"),
         "asperity_load": res.asperity_load, "real_contact_area": res.real_contact_area,

@@ -32,7 +32,7 @@ HEADERS = {"slide_to_roll": "slide_to_roll", "sliding_speed": "sliding_speed_m_s
            "entrainment": "entrainment_m_s", "viscosity": "viscosity_Pa_s",
            "friction_coefficient": "friction_coefficient", "friction_error": "cf_err",
            "hydrodynamic_friction": "hydrodynamic_friction_N",
-           "boundary_friction": "boundary_friction_N",
+           "boundary_force": "boundary_force_N",
            "contact_load_fraction": "contact_load_fraction", "h_d": "h_d_m"}
 #: the MTM's usual sweep: pure rolling to 100 % sliding (SRR = u_r / u_m)
 DEFAULT_RATIOS = (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0)
@@ -43,7 +43,7 @@ class TractionCurve:
     """C_f versus SRR at one entrainment speed ``entrainment`` [m/s] and viscosity mu_0
     [Pa s]; arrays over ``slide_to_roll`` (increasing): friction_coefficient [-] with its
     estimated discretisation error friction_error [-], the F_T parts hydrodynamic_friction
-    and boundary_friction [N], contact_load_fraction [-] and the separation h_d [m]."""
+    and boundary_force [N], contact_load_fraction [-] and the separation h_d [m]."""
 
     slide_to_roll: np.ndarray
     entrainment: float
@@ -51,7 +51,7 @@ class TractionCurve:
     friction_coefficient: np.ndarray
     friction_error: np.ndarray
     hydrodynamic_friction: np.ndarray
-    boundary_friction: np.ndarray
+    boundary_force: np.ndarray
     contact_load_fraction: np.ndarray
     h_d: np.ndarray
 
@@ -108,7 +108,7 @@ def traction_sweep(request: SweepRequest, slide_to_roll=DEFAULT_RATIOS,
         friction_coefficient=get("friction_coefficient"),
         friction_error=np.array([results[s].meta["error_estimate"]["total"] for s in ratios]),
         hydrodynamic_friction=get("hydrodynamic_friction"),
-        boundary_friction=get("boundary_friction"),
+        boundary_force=get("boundary_force"),
         contact_load_fraction=get("contact_load") / load, h_d=get("h_d"))
 
 
