@@ -140,4 +140,4 @@ def test_a_stribeck_csv_of_before_the_boundary_force_rename_reads(tmp_path):
     path = write_stribeck_csv(tmp_path / "stribeck.csv", [curve])
     path.write_text(path.read_text().replace("boundary_force_N", "boundary_friction_N"))
     old, = read_stribeck_csv(path)
-    assert np.array_equal(old.boundary_force, curve.boundary_force)
+    assert np.allclose(old.boundary_force, curve.boundary_force, rtol=1e-9, atol=0)
