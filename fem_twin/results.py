@@ -44,7 +44,8 @@ def flow_factor_dataset(factors, labels):
     """Flow factors of several patches as a Dataset over (patch, h0), h0 the union of their
     samples: NaN where a patch's adaptive sample skipped an h0 (its interpolant,
     ``FlowFactors.at``, reads it there); A, b, C, d and the friction tensor C_F split into
-    named components (A11, A12, ..., d2), the friction factors as sC, fP1 and fP2."""
+    named components (A11, A12, ..., d2), the friction factors as sC, fP1 and fP2, the
+    local shear's spread as film_fraction and log_sC."""
     import xarray as xr
     h0 = np.unique(np.concatenate([f.h0 for f in factors]))
     where = [np.searchsorted(h0, f.h0) for f in factors]
@@ -68,6 +69,10 @@ def flow_factor_dataset(factors, labels):
     for i in range(2):
         data[f"fP{i + 1}"] = (stack("pressure_friction")[:, :, i], "1",
                               "Poiseuille friction on the pin, -(h_m / 2) fP . grad p")
+    data["film_fraction"] = (stack("film_fraction"), "1", "share of the cell whose film "
+                             "carries film friction (thicker than the boundary film)")
+    data["log_sC"] = (stack("log_friction"), "1", "log mean of the local dissipation over "
+                      "that film, h_m s (the Eyring film's spread)")
     ds = xr.Dataset({k: (("patch", "h0"), v, {"units": u, "long_name": n})
                      for k, (v, u, n) in data.items()},
                     coords={"patch": list(labels), "h0": ("h0", h0, {"units": "m"})})

@@ -97,7 +97,9 @@ def outputs() -> str:
               "(patch, viscosity, speed) |", "",
               "Group `flow_factors`, over (patch: `\"1\"`, ..., `\"average\"`; h0 [m]): `h_m` "
               "[m], `p_con` [Pa], `contact_fraction`, `A11` ... `A22` (eq 13), `b1`, `b2` "
-              "(eq 14), `C11` ... `C22` (eq 15), `d1`, `d2` (eq 16); NaN where a patch's "
+              "(eq 14), `C11` ... `C22` (eq 15), `d1`, `d2` (eq 16), the friction factors "
+              "`sC`, `fP1`, `fP2`, and `film_fraction`, `log_sC` (the local shear's spread "
+              "an Eyring film averages); NaN where a patch's "
               "adaptive sample skipped an h0.", "",
               "## `fields.nc`", "", "Over (viscosity, speed, x2 [m], x1 [m]):", "",
               "| variable | unit |", "|---|---|"]
