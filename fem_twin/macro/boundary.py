@@ -82,10 +82,11 @@ class BoundaryLaw:
 
 def boundary_area(shear, law: BoundaryLaw) -> np.ndarray:
     """a_r [-] from the shear factors ``shear`` (LocalFactors): the contact fraction, and
-    with ``law.thin_films`` the films below the boundary film too, ``1 - film_fraction``."""
+    with ``law.thin_films`` the films below the boundary film too, ``1 - film_fraction``
+    (at most 1: an error estimate's variant of the factors may overshoot)."""
     if not law.thin_films or shear.film_fraction is None:
         return shear.contact_fraction
-    return np.maximum(shear.contact_fraction, 1 - shear.film_fraction)
+    return np.clip(np.maximum(shear.contact_fraction, 1 - shear.film_fraction), 0.0, 1.0)
 
 
 def asperity_load(contact_pressure, film_pressure, contact_fraction,
