@@ -343,7 +343,7 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
         point = st.sel(viscosity=float(r["viscosity_Pa_s"]), speed=float(r["speed_m_s"]),
                        method="nearest")
         for k in ("hersey", "friction_coefficient", "hydrodynamic_friction",
-                  "boundary_friction", "contact_load_fraction", "h_d", "iterations", "cf_min",
+                  "boundary_force", "contact_load_fraction", "h_d", "iterations", "cf_min",
                   "cf_max"):
             assert float(point[k]) == pytest.approx(float(r[HEADERS.get(k, k)]), rel=1e-9,
                                                     abs=1e-300), k
