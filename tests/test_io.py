@@ -131,7 +131,7 @@ def test_files_are_written_on_worker_processes(tmp_path):
 
 def test_a_stribeck_csv_of_before_the_boundary_force_rename_reads(tmp_path):
     """``boundary_friction_N`` (the boundary part of F_T, named like the case file's C_f,b
-    before 2026-11-29) reads as ``boundary_force``, the same numbers."""
+    in earlier versions) reads as ``boundary_force``, the same numbers."""
     from fem_twin.stribeck.curve import StribeckCurve, read_stribeck_csv, write_stribeck_csv
     u = np.geomspace(1.0, 0.01, 4)
     curve = StribeckCurve(speed=u, hersey=u * 3.5e-6, friction_coefficient=0.01 / u ** 0.5,

@@ -104,8 +104,8 @@ def outputs() -> str:
               "## `fields.nc`", "", "Over (viscosity, speed, x2 [m], x1 [m]):", "",
               "| variable | unit |", "|---|---|"]
     lines += [f"| `{k}` | {u} |" for k, u in FIELD_UNITS.items()]
-    lines += ["", "## Older names", "", "Files written before 2026-11-29 are read with "
-              "today's names:", "", "| then | now |", "|---|---|"]
+    lines += ["", "## Older names", "", "Files of earlier versions are read with today's "
+              "names:", "", "| then | now |", "|---|---|"]
     lines += [f"| `{old}` | `{new}` |" for old, new in LEGACY.items()]
     return "\n".join(lines) + "\n"
 

@@ -239,9 +239,11 @@ class CellSolver:
                            for j in (1, 2)], axis=2)            # <w G[i, j]>: (w, i, j)
         w_mean = weights.mean(axis=1)
         eye = np.eye(2)
-        grads = ([g1] * len(film) if chi_1 is None or len(chi_1) == 1
-                 else [self.gradient(c).reshape(2, n) for c in chi_1])
-        density = [weights[0] * (g * g).sum(axis=0) for g in grads]
+        if chi_1 is None or len(chi_1) == 1:                   # one chi_1 for every film
+            density = [weights[0] * (g1 * g1).sum(axis=0)] * len(film)
+        else:
+            density = [weights[0] * (g * g).sum(axis=0)
+                       for g in (self.gradient(c).reshape(2, n) for c in chi_1)]
         out = ({} if shear_weight is None
                else shear_spread(weights[1], density, film, shear_weight))
         return {**out, "h": float(w_mean[1]),

@@ -154,16 +154,18 @@ class CellSolverFV:
                              (np.roll(f, -1, axis=0) - f) / dx[1]])
 
         g1 = grad(chi[0])
-        grads = [g1] * len(film) if chi_1 is None or len(chi_1) == 1 else [
-            grad(c) for c in chi_1]
+        if chi_1 is None or len(chi_1) == 1:                   # one chi_1 for every film
+            faces = [cf * g1 * g1] * len(film)                  # dissipation on the faces
+        else:
+            faces = [cf * g * g for g in (grad(c) for c in chi_1)]
         G = np.stack([grad(chi[1]), grad(chi[2])], axis=1)      # (i, j, ny, nx): D_i chi_{j+2}
         eye = np.eye(2)[:, :, None, None]
         out = {} if shear_weight is None else shear_spread(
-            h.ravel(), [(cf * g * g).sum(axis=0).ravel() for g in grads], film, shear_weight)
+            h.ravel(), [d.sum(axis=0).ravel() for d in faces], film, shear_weight)
         return {**out, "h": float(h.mean()),
                 "h3_grad": (cf[:, None] * (eye + G)).mean(axis=(2, 3)),
                 "h3_g1": (cf * g1).mean(axis=(1, 2)),
                 "h_grad": (hf[:, None] * (eye + G)).mean(axis=(2, 3)),
                 "h_g1": (hf * g1).mean(axis=(1, 2)),
-                "h3_g1g1": np.array([np.where(hf > cut, cf * g * g, 0.0).mean(axis=(1, 2)).sum()
-                                     for cut, g in zip(film, grads)])}
+                "h3_g1g1": np.array([np.where(hf > cut, d, 0.0).mean(axis=(1, 2)).sum()
+                                     for cut, d in zip(film, faces)])}

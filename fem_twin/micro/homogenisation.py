@@ -26,7 +26,7 @@ from .estimate import QUANTITIES, discrepancy, variants, watched
 from .flow_factors import ARRAYS, FlowFactors
 from .sampling import adaptive_separations
 from .schedule import Separations, coarse_moments, progress_bar
-from .sliding import CellSettings, factors_from_moments
+from .sliding import CellSettings, factors_from_moments, film_spread
 from .store import cell_key
 
 #: the paper's separations: 100 values geometrically spaced in [0.1, 1] um
@@ -197,10 +197,9 @@ def _film_variant(factors, moments, k) -> FlowFactors:
     def get(key):
         return np.array([m[key][k] for m in moments])
 
-    h_m, out = factors.h_m, {"friction_factor": get("s_c") * factors.h_m}
+    out = {"friction_factor": get("s_c") * factors.h_m}
     if all("film_area" in m for m in moments):
-        out["film_fraction"] = get("film_area")
-        out["log_friction"] = get("log_shear") + out["film_fraction"] * np.log(h_m)
+        out.update(film_spread(get("film_area"), get("log_shear"), factors.h_m))
     return replace(factors, meta={}, **out)
 
 

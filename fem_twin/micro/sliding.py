@@ -350,9 +350,7 @@ def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
     h_m = get("h")
     spread = {}
     if all(prefix + "film_area" in m for m in moments):
-        area = get("film_area")[:, 0]
-        spread = {"film_fraction": area,
-                  "log_friction": get("log_shear")[:, 0] + area * np.log(h_m)}
+        spread = film_spread(get("film_area")[:, 0], get("log_shear")[:, 0], h_m)
     return FlowFactors(h0=np.asarray(h0, float), h_m=h_m, p_con=get("p_con"), **spread,
                        A=get("h3_grad") / h_m[:, None, None] ** 3,
                        b=np.array([1.0, 0.0]) - get("h3_g1") / h_m[:, None],
@@ -360,3 +358,10 @@ def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
                        friction_factor=get("s_c")[:, 0] * h_m,
                        pressure_friction=np.array([1.0, 0.0]) + get("h3_g1_pin") / h_m[:, None],
                        contact_fraction=get("contact_fraction"), meta=meta)
+
+
+def film_spread(film_area, log_shear, h_m) -> dict:
+    """``FlowFactors.film_fraction`` and ``log_friction`` from the time-averaged moments
+    ``film_area`` [-] and ``log_shear`` (the area mean of ``ln s``, s in 1/m) at ``h_m``
+    [m]: ``<ln(h_m s)>`` over the film."""
+    return {"film_fraction": film_area, "log_friction": log_shear + film_area * np.log(h_m)}

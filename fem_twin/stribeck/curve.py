@@ -20,7 +20,7 @@ COLUMNS = ("speed", "hersey", "friction_coefficient", "viscosity", "hydrodynamic
 HEADERS = dict(zip(COLUMNS, ("speed_m_s", "hersey", "friction_coefficient", "viscosity_Pa_s",
                              "hydrodynamic_friction_N", "boundary_force_N",
                              "contact_load_fraction", "h_d_m", "iterations")))
-#: the names of fem_twin before 2026-11-29, read as today's (the boundary part of F_T was
+#: the names earlier fem_twin versions wrote, read as today's (the boundary part of F_T was
 #: ``boundary_friction``, the case file's coefficient C_f,b): CSV headers and variables
 LEGACY = {"boundary_friction_N": "boundary_force_N", "boundary_friction": "boundary_force"}
 #: the columns a curve has when its run gives them: a thermal run's temperatures [C] and

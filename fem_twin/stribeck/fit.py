@@ -10,8 +10,8 @@ face's share of the load, the first viscosity swept at :data:`LOAD_SHARES`;
 
 Least squares on C_f,dev (eq 35) at the measured speeds (PCHIP in log speed), weighted by
 ``sigma = (cf_max - cf_min) / 1.693`` where the measured CSV gives its scatter, else equal
-weights with the HC3 covariance (:func:`_covariance`); intervals ``t_{0.975, n - p}`` times
-its diagonal's root."""
+weights with the HC3 covariance (:func:`.fit_statistics.covariance`); intervals
+``t_{0.975, n - p}`` times its diagonal's root."""
 
 from __future__ import annotations
 
@@ -24,6 +24,7 @@ from ..errors import InputError, NotConverged
 from ..macro.boundary import BoundaryLaw
 from ..macro.viscosity import WaltherLaw
 from .curve import MeasuredCurve, StribeckCurve
+from .fit_statistics import correlation, covariance, interval
 
 #: the shear law's parameters a fit can identify (``[boundary]`` keys), with their bounds
 SHEAR = {"shear_strength": (0.0, 5e8), "pressure_coefficient": (0.0, 1.0),
@@ -314,17 +315,6 @@ def _sigma(m: MeasuredCurve):
     return np.maximum(s, 1e-3 * np.abs(m.friction_coefficient).max())
 
 
-def interval(value: float, half: float, lower: float, upper: float) -> dict:
-    """A fitted value with its 95 % interval ``value +- half``, clipped to the parameter's
-    bounds ``[lower, upper]`` (a share above 1, a negative resistance); a clipped interval
-    names the bounds (``"clipped_to_bounds"``)."""
-    low, high = max(value - half, lower), min(value + half, upper)
-    out = {"value": float(value), "low": float(low), "high": float(high)}
-    if low > value - half or high < value + half:
-        out["clipped_to_bounds"] = [float(lower), float(upper)]
-    return out
-
-
 def _summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
     n, p = sol.fun.size, sol.x.size
     dof = n - p
@@ -337,7 +327,7 @@ def _summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
                          "depend on it (C_f,b in full film), or are too few; measure the "
                          "speeds where it acts")
     scale = np.array(bounds[1]) - np.array(bounds[0])      # unknowns of like size
-    cov = _covariance(sol.jac * scale, sol.fun, weighted) * np.outer(scale, scale)
+    cov = covariance(sol.jac * scale, sol.fun, weighted) * np.outer(scale, scale)
     from scipy import stats
     half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
     out = {name: interval(v, h, lo, hi)
@@ -364,7 +354,7 @@ def _summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
                   "rms_cf_dev": float(np.sqrt(np.mean(dev ** 2))),
                   "max_abs_cf_dev": float(np.abs(dev).max()),
                   "points_outside_simulated_range": outside,
-                  "correlation": _correlation(cov).tolist(), "covariance": cov.tolist(),
+                  "correlation": correlation(cov).tolist(), "covariance": cov.tolist(),
                   "t_factor": float(stats.t.ppf(0.975, dof))}
     out["residuals"] = rows
     out["fit"]["warnings"] = _temperature_warnings(model, out, len(measured))
@@ -383,24 +373,3 @@ def _temperature_warnings(model: FitModel, out: dict, n: int) -> list[str]:
                             "usual; a larger offset may stand for another load or lubricant "
                             "(the Hersey collapse trades the two)")
     return warnings
-
-
-def _covariance(jac, res, weighted: bool):
-    """Covariance of the fitted parameters: ``(J^T J)^-1`` for residuals weighted by the
-    measured scatter; without it, the heteroscedasticity-consistent sandwich estimator HC3
-    (MacKinnon and White 1985), ``(J^T J)^-1 J^T diag(r_i^2 / (1 - h_i)^2) J (J^T J)^-1``
-    with the leverages ``h_i``: the scatter of a measured C_f grows with C_f (a per cent of
-    it), and one variance from all the residuals understates it where the parameters are
-    decided (the boundary regime)."""
-    inv = np.linalg.pinv(jac.T @ jac)
-    if weighted:
-        return inv
-    leverage = np.einsum("ij,jk,ik->i", jac, inv, jac)
-    meat = jac.T @ (jac * (res / np.maximum(1 - leverage, 1e-3))[:, None] ** 2)
-    return inv @ meat @ inv
-
-
-def _correlation(cov):
-    d = np.sqrt(np.diag(cov))
-    outer = np.outer(d, d)
-    return np.divide(cov, outer, out=np.zeros_like(cov), where=outer > 0)
