@@ -2,10 +2,10 @@
 LocalCluster of all workers (with the cluster extra).
 
 Each run is a fresh ``fem-twin run`` of ``examples/pin_on_disk.toml`` with ``[run] workers``
-(and ``scheduler = "local"``) set, in its own process and folder.  Printed per run: the wall time,
-the run's own estimate, and from its task graph (``summary.json``, :mod:`fem_twin.taskgraph`) the
-CPU time, the critical path and the wall times it predicts on 16 and 64 workers.  The
-baseline is the one-worker run.
+(and ``scheduler = "local"``) set, in its own process and folder.  Printed per run: the
+wall time, the run's own estimate, and from its task graph (``summary.json``,
+:mod:`fem_twin.runtime.taskgraph`) the CPU time, the critical path and the wall times it
+predicts on 16 and 64 workers.  The baseline is the one-worker run.
 """
 
 from __future__ import annotations

@@ -18,8 +18,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from fem_twin import pipeline
 from fem_twin.case import load_case
+from fem_twin.stages import pipeline
 from fem_twin.stribeck.curve import read_stribeck_csv
 
 HERE = os.path.dirname(os.path.abspath(__file__))

@@ -1,6 +1,6 @@
 """The ``deterministic`` group: the twin against a deterministic solution in the mixed regime.
 
-The crowned pad of :mod:`fem_twin.verification` (sample patch pair 1, 256 px cut, resampled
+The crowned pad of :mod:`fem_twin.studies.verification` (sample patch pair 1, 256 px cut, resampled
 to 32 px; 1 MPa mean pressure, 1 um crown, the bundled case's oil at 24 C, E' and hardness
 of Table 4) with 2, 4, 8 and 16 cells a side, 8 speeds from full film to 90 % of the load on
 asperities.  Per point: the load share, the separation, the film friction and C_f of both,
@@ -19,8 +19,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from fem_twin import verification as V
 from fem_twin.macro import Lubricant
+from fem_twin.studies import verification as V
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SAMPLE = os.path.join(HERE, "..", "meshes", "sample")

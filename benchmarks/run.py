@@ -528,7 +528,7 @@ def _run_kept(case, name, reuse=False):
     import json
     import tempfile
 
-    from fem_twin import pipeline
+    from fem_twin.stages import pipeline
     from fem_twin.stribeck.curve import read_stribeck_csv
 
     keep = os.environ.get("FEM_TWIN_BENCH_DIR")

@@ -10,7 +10,8 @@ Homogenises each of the six bundled patch pairs (256 x 256 px cut, as the bundle
 with both methods at h0 = 0.1, 0.15, 0.3, 0.6, 1 um and N sliding steps (default 8), and
 writes OUT/fe_fvm_flow_factors.csv with, per patch (and for the patch average) and h0,
 the differences of
-:func:`fem_twin.compare.flow_factor_differences`: ``max |Delta A| / max |A|`` (likewise b, C),
+:func:`fem_twin.studies.compare.flow_factor_differences`: ``max |Delta A| / max |A|``
+(likewise b, C),
 ``|Delta d|`` (absolute, d is O(1) and crosses zero) and ``|Delta h_m| / h0``.  About 2 minutes on
 2 cores with 8 steps, 10 minutes with the paper's 32.  The factors themselves are kept as
 OUT/patch_<k>_<method>.npz (``FlowFactors.load``), so a rerun only recomputes what is
@@ -33,12 +34,12 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from fem_twin.compare import flow_factor_differences
 from fem_twin.fvm import CellSolverFV
 from fem_twin.io.files import read_topography
 from fem_twin.io.table import write_csv
 from fem_twin.micro import CellSolver, FlowFactors, average, homogenise
 from fem_twin.micro.sliding import CellSettings, sliding_contacts, sliding_pass
+from fem_twin.studies.compare import flow_factor_differences
 from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import prepare_patch
 

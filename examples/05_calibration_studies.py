@@ -23,8 +23,8 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 
-from fem_twin.calibration import calibrate
 from fem_twin.case import load_case
+from fem_twin.studies.calibration import calibrate
 
 HERE = Path(sys.argv[0]).resolve().parent
 

@@ -29,7 +29,7 @@ import numpy as np
 from fem_twin import read_topography, write_topography
 from fem_twin.case import load_case
 from fem_twin.micro import FlowFactors
-from fem_twin.pipeline import run
+from fem_twin.stages.pipeline import run
 from fem_twin.stribeck import friction_deviation, read_stribeck_csv
 from fem_twin.topography import extract_patch, fill_defects
 

@@ -15,7 +15,7 @@ would give.  No real measurement is involved, so the truth is known.
 
 Then, as a tribologist with one measured curve would:
 
-1. ``fem_twin.fitting.fit_case`` fits C_f,b and the contact temperature to the 24 C curve
+1. ``fem_twin.studies.fitting.fit_case`` fits C_f,b and the contact temperature to the 24 C curve
    alone (least squares on C_f,dev, eq 35; the micro and macro stages run once, the fit
    re-solves nothing);
 2. the fitted parameters predict the curve at 50 C with its 95 % band
@@ -38,10 +38,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from fem_twin.case import load_case
-from fem_twin.fitting import fit_case
 from fem_twin.macro.viscosity import WaltherLaw
-from fem_twin.pipeline import run
+from fem_twin.stages.pipeline import run
 from fem_twin.stribeck.curve import read_stribeck_csv
+from fem_twin.studies.fitting import fit_case
 
 HERE = Path(sys.argv[0]).resolve().parent
 TRUE_CFB, HEATING = 0.15, 3.0          # the synthetic truth: C_f,b and the contact's +3 K

@@ -39,7 +39,7 @@ import numpy as np
 
 from fem_twin import Topography, read_topography, write_topography
 from fem_twin.case import load_case
-from fem_twin.pipeline import traction
+from fem_twin.stages.pipeline import traction
 from fem_twin.topography import extract_patch, fill_defects
 from fem_twin.topography.sphere import fit_sphere
 

@@ -6,7 +6,7 @@ The twin against a solution that does not homogenise: a crowned square pad carry
 roughness cell tiled ``n`` times per side (the bundled patch pair 1, the disk smooth), solved
 with the roughness resolved on the film's grid, the asperity contact and the film together
 (:func:`fem_twin.macro.deterministic.solve_deterministic`), and by the twin with the flow
-factors of that cell (:mod:`fem_twin.verification`).
+factors of that cell (:mod:`fem_twin.studies.verification`).
 
     python examples/13_deterministic_mixed.py [OUT] [--quick]
 
@@ -27,7 +27,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from fem_twin import verification as V
+from fem_twin.studies import verification as V
 
 SAMPLE = Path(sys.argv[0]).resolve().parents[1] / "meshes" / "sample"
 

@@ -3,7 +3,9 @@
 Pipeline ``topography -> contact -> micro -> macro -> stribeck`` (``fvm``: the FE solvers'
 reference twin; ``io``: files, meshes, VTK), SI units throughout.  A module imports only
 from its own layer or an earlier one (0: shared plumbing; tests/test_architecture.py
-reads this table; docs: ARCHITECTURE.md)::
+reads this table; docs: ARCHITECTURE.md).  The workflow's packages run in
+that order: the case file, what a run costs, the results as data, the main job's stages
+(``stages.pipeline``), the studies built on it::
 
     1    topography, io
     2    contact
@@ -11,11 +13,10 @@ reads this table; docs: ARCHITECTURE.md)::
     4    macro, fvm
     5    stribeck
     6.0  case
-    6.1  results
-    6.2  stages, taskgraph
-    6.3  pipeline
-    6.4  compare, calibration, verification, fitting
-    6.5  report, samples
+    6.1  runtime
+    6.2  results
+    6.3  stages
+    6.4  studies
     7    cli
 """
 

@@ -130,7 +130,7 @@ def test_a_constant_coefficient_fit_is_refused_on_a_shear_law_case(tmp_path):
     from conftest import ROOT
 
     from fem_twin.case import load_case
-    from fem_twin.fitting import apply_fit, fit_case
+    from fem_twin.studies.fitting import apply_fit, fit_case
     case = load_case(ROOT / "examples" / "pin_on_disk.toml")
     case = replace(case, boundary=SHEAR)
     fit = {"fit": {"parameters": ["boundary_friction"]}, "case": {"temperatures": [24.0]},

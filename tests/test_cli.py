@@ -16,6 +16,7 @@ from fem_twin import Topography, read_topography, write_topography
 from fem_twin.case import load_case
 from fem_twin.cli import main
 from fem_twin.micro import FlowFactors
+from fem_twin.runtime.cost import estimated_seconds
 
 
 def test_help_lists_pipeline_stages(capsys):
@@ -199,7 +200,7 @@ def test_example_case_ships_with_the_package(tmp_path, capsys):
 def test_run_time_estimates_hold():
     """Fem-twin run's estimate on the calibration machine
     lies within 30 % of the wall time measured on 2 cores, scaled by the probe of
-    fem_twin.case.machine of the same run (2026-11-28, 13:20-13:40): the bundled case
+    fem_twin.runtime.machine of the same run (2026-11-28, 13:20-13:40): the bundled case
     50.9 s with the thermal film (probe 0.57x) and 48.6 s without (0.60x), the paper case
     157.8 s (cells at 128^2, the default; 0.57x) and 317.7 s with its cells at 256^2
     (0.52x; 307.6 s that morning, 0.52x), the ball-on-disk case 63.5 s (0.53x); on one
@@ -215,7 +216,7 @@ def test_run_time_estimates_hold():
                                     (paper_256, 307.6 / 0.52, 2),
                                     (cases["ball_on_disk"], 63.5 / 0.53, 2),
                                     (bundled, 84.6 / 0.55, 1)):
-        estimate = case.estimated_seconds(workers)
+        estimate = estimated_seconds(case, workers)
         assert 0.7 < estimate / measured < 1.3, (case.name, workers, estimate, measured)
 
 
@@ -225,7 +226,7 @@ def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     twice as slow gets twice the estimate.  The probe is one thread's time of real work
     (0.05-3 s: 0.24 s on the calibration machine), and the printed durations read as a
     person would write them."""
-    import fem_twin.case.machine as speed
+    import fem_twin.runtime.machine as speed
     from fem_twin.cli.runs import _confirm_cost, duration
     monkeypatch.delenv("FEM_TWIN_SLOWDOWN")                   # the probe itself
     t = speed.probe_seconds(repeats=1)

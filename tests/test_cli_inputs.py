@@ -12,6 +12,7 @@ from sample_cases import small_case
 from fem_twin import Topography, read_topography, write_topography
 from fem_twin.case import CaseError, load_case
 from fem_twin.cli import main
+from fem_twin.runtime.cost import estimated_seconds
 
 
 def test_cli_reports_bad_input_clearly(tmp_path, capsys):
@@ -105,12 +106,12 @@ def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, 
     from fem_twin.cli.runs import BUNDLED_SECONDS, LONG_RUN_SECONDS
     monkeypatch.setenv("FEM_TWIN_SLOWDOWN", slowdown)
     bundled = load_case(ROOT / "examples" / "pin_on_disk.toml")
-    assert bundled.estimated_seconds(2) == pytest.approx(BUNDLED_SECONDS, rel=0.02)
+    assert estimated_seconds(bundled, 2) == pytest.approx(BUNDLED_SECONDS, rel=0.02)
     text = (ROOT / "examples" / "pin_on_disk.toml").read_text()
     text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
     cut = tmp_path / "cut.toml"
     cut.write_text(text[:text.index("[preprocessing]")] + "[sweep]\ncount = 60\n")
-    assert load_case(cut).estimated_seconds(2) > LONG_RUN_SECONDS
+    assert estimated_seconds(load_case(cut), 2) > LONG_RUN_SECONDS
     assert main(["run", str(cut), "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "defaults used: [preprocessing], [tribometer]" in err and "[micro]" in err
@@ -118,7 +119,7 @@ def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, 
     assert "x the bundled case" in err and f"takes {float(slowdown):.2g}x" in err
     assert not (tmp_path / "o" / "geometry").exists()
     for name in ("pin_on_disk", "paper", "ball_on_disk"):    # the examples run unasked
-        assert load_case(ROOT / "examples" / f"{name}.toml").estimated_seconds(2) < (
+        assert estimated_seconds(load_case(ROOT / "examples" / f"{name}.toml"), 2) < (
             LONG_RUN_SECONDS)
 
 
@@ -128,7 +129,7 @@ def test_failures_are_one_line_with_documented_exit_codes(tmp_path, monkeypatch,
     table; the traceback only with --debug (and in run.log)."""
     import errno
 
-    import fem_twin.pipeline as pipeline
+    import fem_twin.stages.pipeline as pipeline
     case = small_case(tmp_path)
     out = tmp_path / "o"
 

@@ -131,7 +131,7 @@ def test_sliding_direction_turns_the_roughness_patches_too(tmp_path):
     ridges across the sliding direction became ridges along it).  The bundled patches
     written as if measured with the disk moving along +x2 give the same cells, bit for
     bit, as the bundled case."""
-    from fem_twin.pipeline import reconstruct_geometry
+    from fem_twin.stages.pipeline import reconstruct_geometry
     case = load_case(small_case(tmp_path))
     turned = {}
     for pair in case.geometry.patches:

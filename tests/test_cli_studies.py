@@ -58,7 +58,7 @@ def test_resolution_study_follows_the_papers_protocol(tmp_path, monkeypatch):
     paper's five speeds only, the others at the case's speeds and those.  Run small (maps
     taken as 32 px, grids 24, 32, 48): the reference deviates by zero, the finer grid is
     compared at its five speeds, every variant has its points in stribeck.csv."""
-    from fem_twin import calibration
+    from fem_twin.studies import calibration
     case = load_case(small_case(tmp_path))
     cases, ref = calibration.variants(case, "resolution")
     assert list(cases) == ["128 px", "256 px", "500 px", "999 px", "1997 px"]

@@ -1,7 +1,7 @@
 """The deterministic mixed-lubrication solver (fem_twin.macro.deterministic) against the
 references the twin passes: the plane slider (smooth limit), Hertz and rigid-plastic
 contact (dry limit), the resolved ridged slider (full film); and the twin beside it on a
-rough pad (fem_twin.verification)."""
+rough pad (fem_twin.studies.verification)."""
 
 import pickle
 import sys
@@ -161,13 +161,13 @@ def test_bad_inputs_and_no_convergence_are_clear():
 
 def test_the_twin_meets_the_deterministic_pad():
     """The mixed regime: sample patch pair 1 at 16 px tiled 8 x 8 on the crowned pad of
-    fem_twin.verification (1 MPa, 0.075 m/s, the bundled oil at 24 C): the deterministic
+    fem_twin.studies.verification (1 MPa, 0.075 m/s, the bundled oil at 24 C): the deterministic
     solution carries 70 % of the load on asperities, and the twin with that cell's flow
     factors agrees within 0.02 in load share, 5 nm in separation and 2 % in film friction
     (measured 0.012, 3.0 nm, 0.45 %); at 2 cells a side (0.3 m/s), where the crown rises
     1 um across a cell, the twin misses the share by 0.06 and the separation by 49 nm:
     scale separation."""
-    from fem_twin import verification as V
+    from fem_twin.studies import verification as V
     pad = V.sample_pad(Path(__file__).parents[1] / "meshes" / "sample", 16)
     factors = V.pad_factors(pad, np.geomspace(3e-8, 3e-6, 60))
     gaps = {}
@@ -184,7 +184,7 @@ def test_the_twin_meets_the_deterministic_pad():
 @pytest.mark.parametrize("order", [1.0, 2.0])
 def test_the_extrapolation_to_scale_separation_is_exact_on_a_power_law(order):
     """``to_zero`` recovers ``a`` and ``p`` of ``a + b eps^p`` from eps = 1/2 .. 1/16."""
-    from fem_twin.verification import to_zero
+    from fem_twin.studies.verification import to_zero
     eps = [1 / 2, 1 / 4, 1 / 8, 1 / 16]
     limit, p = to_zero(eps, [0.3 + 0.05 * e ** order for e in eps])
     assert limit == pytest.approx(0.3, abs=1e-12) and p == pytest.approx(order)
@@ -193,7 +193,7 @@ def test_the_extrapolation_to_scale_separation_is_exact_on_a_power_law(order):
 def test_the_benchmarks_summary_line():
     """``benchmarks/run.py deterministic`` ends in exactly this line (issue 70's bar), from
     the worst point of the finest pad."""
-    from fem_twin.verification import Pair, summary
+    from fem_twin.studies.verification import Pair, summary
     pairs = [Pair(16, 0.1, 0.223, 0.234, 2e-7, 2e-7, 1e-3, 1e-3, 0.0556, 0.0577),
              Pair(16, 0.01, 0.899, 0.900, 2e-7, 2e-7, 1e-3, 1e-3, 0.1744, 0.1747)]
     assert summary(pairs, 0.19245) == ("mixed regime: worst |C_f - C_f,det| = 1.09 % C_f,b, "

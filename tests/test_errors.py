@@ -148,10 +148,10 @@ WRONG = [None, "x", object(), np.zeros(0), np.zeros((0, 0)), np.full((6, 6), np.
 def _extra_callables() -> dict:
     """Public callables outside the packages' ``__all__``: the thermal, kinematics,
     viscosity-law, case-reading and fit-application functions (issue 72 item 5)."""
-    from fem_twin import fitting
     from fem_twin.case import load_case
     from fem_twin.macro import kinematics, thermal
     from fem_twin.macro.viscosity import WaltherLaw
+    from fem_twin.studies import fitting
     return {"ThermalSettings": thermal.ThermalSettings,
             "surface_temperature": thermal.surface_temperature,
             "face_flash": thermal.face_flash, "disk_velocity": kinematics.disk_velocity,

@@ -250,7 +250,7 @@ def test_a_fit_file_is_read_as_numbers_and_checked_against_the_case(tmp_path):
     from dataclasses import replace
 
     from fem_twin.case import load_case
-    from fem_twin.fitting import apply_fit, read_fit
+    from fem_twin.studies.fitting import apply_fit, read_fit
     case = load_case(Path(__file__).parents[1] / "examples" / "pin_on_disk.toml")
     fit = {"fit": {"parameters": ["boundary_friction", "bulk_resistance"]},
            "case": {"temperatures": [24.0, 50.0]},

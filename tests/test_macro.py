@@ -674,10 +674,10 @@ def test_a_sweeps_points_run_in_parallel_from_its_guide(factors, tmp_path):
     from dataclasses import replace
 
     from fem_twin.numerics.threads import executor_for
+    from fem_twin.runtime.taskgraph import critical_path, sweep_tasks
     from fem_twin.stages.sweeps import guide_of, run_sweeps
     from fem_twin.stribeck import SweepRequest, stribeck_sweep
     from fem_twin.stribeck.sweep import GUIDED_BY, point_files, point_meta
-    from fem_twin.taskgraph import critical_path, sweep_tasks
     gap, dx, face = macro_case(96)
     speeds = [0.1, 0.05, 0.03, 0.02]
     request = SweepRequest(gap, dx, factors, speeds, load=150.0, lubricant=Lubricant(0.066),

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 from conftest import SAMPLE
 
-from fem_twin import read_topography, samples
+from fem_twin import read_topography
 from fem_twin import topography as tp
+from fem_twin.io import samples
 from fem_twin.topography.prepare import prepare_pin
 
 

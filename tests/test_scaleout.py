@@ -108,10 +108,10 @@ def test_micro_tasks_follow_the_cluster_size():
 
 
 def test_the_schedule_of_a_task_graph():
-    """fem_twin.taskgraph.makespan: one worker runs the sum of the tasks, unlimited workers
+    """fem_twin.runtime.taskgraph.makespan: one worker runs the sum of the tasks, unlimited workers
     the critical path; a diamond a -> (b, c) -> d of 1, 2, 3 and 1 s takes 7 s on one
     worker, 5 s on two (b and c side by side) and on more."""
-    from fem_twin.taskgraph import Task, critical_path, makespan
+    from fem_twin.runtime.taskgraph import Task, critical_path, makespan
     tasks = [Task("a", 1.0), Task("b", 2.0, ("a",)), Task("c", 3.0, ("a",)),
              Task("d", 1.0, ("b", "c"))]
     assert makespan(tasks, 1) == 7.0 and makespan(tasks, 2) == 5.0
@@ -141,7 +141,7 @@ def test_the_task_graph_of_a_finished_run(tmp_path):
     from fem_twin.case import load_case
     from fem_twin.cli import main
     from fem_twin.micro.sampling import START
-    from fem_twin.taskgraph import critical_path, makespan, run_task_graph
+    from fem_twin.runtime.taskgraph import critical_path, makespan, run_task_graph
     path = small_case(tmp_path, workers=2, band=True)
     path.write_text(path.read_text().replace("h0_count = 6", "h0_count = 24").replace(
         "steps = 4", "steps = 8"))                                # 2+ rounds of the sampler
@@ -179,8 +179,8 @@ def test_the_band_runs_beside_the_main_points(tmp_path):
 
     from fem_twin.case import load_case
     from fem_twin.cli import main
+    from fem_twin.runtime.taskgraph import critical_path, run_task_graph, sweep_tasks
     from fem_twin.stribeck.sweep import point_files
-    from fem_twin.taskgraph import critical_path, run_task_graph, sweep_tasks
     path = small_case(tmp_path, workers=2, band=True)
     path.write_text(path.read_text().replace("resolution = [48, 48] #", "resolution = [96, 96] #")
                     .replace("refine = 0 ", "refine = 1 "))

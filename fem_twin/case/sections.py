@@ -18,7 +18,6 @@ from ..macro.thermal import ThermalSettings
 from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN, h0_candidates
 from ..micro.sliding import CellSettings
 from ..topography.prepare import MacroOptions
-from .cost import estimated_seconds
 
 
 @dataclass(frozen=True)
@@ -285,11 +284,6 @@ class Case:
         sets taken from this case (:data:`FILLED`)."""
         return replace(settings, **{f.name: FILLED[f.name][1](self) for f in fields(settings)
                                     if f.metadata.get("section")})
-
-    def estimated_seconds(self, cores: int = 2) -> float:
-        """Rough wall time of ``fem-twin run`` on ``cores`` cores of the calibration
-        machine [s] (:func:`fem_twin.case.cost.estimated_seconds`)."""
-        return estimated_seconds(self, cores)
 
     @property
     def macro_shape(self) -> tuple[int, int]:

@@ -27,23 +27,24 @@ LONG_RUN_SECONDS = LONG_RUN_RATIO * BUNDLED_SECONDS
 
 def _confirm_cost(case, yes: bool) -> float | None:
     """Say which sections take defaults and what the run will cost on this machine now
-    (:func:`fem_twin.case.machine.slowdown`); the estimate [s], or None (refused: a run
+    (:func:`fem_twin.runtime.machine.slowdown`); the estimate [s], or None (refused: a run
     estimated above :data:`LONG_RUN_RATIO` times the bundled case without ``--yes``)."""
-    from ..case.machine import slowdown
+    from ..runtime.cost import estimated_seconds
+    from ..runtime.machine import slowdown
     if case.defaulted:
         print(f"fem-twin run: sections not in {case.source.name}, defaults used: " + ", ".join(
             f"[{s}]" for s in case.defaulted), file=sys.stderr)
     cores = case.run.workers or os.cpu_count() or 1
     speed = slowdown()
-    calibration = case.estimated_seconds(cores)
+    calibration = estimated_seconds(case, cores)
     seconds = calibration * speed
     mc = case.micro
     print(f"fem-twin run: {len(case.geometry.patches)} patch pairs at {mc.resolution[0]}x"
           f"{mc.resolution[1]}, {mc.h0_count} h0 x {mc.steps} steps"
           f"{f' (adaptive h0, tolerance {mc.h0_tol:g})' if mc.h0_tol else ''}; "
           f"{len(case.lubricant.viscosities)} x {case.sweep.count} speeds; estimated "
-          f"{duration(seconds)} on {cores} cores, {duration(case.estimated_seconds(16) * speed)}"
-          f" on 16 and {duration(case.estimated_seconds(64) * speed)} on 64 (this machine "
+          f"{duration(seconds)} on {cores} cores, {duration(estimated_seconds(case, 16) * speed)}"
+          f" on 16 and {duration(estimated_seconds(case, 64) * speed)} on 64 (this machine "
           f"takes {speed:.2g}x the calibration machine's time now)", file=sys.stderr)
     if calibration > LONG_RUN_SECONDS and not yes:
         ratio = calibration / BUNDLED_SECONDS
@@ -64,14 +65,14 @@ def duration(seconds: float) -> str:
 
 def run(args):
     from ..case import load_case
-    from ..pipeline import run
+    from ..stages.pipeline import run
     if not args.case.is_file():
         raise MissingFile(f"case file not found: {args.case} (give the case file as "
                                 "the first argument)")
     case = load_case(args.case)
     fitted = case
     if args.from_fit is not None:
-        from ..fitting import apply_fit, read_fit, run_from_fit
+        from ..studies.fitting import apply_fit, read_fit, run_from_fit
         fitted = apply_fit(case, read_fit(args.from_fit))        # checked before any work
     estimate = _confirm_cost(fitted, args.yes)
     if estimate is None:
@@ -92,7 +93,7 @@ def run(args):
 def traction(args):
     from ..case import load_case
     from ..checks import plausible
-    from ..pipeline import traction
+    from ..stages.pipeline import traction
     from ..stribeck.traction import DEFAULT_RATIOS
     if not args.case.is_file():
         raise MissingFile(f"case file not found: {args.case}")
@@ -143,7 +144,7 @@ def _short_summary(summary: dict, out: Path) -> str:
         wall = graph["wall_s"]
         lines.append(f"  its {graph['tasks']} tasks ({graph['cpu_s']:.0f} CPU s) would take "
                      f"{wall['8']:.0f} s on 8 workers, {wall['64']:.0f} s on 64 (critical "
-                     f"path {graph['critical_path_s']:.0f} s; fem_twin.taskgraph)")
+                     f"path {graph['critical_path_s']:.0f} s; fem_twin.runtime.taskgraph)")
     lines.append(f"results in {out}/ (stribeck.csv, plots, results.nc and fields.nc for "
                  f"fem_twin.results.open_run, fields/ for ParaView, summary.json, run.log); "
                  f"the figures on one page: fem-twin report {shlex.quote(str(out))}")
@@ -152,7 +153,7 @@ def _short_summary(summary: dict, out: Path) -> str:
 
 def fit(args):
     from ..case import load_case
-    from ..fitting import fit_case
+    from ..studies.fitting import fit_case
     if not args.case.is_file():
         raise MissingFile(f"case file not found: {args.case}")
     case = load_case(args.case)
@@ -174,8 +175,8 @@ def fit(args):
 
 
 def calibrate(args):
-    from ..calibration import calibrate
     from ..case import load_case
+    from ..studies.calibration import calibrate
     summary = calibrate(load_case(args.case), args.study, args.output, values=args.values,
                         progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
@@ -183,7 +184,7 @@ def calibrate(args):
 
 
 def html_report(args):
-    from ..report import write_report
+    from ..studies.report import write_report
     if args.output is not None and Path(args.output).is_dir():
         raise InputError(f"report -o {args.output} is a folder: give the page's file name "
                          "(e.g. report.html)")
@@ -256,7 +257,7 @@ def _run_case_file(run: Path):
 def example(args):
     from importlib.resources import files
 
-    from ..samples import generate
+    from ..io.samples import generate
     args.folder.mkdir(parents=True, exist_ok=True)
     case = args.folder / "pin_on_disk.toml"
     case.write_text(files("fem_twin.cases").joinpath("pin_on_disk.toml").read_text())
@@ -268,7 +269,7 @@ def example(args):
 
 def compare(args):
     from ..case import load_case
-    from ..compare import compare
+    from ..studies.compare import compare
     summary = compare(load_case(args.case), args.output, progress=not args.no_progress)
     print(json.dumps(summary, indent=2))
     return 0

@@ -183,7 +183,7 @@ def mesh(args):
 
 
 def sample(args):
-    from .. import samples
+    from ..io import samples
     for path in samples.generate(args.output):
         print(path)
     return 0

@@ -11,14 +11,10 @@ from tqdm import tqdm
 
 from ..macro.nested import nested_levels
 from ..numerics.threads import worker_heap
+from ..runtime.cost import sweep_cost
 from ..stribeck import stribeck_sweep
 from ..stribeck.curve import joined
 from ..stribeck.sweep import point_file, point_files, point_key
-
-#: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH (the resolution
-#: study's points grow as N^1.39 from 500^2 to 1997^2, benchmarks/README.md), so that the
-#: largest-first schedule starts the finest grids' points first
-COST_GROWTH = 1.35
 
 
 def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points",
@@ -99,7 +95,7 @@ def _run(requests, executor, progress: bool, desc: str) -> list:
             return [_sweep_task((requests[0], progress))]
         return [_sweep_task((r, False)) for r in tqdm(requests, desc=desc, unit="task",
                                                       disable=not progress)]
-    order = sorted(range(len(requests)), key=lambda j: -_cost(requests[j]))
+    order = sorted(range(len(requests)), key=lambda j: -sweep_cost(requests[j]))
     submitted = {j: executor.submit(_sweep_task, (requests[j], False)) for j in order}
     futures = [submitted[j] for j in range(len(requests))]
     total = sum(r.speeds.size for r in requests)
@@ -122,20 +118,15 @@ def chains(tasks, workers: int) -> list:
     the coarsest nested level), about as fast as a warm one on fine grids and with the same
     C_f to 2e-6 (benchmarks/README.md).  A sweep that writes fields stays whole (one VTU per speed,
     numbered along the sweep, and one PVD)."""
-    share = sum(map(_cost, tasks)) / max(workers, 1)
+    share = sum(map(sweep_cost, tasks)) / max(workers, 1)
     out = []
     for i, task in enumerate(tasks):
         n = task.speeds.size
-        whole = workers <= 1 or task.fields is not None or _cost(task) <= share
-        count = 1 if whole else min(n, int(np.ceil(2 * _cost(task) / share)))
+        whole = workers <= 1 or task.fields is not None or sweep_cost(task) <= share
+        count = 1 if whole else min(n, int(np.ceil(2 * sweep_cost(task) / share)))
         out += [(i, replace(task, speeds=task.speeds[part]))
                 for part in np.array_split(np.arange(n), count)]
     return out
-
-
-def _cost(request) -> float:
-    """A sweep's cost: speeds times nodes to the power :data:`COST_GROWTH`."""
-    return float(request.gap.size) ** COST_GROWTH * request.speeds.size
 
 
 def _sweep_task(args):

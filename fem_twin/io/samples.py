@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .io.files import write_topography
-from .topography.core import Topography
-from .topography.levelling import level
-from .topography.synthetic import self_affine
+from ..topography.core import Topography
+from ..topography.levelling import level
+from ..topography.synthetic import self_affine
+from .files import write_topography
 
 SEED = 2023
 #: Table 5 of the paper: Sq of the roughness patches of test 2.1 [m], (disk = up, pin = low).
@@ -99,7 +99,7 @@ def worn_pin(seed: int, k: int) -> Topography:
     z[invalid] = np.nan
     meta = {"sample": f"worn pin {k}",
             "instrument": "FRT-like confocal, 500 x 500 px over 8 x 8 mm",
-            "generator": "fem_twin.samples.worn_pin", "seed": int(seed), "unit": "m",
+            "generator": "fem_twin.io.samples.worn_pin", "seed": int(seed), "unit": "m",
             "pin_radius": PIN_RADIUS, "crown": crown, "edge_roll_off": roll}
     return Topography(z, dx, origin=(x[0], x[0]), meta=meta)
 
@@ -122,7 +122,7 @@ def worn_disk(seed: int, k: int) -> Topography:
     z += tilt[0] * X1 + tilt[1] * X2 + rng.uniform(-5e-6, 5e-6)
     z[rng.random(MACRO_SHAPE) < 1e-3] = np.nan
     meta = {"sample": f"disk {k}", "instrument": "FRT-like confocal, 500 x 500 px over 8 x 8 mm",
-            "generator": "fem_twin.samples.worn_disk", "seed": int(seed), "unit": "m",
+            "generator": "fem_twin.io.samples.worn_disk", "seed": int(seed), "unit": "m",
             "sliding_radius": SLIDING_RADIUS, "track_depth": depth}
     return Topography(z, dx, origin=(x[0], x[0]), meta=meta)
 
@@ -139,6 +139,6 @@ def roughness_patch(seed: int, sq: float, label: str) -> Topography:
     heights = levelled.heights * (sq / levelled.rms_height())
     heights = heights + tilt[0] * X1 + tilt[1] * X2        # measurement tilt, removed by level
     meta = {"sample": label, "instrument": "Sensofar-like WLI, 768 x 576 px over 84.9 x 63.7 um",
-            "generator": "fem_twin.samples.roughness_patch", "seed": int(seed), "unit": "m",
+            "generator": "fem_twin.io.samples.roughness_patch", "seed": int(seed), "unit": "m",
             "sq_levelled": sq, "hurst": 0.8}
     return Topography(heights, spacing, meta=meta)

@@ -20,21 +20,21 @@ from dataclasses import replace
 
 import numpy as np
 
-from .case import Case
-from .checks import memory_shortfall
-from .errors import InputError
-from .io.atomic import atomic_path
-from .io.checkpoint import input_key
-from .io.figure import save_figure
-from .io.files import read_topography
-from .io.layout import RunLayout
-from .micro import FlowFactors
-from .numerics.threads import executor_for
-from .stages.factors import homogenise_patches
-from .stages.geometry import prepare_pins, reconstruct_geometry
-from .stages.requests import sweep_request
-from .stages.sweeps import run_sweeps
-from .stribeck import friction_deviation, plot_stribeck, write_stribeck_csv
+from ..case import Case
+from ..checks import memory_shortfall
+from ..errors import InputError
+from ..io.atomic import atomic_path
+from ..io.checkpoint import input_key
+from ..io.figure import save_figure
+from ..io.files import read_topography
+from ..io.layout import RunLayout
+from ..micro import FlowFactors
+from ..numerics.threads import executor_for
+from ..stages.factors import homogenise_patches
+from ..stages.geometry import prepare_pins, reconstruct_geometry
+from ..stages.requests import sweep_request
+from ..stages.sweeps import run_sweeps
+from ..stribeck import friction_deviation, plot_stribeck, write_stribeck_csv
 
 STUDIES = ("filter", "resolution", "disk", "pins", "patches")
 #: the paper's resolution study (3.2, Figure 10): macro grids [px] interpolated from its

@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError, MissingFile
-from .io.atomic import atomic_path
-from .io.figure import save_figure
-from .io.files import read_topography
-from .io.layout import RunLayout
-from .io.render import render_views
+from ..errors import InputError, MissingFile
+from ..io.atomic import atomic_path
+from ..io.figure import save_figure
+from ..io.files import read_topography
+from ..io.layout import RunLayout
+from ..io.render import render_views
 
 
 def write_report(outdir, path=None, *, render: bool = True) -> Path:

@@ -7,8 +7,8 @@ cell's pass of the grid-error estimate; after every patch, per viscosity, the sw
 solve, nested coarse solve, error estimate and a thermal run's earlier iterations), the
 refinement's guide and added points, and the patch band's sweeps (chains, which start from
 the guide's points).  The rounds are replayed from the checkpoints (the sampler is
-deterministic).  :func:`~fem_twin.case.schedule.makespan` schedules the graph greedily on
-``workers`` processes, :func:`~fem_twin.case.schedule.critical_path` is the bound no number
+deterministic).  :func:`~fem_twin.runtime.schedule.makespan` schedules the graph greedily on
+``workers`` processes, :func:`~fem_twin.runtime.schedule.critical_path` is the bound no number
 of workers beats.  Left out: the geometry, levelling and result writing (serial), and what
 one-h0 tasks lose against chunks of several h0, which warm-start contact along them
 (docs/performance.md, "How many workers")."""
@@ -19,15 +19,15 @@ from collections import defaultdict
 
 import numpy as np
 
-from .case import Case
-from .case.schedule import Task, critical_path, makespan
-from .errors import MissingFile
-from .io.layout import RunLayout
-from .micro import FlowFactors
-from .micro.sampling import adaptive_separations
-from .micro.sliding import factors_from_moments
-from .micro.store import load_point
-from .stribeck.sweep import GUIDED_BY, LEVEL_OF, point_files, point_key, point_meta
+from ..case import Case
+from ..errors import MissingFile
+from ..io.layout import RunLayout
+from ..micro import FlowFactors
+from ..micro.sampling import adaptive_separations
+from ..micro.sliding import factors_from_moments
+from ..micro.store import load_point
+from ..stribeck.sweep import GUIDED_BY, LEVEL_OF, point_files, point_key, point_meta
+from .schedule import Task, critical_path, makespan
 
 
 def run_task_graph(case: Case, outdir) -> list[Task]:

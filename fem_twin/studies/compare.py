@@ -16,22 +16,22 @@ from pathlib import Path
 
 import numpy as np
 
-from .case import Case
-from .errors import InputError
-from .io.atomic import atomic_path
-from .io.figure import save_figure
-from .io.layout import RunLayout
-from .io.table import write_csv
-from .macro import MixedResult
-from .micro import FlowFactors
-from .micro.estimate import discrepancy, grid_separations
-from .micro.flow_factors import ARRAYS
-from .numerics.threads import executor_for
-from .stages.factors import homogenise_patches
-from .stages.geometry import level_pins, reconstruct_geometry
-from .stages.requests import macro_settings, sweep_request
-from .stribeck import friction_deviation, stribeck_sweep
-from .stribeck.sweep import point_files
+from ..case import Case
+from ..errors import InputError
+from ..io.atomic import atomic_path
+from ..io.figure import save_figure
+from ..io.layout import RunLayout
+from ..io.table import write_csv
+from ..macro import MixedResult
+from ..micro import FlowFactors
+from ..micro.estimate import discrepancy, grid_separations
+from ..micro.flow_factors import ARRAYS
+from ..numerics.threads import executor_for
+from ..stages.factors import homogenise_patches
+from ..stages.geometry import level_pins, reconstruct_geometry
+from ..stages.requests import macro_settings, sweep_request
+from ..stribeck import friction_deviation, stribeck_sweep
+from ..stribeck.sweep import point_files
 
 
 def flow_factor_differences(fe: FlowFactors, fvm: FlowFactors) -> dict:

@@ -21,17 +21,17 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from .case import Case
-from .errors import InputError, RunLocked
-from .io.atomic import atomic_path
-from .io.layout import RunLayout
-from .io.writers import Writers
-from .numerics.threads import executor_for, one_thread
-from .stages.curves import stribeck_curves
-from .stages.factors import homogenise_patches
-from .stages.geometry import level_pins, reconstruct_geometry
-from .stages.provenance import provenance, stage_keys
-from .stribeck import read_measured_csv
+from ..case import Case
+from ..errors import InputError, RunLocked
+from ..io.atomic import atomic_path
+from ..io.layout import RunLayout
+from ..io.writers import Writers
+from ..numerics.threads import executor_for, one_thread
+from ..stribeck import read_measured_csv
+from .curves import stribeck_curves
+from .factors import homogenise_patches
+from .geometry import level_pins, reconstruct_geometry
+from .provenance import provenance, stage_keys
 
 log = logging.getLogger("fem_twin")
 
@@ -110,7 +110,7 @@ def traction(case: Case, outdir, entrainment: float, ratios, *, progress: bool =
     [m/s], :mod:`fem_twin.stages.traction`) into ``outdir``, with the stages before them
     cached and resumed as in :func:`run`; returns the summary (not written: the folder's
     ``summary.json`` belongs to ``fem-twin run``)."""
-    from .stages.traction import traction_curves
+    from .traction import traction_curves
     if not case.tribometer.ball:
         raise InputError("a traction curve needs a rolling-sliding contact: [tribometer] "
                          "kind = \"ball-on-disk\" (a pin on a disk only slides)")
@@ -127,9 +127,9 @@ def traction(case: Case, outdir, entrainment: float, ratios, *, progress: bool =
 
 def _task_graph(case: Case, out: RunLayout) -> dict:
     """The run's task graph and its wall time on more workers
-    (:func:`fem_twin.taskgraph.scaling`; on a worker beside the last files, 1.5 s of the
+    (:func:`fem_twin.runtime.taskgraph.scaling`; on a worker beside the last files, 1.5 s of the
     bundled case); an empty dict, logged, if it cannot be read."""
-    from .taskgraph import scaling
+    from ..runtime.taskgraph import scaling
     try:
         return scaling(case, out.root)
     except (OSError, ValueError, KeyError) as err:

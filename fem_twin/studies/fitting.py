@@ -12,20 +12,21 @@ from pathlib import Path
 
 import numpy as np
 
-from .case import Case
-from .checks import QUANTITIES, arguments, plausible
-from .errors import InputError
-from .io.atomic import atomic_path
-from .io.layout import RunLayout
-from .io.table import write_csv
-from .macro.boundary import BoundaryLaw
-from .macro.viscosity import WaltherLaw
-from .numerics.threads import executor_for
-from .stages.requests import per_viscosity, sweep_request
-from .stages.sweeps import run_sweeps
-from .stribeck import read_measured_csv
-from .stribeck.curve import read_stribeck_csv
-from .stribeck.fit import (
+from ..case import Case
+from ..checks import QUANTITIES, arguments, plausible
+from ..errors import InputError
+from ..io.atomic import atomic_path
+from ..io.layout import RunLayout
+from ..io.table import write_csv
+from ..macro.boundary import BoundaryLaw
+from ..macro.viscosity import WaltherLaw
+from ..numerics.threads import executor_for
+from ..runtime.taskgraph import fit_scaling
+from ..stages.requests import per_viscosity, sweep_request
+from ..stages.sweeps import run_sweeps
+from ..stribeck import read_measured_csv
+from ..stribeck.curve import read_stribeck_csv
+from ..stribeck.fit import (
     LOAD_SHARES,
     PARAMETERS,
     RESISTANCES,
@@ -35,8 +36,7 @@ from .stribeck.fit import (
     check_parameters,
     fit_curves,
 )
-from .stribeck.prediction import plot_fit, predict
-from .taskgraph import fit_scaling
+from ..stribeck.prediction import plot_fit, predict
 
 log = logging.getLogger("fem_twin")
 
@@ -61,7 +61,7 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), predict_loa
     law = (WaltherLaw.through(lb.temperatures, lb.viscosities, lb.density)
            if len(set(lb.temperatures)) > 1 else None)
     if run is None:
-        from .pipeline import run
+        from ..stages.pipeline import run
     run(case, outdir, progress=progress)
     out = RunLayout(outdir)
     simulated = _simulated(case, out, tests, progress)
@@ -326,11 +326,11 @@ def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=Non
     thermal resistance by more sweeps at its interval's ends) and the curve's C_f error
     estimate.
     Returns the run's summary with ``"prediction"``; ``options`` go to ``run``
-    (:func:`fem_twin.pipeline.run`)."""
+    (:func:`fem_twin.stages.pipeline.run`)."""
     result = read_fit(fit_path)
     fitted = apply_fit(case, result)
     if run is None:
-        from .pipeline import run
+        from ..stages.pipeline import run
     summary = run(fitted, outdir, progress=progress, **options)
     out = RunLayout(outdir)
     curves = read_stribeck_csv(out.stribeck_csv)

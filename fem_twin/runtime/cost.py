@@ -1,6 +1,6 @@
 """The run-time cost model: a case's wall time on the calibration machine, before it runs.
 
-``fem-twin run`` prints it scaled to this machine by :func:`fem_twin.case.machine.slowdown` and
+``fem-twin run`` prints it scaled to this machine by :func:`fem_twin.runtime.machine.slowdown` and
 asks for ``--yes`` above seven times the bundled case's.  The constants were fitted to the
 bundled, paper and ball cases on the calibration machine (their measurements:
 ``benchmarks/README.md``, "The run-time cost model"); ``tests/test_cli.py`` holds the
@@ -43,17 +43,22 @@ MICRO_SECONDS = 3.5e-6
 #: most the candidates)
 ADAPTIVE_H0 = (5.5, 2.7)
 
+#: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH (the resolution
+#: study's points grow as N^1.39 from 500^2 to 1997^2, benchmarks/README.md), so that the
+#: largest-first schedule starts the finest grids' points first
+COST_GROWTH = 1.35
+
 
 def estimated_seconds(case, cores: int = 2) -> float:
     """Rough wall time of ``fem-twin run`` of ``case`` (a :class:`~fem_twin.case.Case`) on
     ``cores`` workers of the calibration machine [s]: its work as tasks
-    (:func:`cost_tasks`) scheduled on them (:func:`~fem_twin.case.schedule.makespan`)."""
+    (:func:`cost_tasks`) scheduled on them (:func:`~fem_twin.runtime.schedule.makespan`)."""
     return makespan(cost_tasks(case), max(cores, 1))
 
 
 def cost_tasks(case) -> list[Task]:
     """The run's work as tasks with their seconds on one core of the calibration machine,
-    as the run's own task graph has them (:mod:`fem_twin.taskgraph`): per patch pair the
+    as the run's own task graph has them (:mod:`fem_twin.runtime.taskgraph`): per patch pair the
     h0 of each of :data:`H0_ROUNDS` rounds at ``MICRO_SECONDS`` per cell pixel, step and
     separation; per viscosity the sweep's guide, each point (a warm point of
     ``POINT_SECONDS``, a ball's of ``BALL_POINT_SECONDS``, with its error estimate), each
@@ -148,3 +153,9 @@ def _band_point_cost(case) -> float:
         return BAND_POINT_COST[case.run.band_grid]
     return (BAND_POINT_COST["coarse"]
             * BAND_LEVEL_COST ** (case.band_coarsening(case.macro_shape) - 1))
+
+
+def sweep_cost(request) -> float:
+    """A sweep request's relative cost, to schedule the largest first: its speeds times its
+    nodes to the power :data:`COST_GROWTH` [-]."""
+    return float(request.gap.size) ** COST_GROWTH * request.speeds.size

@@ -1,6 +1,6 @@
 """Tasks with their seconds and dependencies, and their wall time on N workers: the model
-of both a finished run's task graph (:mod:`fem_twin.taskgraph`) and a case's estimate
-before it runs (:mod:`fem_twin.case.cost`)."""
+of both a finished run's task graph (:mod:`fem_twin.runtime.taskgraph`) and a case's estimate
+before it runs (:mod:`fem_twin.runtime.cost`)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """How fast this machine runs fem_twin now, against the machine and hour the run-time
-estimates were measured on (:meth:`fem_twin.case.Case.estimated_seconds`).
+estimates were measured on (:func:`fem_twin.runtime.cost.estimated_seconds`).
 
 Costs measured on one machine say little about another (a laptop, SuperLU instead of
 PARDISO), and a shared machine runs the same work up to about 2x slower from one hour to

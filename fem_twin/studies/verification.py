@@ -17,13 +17,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .io.files import read_topography
-from .macro import Lubricant, MacroSettings, solve_mixed
-from .macro.deterministic import DeterministicSettings, solve_deterministic
-from .micro import homogenise
-from .topography import Topography, resample_cell
-from .topography.prepare import prepare_patch
+from ..errors import InputError
+from ..io.files import read_topography
+from ..macro import Lubricant, MacroSettings, solve_mixed
+from ..macro.deterministic import DeterministicSettings, solve_deterministic
+from ..micro import homogenise
+from ..topography import Topography, resample_cell
+from ..topography.prepare import prepare_patch
 
 #: the pads' tile counts of ``benchmarks/run.py deterministic`` (eps = 1/2 .. 1/16)
 TILES = (2, 4, 8, 16)
