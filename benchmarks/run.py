@@ -427,7 +427,8 @@ def bench_paper():
     Baseline: the measured micro time of one h0."""
     from fem_twin.case import load_case
     from fem_twin.macro import Lubricant
-    from fem_twin.macro.nested import coarsened, nested_levels
+    from fem_twin.macro.nested import nested_levels
+    from fem_twin.macro.point import coarsened
     from fem_twin.micro import DEFAULT_H0, homogenise
     from fem_twin.stribeck import SweepRequest, stribeck_sweep
 

@@ -67,14 +67,15 @@ def _point(n: int, factors: str) -> dict:
 
     from fem_twin.macro import Lubricant
     from fem_twin.macro.nested import solve_nested
+    from fem_twin.macro.point import OperatingPoint
     from fem_twin.micro import FlowFactors
     ff = FlowFactors.load(factors)
     gap, spacing, face = macro_gap(n)
     common = dict(load=150.0, face=face, lubricant=Lubricant(0.066))
     t0 = time.perf_counter()
-    cold = solve_nested(gap, spacing, ff, speed=COLD, **common)
+    cold = solve_nested(OperatingPoint(gap, spacing, ff, speed=COLD, **common))
     t1 = time.perf_counter()
-    warm = solve_nested(gap, spacing, ff, speed=WARM, previous=cold, **common)
+    warm = solve_nested(OperatingPoint(gap, spacing, ff, speed=WARM, **common), cold)
     t2 = time.perf_counter()
     return {"n": n, "cold": t1 - t0, "warm": t2 - t1, "cf": cold[0].friction_coefficient,
             "cold_iterations": cold[0].iterations, "warm_iterations": warm[0].iterations,

@@ -303,7 +303,7 @@ def test_the_band_grid_is_the_coarsest_nested_grid():
     "coarse" halves the grid once and "full" keeps it."""
     from dataclasses import replace
 
-    from fem_twin.macro.nested import coarsened
+    from fem_twin.macro.point import coarsened
     case = load_case(ROOT / "examples" / "paper.toml")
     assert case.run.band_grid == "coarsest"
     for side, levels in ((48, 1), (128, 1), (200, 2), (256, 2), (1024, 4)):

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from fem_twin.io.files import read_topography
-from fem_twin.macro import BOUNDARY_FRICTION, Lubricant, MacroSettings, solve_mixed
+from fem_twin.macro import BOUNDARY_FRICTION, Lubricant, MacroSettings, OperatingPoint, solve_mixed
 from fem_twin.macro.estimate import friction_error
 from fem_twin.micro import homogenise
 from fem_twin.topography import resample_cell
@@ -51,7 +51,8 @@ def test_estimate_bounds_the_change_to_a_refined_run(runs, speed):
     kw = dict(load=150.0, speed=speed, lubricant=Lubricant(0.066), settings=MacroSettings())
     point = solve_mixed(gap, dx, factors, face=face, **kw)
     kw.pop("speed")
-    estimate = friction_error(point, gap, dx, factors, face=face, **kw)["total"]
+    estimate = friction_error(point, OperatingPoint(gap, dx, factors, face=face, speed=speed,
+                                                    **kw))["total"]
     reference = solve_mixed(gap_r, dx_r, factors_r, face=face_r, speed=speed, **kw)
     actual = abs(point.friction_coefficient - reference.friction_coefficient)
     floor = 5e-4 * BOUNDARY_FRICTION

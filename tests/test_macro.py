@@ -377,11 +377,13 @@ def test_friction_error_parts(case32, factors):
     factors without variants report theirs as missing (NaN, left out of the total)."""
     from dataclasses import replace
 
-    from fem_twin.macro.estimate import FILM_COUPLING, MACRO_ORDER, PARTS, coarsened, friction_error
+    from fem_twin.macro.estimate import FILM_COUPLING, MACRO_ORDER, PARTS, friction_error
+    from fem_twin.macro.point import OperatingPoint, coarsened
     gap, dx, face = case32
     kw = dict(load=150.0, lubricant=Lubricant(0.066), settings=MacroSettings())
     res = solve_mixed(gap, dx, factors, speed=0.05, face=face, **kw)
-    est = friction_error(res, gap, dx, factors, face=face, **kw)
+    point = OperatingPoint(gap, dx, factors, speed=0.05, face=face, **kw)
+    est = friction_error(res, point)
     gap2, dx2, face2 = coarsened(gap, dx, face)
     base = solve_mixed(gap2, dx2, factors, speed=0.05, face=face2, initial=res, **kw)
     assert est["macro"] == pytest.approx(abs(res.friction_coefficient
@@ -396,7 +398,7 @@ def test_friction_error_parts(case32, factors):
     # friction factor)
     tight = dict(kw, settings=MacroSettings(tol=1e-8))        # below the film's change
     res = solve_mixed(gap, dx, factors, speed=0.05, face=face, initial=res, **tight)
-    est_film = friction_error(res, gap, dx, factors, face=face, **tight)["film"]
+    est_film = friction_error(res, replace(point, settings=tight["settings"]))["film"]
     films = [solve_mixed(gap, dx, factors.variants()[k], speed=0.05, face=face, initial=res,
                          **tight) for k in ("film_thin", "film_thick")]
     assert all(f.h_d == pytest.approx(res.h_d, rel=1e-6) for f in films)
@@ -414,11 +416,11 @@ def test_friction_error_parts(case32, factors):
     assert est["total"] == pytest.approx(sum(est[p] for p in PARTS))
     assert all(est[p] > 0 for p in PARTS) and "missing" not in est
     bare = replace(factors, meta={})
-    est = friction_error(res, gap, dx, bare, face=face, **kw)
+    est = friction_error(res, replace(point, factors=bare))
     assert est["missing"] == ["time", "grid", "h0", "film"] and np.isnan(est["grid"])
     assert est["total"] == pytest.approx(est["macro"])
     smooth = solve_mixed(gap, dx, FlowFactors.smooth(), speed=1.0, face=face, **kw)
-    est = friction_error(smooth, gap, dx, FlowFactors.smooth(), face=face, **kw)
+    est = friction_error(smooth, replace(point, factors=FlowFactors.smooth(), speed=1.0))
     assert est["time"] == est["grid"] == est["h0"] == est["film"] == 0
     assert est["total"] == est["macro"] > 0
 
@@ -431,25 +433,28 @@ def test_the_micro_parts_of_a_fine_grid_are_solved_on_a_coarser_level(factors, m
     is not solved again (here: the 64^2 one, so 4 solves: the 32^2 point and 3 variants)."""
     import fem_twin.macro.estimate as E
     from fem_twin.macro.nested import solve_nested
+    from fem_twin.macro.point import OperatingPoint
     assert [E.micro_parts_level((n, n)) for n in (128, 512, 1024, 1997, 2048)] == [1, 1, 2,
                                                                                 3, 3]
     monkeypatch.setattr(E, "MICRO_PARTS_SIDE", 32)
     gap, dx, face = macro_case(128)
     kw = dict(load=150.0, lubricant=Lubricant(0.066), settings=MacroSettings())
-    point, *levels = solve_nested(gap, dx, factors, speed=0.05, face=face, **kw)
+    op = OperatingPoint(gap, dx, factors, speed=0.05, face=face, **kw)
+    point, *levels = solve_nested(op)
     assert [lv.pressure.shape for lv in levels] == [(64, 64)]
     solves = []
-    counted = E.solve_mixed
-    monkeypatch.setattr(E, "solve_mixed", lambda *a, **k: solves.append(1) or counted(*a, **k))
-    est = E.friction_error(point, gap, dx, factors, face=face, levels=levels, **kw)
+    counted = E.solve_point
+    monkeypatch.setattr(E, "solve_point", lambda *a, **k: solves.append(1) or counted(*a, **k))
+    est = E.friction_error(point, op, levels)
     assert len(solves) == 4
     assert est["macro"] == pytest.approx(abs(point.friction_coefficient
                                              - levels[0].friction_coefficient)
                                          / (2 ** E.MACRO_ORDER - 1), rel=1e-12)
     four = dict(face=face[::4, ::4], speed=0.05, **kw)
-    base = counted(gap[::4, ::4], (4 * dx[0], 4 * dx[1]), factors, initial=levels[0], **four)
-    time = counted(gap[::4, ::4], (4 * dx[0], 4 * dx[1]), factors.variants()["time"],
-                   initial=base, **four)
+    base = solve_mixed(gap[::4, ::4], (4 * dx[0], 4 * dx[1]), factors, initial=levels[0],
+                       **four)
+    time = solve_mixed(gap[::4, ::4], (4 * dx[0], 4 * dx[1]), factors.variants()["time"],
+                       initial=base, **four)
     assert est["time"] == pytest.approx(abs(time.friction_coefficient
                                             - base.friction_coefficient), rel=1e-9)
 
@@ -461,15 +466,16 @@ def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors)
     fine-grid iterations (sample pin 1 at 112^2, mixed lubrication 0.05 -> 0.03 m/s:
     measured 24 against 42); its coarse point is the one the error estimate solves."""
     from fem_twin.macro.estimate import friction_error
-    from fem_twin.macro.nested import coarsened, nested_levels, solve_nested
+    from fem_twin.macro.nested import nested_levels, solve_nested
+    from fem_twin.macro.point import OperatingPoint, coarsened
     from fem_twin.stribeck import SweepRequest, stribeck_sweep
     gap, dx, face = macro_case(112)
     kw = dict(load=150.0, lubricant=Lubricant(0.066), face=face,
               settings=MacroSettings(tol=TIGHT))
-    first, first_coarse = solve_nested(gap, dx, factors, speed=0.05, **kw)
+    first, first_coarse = solve_nested(OperatingPoint(gap, dx, factors, speed=0.05, **kw))
     assert first_coarse.pressure.shape == (56, 56)
-    nested, coarse = solve_nested(gap, dx, factors, speed=0.03,
-                                  previous=(first, first_coarse), **kw)
+    op = OperatingPoint(gap, dx, factors, speed=0.03, **kw)
+    nested, coarse = solve_nested(op, (first, first_coarse))
     plain = solve_mixed(gap, dx, factors, speed=0.03, initial=first, **kw)
     assert abs(nested.friction_coefficient - plain.friction_coefficient) < 1e-6 * 0.19245
     assert nested.iterations < 0.75 * plain.iterations
@@ -483,8 +489,8 @@ def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors)
     assert abs(curve.coarse_friction_coefficient[0, 1]
                - again.friction_coefficient) < 1e-6 * 0.19245
     assert curve.coarse_friction_coefficient[0, 0] == first_coarse.friction_coefficient
-    est = friction_error(nested, gap, dx, factors, levels=(coarse,), **kw)
-    ref = friction_error(nested, gap, dx, factors, **kw)
+    est = friction_error(nested, op, (coarse,))
+    ref = friction_error(nested, op)
     assert est["total"] == pytest.approx(ref["total"], rel=1e-3, abs=1e-6 * 0.19245)
 
 
@@ -497,15 +503,17 @@ def test_nested_levels_each_start_from_the_next_coarser_change(factors, monkeypa
     stop at the coupling tolerance 1e-6)."""
     from fem_twin.macro import mixed
     from fem_twin.macro import nested as nest
+    from fem_twin.macro.point import OperatingPoint, coarsened
     monkeypatch.setattr(mixed, "COARSE_START", 28)
     monkeypatch.setattr(nest, "COARSE_START", 28)
     gap, dx, face = macro_case(112)
     kw = dict(load=150.0, lubricant=Lubricant(0.066), settings=MacroSettings(tol=TIGHT))
-    first = nest.solve_nested(gap, dx, factors, speed=0.05, face=face, **kw)
+    first = nest.solve_nested(OperatingPoint(gap, dx, factors, speed=0.05, face=face, **kw))
     assert [r.pressure.shape[0] for r in first] == [112, 56, 28]
-    warm = nest.solve_nested(gap, dx, factors, speed=0.03, previous=first, face=face, **kw)
+    warm = nest.solve_nested(OperatingPoint(gap, dx, factors, speed=0.03, face=face, **kw),
+                             first)
     assert [r.pressure.shape[0] for r in warm] == [112, 56, 28]
-    gap2, dx2, face2 = nest.coarsened(gap, dx, face)
+    gap2, dx2, face2 = coarsened(gap, dx, face)
     alone = solve_mixed(gap2, dx2, factors, speed=0.03, initial=first[1], face=face2, **kw)
     assert warm[1].iterations < alone.iterations
     assert abs(warm[1].friction_coefficient - alone.friction_coefficient) < 1e-6 * 0.19245
@@ -530,6 +538,7 @@ def test_the_patch_band_starts_from_the_main_points_nested_levels(tmp_path, fact
     from dataclasses import replace as moved
 
     from fem_twin.macro import nested
+    from fem_twin.macro.point import coarsened
     from fem_twin.stribeck import SweepRequest, stribeck_sweep
     gap, dx, face = macro_case(96)
     speeds = [0.08, 0.04, 0.025, 0.018]
@@ -538,7 +547,7 @@ def test_the_patch_band_starts_from_the_main_points_nested_levels(tmp_path, fact
                           factors_key="average", keep_level=1, **kw))
     guide = SweepRequest(gap, dx, factors, speeds, face=face, factors_key="average",
                          **kw).level_key(1)
-    gap2, dx2, face2 = nested.coarsened(gap, dx, face)
+    gap2, dx2, face2 = coarsened(gap, dx, face)
     calls = []
     monkeypatch.setattr("fem_twin.stribeck.sweep.solve_nested",
                         lambda *a, **k: calls.append(1) or nested.solve_nested(*a, **k))
@@ -627,11 +636,12 @@ def test_a_cold_nested_point_starts_from_the_coarse_levels_anderson_pairs(factor
     measured 2026-11-27: 18 against 22)."""
     from fem_twin.macro.mixed import seeded_point
     from fem_twin.macro.nested import solve_nested
+    from fem_twin.macro.point import OperatingPoint
     gap, dx, face = macro_case(192)
-    kw = dict(load=150.0, lubricant=Lubricant(0.066), face=face,
-              settings=MacroSettings(tol=TIGHT))
-    levels = solve_nested(gap, dx, factors, speed=0.03, **kw)
-    plain, secants = seeded_point(gap, dx, factors, speed=0.03, initial=levels[1], **kw)
+    op = OperatingPoint(gap, dx, factors, speed=0.03, load=150.0, lubricant=Lubricant(0.066),
+                        face=face, settings=MacroSettings(tol=TIGHT))
+    levels = solve_nested(op)
+    plain, secants = seeded_point(op, initial=levels[1])
     assert secants.dx.shape == secants.df.shape == (4, 192 * 192 + 1)
     assert abs(levels[0].friction_coefficient - plain.friction_coefficient) < 1e-6 * 0.19245
     assert levels[0].iterations < plain.iterations

@@ -6,12 +6,14 @@ from .deterministic import DeterministicResult, DeterministicSettings, solve_det
 from .friction import hydrodynamic_shear
 from .kinematics import disk_velocity
 from .lubricant import Lubricant
-from .mixed import MacroSettings, MixedNotConverged, MixedResult, solve_mixed
+from .mixed import MacroSettings, MixedNotConverged, MixedResult, solve_mixed, solve_point
+from .point import OperatingPoint
 from .reynolds import ReynoldsNotConverged, ReynoldsResult, solve_reynolds
 
 __all__ = ["BOUNDARY_FRICTION", "BoundaryLaw", "boundary_traction", "hydrodynamic_shear",
            "disk_velocity",
            "DeterministicResult", "DeterministicSettings", "solve_deterministic",
            "Lubricant",
-           "MacroSettings", "MixedNotConverged", "MixedResult", "solve_mixed",
+           "MacroSettings", "MixedNotConverged", "MixedResult", "OperatingPoint", "solve_mixed",
+           "solve_point",
            "ReynoldsNotConverged", "ReynoldsResult", "solve_reynolds"]

@@ -16,12 +16,14 @@ reason in ``"failed"``.  Smooth factors have no micro parts (0)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..errors import MixedNotConverged
 from ..micro.estimate import FILM_VARIANTS
-from .mixed import solve_mixed
-from .nested import coarsened
+from .mixed import solve_point
+from .point import OperatingPoint
 from .result import friction_with
 
 #: the order assumed in ``|C_f(h) - C_f(2h)| / (2^p - 1)``.  The scheme's is 2 (bundled
@@ -61,18 +63,15 @@ def micro_parts_level(shape) -> int:
     return level
 
 
-def friction_error(result, gap, spacing, factors, *, load: float, lubricant, face=None,
-                   settings, entrainment: float | None = None, levels=()) -> dict:
+def friction_error(result, point: OperatingPoint, levels=()) -> dict:
     """Estimated discretisation error of ``result.friction_coefficient`` per part and in
     total (see the module docstring), for the point ``result`` that
-    :func:`~fem_twin.macro.solve_mixed` returned for these arguments; ``levels``: the same
-    point already solved on the grid's coarsenings by two, finest first
-    (:func:`.nested.solve_nested`'s levels after the first), which are then not solved
-    again."""
-    face = np.ones(np.shape(gap), bool) if face is None else face
-    common = dict(load=load, speed=result.speed, entrainment=entrainment,
-                  lubricant=lubricant, settings=settings)
-    solve = _Levels(result, gap, spacing, face, factors, levels, common)
+    :func:`~fem_twin.macro.mixed.solve_point` returned for the operating ``point`` (its
+    ``lubricant`` the film's); ``levels``: the same point already solved on the grid's
+    coarsenings by two, finest first (:func:`.nested.solve_nested`'s levels after the
+    first), which are then not solved again."""
+    factors, settings, lubricant = point.factors, point.settings, point.lubricant
+    solve = _Levels(result, point, levels)
     try:
         base = solve(1)
     except MixedNotConverged as err:
@@ -80,7 +79,7 @@ def friction_error(result, gap, spacing, factors, *, load: float, lubricant, fac
                 "failed": [f"coarse grid: {err.args[0]}"]}
     signed = {"macro": (base.friction_coefficient - result.friction_coefficient)
               / (2 ** MACRO_ORDER - 1)}
-    micro, failed = _micro_parts(solve, factors, micro_parts_level(np.shape(gap)))
+    micro, failed = _micro_parts(solve, factors, micro_parts_level(point.gap.shape))
     signed.update(micro)
     films = [v for k, v in factors.variants().items() if k in FILM_VARIANTS]
     if films:                                 # the friction factor alone: no solve
@@ -130,27 +129,26 @@ class _Levels:
     ``level`` times, with ``factors`` (default: the point's own) warm from ``initial``; a
     known level of the point's own factors is taken, not solved again (nor twice)."""
 
-    def __init__(self, result, gap, spacing, face, factors, levels, common):
-        self.result, self.factors, self.common = result, factors, common
-        self.grids, self.known = [(gap, spacing, face)], {}
+    def __init__(self, result, point, levels):
+        self.result, self.points, self.known = result, [point], {}
         for k, level in enumerate(levels, 1):
-            if level.pressure.shape != np.shape(self.grid(k)[0]):
+            if level.pressure.shape != self.point(k).gap.shape:
                 break                                     # a level the nested solve left out
             self.known[k] = level
 
-    def grid(self, level):
-        while len(self.grids) <= level:
-            self.grids.append(coarsened(*self.grids[-1]))
-        return self.grids[level]
+    def point(self, level):
+        while len(self.points) <= level:
+            self.points.append(self.points[-1].coarsened())
+        return self.points[level]
 
     def __call__(self, level, factors=None, initial=None):
         if factors is None and level in self.known:
             return self.known[level]
-        gap, spacing, face = self.grid(level)
+        point = self.point(level)
         if initial is None:
             initial = self.known.get(level - 1, self.result)
-        point = solve_mixed(gap, spacing, self.factors if factors is None else factors,
-                            face=face, initial=initial, **self.common)
+        solved = solve_point(point if factors is None else replace(point, factors=factors),
+                             initial=initial)
         if factors is None:
-            self.known[level] = point
-        return point
+            self.known[level] = solved
+        return solved

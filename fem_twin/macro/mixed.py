@@ -19,10 +19,8 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 
-import numpy as np
-
-from ..checks import as_field, as_pair, number, plausible
-from ..errors import InputError, MixedNotConverged
+from ..checks import check
+from ..errors import MixedNotConverged
 from ..micro.flow_factors import FlowFactors
 from ..micro.rolling import at_slide_to_roll
 from ..numerics.threads import one_thread
@@ -30,19 +28,17 @@ from . import newton
 from .fixed_point import Concentrated, solve_fixed_point
 from .kinematics import disk_velocity
 from .lubricant import Lubricant
+from .point import OperatingPoint
 from .problem import macro_problem
 from .result import MixedResult, mixed_result, on_grid
-from .reynolds import check_closed
 from .settings import MacroSettings
 
-__all__ = ["MacroSettings", "MixedNotConverged", "MixedResult", "solve_mixed"]
+__all__ = ["MacroSettings", "MixedNotConverged", "MixedResult", "OperatingPoint", "solve_mixed",
+           "solve_point"]
 
 #: Newton iterations per load of the ``"newton"`` coupling (it converges in 5-20), at most
 #: ``MacroSettings.max_iter``
 NEWTON_MAX_ITER = 60
-
-#: the largest rigid gap [m] either way: a pin's holder lies 1 mm below its face
-MAX_GAP = 0.05
 
 #: Cold starts on grids of at least twice this size begin with a solve on the coarser grid.
 COARSE_START = 48
@@ -72,49 +68,45 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
     face : (ny, nx) bool, the pin face for the friction integral (eq 33); all if None
     initial : a result to warm-start from (e.g. the neighbouring speed of a sweep)
     progress : optional callable ``progress(iteration, residual)``
+
+    The same as :func:`solve_point` of the :class:`~fem_twin.macro.point.OperatingPoint`
+    of these arguments.
     """
-    return seeded_point(gap, spacing, factors, load=load, speed=speed,
-                        entrainment=entrainment, lubricant=lubricant, face=face,
-                        settings=settings, initial=initial, progress=progress)[0]
+    point = OperatingPoint(gap, spacing, factors, load=load, speed=speed,
+                           entrainment=entrainment, lubricant=lubricant, face=face,
+                           settings=settings)
+    return seeded_point(point, initial=initial, progress=progress)[0]
 
 
 @one_thread
-def seeded_point(gap, spacing, factors: FlowFactors, *, load: float, speed: float,
-                 entrainment: float | None = None, lubricant: Lubricant, face=None,
-                 settings: MacroSettings = MacroSettings(),
-                 initial: MixedResult | None = None, secants=None, progress=None):
-    """:func:`solve_mixed` whose Anderson coupling starts from ``secants``, the last
+def solve_point(point: OperatingPoint, initial: MixedResult | None = None,
+                progress=None) -> MixedResult:
+    """The converged state of the operating ``point`` (eqs 17-34), warm from ``initial``
+    (a result on any grid), reporting ``progress(iteration, residual)``."""
+    return seeded_point(point, initial=initial, progress=progress)[0]
+
+
+@one_thread
+def seeded_point(point: OperatingPoint, *, initial: MixedResult | None = None, secants=None,
+                 progress=None):
+    """:func:`solve_point` whose Anderson coupling starts from ``secants``, the last
     differences of the same point's coupling on a coarser grid
     (:class:`~fem_twin.macro.fixed_point.Secants`, interpolated).  Returns ``(result,
     secants)``, the second this solve's own (None where the coupling is not Anderson):
     :func:`~fem_twin.macro.nested.solve_nested` hands them from level to level.
     """
-    if not isinstance(factors, FlowFactors):
-        raise InputError(f"factors must be FlowFactors (fem_twin.micro.homogenise, or "
-                         f"FlowFactors.smooth()), got {type(factors).__name__}")
-    h_g = as_field("gap [m]", gap, 3)
-    if np.abs(h_g).max() > MAX_GAP:
-        raise InputError(f"gap [m] spans {h_g.min():.3g} to {h_g.max():.3g} m: implausible for a "
-                         f"pin or a ball (at most {MAX_GAP:g} m either way); give it in metres")
-    check_closed(h_g)
-    load = number("load [N]", load, "load")
-    if entrainment is None or speed != 0:                # 0 with u_m: pure rolling
-        speed = number("speed [m/s]", speed, "speed")
-    dx = as_pair("spacing [m]", spacing)
-    plausible("spacing [m]", dx, "pitch")
-    u_m = speed / 2 if entrainment is None else number("entrainment [m/s]", entrainment, "speed")
-    factors = at_slide_to_roll(factors, speed / u_m)
-    face = np.ones(h_g.shape, bool) if face is None else np.asarray(face, bool)
-    if face.shape != h_g.shape:
-        raise InputError(f"face mask {face.shape} does not match the gap {h_g.shape}")
+    check("point", point, OperatingPoint)
+    h_g, dx, face, settings = point.gap, point.spacing, point.face, point.settings
+    factors = at_slide_to_roll(point.factors, point.speed / point.u_m)
     t0 = time.perf_counter()
     if initial is None and min(h_g.shape) >= 2 * COARSE_START:
-        initial, secants = _coarse_start(h_g, dx, factors, load, speed, entrainment,
-                                         lubricant, face, settings)
+        initial, secants = _coarse_start(replace(point, factors=factors))
     if initial is not None:
         initial = on_grid(initial, h_g.shape, dx)
     velocity = disk_velocity(face, dx, settings.track_radius)
-    P = macro_problem(h_g, dx, factors, lubricant, settings, speed, u_m, velocity)
+    P = macro_problem(h_g, dx, factors, point.lubricant, settings, point.speed, point.u_m,
+                      velocity)
+    load = point.load
     if settings.coupling == "newton" or (settings.coupling == "auto" and initial is not None
                                          and initial.meta.get("coupling") == "newton"):
         return _solve_newton(P, load, face, initial, progress, t0), None
@@ -129,15 +121,14 @@ def seeded_point(gap, spacing, factors: FlowFactors, *, load: float, speed: floa
                         time.perf_counter() - t0), secants
 
 
-def _coarse_start(h_g, dx, factors, load, speed, entrainment, lubricant, face, settings):
+def _coarse_start(point: OperatingPoint):
     """The point solved on the grid coarsened by 2 (recursively), to a looser tolerance,
     with its coupling's secants, or ``(None, None)`` when that grid is too coarse to resolve
     the contact."""
+    coarse = point.coarsened()
     try:
-        return seeded_point(h_g[::2, ::2], (2 * dx[0], 2 * dx[1]), factors, load=load,
-                           speed=speed, entrainment=entrainment, lubricant=lubricant,
-                           face=face[::2, ::2], settings=replace(settings,
-                                                                  tol=max(settings.tol, 1e-4)))
+        return seeded_point(replace(coarse, settings=replace(
+            coarse.settings, tol=max(coarse.settings.tol, 1e-4))))
     except MixedNotConverged:
         return None, None
 

@@ -22,16 +22,11 @@ import numpy as np
 
 from ..errors import MixedNotConverged
 from .mixed import COARSE_START, seeded_point
+from .point import OperatingPoint
 from .result import MixedResult, resampled
 
 #: the fields a coarse-grid correction moves (``h_d`` besides)
 CORRECTED = ("pressure", "elastic_deformation", "cavity_fraction", "contact_pressure")
-
-
-def coarsened(gap, spacing, face):
-    """``(gap, spacing, face)`` on every other node of the grid [m] (``face`` None: None)."""
-    return (np.asarray(gap)[::2, ::2], (2 * spacing[0], 2 * spacing[1]),
-            None if face is None else np.asarray(face, bool)[::2, ::2])
 
 
 def nested_levels(shape) -> int:
@@ -43,38 +38,34 @@ def nested_levels(shape) -> int:
     return levels
 
 
-def solve_nested(gap, spacing, factors, *, previous: tuple[MixedResult, ...] = (),
-                 face=None, **point) -> tuple[MixedResult, ...]:
-    """One sweep point on its grid and on each coarsening by two down to the coarse start
-    (:data:`~fem_twin.macro.mixed.COARSE_START`), finest first: ``(point, coarse, ...)``.
+def solve_nested(point: OperatingPoint, previous: tuple[MixedResult, ...] = ()
+                 ) -> tuple[MixedResult, ...]:
+    """The operating ``point`` on its grid and on each coarsening by two down to the coarse
+    start (:data:`~fem_twin.macro.mixed.COARSE_START`), finest first: ``(point, coarse,
+    ...)``.
 
     ``previous``: the last point's levels as this returned them (empty for a cold point; a
     point reloaded from its checkpoint without its levels: ``(point,)``), or a guide: this
     point solved on a coarser grid, which starts that level, the finer ones each from the
-    coarser level's solution as in a cold point.  ``point``: the other arguments of
-    :func:`~fem_twin.macro.solve_mixed` (``load``, ``speed``, ``lubricant``, ...).  Each
-    level starts from the previous point's same level moved by the change one level down
-    (the full approximation scheme, recursively): only the coarsest grid iterates the whole
-    speed change.  A level whose solve fails leaves the finer ones to start from
-    ``previous`` alone, and is left out."""
-    return _levels(gap, spacing, factors, tuple(previous), face, point)[0]
+    coarser level's solution as in a cold point.  Each level starts from the previous
+    point's same level moved by the change one level down (the full approximation scheme,
+    recursively): only the coarsest grid iterates the whole speed change.  A level whose
+    solve fails leaves the finer ones to start from ``previous`` alone, and is left out."""
+    return _levels(point, tuple(previous))[0]
 
 
-def _levels(gap, spacing, factors, previous, face, point):
+def _levels(point, previous):
     """``(levels, secants)``: :func:`solve_nested`'s levels and the finest one's secants."""
-    if min(np.shape(gap)) < 2 * COARSE_START:
-        result, secants = seeded_point(gap, spacing, factors, face=face,
-                                       initial=_last(previous), **point)
+    shape = point.gap.shape
+    if min(shape) < 2 * COARSE_START:
+        result, secants = seeded_point(point, initial=_last(previous))
         return (result,), secants
-    gap2, spacing2, face2 = coarsened(gap, spacing, face)
-    guide = bool(previous) and min(previous[0].pressure.shape) < min(np.shape(gap))
+    guide = bool(previous) and min(previous[0].pressure.shape) < min(shape)
     try:
-        levels, secants = _levels(gap2, spacing2, factors,
-                                  previous if guide else previous[1:] or previous[:1],
-                                  face2, point)
+        levels, secants = _levels(point.coarsened(),
+                                  previous if guide else previous[1:] or previous[:1])
     except MixedNotConverged:
-        result, secants = seeded_point(gap, spacing, factors, face=face,
-                                       initial=_last(previous), **point)
+        result, secants = seeded_point(point, initial=_last(previous))
         return (result,), secants
     coarse = levels[0]
     if not previous or guide:
@@ -83,8 +74,8 @@ def _levels(gap, spacing, factors, previous, face, point):
         start = _film_from(coarse, corrected(previous[0], previous[1], coarse))
     else:
         start = previous[0]
-    result, own = seeded_point(gap, spacing, factors, face=face, initial=start,
-                               secants=secants if guide or not previous else None, **point)
+    result, own = seeded_point(point, initial=start,
+                               secants=secants if guide or not previous else None)
     return (result, *levels), own
 
 

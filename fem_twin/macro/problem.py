@@ -1,6 +1,7 @@
-"""One operating point of the macro scale as a value: the grid, the physics and the speeds.
+"""An operating point's assembled problem: the grid, the physics and the speeds.
 
-:func:`macro_problem` builds the :class:`Problem` that both couplings (:mod:`.fixed_point`
+:func:`macro_problem` builds, from an :class:`~fem_twin.macro.point.OperatingPoint`'s
+values, the :class:`Problem` that both couplings (:mod:`.fixed_point`
 and :mod:`.newton`) solve; :meth:`Problem.coefficients` evaluates eq 17's homogenised
 Poiseuille and Couette coefficients with Roelands (eq 23) and Dowson-Higginson (eq 24) at a
 pressure and a separation field.
@@ -8,17 +9,22 @@ pressure and a separation field.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import cached_property, partial
 
 import numpy as np
 import scipy.fft as fft
+import scipy.sparse as sp
 
-from ..contact.elastic import elastic_operator
+from ..contact.elastic import ElasticOperator, elastic_operator
+from ..micro.flow_factors import FlowFactors
 from .contact_load import nodal_contact_pressure
 from .kinematics import in_grid_frame, rotations
+from .lubricant import Lubricant
 from .reynolds import OPEN_GAP, fe_poiseuille, trapezoid_weights
 from .reynolds_fv import fvm_poiseuille
+from .settings import MacroSettings
 
 #: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
 #: clipped before eqs 23-24 are evaluated (both couplings), so that the Roelands
@@ -34,12 +40,12 @@ class Problem:
     """The grid, the physics and the speeds of one operating point (SI units)."""
 
     gap: np.ndarray            # rigid gap h_g (ny, nx) [m]
-    spacing: tuple             # (dx1, dx2) [m]
-    factors: object            # FlowFactors
-    lubricant: object          # Lubricant
-    settings: object           # MacroSettings
-    poiseuille: object         # (g, A) -> sparse K
-    elastic: object            # ElasticOperator
+    spacing: tuple[float, float]  # (dx1, dx2) [m]
+    factors: FlowFactors       # at the point's slide-to-roll ratio
+    lubricant: Lubricant
+    settings: MacroSettings
+    poiseuille: Callable[[np.ndarray, np.ndarray | None], sp.csr_matrix]  # (g, A) -> K
+    elastic: ElasticOperator   # eqs 20-22 on the padded grid
     area: np.ndarray           # trapezoid weights [m^2]
     interior: np.ndarray       # flat indices of the interior nodes
     speed: float               # sliding speed u_r [m/s]

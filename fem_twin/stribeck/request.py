@@ -17,7 +17,7 @@ from ..checks import as_field, as_pair, check, number
 from ..errors import InputError
 from ..io.checkpoint import input_key
 from ..macro import Lubricant, MacroSettings
-from ..macro.nested import coarsened
+from ..macro.point import OperatingPoint, coarsened
 from ..micro.flow_factors import FlowFactors
 
 
@@ -119,6 +119,13 @@ class SweepRequest:
     def face_load(self) -> float:
         """The load the face carries, ``load`` times ``load_share`` [N] (eq 28)."""
         return self.load * self.load_share
+
+    def operating_point(self, speed: float) -> OperatingPoint:
+        """The macro operating point at the sweep ``speed`` [m/s] (a sliding speed, or an
+        entrainment speed, by the ``motion``), the face carrying :attr:`face_load`."""
+        return OperatingPoint(self.gap, self.spacing, self.factors, load=self.face_load,
+                              lubricant=self.lubricant, face=self.face,
+                              settings=self.settings, **self.motion.speeds(speed))
 
     @property
     def key(self) -> str:

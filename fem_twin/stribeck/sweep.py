@@ -100,7 +100,7 @@ def stribeck_sweep(request: SweepRequest, progress: bool = False) -> StribeckCur
             res, *coarser = point.solve(float(speed), guided.start(r.speeds, i, previous),
                                         path, (folder, kept, r.keep_level, key))
         if r.error_estimate and "error_estimate" not in res.meta:
-            res = point.estimated(res, coarser, path)
+            res = point.estimated(float(speed), res, coarser, path)
         if fields is not None:
             vtu = res.write_vtu(fields / f"mu{mu:g}_{i:03d}.vtu", r.origin)
             entries.append((float(res.speed), vtu))            # ParaView time = U [m/s]
@@ -146,13 +146,12 @@ class _Point:
                 point_file(folder, kept, speed))
         return (res, *coarser)
 
-    def estimated(self, res, coarser, path):
-        """``res`` with its C_f error estimate in ``meta`` (saved at ``path``)."""
+    def estimated(self, speed, res, coarser, path):
+        """``res``, the point at the sweep ``speed``, with its C_f error estimate in
+        ``meta`` (saved at ``path``)."""
         t0, r = time.perf_counter(), self.request
-        estimate = friction_error(res, r.gap, r.spacing, r.factors, load=r.face_load,
-                                  lubricant=film_lubricant(res, r.lubricant), face=r.face,
-                                  settings=r.settings, entrainment=res.meta.get("entrainment"),
-                                  levels=coarser)
+        point = replace(r.operating_point(speed), lubricant=film_lubricant(res, r.lubricant))
+        estimate = friction_error(res, point, coarser)
         res = replace(res, meta={**res.meta, "error_estimate": estimate,
                                  "seconds_estimate": time.perf_counter() - t0})
         if path is not None:
@@ -228,17 +227,14 @@ def _solve_point(request: SweepRequest, speed: float, previous):
     ``thermal`` model at the film temperature of its own heat (the record in the result's
     ``meta["thermal"]``)."""
     r = request
-    sliding = r.motion.speeds(speed)
+    point = r.operating_point(speed)
 
     def solve(lub, start):
-        return solve_nested(r.gap, r.spacing, r.factors, load=r.face_load, **sliding,
-                            lubricant=lub, face=r.face, settings=r.settings,
-                            previous=start or previous)
+        return solve_nested(replace(point, lubricant=lub), start or previous)
 
     if r.thermal is None:
         return solve(r.lubricant, None)
-    u_m = sliding.get("entrainment", speed / 2)
-    surfaces = (u_m - sliding["speed"] / 2, u_m + sliding["speed"] / 2)
+    surfaces = point.surface_speeds
     start = time.perf_counter()
     levels, film, record = thermal_point(solve, r.lubricant, r.thermal, r.factors, surfaces,
                                          previous[0].meta.get("thermal") if previous

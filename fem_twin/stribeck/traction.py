@@ -21,7 +21,7 @@ from ..errors import InputError
 from ..io.checkpoint import made_for
 from ..io.figure import save_figure
 from ..io.table import write_csv
-from ..macro import solve_mixed
+from ..macro import solve_point
 from ..macro.estimate import friction_error
 from ..numerics.threads import one_thread
 from .request import RollingSliding, SweepRequest
@@ -85,17 +85,16 @@ def traction_sweep(request: SweepRequest, slide_to_roll=DEFAULT_RATIOS,
     folder = None if r.checkpoint is None else Path(r.checkpoint)
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
-    common = dict(load=r.face_load, entrainment=entrainment, lubricant=r.lubricant, face=r.face,
-                  settings=r.settings)
+    rolling = r.operating_point(entrainment)
     results, previous = {}, None
     for srr in tqdm(ratios[::-1], desc=f"traction mu0={r.lubricant.viscosity:g}",
                     disable=not progress, unit="point"):
         path = None if folder is None else point_file(folder, key, srr)
         res = None if path is None else load_point(path, key, srr)
         if res is None:
-            res = solve_mixed(r.gap, r.spacing, r.factors, speed=float(srr * entrainment),
-                              initial=previous, **common)
-            estimate = friction_error(res, r.gap, r.spacing, r.factors, **common)
+            point = replace(rolling, speed=float(srr * entrainment))
+            res = solve_point(point, initial=previous)
+            estimate = friction_error(res, point)
             res = replace(res, meta={**res.meta, "error_estimate": estimate,
                                      **made_for(key, srr)})
             if path is not None:
