@@ -130,12 +130,14 @@ def stribeck_dataset(curves, patch_curves=None):
     return ds
 
 
-def fields_dataset(points, origin=(0.0, 0.0)):
-    """Macro fields of ``points`` {(viscosity, speed): MixedResult} as a Dataset over
-    (viscosity, speed, x2, x1); the coordinate ``viscosity`` is mu_0 of the sweep, the
-    field ``local_viscosity`` the piezoviscous mu(p) of eq 23."""
+def fields_dataset(sweeps, origin=(0.0, 0.0)):
+    """Macro fields of the points of ``sweeps``, ``[(viscosity, {speed: MixedResult})]``
+    (one entry per sweep, in the run's order), as a Dataset over (viscosity, speed, x2,
+    x1); the coordinate ``viscosity`` is mu_0 of the sweep, the field ``local_viscosity``
+    the piezoviscous mu(p) of eq 23."""
     import xarray as xr
-    mus = np.unique([k[0] for k in points])
+    points = {(mu, u): res for mu, sweep in sweeps for u, res in sweep.items()}
+    mus = np.unique([mu for mu, _ in sweeps])
     speeds = np.unique([k[1] for k in points])
     first = next(iter(points.values()))
     ny, nx = first.pressure.shape

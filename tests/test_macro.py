@@ -696,15 +696,18 @@ def test_a_sweeps_points_run_in_parallel_from_its_guide(factors, tmp_path):
     chained = stribeck_sweep(replace(request, checkpoint=None))
     guide = guide_of(request)
     assert guide.gap.shape == (48, 48)
-    one, = run_sweeps([request], None, progress=False)
+    (one,), points = run_sweeps([request], None, progress=False)
     assert np.abs(one.friction_coefficient - chained.friction_coefficient).max() < (
         10 * TIGHT * BOUNDARY_FRICTION)
     with executor_for(2) as pool:
-        two, = run_sweeps([replace(request, checkpoint=tmp_path / "two")], pool,
-                          progress=False)
+        (two,), _ = run_sweeps([replace(request, checkpoint=tmp_path / "two")], pool,
+                               progress=False)
     assert np.array_equal(one.friction_coefficient, two.friction_coefficient)
     metas = [point_meta(p)[1] for p in point_files(tmp_path / "one", request.key)]
     assert len(metas) == 4 and all(m[GUIDED_BY] == guide.key for m in metas)
+    # the index run_sweeps returns: each checkpoint once, fast to slow, with its meta
+    assert [p.speed for p in points] == list(speeds) and {p.sweep for p in points} == {0}
+    assert all(p.meta[GUIDED_BY] == guide.key for p in points)
     tasks = sweep_tasks(tmp_path / "one", speeds, (), refine=False)
     lead = next(t for t in tasks if t.name == f"sweep {guide.key}")
     points = [t for t in tasks if t.name.startswith("point")]

@@ -49,11 +49,11 @@ def test_dask_local_cluster_gives_the_serial_numbers(tmp_path):
     common = small_sweep()
     lubricants = [Lubricant(0.066), Lubricant(0.024)]
     tasks = [SweepRequest(**common, lubricant=lub) for lub in lubricants]
-    serial = run_sweeps(tasks, None, progress=False)
+    serial = run_sweeps(tasks, None, progress=False).curves
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
-        remote = run_sweeps(tasks, client.get_executor(), progress=False)
+        remote = run_sweeps(tasks, client.get_executor(), progress=False).curves
     for a, b in zip(serial, remote):
         assert a.viscosity == b.viscosity
         assert np.array_equal(a.friction_coefficient, b.friction_coefficient)
@@ -224,7 +224,7 @@ def test_the_largest_sweeps_are_submitted_first(monkeypatch):
     pool = Recording()
     tasks = [Scheduled(np.zeros((n, n)), np.ones(k))
              for n, k in ((128, 17), (999, 5), (1997, 5), (256, 17))]
-    assert curves.run_sweeps(tasks, pool, progress=False) == [128, 999, 1997, 256]
+    assert curves.run_sweeps(tasks, pool, progress=False).curves == [128, 999, 1997, 256]
     assert pool.order == [1997, 999, 256, 128]
 
 
@@ -260,7 +260,7 @@ def test_a_sweep_longer_than_a_workers_share_runs_as_chains(monkeypatch):
     speeds = {128: 17, 256: 17, 500: 17, 999: 5, 1997: 5}
     tasks = [Scheduled(np.zeros((n, n)), np.geomspace(2, 0.005, k)) for n, k in speeds.items()]
     pool = Pool()
-    out = curves.run_sweeps(tasks, pool, progress=False)
+    out = curves.run_sweeps(tasks, pool, progress=False).curves
     assert pool.order == [(1997, 2), (1997, 1), (1997, 1), (1997, 1), (999, 5), (500, 17),
                           (256, 17), (128, 17)]
     for task, c in zip(tasks, out):

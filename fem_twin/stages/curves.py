@@ -22,7 +22,7 @@ from ..stribeck import plot_stribeck, read_measured_csv, write_stribeck_csv
 from ..stribeck.accuracy import error_summary, range_summary
 from ..stribeck.analysis import defect_corrected, hersey_collapse, patch_band, transition_speeds
 from ..stribeck.curve import plot_temperatures
-from ..stribeck.sweep import LOAD_BELOW, point_files, point_key, point_meta, point_speed
+from ..stribeck.sweep import LOAD_BELOW, point_files, point_key
 from ..stribeck.validation import validate_curves
 from .geometry import ball_contact, hersey_length
 from .provenance import provenance
@@ -44,28 +44,29 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     writers = Writers(executor) if own else writers
     tr = case.tribometer
     request = sweep_request(case, out)
-    curves, speeds = refined_curves(case, out, request, executor, progress)
+    (curves, points), speeds = refined_curves(case, out, request, executor, progress)
     request = replace(request, speeds=speeds)
     tasks = per_viscosity(case, replace(request, error_estimate=True))
-    _plot_fields(out, tasks, writers)                             # beside the band's sweeps
-    writers.write(write_run_fields, case, out, tasks, request.origin)
+    _plot_fields(out, points, curves, writers)                    # beside the band's sweeps
+    writers.write(write_run_fields, case, out, points, curves, request.origin)
     band_run = band_tasks(case, out, request)
-    patch_curves, patch_tasks = band_curves(
-        case, request, curves, band_run,
-        run_sweeps(band_run, executor, progress, desc="patch band points"), executor,
-        progress)
+    band_swept = run_sweeps(band_run, executor, progress, desc="patch band points")
+    patch_curves, extra = band_curves(case, request, curves, band_run, band_swept.curves,
+                                      executor, progress)
     band = patch_band(patch_curves) if patch_curves else None
+    patch_tasks = band_run + [task for added, _ in extra for task in added]
     _prune_points(out.points, tasks + patch_tasks)
     write_stribeck_csv(out.stribeck_csv, curves, band)
     summary = _summary(case, out, curves, band)
     writers.write(write_run_results, case, out, curves, patch_curves)
     plot_curves(case, curves, band, out, writers)
-    summary["h0_range"] = _range_check(tasks + patch_tasks)
+    summary["h0_range"] = _range_check([(tasks, points), (band_run, band_swept.points),
+                                        *extra])
     _log_points(curves)
     if len(curves) > 1:
         summary["hersey_collapse_max_abs_cf_dev"] = hersey_collapse(curves, tr.boundary_friction)
     if tr.ball:
-        summary["ehl_film"] = ehl_film(case, sweep_points(tasks))
+        summary["ehl_film"] = ehl_film(case, points)
     if any(case.measured):
         summary["validation"] = validate_curves(
             curves, case.measured, tr.boundary_friction, curve_labels(case, curves),
@@ -79,10 +80,12 @@ def refined_curves(case: Case, out: RunLayout, request, executor=None,
                    progress: bool = True):
     """The main curves (with their C_f error estimates) of the sweep ``request`` over the
     case's viscosities, then ``[sweep] refine`` passes adding the midpoints where C_f
-    jumps; ``(curves, speeds)``.  With the patch band on, each point also keeps its solve
-    on the band's grid (``keep_level``), which the band's sweeps start from; where that
-    grid is the guides' (:meth:`~fem_twin.case.Case.band_after_guides`), each pass of the
-    band runs beside the main points."""
+    jumps; ``(swept, speeds)``, ``swept`` the last pass's
+    (:class:`~fem_twin.stages.sweeps.Swept`: its curves and the index of their points).
+    With the patch band on, each point also keeps its solve on the band's grid
+    (``keep_level``), which the band's sweeps start from; where that grid is the guides'
+    (:meth:`~fem_twin.case.Case.band_after_guides`), each pass of the band runs beside the
+    main points."""
     step = case.sweep.refine_step * case.tribometer.boundary_friction
     speeds = request.speeds
     keep = case.band_coarsening(request.gap.shape) if case.run.patch_band else 0
@@ -98,16 +101,16 @@ def refined_curves(case: Case, out: RunLayout, request, executor=None,
 
     for level in range(case.sweep.refine + 1):
         final = level == case.sweep.refine
-        curves = sweeps(final)
-        extra = transition_speeds(curves, step)
+        swept = sweeps(final)
+        extra = transition_speeds(swept.curves, step)
         if final or extra.size == 0:
             break
         log.info("sweep refinement %d: %d speeds added where C_f changes by more than "
                  "%.3g", level + 1, extra.size, step)
         speeds = np.unique(np.r_[speeds, extra])[::-1]
     if not final:                          # every main point checkpointed: the fields
-        curves = sweeps(True)
-    return curves, speeds
+        swept = sweeps(True)
+    return swept, speeds
 
 
 def band_tasks(case: Case, out: RunLayout, request) -> list:
@@ -127,27 +130,27 @@ def band_tasks(case: Case, out: RunLayout, request) -> list:
 def band_curves(case: Case, request, curves, tasks, swept, executor=None,
                 progress: bool = True):
     """The single-patch curves of the scatter band, one list per patch over the
-    viscosities, from the curves ``swept`` of :func:`band_tasks`' ``tasks``, and the tasks
-    (with any sweep added here).  Swept on a coarsened grid, they are corrected by the
-    main ``curves``' relative change to the full grid
-    (:func:`~fem_twin.stribeck.analysis.defect_corrected`): the main sweeps' own points on
-    that grid (their nested solves) give that change, or, where a point has none (a coarse
-    solve that failed, checkpoints of an earlier version), the average factors are swept
-    on the band's grid too."""
+    viscosities, from the curves ``swept`` of :func:`band_tasks`' ``tasks``, and the sweeps
+    added here as ``[(tasks, points)]`` (:func:`~fem_twin.stages.sweeps.point_index`).
+    Swept on a coarsened grid, they are corrected by the main ``curves``' relative change
+    to the full grid (:func:`~fem_twin.stribeck.analysis.defect_corrected`): the main
+    sweeps' own points on that grid (their nested solves) give that change, or, where a
+    point has none (a coarse solve that failed, checkpoints of an earlier version), the
+    average factors are swept on the band's grid too."""
     n = len(case.lubricant.lubricants())
     per_patch = [swept[i:i + n] for i in range(0, len(swept), n)]
     level = case.band_coarsening(request.gap.shape)
     if not per_patch or level == 0:
-        return per_patch, tasks
+        return per_patch, []
     coarse = [c.coarse_friction_coefficient for c in curves]
     if all(cf is not None and cf.shape[0] >= level and np.all(np.isfinite(cf[level - 1]))
            for cf in coarse):
         return defect_corrected(per_patch, curves, [
             replace(c, friction_coefficient=cf[level - 1])
-            for c, cf in zip(curves, coarse)]), tasks
+            for c, cf in zip(curves, coarse)]), []
     average = per_viscosity(case, request.coarsened(level))
     coarse = run_sweeps(average, executor, progress, desc="patch band points")
-    return defect_corrected(per_patch, curves, coarse), tasks + average
+    return defect_corrected(per_patch, curves, coarse.curves), [(average, coarse.points)]
 
 
 def _summary(case: Case, out: RunLayout, curves, band) -> dict:
@@ -169,36 +172,35 @@ def _summary(case: Case, out: RunLayout, curves, band) -> dict:
     return summary
 
 
-def _range_check(tasks) -> dict:
+def _range_check(swept) -> dict:
     """:func:`~fem_twin.stribeck.accuracy.range_summary` over the points of the sweeps
-    ``tasks`` (the main curves' and the band's, whose single patches reach lower
-    separations), each share read from its checkpoint's meta (``LOAD_BELOW``; a checkpoint
-    without it is loaded whole)."""
-    h0_min = tasks[0].factors.h0[0]
+    ``swept``, ``[(tasks, points)]`` (the main curves' and the band's, whose single patches
+    reach lower separations; :func:`~fem_twin.stages.sweeps.point_index`), each share read
+    from its checkpoint's meta (``LOAD_BELOW``; a checkpoint without it is loaded whole)."""
+    h0_min = swept[0][0][0].factors.h0[0]
 
     def shares():
-        for task in tasks:
-            name = task.factors_key.rsplit("-", 1)[-1]
-            factors = name if name.startswith("patch") else "average"
-            for path in point_files(task.checkpoint, task.key):
-                scalars, meta = point_meta(path)
-                share = meta.get(LOAD_BELOW)
+        for tasks, points in swept:
+            for point in points:
+                task = tasks[point.sweep]
+                name = task.factors_key.rsplit("-", 1)[-1]
+                factors = name if name.startswith("patch") else "average"
+                share = point.meta.get(LOAD_BELOW)
                 if share is None:
-                    share = MixedResult.load(path).contact_load_below(h0_min)
-                speed = task.motion.sweep_speed(scalars["speed"], meta)
+                    share = MixedResult.load(point.path).contact_load_below(h0_min)
                 yield share, (f"{factors} factors, mu_0 = {task.lubricant.viscosity:g} Pa s, "
-                              f"U = {speed:.3g} m/s")
+                              f"U = {point.speed:.3g} m/s")
     return range_summary(shares(), h0_min)
 
 
-def _plot_fields(out: RunLayout, tasks, writers: Writers) -> None:
-    """The fields of the fastest, a middle and the slowest point of each main sweep
-    ``tasks``, from their checkpoints."""
-    for task in tasks:
-        files = sorted(point_files(task.checkpoint, task.key), key=point_speed,
-                       reverse=True)                                     # fast to slow
-        chosen = [files[i] for i in sorted({0, len(files) // 2, len(files) - 1})]
-        mu = task.lubricant.viscosity
+def _plot_fields(out: RunLayout, points, curves, writers: Writers) -> None:
+    """The fields of the fastest, a middle and the slowest point of each main sweep (its
+    ``curves``), from their checkpoints (``points``,
+    :func:`~fem_twin.stages.sweeps.point_index`)."""
+    for i, curve in enumerate(curves):
+        files = [p.path for p in points if p.sweep == i]                  # fast to slow
+        chosen = [files[k] for k in sorted({0, len(files) // 2, len(files) - 1})]
+        mu = curve.viscosity
         writers.write(plot_point_files, chosen, out.fields_png(mu), mu)
 
 
@@ -226,12 +228,13 @@ def curve_labels(case: Case, curves) -> list[str]:
 
 
 def ehl_film(case: Case, points) -> dict:
-    """The film of a ball-on-disk sweep's fastest point (first viscosity) beside the
-    Hamrock-Dowson films of the smooth ball at the same u_m and the film's viscosity (the
-    oil's, or a thermal run's at the film temperature): the full-film end of the curve."""
+    """The film of a ball-on-disk sweep's fastest point (the first sweep's, of its
+    ``points``, :func:`~fem_twin.stages.sweeps.point_index`) beside the Hamrock-Dowson films
+    of the smooth ball at the same u_m and the film's viscosity (the oil's, or a thermal
+    run's at the film temperature): the full-film end of the curve."""
     mu = case.lubricant.viscosities[0]
-    u_m = max(u for m, u in points if m == mu)
-    point = points[mu, u_m]
+    fastest = next(p for p in points if p.sweep == 0)
+    u_m, point = fastest.speed, MixedResult.load(fastest.path)
     film_mu = point.meta.get("thermal", {}).get("viscosity_Pa_s", mu)
     _, _, x1, x2 = ball_contact(case).grid(case.macro.grid)
     film = film_against_hamrock_dowson(replace(ball_contact(case), viscosity=film_mu,
@@ -262,16 +265,6 @@ def plot_curves(case: Case, curves, band, out: RunLayout,
                       labels=curve_labels(case, curves))
 
 
-def sweep_points(tasks) -> dict:
-    """{(viscosity, speed): MixedResult} of the checkpoints of the sweeps ``tasks``."""
-    points = {}
-    for task in tasks:
-        for path in point_files(task.checkpoint, task.key):
-            res = MixedResult.load(path)
-            points[task.lubricant.viscosity, task.motion.sweep_speed(res.speed, res.meta)] = res
-    return points
-
-
 def write_run_results(case: Case, out: RunLayout, curves, patch_curves) -> None:
     """``results.nc``: flow factors per patch and average, Stribeck curves with the band,
     settings and error estimates."""
@@ -284,13 +277,15 @@ def write_run_results(case: Case, out: RunLayout, curves, patch_curves) -> None:
                   "stribeck": stribeck_dataset(curves, patch_curves)}, _attributes(case))
 
 
-def write_run_fields(case: Case, out: RunLayout, tasks, origin) -> None:
-    """``fields.nc``: the macro fields of the points of the main sweeps ``tasks``, read
-    from their checkpoints (written beside the band's sweeps: they need only the main
+def write_run_fields(case: Case, out: RunLayout, points, curves, origin) -> None:
+    """``fields.nc``: the macro fields of the main sweeps' ``points``
+    (:func:`~fem_twin.stages.sweeps.point_index`; ``curves`` give each sweep's viscosity),
+    read from their checkpoints (written beside the band's sweeps: they need only the main
     curves)."""
     from ..results import fields_dataset, write_netcdf
-    write_netcdf(out.fields_nc, {None: fields_dataset(sweep_points(tasks),
-                                                      origin)}, _attributes(case))
+    sweeps = [(c.viscosity, {p.speed: MixedResult.load(p.path) for p in points
+                             if p.sweep == i}) for i, c in enumerate(curves)]
+    write_netcdf(out.fields_nc, {None: fields_dataset(sweeps, origin)}, _attributes(case))
 
 
 def _attributes(case: Case) -> dict:

@@ -4,7 +4,9 @@ or Dask), largest first: a sweep's points each a task after its guide, or chains
 from __future__ import annotations
 
 from concurrent.futures import wait
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from tqdm import tqdm
@@ -14,15 +16,52 @@ from ..numerics.threads import worker_heap
 from ..runtime.cost import sweep_cost
 from ..stribeck import stribeck_sweep
 from ..stribeck.curve import joined
-from ..stribeck.sweep import point_file, point_files, point_key
+from ..stribeck.sweep import point_file, point_files, point_key, point_meta
+
+
+@dataclass(frozen=True)
+class SweptPoint:
+    """A checkpointed point of a sweep: the ``sweep`` (the request's index in the tasks),
+    its sweep ``speed`` [m/s] (sliding, or entrainment, by the request's motion), its
+    checkpoint ``path`` and its ``meta`` (read once, without the fields)."""
+
+    sweep: int
+    speed: float
+    path: Path
+    meta: dict
+
+
+class Swept(NamedTuple):
+    """What :func:`run_sweeps` returns: the ``curves`` in the order of the tasks, and the
+    ``points`` of the checkpointed ones (:func:`point_index`)."""
+
+    curves: list
+    points: tuple[SweptPoint, ...]
+
+
+def point_index(tasks) -> tuple[SweptPoint, ...]:
+    """The checkpointed points of the sweeps ``tasks``, each sweep's fast to slow, each
+    checkpoint read once without its fields (the writers and checks take this index)."""
+    out = []
+    for i, task in enumerate(tasks):
+        if task.checkpoint is None:
+            continue
+        found = []
+        for path in point_files(task.checkpoint, task.key):
+            scalars, meta = point_meta(path)
+            found.append(SweptPoint(i, task.motion.sweep_speed(scalars["speed"], meta), path,
+                                    meta))
+        out += sorted(found, key=lambda p: -p.speed)
+    return tuple(out)
 
 
 def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points",
                followers=()):
-    """The sweep requests ``tasks``, serial or as process tasks on ``executor``; their curves
-    in the order of ``tasks``.  ``followers``: sweeps that start from the guides' points
-    (the patch band), run beside the guided points as chains of their missing speeds
-    (:func:`missing_chains`) and left in their checkpoints.
+    """The sweep requests ``tasks``, serial or as process tasks on ``executor``: their curves
+    in the order of ``tasks`` and the index of their checkpointed points (:class:`Swept`).
+    ``followers``: sweeps that start from the guides' points (the patch band), run beside
+    the guided points as chains of their missing speeds (:func:`missing_chains`) and left
+    in their checkpoints.
 
     A checkpointed sweep without a guide runs as guided points: first its guide
     (:func:`guide_of`, a chain on the coarsest nested grid), then every speed a task of its
@@ -45,8 +84,8 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     own = {}
     for (j, _), curve in zip(pieces, swept):
         own.setdefault(unguided[j], []).append(curve)
-    return [joined(own[i]) if i in own else stribeck_sweep(task)   # from the checkpoints
-            for i, task in enumerate(tasks)]
+    return Swept([joined(own[i]) if i in own else stribeck_sweep(task)  # from the checkpoints
+                  for i, task in enumerate(tasks)], point_index(tasks))
 
 
 def guide_of(request):

@@ -132,7 +132,7 @@ def calibrate(case: Case, study: str, outdir, *, values=None, progress: bool = T
             pins.result()
         tasks = [_sweep(variant, folder, out, patch, speeds)
                  for folder, (variant, patch, speeds) in zip(folders, cases.values())]
-        swept = run_sweeps(tasks, executor, progress, desc="calibration points")
+        swept = run_sweeps(tasks, executor, progress, desc="calibration points").curves
     curves = dict(zip(cases, swept))
     ref = curves[ref_label]
     cfb = case.tribometer.boundary_friction

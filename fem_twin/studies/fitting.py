@@ -156,7 +156,7 @@ def _simulated(case: Case, out: RunLayout, tests, progress: bool) -> list:
     tasks = [replace(first, load=load, lubricant=replace(first.lubricant, viscosity=mu))
              for (load, mu), c in zip(tests, own) if c is None]
     with executor_for(case.run.workers, case.run.scheduler) as executor:
-        swept = iter(run_sweeps(tasks, executor, progress, desc="fit loads")
+        swept = iter(run_sweeps(tasks, executor, progress, desc="fit loads").curves
                      if tasks else [])
     return [c if c is not None else next(swept) for c in own]
 
@@ -212,7 +212,7 @@ def extra_curves(case: Case, out: RunLayout, curves, shares=(), resistances=(),
         for c, request in zip(curves, per_viscosity(case, _fit_sweep(case, out)))
         for r in at_resistances]
     with executor_for(case.run.workers, case.run.scheduler) as executor:
-        swept = run_sweeps(tasks, executor, progress, desc="fit points")
+        swept = run_sweeps(tasks, executor, progress, desc="fit points").curves
     by_share, rest = swept[:len(at_shares)], swept[len(at_shares):]
     ascending = lambda pairs: tuple(sorted(pairs, key=lambda p: p[0]))  # noqa: E731
     n = len(at_resistances)
