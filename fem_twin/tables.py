@@ -3,6 +3,7 @@ source of every default taken from them (case file defaults, solver settings, le
 
 #: Table 1: the tribometer
 PIN_DIAMETER = 8e-3                   # D of the Hersey number, eq 46 [m]
+HOLDER_HEIGHT = -1e-3                 # the holder's surface below the pin's face (a 1 mm pin) [m]
 
 #: Table 4: pin levelling and dry contact
 E_STEEL = 210e9                       # Young's modulus of pin and disk [Pa]

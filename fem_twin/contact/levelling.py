@@ -55,7 +55,7 @@ def torque_residuals(pressure: np.ndarray, x1: np.ndarray, x2: np.ndarray) -> np
 
 
 @arguments(pin=Topography, tilt="pair")
-def tilt_pin(pin: Topography, tilt, holder_height: float = -1e-3) -> Topography:
+def tilt_pin(pin: Topography, tilt, holder_height: float = T.HOLDER_HEIGHT) -> Topography:
     """Eq 7 on the pin face: ``x3_low = x3_low0 + x2 tan(a_x1) - x1 tan(a_x2)``.
 
     The holder (pixels at ``holder_height``) stays where it is.
@@ -110,7 +110,7 @@ def _broyden(evaluate, tilt, tol, max_iter, pin, holder_height, history):
 def level_pin(pin: Topography, disk: Topography | None = None, *, load: float = TABLE4["load"],
               e_reduced: float = TABLE4["e_reduced"], hardness: float = TABLE4["hardness"],
               method: str = "broyden", tol: float = 1e-6, max_iter: int = 200,
-              gains=TABLE4["gains"], holder_height: float = -1e-3) -> LevellingResult:
+              gains=TABLE4["gains"], holder_height: float = T.HOLDER_HEIGHT) -> LevellingResult:
     """Tilt ``pin`` (mounted, origin at its centre) until the contact torques vanish.
 
     ``disk`` is the flipped upper surface on the same grid (flat if None).  ``method`` is
@@ -154,7 +154,7 @@ def _residuals(history) -> list:
     return [float(np.max(np.abs(h[2:]))) for h in history]
 
 
-def mean_plane_tilt(pin: Topography, upper: np.ndarray, holder_height: float = -1e-3):
+def mean_plane_tilt(pin: Topography, upper: np.ndarray, holder_height: float = T.HOLDER_HEIGHT):
     """Tilt (eq 7) that removes the mean-plane slope of the gap over the pin face [rad].
 
     The paper's initial levelling guess; exact for a flat face and any centro-symmetric
@@ -184,7 +184,7 @@ def _initial_jacobian(evaluate, tilt, r, pin, holder_height):
 
 @arguments(pins=[Topography])
 def average_pins(pins, *, radius: float = 3e-3, truncation: float = -20e-6,
-                 holder_height: float = -1e-3) -> Topography:
+                 holder_height: float = T.HOLDER_HEIGHT) -> Topography:
     """Set average of levelled pins (paper 2.2.1, Figure 3).
 
     Each pin is re-zeroed at its mean plane within ``radius`` of its centre, interpolated

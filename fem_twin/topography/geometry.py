@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import tables as T
 from ..checks import arguments
 from ..errors import InputError
 from .core import Topography
@@ -92,7 +93,7 @@ def centre_on(topo: Topography, centre) -> Topography:
 
 
 @arguments(topo=Topography, truncation="number", holder_height="number")
-def mount_pin(topo: Topography, truncation: float = -20e-6, holder_height: float = -1e-3,
+def mount_pin(topo: Topography, truncation: float = -20e-6, holder_height: float = T.HOLDER_HEIGHT,
               radius: float | None = None) -> Topography:
     """Put the pin face in its holder: everything off the face is the holder at -1 mm.
 
@@ -114,7 +115,7 @@ def mount_pin(topo: Topography, truncation: float = -20e-6, holder_height: float
 
 
 @arguments(topo=Topography, holder_height="number")
-def pin_face(topo: Topography, holder_height: float = -1e-3) -> np.ndarray:
+def pin_face(topo: Topography, holder_height: float = T.HOLDER_HEIGHT) -> np.ndarray:
     """Boolean mask of the pin face of a mounted pin: pixels above half the holder's depth
     ``holder_height`` [m] (a rim pixel that resampling left between face and holder counts
     with the side it is nearer).  The one rule of the face, for every stage."""

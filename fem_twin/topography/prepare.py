@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import tables as T
 from ..checks import check_choices, check_ranges, setting
 from ..errors import InputError
 from .core import Topography
@@ -30,7 +31,7 @@ class MacroOptions:
                                    choices=("linear", "cubic"))
     truncation: float = setting(-20e-6, "below this height a pin pixel belongs to the "
                                 "holder", "depth")
-    holder_height: float = setting(-1e-3, "the holder surface (pin height 1 mm)", "depth")
+    holder_height: float = setting(T.HOLDER_HEIGHT, "the holder surface (pin height 1 mm)", "depth")
     level_radius: float = setting(3e-3, "radius about the pin centre of the final "
                                   "mean-plane fit", "length")
     sliding_direction: str = setting("+x1", "measured axis along the disk velocity",
