@@ -170,3 +170,37 @@ def test_every_setting_another_section_sets_is_filled_from_it():
     assert cell.e_reduced != CellSettings().e_reduced and cell.hardness == 3e9
     assert macro.boundary_friction == 0.12 and macro.track_radius == 0.05
     assert cell.slide_to_roll == 2.0                 # the cells slide; a ball's SRR comes later
+
+
+#: literals equal to a table value that are not that value: (file, the table's name, why)
+NOT_THE_TABLES = {("macro/point_contact.py", "ROELANDS_ALPHA"): "Moes' alpha of a test case",
+                  ("io/samples.py", "PIN_DIAMETER"): "the sample map's 8 mm field of view"}
+
+
+def test_the_papers_table_values_are_declared_once():
+    """A distinctive value of the paper's tables (fem_twin/tables.py: its moduli, hardness,
+    lubricant constants, pin and holder, C_f,b, the load) is written only there: anywhere
+    else the same number is a second home, which a change of the table would miss.  Common
+    numbers (0.3, 0.05, 50, 1e5) are left out: they are also other things."""
+    import ast
+    import math
+
+    import fem_twin.tables as T
+    distinctive = {k: v for k, v in vars(T).items() if k.isupper() and isinstance(v, float)
+                   and k not in ("NU_STEEL", "RELAXATION_PCON", "LEVELLING_LOAD",
+                                 "AMBIENT_PRESSURE")}
+    twice = []
+    for path in PACKAGE.rglob("*.py"):
+        if path.name == "tables.py":
+            continue
+        where = str(path.relative_to(PACKAGE))
+        for node in ast.walk(ast.parse(path.read_text())):
+            sign = -1.0 if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub) else 1
+            leaf = node.operand if sign < 0 else node
+            if not (isinstance(leaf, ast.Constant) and type(leaf.value) in (int, float)):
+                continue
+            twice += [f"{where}:{node.lineno} {name}" for name, value in distinctive.items()
+                      if math.isclose(sign * leaf.value, value, rel_tol=1e-9)
+                      and (where, name) not in NOT_THE_TABLES]
+    assert not twice, "the tables' values written again (use fem_twin.tables):\n" + "\n".join(
+        twice)

@@ -201,7 +201,7 @@ def _curves(rows) -> list[StribeckCurve]:
 @arguments(curves=[StribeckCurve], path="path")
 def plot_stribeck(curves, path, *, x: str = "speed", labels=None, reference=None,
                   boundary_friction: float, bands=None, measured=None,
-                  diameter: float = T.PIN_DIAMETER, load: float = 150.0,
+                  diameter: float = T.PIN_DIAMETER, load: float = T.LOAD,
                   speed_label: str = "sliding speed $U$ [m/s]") -> Path:
     """C_f versus sliding speed (``x="speed"``) or Hersey number (``"hersey"``), log x.
 
