@@ -3,6 +3,7 @@
     python benchmarks/run.py [GROUP ...]      # topography contact micro macro stribeck ...
                                               # (micro-full: ~15 min, estimate: ~40 min,
                                               #  estimate-paper: ~100 min, scale: ~10 min,
+                                              #  amg: ~3 min,
                                               #  cores: the bundled case on 1, 2, all workers;
                                               #  deterministic: the mixed regime, ~20 min;
                                               #  only when named)
@@ -25,6 +26,7 @@ from fem_twin.topography.prepare import prepare_pin  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+from amg import bench_amg  # noqa: E402
 from common import SAMPLE, best_of, macro_factors, macro_gap  # noqa: E402
 from cores import bench_cores  # noqa: E402
 from defaults import bench_defaults  # noqa: E402
@@ -589,7 +591,7 @@ def bench_estimate(case_file="pin_on_disk.toml", viscosity=0.066):
 GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": bench_micro,
           "contact-pk": bench_contact_pk, "macro": bench_macro, "newton": bench_newton,
           "paper": bench_paper, "stribeck": bench_stribeck,
-          "estimate": bench_estimate, "scale": bench_scale, "cores": bench_cores,
+          "estimate": bench_estimate, "scale": bench_scale, "amg": bench_amg, "cores": bench_cores,
           "estimate-paper": lambda: bench_estimate("paper.toml"),
           "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults,
           "deterministic": bench_deterministic}
@@ -597,7 +599,7 @@ GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": ben
 
 def main(argv):
     groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "estimate-paper",
-                                                        "scale", "cores", "defaults",
+                                                        "scale", "amg", "cores", "defaults",
                                                         "deterministic")]
     for name in groups:
         base, rows, *summary = GROUPS[name]()
