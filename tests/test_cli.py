@@ -222,26 +222,33 @@ def test_run_time_estimates_hold():
 
 def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     """The machine ran the same work up to 1.9x slower from hour to hour,
-    so the estimate scales by a probe of the micro stage timed before the run: a machine
-    twice as slow gets twice the estimate.  The probe is one thread's time of real work
-    (0.05-3 s: 0.24 s on the calibration machine), and the printed durations read as a
-    person would write them."""
+    so the estimate scales by probes of the micro stage and of a macro point timed before
+    the run: a machine twice as slow gets twice the estimate, one slower at the macro
+    points alone a longer Stribeck stage alone.  Each probe is one thread's time of real
+    work (0.05-3 s), and the printed durations read as a person would write them."""
     import fem_twin.runtime.machine as speed
     from fem_twin.cli.runs import _confirm_cost, duration
-    monkeypatch.delenv("FEM_TWIN_SLOWDOWN")                   # the probe itself
-    t = speed.probe_seconds(repeats=1)
-    assert 0.05 < t < 3.0
+    from fem_twin.runtime.cost import MICRO, cost_tasks
+    monkeypatch.delenv("FEM_TWIN_SLOWDOWN")                   # the probes themselves
+    for kind in ("micro", "macro"):
+        assert 0.05 < speed.probe_seconds(kind, repeats=1) < 3.0
     case = load_case(ROOT / "examples" / "pin_on_disk.toml")
     estimates = []
     for factor in (1.0, 2.0):
-        monkeypatch.setattr(speed, "probe_seconds", lambda: factor * speed.REFERENCE_SECONDS)
+        monkeypatch.setattr(speed, "probe_seconds",
+                            lambda kind: factor * speed.REFERENCE_SECONDS[kind])
         estimates.append(_confirm_cost(case, yes=True))
     assert estimates[1] == pytest.approx(2 * estimates[0])
     assert "takes 2x the calibration machine's time" in capsys.readouterr().err
-    monkeypatch.setattr(speed, "probe_seconds", lambda: 100.0)
-    assert speed.slowdown() == speed.BOUNDS[1]
+    serial = sum(t.seconds for t in cost_tasks(case) if not t.name.startswith(MICRO))
+    slow = speed.Slowdown(1.0, 3.0)                           # the macro points alone
+    assert estimated_seconds(case, 1, slow) == pytest.approx(
+        estimated_seconds(case, 1) + 2 * serial)
+    assert str(slow) == "1x for the cells and 3x for the macro points"
+    monkeypatch.setattr(speed, "probe_seconds", lambda kind: 100.0)
+    assert speed.slowdown() == speed.Slowdown(*speed.BOUNDS[1:] * 2)
     monkeypatch.setenv("FEM_TWIN_SLOWDOWN", "0.5")            # forced: no probe
-    assert speed.slowdown() == 0.5
+    assert speed.slowdown() == speed.Slowdown(0.5, 0.5)
     monkeypatch.setenv("FEM_TWIN_SLOWDOWN", "fast")
     with pytest.raises(ValueError, match="FEM_TWIN_SLOWDOWN"):
         speed.slowdown()

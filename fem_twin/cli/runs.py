@@ -35,21 +35,22 @@ def _confirm_cost(case, yes: bool) -> float | None:
         print(f"fem-twin run: sections not in {case.source.name}, defaults used: " + ", ".join(
             f"[{s}]" for s in case.defaulted), file=sys.stderr)
     cores = case.run.workers or os.cpu_count() or 1
-    speed = slowdown()
+    speed = slowdown(case.tribometer.ball)
     calibration = estimated_seconds(case, cores)
-    seconds = calibration * speed
+    seconds = estimated_seconds(case, cores, speed)
+    on = {n: duration(estimated_seconds(case, n, speed)) for n in (16, 64)}
     mc = case.micro
     print(f"fem-twin run: {len(case.geometry.patches)} patch pairs at {mc.resolution[0]}x"
           f"{mc.resolution[1]}, {mc.h0_count} h0 x {mc.steps} steps"
           f"{f' (adaptive h0, tolerance {mc.h0_tol:g})' if mc.h0_tol else ''}; "
           f"{len(case.lubricant.viscosities)} x {case.sweep.count} speeds; estimated "
-          f"{duration(seconds)} on {cores} cores, {duration(estimated_seconds(case, 16) * speed)}"
-          f" on 16 and {duration(estimated_seconds(case, 64) * speed)} on 64 (this machine "
-          f"takes {speed:.2g}x the calibration machine's time now)", file=sys.stderr)
+          f"{duration(seconds)} on {cores} cores, {on[16]} on 16 and {on[64]} on 64 (this "
+          f"machine takes {speed} the calibration machine's time now)", file=sys.stderr)
     if calibration > LONG_RUN_SECONDS and not yes:
         ratio = calibration / BUNDLED_SECONDS
         print(f"fem-twin run: error: this run is estimated at {duration(seconds)}, "
-              f"{ratio:.0f}x the bundled case (about {duration(BUNDLED_SECONDS * speed)} "
+              f"{ratio:.0f}x the bundled case (about "
+              f"{duration(BUNDLED_SECONDS * seconds / calibration)} "
               f"here on 2 cores), above the {LONG_RUN_RATIO:.0f}x that asks first; check the "
               "case and run again with --yes", file=sys.stderr)
         return None

@@ -10,6 +10,7 @@ estimate within 0.7-1.3x of those runs.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from ..macro.nested import nested_levels
 from ..micro.schedule import halves
@@ -17,9 +18,9 @@ from .schedule import Task, makespan
 
 #: a guided Stribeck point of a pin at 128^2 [s], its growth with the nodes, and the cost
 #: of a main-curve point with its C_f error estimate in plain points
-POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 0.61, 1.08, 1.28
+POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 0.50, 0.98, 1.28
 #: a ball's warm point at 73^2 (Newton coupling) [s] and its growth with the grid's side
-BALL_POINT_SECONDS, BALL_POINT_GROWTH = 3.9, 2.4
+BALL_POINT_SECONDS, BALL_POINT_GROWTH = 3.5, 2.4
 #: a band point in main-curve points, by ``[run] band_grid`` (the band's sweeps converge to
 #: ``[run] band_tol`` and carry no error estimate; "coarse" runs them on the coarsened grid)
 BAND_POINT_COST = {"coarse": 0.14, "full": 0.54}
@@ -34,6 +35,8 @@ GUIDE_SECONDS, GUIDE_COST = 0.24, 0.15
 #: what the main process does alone at a 128^2 macro grid (geometry, levelling, reading
 #: the curves back, writing the results) [s], and its growth with the nodes
 SERIAL_SECONDS, SERIAL_GROWTH = 16.7, 0.66
+#: the name of every micro-stage task begins so (the others are the macro stage's)
+MICRO = "patch"
 #: rounds of the adaptive h0 sampler per patch pair (a start, bisection, refinement)
 H0_ROUNDS = 3
 #: micro stage cost per cell pixel, time step and separation on one core [s] (the cell
@@ -49,11 +52,17 @@ ADAPTIVE_H0 = (5.5, 2.7)
 COST_GROWTH = 1.35
 
 
-def estimated_seconds(case, cores: int = 2) -> float:
+def estimated_seconds(case, cores: int = 2, slowdown=None) -> float:
     """Rough wall time of ``fem-twin run`` of ``case`` (a :class:`~fem_twin.case.Case`) on
-    ``cores`` workers of the calibration machine [s]: its work as tasks
-    (:func:`cost_tasks`) scheduled on them (:func:`~fem_twin.runtime.schedule.makespan`)."""
-    return makespan(cost_tasks(case), max(cores, 1))
+    ``cores`` workers [s]: its work as tasks (:func:`cost_tasks`) scheduled on them
+    (:func:`~fem_twin.runtime.schedule.makespan`), on the calibration machine, or on one
+    ``slowdown`` times slower (a :class:`~fem_twin.runtime.machine.Slowdown`: the cells'
+    tasks by its ``micro``, the rest by its ``macro`` part)."""
+    tasks = cost_tasks(case)
+    if slowdown is not None:
+        tasks = [replace(t, seconds=t.seconds * (slowdown.micro if t.name.startswith(MICRO)
+                                                 else slowdown.macro)) for t in tasks]
+    return makespan(tasks, max(cores, 1))
 
 
 def cost_tasks(case) -> list[Task]:
@@ -131,7 +140,8 @@ def _micro_tasks(case) -> list[Task]:
     for k in range(len(case.geometry.patches)):
         before = ()
         for r in range(H0_ROUNDS):
-            new = [Task(f"patch {k} round {r} h0 {i}", seconds, before) for i in range(per_round)]
+            new = [Task(f"{MICRO} {k} round {r} h0 {i}", seconds, before)
+                   for i in range(per_round)]
             tasks += new
             before = tuple(t.name for t in new)
     return tasks

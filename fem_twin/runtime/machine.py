@@ -3,58 +3,127 @@ estimates were measured on (:func:`fem_twin.runtime.cost.estimated_seconds`).
 
 Costs measured on one machine say little about another (a laptop, SuperLU instead of
 PARDISO), and a shared machine runs the same work up to about 2x slower from one hour to
-the next.  Before a run, :func:`slowdown` times a miniature of the micro stage (a 64^2
-roughness patch pair, two separations, four instants: periodic contact and the three cell
-problems, with the sparse backend the run will use) and divides by its time at the
-calibration.  It sees the machine for about a second, so the estimate carries the scatter
-of the machine's speed within a minute (benchmarks/README.md, "speed").
+the next.  The two stages' kernels need not move together (a processor's single-precision
+factorisations, a missing MKL), so before a run :func:`slowdown` times a miniature of each:
+of the micro stage (a 64^2 roughness patch pair, two separations, four instants: periodic
+contact and the three cell problems) and of a Stribeck point (a cold mixed point of a
+crowned 64^2 pin: the Reynolds Newton steps, the FFT half-space and the coupling), both
+with the sparse backend the run will use, and divides each by its time at the calibration.
+It sees the machine for about two seconds, so the estimate carries the scatter of the
+machine's speed within a minute (benchmarks/README.md, "speed").
 """
 
 from __future__ import annotations
 
 import os
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
+from .. import tables as T
 from ..errors import InputError
-from ..micro import homogenise
+from ..macro import Lubricant, MacroSettings, solve_mixed
+from ..macro.point_contact import PointContact
+from ..micro import FlowFactors, homogenise
 from ..numerics.threads import one_thread
 from ..topography.synthetic import self_affine
 
-#: the miniature's time on the calibration machine, the hour the estimate's costs were
-#: measured (best of five, PARDISO) [s]
-REFERENCE_SECONDS = 0.18
-#: timed repeats of the miniature (the best counts: the machine's speed, not a hiccup)
-REPEATS = 5
+#: the miniatures' times on the calibration machine, the hour the estimate's costs were
+#: measured (best of five, PARDISO) [s]: the cells' was timed then; the macro point's is
+#: the cells' times their ratio on that machine, timed back to back (benchmarks/README.md,
+#: "The run-time cost model")
+REFERENCE_SECONDS = {"micro": 0.18, "macro": 0.84, "ball": 0.88}
+#: timed repeats of each miniature (the best counts: the machine's speed, not a hiccup)
+REPEATS = {"micro": 5, "macro": 3, "ball": 3}
 #: the slowdown is kept within these bounds (a probe sees about a second and can misjudge;
 #: an estimate off by more than 4x says more about the machine than about the case)
 BOUNDS = (0.25, 4.0)
 
 
+@dataclass(frozen=True)
+class Slowdown:
+    """This machine's time over the calibration machine's for the cells (``micro``) and
+    for the macro points (``macro``) [-]."""
+
+    micro: float
+    macro: float
+
+    def __str__(self) -> str:
+        if f"{self.micro:.2g}" == f"{self.macro:.2g}":
+            return f"{self.micro:.2g}x"
+        return f"{self.micro:.2g}x for the cells and {self.macro:.2g}x for the macro points"
+
+
 @one_thread
-def probe_seconds(repeats: int = REPEATS) -> float:
-    """The best of ``repeats`` timings of the miniature (one thread, as the workers) [s]."""
-    rng = np.random.default_rng(0)
-    pin, disk = (self_affine((64, 64), 1e-6, 0.8, 0.3e-6, rng=rng) for _ in range(2))
-    h0 = np.array([0.2e-6, 0.5e-6])
+def probe_seconds(kind: str = "micro", repeats: int | None = None) -> float:
+    """The best of ``repeats`` timings of the ``kind`` miniature (``"micro"``, ``"macro"``
+    or ``"ball"``; one thread, as the workers; ``repeats`` None: :data:`REPEATS`) [s]."""
+    work = {"micro": _cells, "macro": _macro_point, "ball": _ball_point}[kind]()
     best = np.inf
-    for _ in range(repeats):
+    for _ in range(REPEATS[kind] if repeats is None else repeats):
         t = time.perf_counter()
-        homogenise(pin, disk, h0, steps=4, error_estimate=False)
+        work()
         best = min(best, time.perf_counter() - t)
     return best
 
 
-def slowdown() -> float:
-    """This machine's time for the same work over the calibration machine's, now (about 1
-    s to measure), within :data:`BOUNDS`; ``FEM_TWIN_SLOWDOWN`` (a number) sets it without
-    measuring."""
+def _cells():
+    rng = np.random.default_rng(0)
+    pin, disk = (self_affine((64, 64), 1e-6, 0.8, 0.3e-6, rng=rng) for _ in range(2))
+    h0 = np.array([0.2e-6, 0.5e-6])
+    return lambda: homogenise(pin, disk, h0, steps=4, error_estimate=False)
+
+
+def _ball_point():
+    """The bundled ball's kind of point, smaller: a 3/4 inch steel ball under 20 N on a
+    37^2 grid over the Hertz zone, u_m 0.5 m/s at SRR 2, the Newton coupling, asperities
+    ``1e10 exp(-h0 / 40 nm)`` Pa (29 % of the load on them, 25 Newton iterations)."""
+    contact = PointContact(9.525e-3, 20.0, T.E_REDUCED, 0.066, T.ROELANDS_ALPHA, 0.5)
+    gap, spacing, _, _ = contact.grid(37)
+    settings = MacroSettings(coupling="newton", cavitation_pressure=T.AMBIENT_PRESSURE)
+    factors = _asperities()
+    return lambda: solve_mixed(gap, spacing, factors, load=20.0, speed=1.0,
+                               entrainment=0.5, lubricant=Lubricant(0.066), settings=settings)
+
+
+def _asperities() -> FlowFactors:
+    """Smooth flow factors with the contact pressure ``1e10 exp(-h0 / 40 nm)`` [Pa]."""
+    h0 = np.geomspace(1e-8, 3e-6, 200)
+    k = h0.size
+    return FlowFactors(h0=h0, h_m=h0.copy(), p_con=1e10 * np.exp(-h0 / 40e-9),
+                       A=np.tile(np.eye(2), (k, 1, 1)), b=np.tile([1.0, 0.0], (k, 1)),
+                       C=np.tile(np.eye(2), (k, 1, 1)), d=np.zeros((k, 2)),
+                       friction_factor=np.ones(k),
+                       pressure_friction=np.tile([1.0, 0.0], (k, 1)),
+                       contact_fraction=np.zeros(k))
+
+
+def _macro_point():
+    """A crowned 7 mm face (2 um at its rim) on a 64^2 grid over the paper's 8 mm pin, the
+    holder 1 mm below, the paper's 150 N at 0.02 m/s, asperities ``1e10 exp(-h0 / 40 nm)``
+    Pa: mixed lubrication (42 % of the load on the asperities, 75 coupling iterations)."""
+    n, size, rim = 64, T.PIN_DIAMETER, 3.5e-3
+    x = (np.arange(n) - (n - 1) / 2) * size / (n - 1)
+    r2 = x[None, :] ** 2 + x[:, None] ** 2
+    face = r2 <= rim ** 2
+    gap = np.where(face, 2e-6 * r2 / rim ** 2, -T.HOLDER_HEIGHT)
+    spacing, factors = (size / (n - 1),) * 2, _asperities()
+    return lambda: solve_mixed(gap, spacing, factors, load=T.LOAD, speed=0.02,
+                               lubricant=Lubricant(0.066), face=face)
+
+
+def slowdown(ball: bool = False) -> Slowdown:
+    """This machine's time for the same work over the calibration machine's, now (about 2
+    s to measure), each kernel's within :data:`BOUNDS`: the cells', and a pin's macro point
+    or (``ball``) a ball's; ``FEM_TWIN_SLOWDOWN`` (a number) sets both without measuring."""
     forced = os.environ.get("FEM_TWIN_SLOWDOWN")
     if forced:
         try:
-            return float(np.clip(float(forced), *BOUNDS))
+            both = float(np.clip(float(forced), *BOUNDS))
         except ValueError:
             raise InputError(f"FEM_TWIN_SLOWDOWN must be a number (this machine's time over "
                              f"the calibration machine's), got {forced!r}") from None
-    return float(np.clip(probe_seconds() / REFERENCE_SECONDS, *BOUNDS))
+        return Slowdown(both, both)
+    return Slowdown(*(float(np.clip(probe_seconds(kind) / REFERENCE_SECONDS[kind], *BOUNDS))
+                      for kind in ("micro", "ball" if ball else "macro")))
