@@ -123,9 +123,10 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
     s, dx, area, speed, lubricant = P.settings, P.spacing, P.area, P.speed, P.lubricant
     loc = ev.loc
     p_hd = ev.p + s.cavitation_pressure
-    tau_hd, tau_con, asperity, a_r = pin_friction(
-        p_hd, ev.theta, ev.mu, ev.h0, loc.h_m, ev.p_con, dx, P.factors, s, lubricant, speed,
-        P.entrainment, face, P.velocity)
+    film = Film(pressure=p_hd, cavity_fraction=ev.theta, viscosity=ev.mu, h0=ev.h0,
+                mean_gap=loc.h_m, contact_pressure=ev.p_con, face=face)
+    tau_hd, tau_con, asperity, a_r = pin_friction(film, Shearing(
+        dx, P.factors, s, lubricant, speed, P.entrainment, P.velocity))
     weights = area * face                         # the load's trapezoidal rule on the face
     F_hd = float(np.sum(weights * tau_hd))
     F_con = float(np.sum(weights * tau_con))
@@ -153,16 +154,52 @@ def _plain(settings) -> dict:
             for f in fields(settings) for v in [getattr(settings, f.name)]}
 
 
-def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubricant, speed,
-                 entrainment, face=None, velocity=None):
-    """The film's and the contacts' tangential tractions [Pa] of a converged state as the
-    rig reads them (``settings.reading``): on the pin along x1 (eqs 31-32, or the force on
-    the pin: ``settings.friction``, :func:`.friction.hydrodynamic_shear`), or the disk's
-    drag times ``|v|`` (its torque over the track radius, :func:`.friction.disk_shear`);
-    ``factors`` at the state's slide-to-roll ratio, on the pin ``face``, the disk moving at
-    ``velocity`` (:func:`.kinematics.disk_velocity`; None: along x1); and the asperities'
-    load field (:func:`.boundary.asperity_load`) [Pa] and contact fraction a_r [-] the law
-    reads, each weighted alike (the x1 share of the sliding, or ``|v|``)."""
+@dataclass(frozen=True, eq=False)
+class Film:
+    """The fields of a converged state that its friction reads (a :class:`MixedResult`
+    has the same names): the film ``pressure`` (absolute) [Pa], the ``cavity_fraction``
+    [-], the local ``viscosity`` [Pa s], the separation ``h0`` and the ``mean_gap`` h_m
+    [m], the ``contact_pressure`` [Pa] and the pin ``face`` (bool), all (ny, nx)."""
+
+    pressure: np.ndarray
+    cavity_fraction: np.ndarray
+    viscosity: np.ndarray
+    h0: np.ndarray
+    mean_gap: np.ndarray
+    contact_pressure: np.ndarray
+    face: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Shearing:
+    """What turns a state's fields into tractions: the grid ``spacing`` (dx1, dx2) [m],
+    the ``factors`` at the state's slide-to-roll ratio, the macro ``settings``, the
+    ``lubricant``, the sliding ``speed`` u_r and the ``entrainment`` u_m [m/s] (None: u_r
+    / 2), and the disk's ``velocity`` (:func:`.kinematics.disk_velocity`; None: along
+    x1)."""
+
+    spacing: tuple[float, float]
+    factors: object
+    settings: object
+    lubricant: object
+    speed: float
+    entrainment: float | None
+    velocity: np.ndarray | None
+
+
+def pin_friction(film, how: Shearing):
+    """The film's and the contacts' tangential tractions [Pa] of a converged state's
+    ``film`` (a :class:`Film` or a :class:`MixedResult`) as the rig reads them
+    (``settings.reading``): on the pin along x1 (eqs 31-32, or the force on the pin:
+    ``settings.friction``, :func:`.friction.hydrodynamic_shear`), or the disk's drag times
+    ``|v|`` (its torque over the track radius, :func:`.friction.disk_shear`), sheared
+    ``how``; and the asperities' load field (:func:`.boundary.asperity_load`) [Pa] and
+    contact fraction a_r [-] the law reads, each weighted alike (the x1 share of the
+    sliding, or ``|v|``)."""
+    p_hd, theta, mu, h_m, p_con = (film.pressure, film.cavity_fraction, film.viscosity,
+                                   film.mean_gap, film.contact_pressure)
+    h0, face, velocity, settings = film.h0, film.face, how.velocity, how.settings
+    dx, factors, speed, lubricant = how.spacing, how.factors, how.speed, how.lubricant
     shear = factors.at(h0)              # the shear factors (the iterations read none)
     cos, _, local = (1.0, 0.0, 1.0) if velocity is None else rotations(velocity)
     if settings.reading == "torque":    # the disk's drag times |v| = r / R (its lever)
@@ -172,7 +209,7 @@ def pin_friction(p_hd, theta, mu, h0, h_m, p_con, dx, factors, settings, lubrica
     else:                               # the load cell on the pin: the x1 component
         along = cos
         tau_hd = hydrodynamic_shear(p_hd, h_m, theta, mu, shear, dx, speed,
-                                    entrainment=entrainment,
+                                    entrainment=how.entrainment,
                                     eyring_stress=lubricant.eyring_stress,
                                     law=settings.friction, face=face,
                                     ambient_pressure=settings.ambient_pressure,
@@ -192,12 +229,10 @@ def friction_with(result: MixedResult, factors, settings, lubricant) -> float:
     does not read (the friction factors)."""
     u_m = result.meta.get("entrainment") or result.speed / 2
     moved = at_slide_to_roll(factors, result.speed / u_m)
-    tau_hd, tau_con, *_ = pin_friction(result.pressure, result.cavity_fraction, result.viscosity,
-                                   result.h0, result.mean_gap, result.contact_pressure,
-                                   result.spacing, moved, settings, lubricant, result.speed,
-                                   result.meta.get("entrainment"), result.face,
-                                   disk_velocity(result.face, result.spacing,
-                                                 settings.track_radius))
+    tau_hd, tau_con, *_ = pin_friction(result, Shearing(
+        result.spacing, moved, settings, lubricant, result.speed,
+        result.meta.get("entrainment"), disk_velocity(result.face, result.spacing,
+                                                      settings.track_radius)))
     weights = trapezoid_weights(result.face.shape, result.spacing) * result.face
     return float(np.sum(weights * (tau_hd + tau_con)) / result.normal_load)
 
