@@ -214,12 +214,12 @@ def pin_friction(film, how: Shearing):
                                     law=settings.friction, face=face,
                                     ambient_pressure=settings.ambient_pressure,
                                     velocity=velocity)
-    film = np.maximum(np.asarray(p_hd, float) - settings.ambient_pressure, 0.0)
+    gauge = np.maximum(np.asarray(p_hd, float) - settings.ambient_pressure, 0.0)
     a_r = boundary_area(shear, settings.boundary)
-    tau_con = boundary_traction(p_con, film, a_r, speed * local, settings.boundary,
+    tau_con = boundary_traction(p_con, gauge, a_r, speed * local, settings.boundary,
                                 settings.boundary_friction)
     return (tau_hd, tau_con * along * (speed > 0),   # along the reading; 0: no sliding
-            asperity_load(p_con, film, a_r, settings.boundary) * along, a_r * along)
+            asperity_load(p_con, gauge, a_r, settings.boundary) * along, a_r * along)
 
 
 def friction_with(result: MixedResult, factors, settings, lubricant) -> float:
