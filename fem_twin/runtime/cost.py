@@ -19,7 +19,8 @@ from .schedule import Task, makespan
 #: a guided Stribeck point of a pin at 128^2 [s], its growth with the nodes, and the cost
 #: of a main-curve point with its C_f error estimate in plain points
 POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 0.50, 0.98, 1.28
-#: a ball's warm point at 73^2 (Newton coupling) [s] and its growth with the grid's side
+#: a ball's point at 73^2, started from its 37^2 guide (Newton coupling) [s], and its
+#: growth with the grid's side
 BALL_POINT_SECONDS, BALL_POINT_GROWTH = 3.5, 2.4
 #: a band point in main-curve points, by ``[run] band_grid`` (the band's sweeps converge to
 #: ``[run] band_tol`` and carry no error estimate; "coarse" runs them on the coarsened grid)
@@ -32,6 +33,10 @@ THERMAL_COST = 1.25
 #: a pin's guide point (the sweep on its coarsest nested grid, 48-95 px a side, warm-started)
 #: [s]; a ball's in its points
 GUIDE_SECONDS, GUIDE_COST = 0.24, 0.15
+#: the share of the speeds a refinement pass adds, a pin's and a ball's: the bundled pin
+#: adds 6 of 12, the paper case 7 of 25, the bundled ball 1 of 12 (its C_f smoother over
+#: log speed)
+REFINED_SHARE = {False: 0.5, True: 0.1}
 #: what the main process does alone at a 128^2 macro grid (geometry, levelling, reading
 #: the curves back, writing the results) [s], and its growth with the nodes
 SERIAL_SECONDS, SERIAL_GROWTH = 16.7, 0.66
@@ -71,15 +76,15 @@ def cost_tasks(case) -> list[Task]:
     h0 of each of :data:`H0_ROUNDS` rounds at ``MICRO_SECONDS`` per cell pixel, step and
     separation; per viscosity the sweep's guide, each point (a warm point of
     ``POINT_SECONDS``, a ball's of ``BALL_POINT_SECONDS``, with its error estimate), each
-    refined speed's guide point and point (half the speeds per pass), then the band's
-    chains (:func:`_band_tasks`); last what the main process does alone."""
+    refined speed's guide point and point (:data:`REFINED_SHARE` of the speeds per pass),
+    then the band's chains (:func:`_band_tasks`); last what the main process does alone."""
     micro = _micro_tasks(case)
     thermal = THERMAL_COST if case.thermal.model != "none" else 1.0
     point = _point_seconds(case) * thermal
     guide = GUIDE_COST * point if case.tribometer.ball else GUIDE_SECONDS * thermal
     estimate = 1.0 if case.tribometer.ball else ESTIMATE_COST
     count = case.sweep.count
-    added = int(round(count * 0.5 * case.sweep.refine))
+    added = int(round(count * REFINED_SHARE[case.tribometer.ball] * case.sweep.refine))
     after, tasks, guides, again = tuple(t.name for t in micro), [], [], []
     if nested_levels(case.macro_shape) == 0:            # no coarser grid: chains of speeds
         tasks = [Task(f"sweep {v}", estimate * point * (count + added), after)
