@@ -161,11 +161,10 @@ class SPDSolver:
             return self._lu.solve(rhs)
         if self._a is None:
             raise SolverError("factor() a matrix before solve()")
-        # one column per call: PARDISO's block solve of 3 columns is slower than three single
-        # ones on small cells, the same on large ones
+        # all columns in one call: 1.4-2.3x faster than one call a column for 2-5 columns of
+        # a 48^2-256^2 cell (benchmarks/README.md)
         b = np.asfortranarray(rhs.reshape(self.n, -1), dtype=self.dtype)
-        x = np.column_stack([self._pardiso(33, b[:, [j]]) for j in range(b.shape[1])])
-        return x.reshape(rhs.shape).astype(float, copy=False)
+        return self._pardiso(33, b).reshape(rhs.shape).astype(float, copy=False)
 
     def release(self) -> None:
         """Free the factors (PARDISO phase 0), keep the ordering and symbolic analysis; the
