@@ -4,6 +4,7 @@
 
 import csv
 import json
+import os
 import subprocess
 import sys
 
@@ -15,6 +16,7 @@ from sample_cases import small_case
 from fem_twin import Topography, read_topography, write_topography
 from fem_twin.case import load_case
 from fem_twin.cli import main
+from fem_twin.errors import SolverError
 from fem_twin.micro import FlowFactors
 from fem_twin.runtime.cost import estimated_seconds
 
@@ -230,8 +232,8 @@ def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     case = load_case(ROOT / "examples" / "pin_on_disk.toml")
     estimates = []
     for factor in (1.0, 2.0):
-        monkeypatch.setattr(speed, "probe_seconds",
-                            lambda kind: factor * speed.REFERENCE_SECONDS[kind])
+        monkeypatch.setattr(speed, "probe_together",
+                            lambda kind, n: factor * speed.REFERENCE_SECONDS[kind])
         estimates.append(_confirm_cost(case, yes=True))
     assert estimates[1] == pytest.approx(2 * estimates[0])
     assert "takes 2x the calibration machine's time" in capsys.readouterr().err
@@ -240,7 +242,7 @@ def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     assert estimated_seconds(case, 1, slow) == pytest.approx(
         estimated_seconds(case, 1) + 2 * serial)
     assert str(slow) == "1x for the cells and 3x for the macro points"
-    monkeypatch.setattr(speed, "probe_seconds", lambda kind: 100.0)
+    monkeypatch.setattr(speed, "probe_together", lambda kind, n: 100.0)
     assert speed.slowdown() == speed.Slowdown(*speed.BOUNDS[1:] * 2)
     monkeypatch.setenv("FEM_TWIN_SLOWDOWN", "0.5")            # forced: no probe
     assert speed.slowdown() == speed.Slowdown(0.5, 0.5)
@@ -248,3 +250,19 @@ def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     with pytest.raises(ValueError, match="FEM_TWIN_SLOWDOWN"):
         speed.slowdown()
     assert [duration(s) for s in (85, 250, 1529)] == ["85 s", "4.2 min", "25 min"]
+
+
+def test_the_probes_run_side_by_side_as_the_workers_will(monkeypatch):
+    """With two workers each probe runs in two processes at once, their repeats started
+    together, so a load on another core slows the probes as it slows the run's workers
+    (docs/performance.md: beside a busy loop the probes read 1.6x, the run took 1.5x).  A
+    process whose miniature fails stops the others and the probe says so, without hanging."""
+    import fem_twin.runtime.machine as speed
+    seconds = speed.probe_together("micro", 2)
+    assert 0.05 < seconds < 3.0
+    monkeypatch.setitem(speed._MINIATURES, "micro", lambda: 1 / 0)
+    assert np.isnan(speed.probe_together("micro", 2))
+    monkeypatch.delenv("FEM_TWIN_SLOWDOWN", raising=False)
+    if (os.cpu_count() or 1) >= 2:                             # one core: one process
+        with pytest.raises(SolverError, match="speed probe failed"):
+            speed.slowdown(workers=2)

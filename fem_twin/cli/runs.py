@@ -35,7 +35,7 @@ def _confirm_cost(case, yes: bool) -> float | None:
         print(f"fem-twin run: sections not in {case.source.name}, defaults used: " + ", ".join(
             f"[{s}]" for s in case.defaulted), file=sys.stderr)
     cores = case.run.workers or os.cpu_count() or 1
-    speed = slowdown(case.tribometer.ball)
+    speed = slowdown(case.tribometer.ball, cores if case.run.scheduler in (None, "local") else 1)
     calibration = estimated_seconds(case, cores)
     seconds = estimated_seconds(case, cores, speed)
     on = {n: duration(estimated_seconds(case, n, speed)) for n in (16, 64)}

@@ -9,24 +9,28 @@ of the micro stage (a 64^2 roughness patch pair, two separations, four instants:
 contact and the three cell problems) and of a Stribeck point (a cold mixed point of a
 crowned 64^2 pin: the Reynolds Newton steps, the FFT half-space and the coupling), both
 with the sparse backend the run will use, and divides each by its time at the calibration.
-It sees the machine for about two seconds, so the estimate carries the scatter of the
-machine's speed within a minute (benchmarks/README.md, "speed").
+Each miniature runs in as many processes at once as the run has local workers (at most one
+a core), so a load on another core slows the probes as it will slow the workers.  It sees
+the machine for about two seconds, so the estimate carries the scatter of the machine's
+speed within a minute (benchmarks/README.md, "speed").
 """
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import time
 from dataclasses import dataclass
+from queue import Empty
 
 import numpy as np
 
 from .. import tables as T
-from ..errors import InputError
+from ..errors import InputError, SolverError
 from ..macro import Lubricant, MacroSettings, solve_mixed
 from ..macro.point_contact import PointContact
 from ..micro import FlowFactors, homogenise
-from ..numerics.threads import one_thread
+from ..numerics.threads import one_thread, quiet_worker
 from ..topography.synthetic import self_affine
 
 #: the miniatures' times on the calibration machine, the hour the estimate's costs were
@@ -36,6 +40,8 @@ from ..topography.synthetic import self_affine
 REFERENCE_SECONDS = {"micro": 0.18, "macro": 0.84, "ball": 0.88}
 #: timed repeats of each miniature (the best counts: the machine's speed, not a hiccup)
 REPEATS = {"micro": 5, "macro": 3, "ball": 3}
+#: how long a probe process may take to report [s]
+PROBE_TIMEOUT = 120.0
 #: the slowdown is kept within these bounds (a probe sees about a second and can misjudge;
 #: an estimate off by more than 4x says more about the machine than about the case)
 BOUNDS = (0.25, 4.0)
@@ -59,7 +65,7 @@ class Slowdown:
 def probe_seconds(kind: str = "micro", repeats: int | None = None) -> float:
     """The best of ``repeats`` timings of the ``kind`` miniature (``"micro"``, ``"macro"``
     or ``"ball"``; one thread, as the workers; ``repeats`` None: :data:`REPEATS`) [s]."""
-    work = {"micro": _cells, "macro": _macro_point, "ball": _ball_point}[kind]()
+    work = _MINIATURES[kind]()
     best = np.inf
     for _ in range(REPEATS[kind] if repeats is None else repeats):
         t = time.perf_counter()
@@ -113,10 +119,62 @@ def _macro_point():
                                lubricant=Lubricant(0.066), face=face)
 
 
-def slowdown(ball: bool = False) -> Slowdown:
+#: each kind of probe's miniature: a function that builds it and returns its timed work
+_MINIATURES = {"micro": _cells, "macro": _macro_point, "ball": _ball_point}
+
+
+def probe_together(kind: str, processes: int) -> float:
+    """:func:`probe_seconds` of ``kind`` in ``processes`` processes at once, each repeat
+    started together (a barrier), as the run's workers will share the machine: a load on
+    another core then slows the probes as it slows the run [s] (the mean over processes
+    of their repeats' median; one process: :func:`probe_seconds` itself)."""
+    if processes <= 1:
+        return probe_seconds(kind)
+    ctx = multiprocessing.get_context()
+    barrier, queue = ctx.Barrier(processes), ctx.Queue()
+    jobs = [ctx.Process(target=_probe_in_step, args=(kind, barrier, queue), daemon=True)
+            for _ in range(processes)]
+    for job in jobs:
+        job.start()
+    try:
+        times = [queue.get(timeout=PROBE_TIMEOUT) for _ in jobs]
+    except Empty:
+        raise SolverError(f"the {kind} probe's {processes} processes did not report within "
+                          f"{PROBE_TIMEOUT:.0f} s") from None
+    finally:
+        for job in jobs:
+            job.join(timeout=1.0)
+            if job.is_alive():
+                job.terminate()
+    return float(np.mean(times))
+
+
+@one_thread
+def _probe_in_step(kind, barrier, queue):
+    """One process of :func:`probe_together`: the median of its repeats, each after the
+    barrier (the best would pick the repeat the scheduler left alone; NaN if its work
+    failed, so that the others are not left waiting)."""
+    quiet_worker()
+    times = []
+    try:
+        work = _MINIATURES[kind]()
+        for _ in range(REPEATS[kind]):
+            barrier.wait(timeout=PROBE_TIMEOUT)
+            t = time.perf_counter()
+            work()
+            times.append(time.perf_counter() - t)
+    except Exception:
+        barrier.abort()
+        times = [np.nan]
+    queue.put(float(np.median(times)))
+
+
+def slowdown(ball: bool = False, workers: int = 1) -> Slowdown:
     """This machine's time for the same work over the calibration machine's, now (about 2
     s to measure), each kernel's within :data:`BOUNDS`: the cells', and a pin's macro point
-    or (``ball``) a ball's; ``FEM_TWIN_SLOWDOWN`` (a number) sets both without measuring."""
+    or (``ball``) a ball's, each timed in ``workers`` processes at once (at most one a
+    core; :func:`probe_together`); ``FEM_TWIN_SLOWDOWN`` (a number) sets both without
+    measuring."""
     forced = os.environ.get("FEM_TWIN_SLOWDOWN")
     if forced:
         try:
@@ -125,5 +183,10 @@ def slowdown(ball: bool = False) -> Slowdown:
             raise InputError(f"FEM_TWIN_SLOWDOWN must be a number (this machine's time over "
                              f"the calibration machine's), got {forced!r}") from None
         return Slowdown(both, both)
-    return Slowdown(*(float(np.clip(probe_seconds(kind) / REFERENCE_SECONDS[kind], *BOUNDS))
-                      for kind in ("micro", "ball" if ball else "macro")))
+    processes = max(1, min(workers, os.cpu_count() or 1))
+    seconds = {kind: probe_together(kind, processes)
+               for kind in ("micro", "ball" if ball else "macro")}
+    if not all(np.isfinite(list(seconds.values()))):
+        raise SolverError(f"a speed probe failed in one of its {processes} processes")
+    return Slowdown(*(float(np.clip(t / REFERENCE_SECONDS[kind], *BOUNDS))
+                      for kind, t in seconds.items()))
