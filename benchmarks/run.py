@@ -3,7 +3,8 @@
     python benchmarks/run.py [GROUP ...]      # topography contact micro macro stribeck ...
                                               # (micro-full: ~15 min, estimate: ~40 min,
                                               #  estimate-paper: ~100 min, scale: ~10 min,
-                                              #  amg: ~3 min,
+                                              #  amg: ~3 min, ab: the example cases on
+                                              #  FEM_TWIN_AB_BASE and now, ~10 min,
                                               #  cores: the bundled case on 1, 2, all workers;
                                               #  deterministic: the mixed regime, ~20 min;
                                               #  only when named)
@@ -26,6 +27,7 @@ from fem_twin.topography.prepare import prepare_pin  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+from ab import bench_ab  # noqa: E402
 from amg import bench_amg  # noqa: E402
 from common import SAMPLE, best_of, macro_factors, macro_gap  # noqa: E402
 from cores import bench_cores  # noqa: E402
@@ -594,13 +596,13 @@ GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": ben
           "estimate": bench_estimate, "scale": bench_scale, "amg": bench_amg, "cores": bench_cores,
           "estimate-paper": lambda: bench_estimate("paper.toml"),
           "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults,
-          "deterministic": bench_deterministic}
+          "deterministic": bench_deterministic, "ab": bench_ab}
 
 
 def main(argv):
     groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "estimate-paper",
                                                         "scale", "amg", "cores", "defaults",
-                                                        "deterministic")]
+                                                        "deterministic", "ab")]
     for name in groups:
         base, rows, *summary = GROUPS[name]()
         print(f"\n## {name}")
