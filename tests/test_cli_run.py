@@ -296,13 +296,16 @@ def test_sweep_refinement_adds_speeds_where_the_curve_turns(tmp_path):
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps
 
 
-def test_the_band_grid_is_the_coarsest_nested_grid():
-    """[run] band_grid = "coarsest" sweeps the band on the main sweeps'
-    coarsest nested grid (sides 48-95 px), whose C_f the main points keep: 64^2 for the
-    macro grids 128^2 to 1024^2, every other node below (the 48^2 test case: 24^2);
-    "coarse" halves the grid once and "full" keeps it."""
+def test_the_band_grid_is_coarsened_to_48_95_nodes_a_side():
+    """[run] band_grid = "coarsest" sweeps the band on the grid coarsened down to
+    sides of 48-95 px, whose C_f the main points keep: 64^2 for the macro grids 128^2 to
+    1024^2, every other node below (the 48^2 test case: 24^2); the main sweeps' guides go
+    on to 36-71 px (a ball's 73^2 nests to 37^2), and where that is coarser than the band's
+    grid, the band starts from the points' kept level, not from the guides; "coarse"
+    halves the grid once and "full" keeps it."""
     from dataclasses import replace
 
+    from fem_twin.macro.nested import nested_levels
     from fem_twin.macro.point import coarsened
     case = load_case(ROOT / "examples" / "paper.toml")
     assert case.run.band_grid == "coarsest"
@@ -312,6 +315,8 @@ def test_the_band_grid_is_the_coarsest_nested_grid():
         for _ in range(levels):
             gap = coarsened(gap, (1.0, 1.0), None)[0]
         assert 48 <= gap.shape[0] < 96 or side < 96
+    assert case.band_after_guides((256, 256)) and not case.band_after_guides((150, 150))
+    assert nested_levels((73, 73)) == 1 and nested_levels((150, 150)) == 2
     for grid, levels in (("coarse", 1), ("full", 0)):
         other = replace(case, run=replace(case.run, band_grid=grid))
         assert other.band_coarsening((256, 256)) == levels

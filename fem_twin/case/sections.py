@@ -224,8 +224,8 @@ class RunSpec:
     # on a band about 46 % C_f,b wide, at a third of the time (benchmarks/README.md)
     band_grid: str = setting("coarsest", "the band's macro grid, C_f corrected by the "
                              "average curve's relative change to the full grid: \"coarsest\" (the "
-                             "main sweeps' coarsest nested grid, 48-95 px a side: 64^2 from "
-                             '128^2 to 1024^2), "coarse" (every other node) or "full"',
+                             "grid coarsened down to 48-95 px a side: 64^2 from 128^2 to "
+                             '1024^2), "coarse" (every other node) or "full"',
                              unit="coarsest, coarse or full",
                              choices=("coarsest", "coarse", "full"))
     # 1e-3: the patches' C_f within 0.04 % C_f,b of 1e-4, far below the band's own grid
@@ -251,6 +251,10 @@ FILLED = {"e_reduced": ("materials", lambda case: case.materials.e_reduced),
           "boundary": ("boundary", lambda case: case.boundary)}
 
 
+#: ``band_grid = "coarsest"`` coarsens the macro grid down to this side to twice it [nodes]
+#: (the band's accuracy was measured at 64^2, docs/accuracy.md); the nested solves go on to
+#: 36-71 (:data:`fem_twin.macro.mixed.COARSE_START`), where a ball's 37^2 guides its 73^2
+BAND_SMALLEST = 48
 #: the case file's sections and the dataclass that declares each one's keys
 #: (``[validation]`` has one key, ``measured``; ``name`` is top-level)
 SECTIONS = {"geometry": Geometry, "preprocessing": MacroOptions, "tribometer": Tribometer,
@@ -295,12 +299,13 @@ class Case:
 
     def band_coarsening(self, shape) -> int:
         """Coarsenings by two of the band's grid below a macro grid of ``shape``
-        (``[run] band_grid``): none ("full"), one ("coarse"), or down to the main sweeps'
-        coarsest nested grid ("coarsest", at least one: 64^2 for the grids 128^2 to
-        1024^2)."""
+        (``[run] band_grid``): none ("full"), one ("coarse"), or down to 48-95 nodes a side
+        ("coarsest", at least one: 64^2 for the grids 128^2 to 1024^2, where the band's
+        accuracy was measured), the main sweeps' coarsest nested grid where that is as
+        large (:data:`BAND_SMALLEST`)."""
         from ..macro.nested import nested_levels
         return {"full": 0, "coarse": 1}.get(self.run.band_grid,
-                                            max(1, nested_levels(shape)))
+                                            max(1, nested_levels(shape, BAND_SMALLEST)))
 
     def band_after_guides(self, shape) -> bool:
         """Whether the band's sweeps start from the main sweeps' guides (their grid is the

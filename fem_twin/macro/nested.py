@@ -29,11 +29,13 @@ from .result import MixedResult, resampled
 CORRECTED = ("pressure", "elastic_deformation", "cavity_fraction", "contact_pressure")
 
 
-def nested_levels(shape) -> int:
+def nested_levels(shape, smallest: int | None = None) -> int:
     """How many coarsenings by two :func:`solve_nested` solves below a grid of ``shape``
-    (down to sides of :data:`~fem_twin.macro.mixed.COARSE_START` to twice that)."""
+    (down to sides of ``smallest`` to twice that; None: the solve's own,
+    :data:`~fem_twin.macro.mixed.COARSE_START`)."""
+    smallest = COARSE_START if smallest is None else smallest
     side, levels = min(shape), 0
-    while side >= 2 * COARSE_START:
+    while side >= 2 * smallest:
         side, levels = (side + 1) // 2, levels + 1
     return levels
 

@@ -30,7 +30,7 @@ BAND_LEVEL_COST = 0.33
 #: the Stribeck stage of the thermal twin (``[thermal] model = "flash"``) against the
 #: isothermal one: each point iterates its film temperature (from its guide's)
 THERMAL_COST = 1.25
-#: a pin's guide point (the sweep on its coarsest nested grid, 48-95 px a side, warm-started)
+#: a pin's guide point (the sweep on its coarsest nested grid, 36-71 px a side, warm-started)
 #: [s]; a ball's in its points
 GUIDE_SECONDS, GUIDE_COST = 0.24, 0.15
 #: the share of the speeds a refinement pass adds, a pin's and a ball's: the bundled pin
