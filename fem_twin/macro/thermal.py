@@ -209,14 +209,18 @@ def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
 
     ``solve(lubricant, previous)`` returns the point's levels ``(result, *coarser)`` with
     the film's ``lubricant``, warm from ``previous`` (None first).  The film temperature
-    ``T = T_oil + R_b Q + theta_face`` is iterated by secant steps on ``T - g(T)``, from the
-    film temperature of ``near`` (a neighbouring point's record on the same oil; else the
-    oil's), until it moves by less than ``settings.tol``; returns ``(levels, lubricant, record)``
-    with the record's temperatures [C] (``oil``, ``film``, ``asperity``), rises [K], power [W] and
-    iterations, or raises :class:`ThermalNotConverged` with the history."""
+    ``T = T_oil + R_b Q + theta_face`` is iterated by secant steps on ``g(T) - T``, from the
+    film temperature of ``near`` (a neighbouring point's record on the same oil, the first
+    step along its ``residual_slope`` if it has one; else the oil's), until it moves by
+    less than ``settings.tol``; returns ``(levels, lubricant, record)`` with the record's
+    temperatures [C] (``oil``, ``film``, ``asperity``), rises [K], power [W], iterations
+    and ``residual_slope`` (d(g - T)/dT [-], for the next point), or raises
+    :class:`ThermalNotConverged` with the history."""
     s, law = thermal.settings, thermal.law
     oil = float(law.temperature(lubricant.viscosity))
-    T = near["film_C"] if near and near["oil_C"] == oil else oil
+    same = bool(near) and near["oil_C"] == oil
+    T = near["film_C"] if same else oil
+    slope = near.get("residual_slope") if same else None
     previous, history, pairs = None, [], []
     for _ in range(s.max_iter):
         film = replace(lubricant, viscosity=float(law.viscosity(T)))
@@ -232,20 +236,36 @@ def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
                       "face_flash_K": heat["flash"], "spot_flash_K": spot,
                       "power_W": heat["power"], "pin_share": heat["pin_share"],
                       "spot_rise_K_Pa": spot_flash(abs(levels[0].speed), speeds, s),
-                      "iterations": len(history)}
+                      "iterations": len(history),
+                      "residual_slope": _slope([*pairs, (T, target - T)], slope)}
             return levels, film, record
         pairs.append((T, target - T))
-        T, previous = _next_temperature(pairs), levels
+        T, previous = _next_temperature(pairs, slope), levels
     raise ThermalNotConverged(f"the film temperature did not settle within {s.tol:g} K in "
                               f"{s.max_iter} iterations (last change {history[-1]:.3g} K)",
                               history)
 
 
-def _next_temperature(pairs) -> float:
-    """The secant root of ``r(T) = g(T) - T`` through the last two ``(T, r)`` pairs, or the
-    plain step ``T + r`` first and where the secant is flat."""
+#: the slopes of ``g(T) - T`` a first step may take from a neighbour's record (``g'`` from
+#: -4 to 0.8: a thinner oil heats less)
+SLOPES = (-5.0, -0.2)
+
+
+def _next_temperature(pairs, slope=None) -> float:
+    """The secant root of ``r(T) = g(T) - T`` through the last two ``(T, r)`` pairs; first,
+    the Newton step along a neighbour's ``slope`` (within :data:`SLOPES`), else the plain
+    step ``T + r``, which is also taken where the secant is flat."""
     T, r = pairs[-1]
     if len(pairs) < 2:
-        return T + r
+        ok = slope is not None and SLOPES[0] <= slope <= SLOPES[1]
+        return T - r / slope if ok else T + r
     T0, r0 = pairs[-2]
     return T + r if r == r0 else T - r * (T - T0) / (r - r0)
+
+
+def _slope(pairs, previous=None):
+    """``dr/dT`` of the last two ``(T, r)`` pairs, or ``previous`` with fewer."""
+    if len(pairs) < 2 or pairs[-1][0] == pairs[-2][0]:
+        return previous
+    (T0, r0), (T, r) = pairs[-2:]
+    return float((r - r0) / (T - T0))
