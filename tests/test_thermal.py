@@ -150,3 +150,37 @@ def test_thermal_settings_refuse_nonsense():
                 dict(bulk_resistance=np.nan)):
         with pytest.raises(Exception, match="model|conductivity|tol|grid|bulk"):
             replace(ThermalSettings(), **bad)
+
+
+def test_a_first_step_along_the_neighbours_slope_lands_within_the_tolerance():
+    """A film temperature whose heat falls with it (g' = -0.2 here: the power 100 mu(T) W
+    on R_b = 1 K/W, mu dropping 3 %/K) started 0.5 K off its root: the plain step leaves it
+    0.1 K off, so the secant needs a third solve; along the slope of g - T that the converged
+    point records (``residual_slope``, -1.2), the second solve lands within the tolerance."""
+    from types import SimpleNamespace
+
+    class Model:
+        settings = ThermalSettings(bulk_resistance=1.0)
+        law = SimpleNamespace(viscosity=lambda T: 0.066 * np.exp(-0.03 * (T - 24.0)),
+                              temperature=lambda mu: 24.0 - np.log(mu / 0.066) / 0.03)
+
+        def tempered(self, result, factors, speeds):
+            return result
+
+        def heat(self, result, speeds):
+            return {"power": result.power, "flash": 0.0, "pin_share": 0.5}
+
+        def spot(self, result, factors, speeds):
+            return 0.0
+
+    def solve(lubricant, previous):
+        return (SimpleNamespace(speed=1.0, power=100 * lubricant.viscosity),)
+
+    _, film, record = thermal_point(solve, Lubricant(0.066), Model(), None, (0.0, 1.0))
+    assert record["residual_slope"] == pytest.approx(-1.0 - 3.0 * film.viscosity, rel=1e-2)
+    off = {**record, "film_C": record["film_C"] + 0.5}
+    plain = thermal_point(solve, Lubricant(0.066), Model(), None, (0.0, 1.0),
+                          {**off, "residual_slope": None})[2]
+    along = thermal_point(solve, Lubricant(0.066), Model(), None, (0.0, 1.0), off)[2]
+    assert plain["iterations"] == 3 and along["iterations"] == 2
+    assert abs(along["film_C"] - record["film_C"]) < Model.settings.tol
