@@ -65,13 +65,20 @@ class Slowdown:
 def probe_seconds(kind: str = "micro", repeats: int | None = None) -> float:
     """The best of ``repeats`` timings of the ``kind`` miniature (``"micro"``, ``"macro"``
     or ``"ball"``; one thread, as the workers; ``repeats`` None: :data:`REPEATS`) [s]."""
-    work = _MINIATURES[kind]()
-    best = np.inf
-    for _ in range(REPEATS[kind] if repeats is None else repeats):
+    return min(_timings(kind, REPEATS[kind] if repeats is None else repeats))
+
+
+def _timings(kind: str, repeats: int, before=None) -> list[float]:
+    """The times [s] of ``repeats`` runs of the ``kind`` miniature, each after ``before()``
+    if given (built once, untimed)."""
+    work, times = _MINIATURES[kind](), []
+    for _ in range(repeats):
+        if before is not None:
+            before()
         t = time.perf_counter()
         work()
-        best = min(best, time.perf_counter() - t)
-    return best
+        times.append(time.perf_counter() - t)
+    return times
 
 
 def _cells():
@@ -155,14 +162,8 @@ def _probe_in_step(kind, barrier, queue):
     barrier (the best would pick the repeat the scheduler left alone; NaN if its work
     failed, so that the others are not left waiting)."""
     quiet_worker()
-    times = []
     try:
-        work = _MINIATURES[kind]()
-        for _ in range(REPEATS[kind]):
-            barrier.wait(timeout=PROBE_TIMEOUT)
-            t = time.perf_counter()
-            work()
-            times.append(time.perf_counter() - t)
+        times = _timings(kind, REPEATS[kind], lambda: barrier.wait(timeout=PROBE_TIMEOUT))
     except Exception:
         barrier.abort()
         times = [np.nan]
