@@ -7,6 +7,9 @@
                                               #  FEM_TWIN_AB_BASE and now, ~10 min,
                                               #  cores: the bundled case on 1, 2, all workers;
                                               #  deterministic: the mixed regime, ~20 min;
+                                              #  estimates: each example's printed run
+                                              #  time against its run, ~4 min, ~9 with
+                                              #  FEM_TWIN_ESTIMATE_LOAD=1;
                                               #  only when named)
 """
 
@@ -33,6 +36,7 @@ from common import SAMPLE, best_of, macro_factors, macro_gap  # noqa: E402
 from cores import bench_cores  # noqa: E402
 from defaults import bench_defaults  # noqa: E402
 from deterministic import bench_deterministic  # noqa: E402
+from estimates import bench_estimates  # noqa: E402
 from scale import bench_scale  # noqa: E402
 
 
@@ -596,13 +600,14 @@ GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": ben
           "estimate": bench_estimate, "scale": bench_scale, "amg": bench_amg, "cores": bench_cores,
           "estimate-paper": lambda: bench_estimate("paper.toml"),
           "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults,
-          "deterministic": bench_deterministic, "ab": bench_ab}
+          "deterministic": bench_deterministic, "ab": bench_ab,
+          "estimates": bench_estimates}
 
 
 def main(argv):
     groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "estimate-paper",
                                                         "scale", "amg", "cores", "defaults",
-                                                        "deterministic", "ab")]
+                                                        "deterministic", "ab", "estimates")]
     for name in groups:
         base, rows, *summary = GROUPS[name]()
         print(f"\n## {name}")

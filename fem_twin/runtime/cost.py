@@ -18,25 +18,25 @@ from .schedule import Task, makespan
 
 #: a guided Stribeck point of a pin at 128^2 [s], its growth with the nodes, and the cost
 #: of a main-curve point with its C_f error estimate in plain points
-POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 0.50, 0.98, 1.28
+POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 0.56, 0.91, 1.28
 #: a ball's point at 73^2, started from its 37^2 guide (Newton coupling) [s], and its
 #: growth with the grid's side
 BALL_POINT_SECONDS, BALL_POINT_GROWTH = 3.5, 2.4
 #: a band point in main-curve points, by ``[run] band_grid`` (the band's sweeps converge to
 #: ``[run] band_tol`` and carry no error estimate; "coarse" runs them on the coarsened grid)
-BAND_POINT_COST = {"coarse": 0.14, "full": 0.54}
+BAND_POINT_COST = {"coarse": 0.22, "full": 0.54}
 #: a band point on a grid coarsened once more, against one on the grid before
-BAND_LEVEL_COST = 0.33
+BAND_LEVEL_COST = 0.24
 #: the Stribeck stage of the thermal twin (``[thermal] model = "flash"``) against the
 #: isothermal one: each point iterates its film temperature (from its guide's)
 THERMAL_COST = 1.25
 #: a pin's guide point (the sweep on its coarsest nested grid, 36-71 px a side, warm-started)
 #: [s]; a ball's in its points
-GUIDE_SECONDS, GUIDE_COST = 0.24, 0.15
-#: the share of the speeds a refinement pass adds, a pin's and a ball's: the bundled pin
-#: adds 6 of 12, the paper case 7 of 25, the bundled ball 1 of 12 (its C_f smoother over
-#: log speed)
-REFINED_SHARE = {False: 0.5, True: 0.1}
+GUIDE_SECONDS, GUIDE_COST = 0.21, 0.15
+#: the speeds a refinement pass adds to a curve, a pin's and a ball's, at most the curve's
+#: count: where C_f jumps, in the mixed regime, whatever the count of speeds (the bundled
+#: pin adds 6 to 12, the paper case 7 to 25, the bundled ball 1 to 12)
+REFINED_SPEEDS = {False: 7, True: 1}
 #: what the main process does alone at a 128^2 macro grid (geometry, levelling, reading
 #: the curves back, writing the results) [s], and its growth with the nodes
 SERIAL_SECONDS, SERIAL_GROWTH = 16.7, 0.66
@@ -76,7 +76,7 @@ def cost_tasks(case) -> list[Task]:
     h0 of each of :data:`H0_ROUNDS` rounds at ``MICRO_SECONDS`` per cell pixel, step and
     separation; per viscosity the sweep's guide, each point (a warm point of
     ``POINT_SECONDS``, a ball's of ``BALL_POINT_SECONDS``, with its error estimate), each
-    refined speed's guide point and point (:data:`REFINED_SHARE` of the speeds per pass),
+    refined speed's guide point and point (:data:`REFINED_SPEEDS` per pass),
     then the band's chains (:func:`_band_tasks`); last what the main process does alone."""
     micro = _micro_tasks(case)
     thermal = THERMAL_COST if case.thermal.model != "none" else 1.0
@@ -84,7 +84,7 @@ def cost_tasks(case) -> list[Task]:
     guide = GUIDE_COST * point if case.tribometer.ball else GUIDE_SECONDS * thermal
     estimate = 1.0 if case.tribometer.ball else ESTIMATE_COST
     count = case.sweep.count
-    added = int(round(count * REFINED_SHARE[case.tribometer.ball] * case.sweep.refine))
+    added = min(count, REFINED_SPEEDS[case.tribometer.ball]) * case.sweep.refine
     after, tasks, guides, again = tuple(t.name for t in micro), [], [], []
     if nested_levels(case.macro_shape) == 0:            # no coarser grid: chains of speeds
         tasks = [Task(f"sweep {v}", estimate * point * (count + added), after)
@@ -138,15 +138,16 @@ def _micro_tasks(case) -> list[Task]:
     if mc.h0_tol:
         a, k = ADAPTIVE_H0
         h0 = min(h0, a + k / math.sqrt(mc.h0_tol))
-    parts = halves(mc)
+    parts, total = halves(mc), max(H0_ROUNDS, int(round(h0)))
     seconds = MICRO_SECONDS * mc.resolution[0] * mc.resolution[1] * mc.steps / parts
-    per_round = max(1, int(round(h0 / H0_ROUNDS))) * parts
+    per_round = [(total // H0_ROUNDS + (r < total % H0_ROUNDS)) * parts
+                 for r in range(H0_ROUNDS)]
     tasks = []
     for k in range(len(case.geometry.patches)):
         before = ()
         for r in range(H0_ROUNDS):
             new = [Task(f"{MICRO} {k} round {r} h0 {i}", seconds, before)
-                   for i in range(per_round)]
+                   for i in range(per_round[r])]
             tasks += new
             before = tuple(t.name for t in new)
     return tasks

@@ -8,11 +8,11 @@ factorisations, a missing MKL), so before a run :func:`slowdown` times a miniatu
 of the micro stage (a 64^2 roughness patch pair, two separations, four instants: periodic
 contact and the three cell problems) and of a Stribeck point (a cold mixed point of a
 crowned 64^2 pin: the Reynolds Newton steps, the FFT half-space and the coupling), both
-with the sparse backend the run will use, and divides each by its time at the calibration.
-Each miniature runs in as many processes at once as the run has local workers (at most one
-a core), so a load on another core slows the probes as it will slow the workers.  It sees
-the machine for about two seconds, so the estimate carries the scatter of the machine's
-speed within a minute (benchmarks/README.md, "speed").
+with the sparse backend and the heap the run's workers will use, and divides each by its
+time at the calibration.  Each miniature runs in as many processes at once as the run has
+local workers (at most one a core), so a load on another core slows the probes as it will
+slow the workers.  It sees the machine for about two seconds, so the estimate carries the
+scatter of the machine's speed within a minute (benchmarks/README.md, "speed").
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from ..errors import InputError, SolverError
 from ..macro import Lubricant, MacroSettings, solve_mixed
 from ..macro.point_contact import PointContact
 from ..micro import FlowFactors, homogenise
-from ..numerics.threads import one_thread, quiet_worker
+from ..numerics.threads import one_thread, quiet_worker, worker_heap
 from ..topography.synthetic import self_affine
 
 #: the miniatures' times on the calibration machine, the hour the estimate's costs were
@@ -70,7 +70,10 @@ def probe_seconds(kind: str = "micro", repeats: int | None = None) -> float:
 
 def _timings(kind: str, repeats: int, before=None) -> list[float]:
     """The times [s] of ``repeats`` runs of the ``kind`` miniature, each after ``before()``
-    if given (built once, untimed)."""
+    if given (built once, untimed), on the workers' heap (:func:`worker_heap`: with glibc's
+    default one, grid-sized temporaries are fresh pages each time, and the pin's point ran
+    1.2x slower than in a worker)."""
+    worker_heap()
     work, times = _MINIATURES[kind](), []
     for _ in range(repeats):
         if before is not None:

@@ -1,0 +1,86 @@
+"""The ``estimates`` group: ``fem-twin run``'s printed estimate against its run.
+
+Each case of ``FEM_TWIN_ESTIMATE_CASES`` (default ``pin_on_disk,ball_on_disk,paper``) runs
+as a fresh ``fem-twin run`` in its own process, quiet, then (``FEM_TWIN_ESTIMATE_LOAD=1``)
+beside a busy loop on one core: a slower machine.  Printed per run: the wall time, the
+estimate over it, the probes' factors the run printed, and the factors its own task graph
+shows (its micro and macro tasks' CPU over the cost model's, :mod:`fem_twin.runtime.cost`):
+what the probes should have read.  The baseline is the first run.
+"""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from fem_twin.case import load_case
+from fem_twin.runtime.cost import MICRO, cost_tasks
+from fem_twin.runtime.taskgraph import run_task_graph
+
+ROOT = Path(__file__).resolve().parents[1]
+#: the probes' factors as ``fem-twin run`` prints them: one, or the cells' and the points'
+PRINTED = re.compile(r"takes ([\d.]+)x(?: for the cells and ([\d.]+)x for the macro points)?")
+
+
+def _busy():
+    """A busy loop, for the slower machine (stopped by its parent)."""
+    while True:
+        pass
+
+
+def _run(case: str, out: Path) -> tuple[float, dict, tuple[float, float]]:
+    """Wall time [s], summary and printed probe factors of one fresh run of ``case``."""
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-m", "fem_twin.cli", "run",
+                           str(ROOT / "examples" / f"{case}.toml"), "-o", str(out),
+                           "--no-progress", "--yes"], check=True, capture_output=True,
+                          text=True, cwd=ROOT)
+    wall = time.perf_counter() - start
+    micro, macro = PRINTED.search(done.stderr).groups()
+    probes = (float(micro), float(macro or micro))
+    return wall, json.loads((out / "summary.json").read_text()), probes
+
+
+def _own_factors(case: str, out: Path) -> tuple[float, float]:
+    """The run's micro and macro task CPU over the cost model's (the serial part aside)."""
+    c = load_case(ROOT / "examples" / f"{case}.toml")
+    ran, model = run_task_graph(c, out), cost_tasks(c)
+
+    def share(tasks, micro):
+        return sum(t.seconds for t in tasks if t.name.startswith(MICRO) == micro
+                   and t.name != "serial")
+    return share(ran, True) / share(model, True), share(ran, False) / share(model, False)
+
+
+def bench_estimates():
+    """Rows: per case (and load), its run with the estimate's ratio and factors."""
+    cases = os.environ.get("FEM_TWIN_ESTIMATE_CASES",
+                           "pin_on_disk,ball_on_disk,paper").split(",")
+    loads = [False, True] if os.environ.get("FEM_TWIN_ESTIMATE_LOAD") == "1" else [False]
+    rows, base = [], None
+    with tempfile.TemporaryDirectory() as tmp:
+        for loaded in loads:
+            for case in cases:
+                busy = multiprocessing.Process(target=_busy, daemon=True) if loaded else None
+                if busy:
+                    busy.start()
+                try:
+                    wall, summary, probes = _run(case, Path(tmp) / f"{case}_{loaded}")
+                finally:
+                    if busy:
+                        busy.terminate()
+                own = _own_factors(case, Path(tmp) / f"{case}_{loaded}")
+                base = wall if base is None else base
+                rows.append((f"{case}{', beside a busy loop' if loaded else ''}", wall,
+                             f"estimate {summary['estimated_s']:.1f} s = "
+                             f"{summary['estimated_s'] / wall:.2f}x the run; probes "
+                             f"{probes[0]:.2f}x, {probes[1]:.2f}x; its tasks "
+                             f"{own[0]:.2f}x, {own[1]:.2f}x (cells, macro)"))
+    return base, rows
