@@ -97,7 +97,7 @@ def test_implausible_case_values_are_refused_naming_the_key(tmp_path, old, new, 
 @pytest.mark.parametrize("slowdown", ["0.25", "4"])
 def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, capsys,
                                                                       monkeypatch, slowdown):
-    """A case cut off after [geometry] (here with 60 speeds) is valid TOML;
+    """A case cut off after [geometry] (here with 100 speeds) is valid TOML;
     the defaults (the paper's 256^2 macro grid, cells at 128^2, 100 h0 x 32 steps) are
     named before work starts, and a run estimated at more than seven times the bundled case
     stops with exit 2 unless --yes is given.
@@ -110,7 +110,7 @@ def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, 
     text = (ROOT / "examples" / "pin_on_disk.toml").read_text()
     text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
     cut = tmp_path / "cut.toml"
-    cut.write_text(text[:text.index("[preprocessing]")] + "[sweep]\ncount = 60\n")
+    cut.write_text(text[:text.index("[preprocessing]")] + "[sweep]\ncount = 100\n")
     assert estimated_seconds(load_case(cut), 2) > LONG_RUN_SECONDS
     assert main(["run", str(cut), "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
