@@ -679,8 +679,9 @@ def test_a_sweeps_points_run_in_parallel_from_its_guide(factors, tmp_path):
     own, started from the guide's point there.  Into the mixed regime (sample pin 1 at
     96^2, 0.1 -> 0.02 m/s) its C_f equals the chained sweep's within ten times the coupling
     tolerance (measured: 1.0e-7 C_f,b at tol 1e-6), bit for bit on one worker and on two, and
-    the run's task graph has each point as a task after the guide: its critical path is the
-    guide and the longest point."""
+    the run's task graph has each point as a task after the guide's point there (the guide a
+    chain of points, fast to slow): its critical path is the longest guide prefix and
+    point."""
     from dataclasses import replace
 
     from fem_twin.numerics.threads import executor_for
@@ -709,7 +710,12 @@ def test_a_sweeps_points_run_in_parallel_from_its_guide(factors, tmp_path):
     assert [p.speed for p in points] == list(speeds) and {p.sweep for p in points} == {0}
     assert all(p.meta[GUIDED_BY] == guide.key for p in points)
     tasks = sweep_tasks(tmp_path / "one", speeds, (), refine=False)
-    lead = next(t for t in tasks if t.name == f"sweep {guide.key}")
-    points = [t for t in tasks if t.name.startswith("point")]
-    assert len(points) == 4 and all(t.after == (lead.name,) for t in points)
-    assert critical_path(tasks) == pytest.approx(lead.seconds + max(t.seconds for t in points))
+    chain = {t.name: t for t in tasks if t.name.startswith(f"sweep {guide.key}")}
+    points = sorted((t for t in tasks if t.name.startswith("point")),
+                    key=lambda t: -float(t.name.split()[-1]))
+    assert len(chain) == 4 and len(points) == 4
+    assert [t.after for t in points] == [(f"sweep {guide.key} {u:.9e}",) for u in speeds]
+    assert [chain[t.after[0]].after for t in points[1:]] == [t.after for t in points[:-1]]
+    reached = np.cumsum([chain[t.after[0]].seconds for t in points])      # fast to slow
+    assert critical_path(tasks) == pytest.approx(max(
+        reached + [t.seconds for t in points]))

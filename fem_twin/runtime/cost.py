@@ -74,8 +74,9 @@ def cost_tasks(case) -> list[Task]:
     """The run's work as tasks with their seconds on one core of the calibration machine,
     as the run's own task graph has them (:mod:`fem_twin.runtime.taskgraph`): per patch pair the
     h0 of each of :data:`H0_ROUNDS` rounds at ``MICRO_SECONDS`` per cell pixel, step and
-    separation; per viscosity the sweep's guide, each point (a warm point of
-    ``POINT_SECONDS``, a ball's of ``BALL_POINT_SECONDS``, with its error estimate), each
+    separation; per viscosity the sweep's guide, a chain of points, each point after its
+    guide's point there (a warm point of ``POINT_SECONDS``, a ball's of
+    ``BALL_POINT_SECONDS``, with its error estimate), each
     refined speed's guide point and point (:data:`REFINED_SPEEDS` per pass),
     then the band's chains (:func:`_band_tasks`); last what the main process does alone."""
     micro = _micro_tasks(case)
@@ -91,10 +92,14 @@ def cost_tasks(case) -> list[Task]:
                  for v in range(len(case.lubricant.viscosities))]
         return micro + tasks + _serial(case, micro + tasks)
     for v in range(len(case.lubricant.viscosities)):
-        guides.append(Task(f"guide {v}", guide * count, after))
-        first = [Task(f"point {v} {i}", estimate * point, (guides[-1].name,))
+        chain = []                                  # the guide's points, fast to slow
+        for i in range(count):
+            chain.append(Task(f"guide {v} point {i}", guide,
+                              (chain[-1].name,) if chain else after))
+        guides.append(chain[-1])
+        first = [Task(f"point {v} {i}", estimate * point, (chain[i].name,))
                  for i in range(count)]
-        tasks += [guides[-1], *first]
+        tasks += [*chain, *first]
         for i in range(added):                 # a refined speed: its guide point, then it
             again.append(Task(f"guide {v} {count + i}", guide,
                               tuple(t.name for t in first)))

@@ -100,10 +100,10 @@ def _halves(moments) -> list:
 def sweep_tasks(folder, first, micro: tuple[str, ...], *, ball: bool = False,
                 refine: bool = True, band_beside: bool = False) -> list[Task]:
     """The sweeps checkpointed in ``folder``, after the tasks ``micro``: the first passes
-    over the speeds ``first`` (all speeds where None; a guide's chain, then each of its
-    points a task; or a sweep as one chain), then the refinement's, then the band's (the
-    nested levels the main points kept for the band are part of those points), after the
-    main points or, with ``band_beside``, beside them
+    over the speeds ``first`` (all speeds where None; a guide's chain of points, each of its
+    guided points a task after the guide's point there; or a sweep as one chain), then the
+    refinement's, then the band's (the nested levels the main points kept for the band are
+    part of those points), after the main points or, with ``band_beside``, beside them
     (:meth:`~fem_twin.case.Case.band_after_guides`)."""
     chains, points = defaultdict(list), []
     for path in point_files(folder):
@@ -124,9 +124,15 @@ def sweep_tasks(folder, first, micro: tuple[str, ...], *, ball: bool = False,
     def in_first(u) -> bool:
         return first is None or bool(np.isclose(u, first, rtol=1e-9).any())
 
-    passes = [Task(f"sweep {k}", sum(s for u, s, _ in v if in_first(u)), micro)
-              for k, v in main.items()]
-    ahead = [Task(f"point {k} {u:.9e}", s, (f"sweep {g}",))
+    passes, ends = [], {}
+    for k, v in main.items():
+        first_pass = [(u, s) for u, s, _ in v if in_first(u)]
+        passes += (_guide_chain(k, first_pass, micro) if k in guides else
+                   [Task(f"sweep {k}", sum(s for _, s in first_pass), micro)])
+        ends[k] = passes[-1].name
+    names = {t.name for t in passes}
+    ahead = [Task(f"point {k} {u:.9e}", s, (f"sweep {g} {u:.9e}"
+                                            if f"sweep {g} {u:.9e}" in names else ends[g],))
              for k, u, s, g in points if in_first(u)]
     done = tuple(t.name for t in passes + ahead)
     refined = [Task(f"refinement {k}", sum(s for u, s, _ in v if not in_first(u)), done)
@@ -138,19 +144,29 @@ def sweep_tasks(folder, first, micro: tuple[str, ...], *, ball: bool = False,
     band = {k: v for k, v in chains.items() if k not in main}
     if band_beside:
         return passes + ahead + refined + later + _band_beside(
-            band, guides, in_first, {t.name for t in refined})
+            band, guides, in_first, {t.name for t in refined}, ends)
     band_after = tuple(t.name for t in refined + later) if refine else done
     return passes + ahead + refined + later + [
         Task(f"band sweep {k}", sum(s for _, s, _ in v), band_after) for k, v in band.items()]
 
 
-def _band_beside(band: dict, guides: set, in_first, refined: set) -> list[Task]:
+def _guide_chain(key: str, speeds, after: tuple[str, ...]) -> list[Task]:
+    """A guide's first pass ``[(speed, seconds)]`` as a chain of point tasks, fast to slow
+    (each guided point starts once its guide's point is checkpointed)."""
+    tasks = []
+    for u, s in sorted(speeds, key=lambda p: -p[0]):
+        tasks.append(Task(f"sweep {key} {u:.9e}", s, (tasks[-1].name,) if tasks else after))
+    return tasks
+
+
+def _band_beside(band: dict, guides: set, in_first, refined: set, ends: dict) -> list[Task]:
     """The band's chains where they start from the guides: each first pass after the
-    guides' first passes, each refined speed after the band's first pass and the guides'
-    points there (among the ``refined`` task names).  The curves of all viscosities share
-    their speeds, so a band sweep waits for every guide, not only its viscosity's."""
+    guides' first passes (their last tasks, ``ends``), each refined speed after the band's
+    first pass and the guides' points there (among the ``refined`` task names).  The
+    curves of all viscosities share their speeds, so a band sweep waits for every guide,
+    not only its viscosity's."""
     tasks = [Task(f"band sweep {k}", sum(s for u, s, _ in v if in_first(u)),
-                  tuple(f"sweep {g}" for g in guides)) for k, v in band.items()]
+                  tuple(ends[g] for g in guides)) for k, v in band.items()]
     return tasks + [Task(f"band refinement {k} {u:.9e}", s, (f"band sweep {k}", *(
         name for g in guides if (name := f"refinement {g} {u:.9e}") in refined)))
                     for k, v in band.items() for u, s, _ in v if not in_first(u)]

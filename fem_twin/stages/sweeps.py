@@ -61,7 +61,8 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     in the order of ``tasks`` and the index of their checkpointed points (:class:`Swept`).
     ``followers``: sweeps that start from the guides' points (the patch band), run beside
     the guided points as chains of their missing speeds (:func:`missing_chains`) and left
-    in their checkpoints.
+    in their checkpoints.  On a pool each guided sweep starts as soon as its guide's points
+    at its speeds are checkpointed, not after every guide (:func:`_run`).
 
     A checkpointed sweep without a guide runs as guided points: first its guide
     (:func:`guide_of`, a chain on the coarsest nested grid), then every speed a task of its
@@ -76,11 +77,10 @@ def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribec
     unguided = [i for i, guide in enumerate(guides) if guide is None]
     pieces = chains([tasks[i] for i in unguided], workers)     # (index in unguided, piece)
     leading = [piece for g in guides if g is not None for piece in missing_chains(g)]
-    swept = _run(leading + [piece for _, piece in pieces], executor, progress,
-                 desc)[len(leading):]
-    _run([point for i, (task, guide) in enumerate(zip(tasks, guides)) if i not in unguided
-          for point in guided_points(task, guide.key)]
-         + [piece for f in followers for piece in missing_chains(f)], executor, progress, desc)
+    swept = _run(leading + [piece for _, piece in pieces], executor, progress, desc,
+                 [point for i, (task, guide) in enumerate(zip(tasks, guides))
+                  if i not in unguided for point in guided_points(task, guide.key)]
+                 + [piece for f in followers for piece in missing_chains(f)])[len(leading):]
     own = {}
     for (j, _), curve in zip(pieces, swept):
         own.setdefault(unguided[j], []).append(curve)
@@ -126,26 +126,45 @@ def guided_points(request, guide: str) -> list:
             if not point_file(request.checkpoint, key, request.speeds[i]).exists()]
 
 
-def _run(requests, executor, progress: bool, desc: str) -> list:
-    """The sweeps ``requests``, serial or on ``executor`` largest first (:func:`_cost`); the
-    bar counts their finished points (checkpoint files, written as each point finishes)."""
-    if executor is None or len(requests) <= 1:
-        if len(requests) == 1:
-            return [_sweep_task((requests[0], progress))]
-        return [_sweep_task((r, False)) for r in tqdm(requests, desc=desc, unit="task",
-                                                      disable=not progress)]
+def _run(requests, executor, progress: bool, desc: str, guided=()) -> list:
+    """The sweeps ``requests``, serial or on ``executor`` largest first (:func:`_cost`), and
+    the ``guided`` ones after them, each submitted once its guide's points are checkpointed
+    (:func:`_guide_done`) or nothing else runs, none after a failure; the results of
+    ``requests``.  The bar counts their finished points (checkpoint files, written as each
+    point finishes)."""
+    if executor is None or len(requests) + len(guided) <= 1:
+        everything = [*requests, *guided]
+        bar = tqdm(everything, desc=desc, unit="task", disable=not progress or len(
+            everything) == 1)
+        return [_sweep_task((r, progress and len(everything) == 1)) for r in bar][
+            :len(requests)]
     order = sorted(range(len(requests)), key=lambda j: -sweep_cost(requests[j]))
     submitted = {j: executor.submit(_sweep_task, (requests[j], False)) for j in order}
     futures = [submitted[j] for j in range(len(requests))]
-    total = sum(r.speeds.size for r in requests)
-    keys = {r.key for r in requests if r.factors_key and r.checkpoint is not None}
-    folders = {r.checkpoint for r in requests if r.checkpoint is not None}
+    running, waiting = list(futures), list(guided)
+    every = [*requests, *guided]
+    total = sum(r.speeds.size for r in every)
+    keys = {r.key for r in every if r.factors_key and r.checkpoint is not None}
+    folders = {r.checkpoint for r in every if r.checkpoint is not None}
     with tqdm(total=total, desc=desc, unit="point", disable=not progress) as bar:
-        while wait(futures, timeout=0.5).not_done:            # the bar, twice a second
+        while (busy := wait(running, timeout=0.5).not_done) or waiting:
+            if any(f.done() and f.exception() is not None for f in running):
+                waiting = []                                  # raised below
+            ready = [r for r in waiting if not busy or _guide_done(r)]
+            running += [executor.submit(_sweep_task, (r, False)) for r in ready]
+            waiting = [r for r in waiting if not any(r is q for q in ready)]
             done = sum(point_key(p) in keys for f in folders for p in point_files(f))
             bar.update(min(done, total) - bar.n)
         bar.update(total - bar.n)
+    for future in running:
+        future.result()
     return [f.result() for f in futures]
+
+
+def _guide_done(request) -> bool:
+    """Whether the points of ``request``'s guide at its speeds are all checkpointed."""
+    return request.guide is None or all(point_file(request.checkpoint, request.guide, u).exists()
+               for u in request.speeds)
 
 
 def chains(tasks, workers: int) -> list:
