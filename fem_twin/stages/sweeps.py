@@ -163,8 +163,8 @@ def _run(requests, executor, progress: bool, desc: str, guided=()) -> list:
 
 def _guide_done(request) -> bool:
     """Whether the points of ``request``'s guide at its speeds are all checkpointed."""
-    return request.guide is None or all(point_file(request.checkpoint, request.guide, u).exists()
-               for u in request.speeds)
+    guide, folder = request.guide, request.checkpoint
+    return guide is None or all(point_file(folder, guide, u).exists() for u in request.speeds)
 
 
 def chains(tasks, workers: int) -> list:
