@@ -283,3 +283,18 @@ def test_the_probes_time_on_the_workers_heap():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           check=True)
     assert done.stdout.strip() == "True"
+
+
+def test_more_local_workers_than_cores_share_them(monkeypatch):
+    """Local workers beyond the machine's cores share its cores: the bundled case with
+    ``[run] workers = 64`` is estimated as on all the cores there are (a ball run with 4
+    workers on 2 cores was estimated at 29 s and took 57 s)."""
+    from dataclasses import replace
+
+    import fem_twin.runtime.machine as speed
+    from fem_twin.cli.runs import _confirm_cost
+    monkeypatch.setattr(speed, "probe_together", lambda kind, n: speed.REFERENCE_SECONDS[kind])
+    case = load_case(ROOT / "examples" / "pin_on_disk.toml")
+    many, own = (_confirm_cost(replace(case, run=replace(case.run, workers=n)), yes=True)
+                 for n in (64, os.cpu_count() or 1))
+    assert many == pytest.approx(own)
