@@ -12,15 +12,13 @@ first case's run on the base.
 
 from __future__ import annotations
 
-import json
 import os
 import subprocess
-import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+from common import run_case
 
 from fem_twin.case import load_case
 from fem_twin.stribeck.curve import read_stribeck_csv
@@ -31,11 +29,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def _run(tree: Path, case: str, out: Path) -> tuple[float, dict]:
     """Wall time [s] and summary of ``fem-twin run examples/CASE.toml`` in ``tree``."""
     env = {**os.environ, "PYTHONPATH": str(tree)}
-    start = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "fem_twin.cli", "run",
-                    str(tree / "examples" / f"{case}.toml"), "-o", str(out), "--no-progress",
-                    "--yes"], check=True, capture_output=True, text=True, cwd=tree, env=env)
-    return time.perf_counter() - start, json.loads((out / "summary.json").read_text())
+    return run_case(tree / "examples" / f"{case}.toml", out, tree, env)[:2]
 
 
 def _change(base: Path, new: Path, boundary_friction: float) -> str:

@@ -1,10 +1,15 @@
 """What the benchmark groups share: the bundled sample's maps, the best of repeated
-timings, and the macro groups' inputs (sample pin 1 on disk 1, patch 1's flow factors)."""
+timings, a fresh ``fem-twin run`` of a case file, and the macro groups' inputs (sample pin 1
+on disk 1, patch 1's flow factors)."""
 
 from __future__ import annotations
 
+import json
 import os
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -24,6 +29,17 @@ def best_of(fn, repeat=3):
         out = fn()
         times.append(time.perf_counter() - t0)
     return min(times), out
+
+
+def run_case(case: Path, out: Path, cwd: Path, env=None) -> tuple[float, dict, str]:
+    """Wall time [s], ``summary.json`` and standard error of one fresh ``fem-twin run`` of
+    the case file ``case`` into ``out``, in a process of its own (in ``cwd``, with ``env``)."""
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-m", "fem_twin.cli", "run", str(case), "-o",
+                           str(out), "--no-progress", "--yes"], check=True,
+                          capture_output=True, text=True, cwd=cwd, env=env)
+    return (time.perf_counter() - start, json.loads((out / "summary.json").read_text()),
+            done.stderr)
 
 
 def macro_factors():

@@ -11,13 +11,11 @@ predicts on 16 and 64 workers.  The baseline is the one-worker run.
 from __future__ import annotations
 
 import importlib.util
-import json
 import os
-import subprocess
-import sys
 import tempfile
-import time
 from pathlib import Path
+
+from common import run_case
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -37,12 +35,7 @@ def _case(folder: Path, workers: int, dask: bool) -> Path:
 def _run(folder: Path, workers: int, dask: bool = False) -> tuple[float, dict]:
     """Wall time [s] of one run and its summary."""
     out = folder / f"out_{workers}{'_dask' * dask}"
-    start = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "fem_twin.cli", "run",
-                    str(_case(folder, workers, dask)),
-                    "-o", str(out), "--no-progress", "--yes"], check=True,
-                   capture_output=True, text=True)
-    return time.perf_counter() - start, json.loads((out / "summary.json").read_text())
+    return run_case(_case(folder, workers, dask), out, ROOT)[:2]
 
 
 def bench_cores():

@@ -10,15 +10,13 @@ what the probes should have read.  The baseline is the first run.
 
 from __future__ import annotations
 
-import json
 import multiprocessing
 import os
 import re
-import subprocess
-import sys
 import tempfile
-import time
 from pathlib import Path
+
+from common import run_case
 
 from fem_twin.case import load_case
 from fem_twin.runtime.cost import MICRO, cost_tasks
@@ -37,15 +35,9 @@ def _busy():
 
 def _run(case: str, out: Path) -> tuple[float, dict, tuple[float, float]]:
     """Wall time [s], summary and printed probe factors of one fresh run of ``case``."""
-    start = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "fem_twin.cli", "run",
-                           str(ROOT / "examples" / f"{case}.toml"), "-o", str(out),
-                           "--no-progress", "--yes"], check=True, capture_output=True,
-                          text=True, cwd=ROOT)
-    wall = time.perf_counter() - start
-    micro, macro = PRINTED.search(done.stderr).groups()
-    probes = (float(micro), float(macro or micro))
-    return wall, json.loads((out / "summary.json").read_text()), probes
+    wall, summary, printed = run_case(ROOT / "examples" / f"{case}.toml", out, ROOT)
+    micro, macro = PRINTED.search(printed).groups()
+    return wall, summary, (float(micro), float(macro or micro))
 
 
 def _own_factors(case: str, out: Path) -> tuple[float, float]:
@@ -71,12 +63,13 @@ def bench_estimates():
                 busy = multiprocessing.Process(target=_busy, daemon=True) if loaded else None
                 if busy:
                     busy.start()
+                out = Path(tmp) / f"{case}_{loaded}"
                 try:
-                    wall, summary, probes = _run(case, Path(tmp) / f"{case}_{loaded}")
+                    wall, summary, probes = _run(case, out)
                 finally:
                     if busy:
                         busy.terminate()
-                own = _own_factors(case, Path(tmp) / f"{case}_{loaded}")
+                own = _own_factors(case, out)
                 base = wall if base is None else base
                 rows.append((f"{case}{', beside a busy loop' if loaded else ''}", wall,
                              f"estimate {summary['estimated_s']:.1f} s = "

@@ -34,9 +34,10 @@ def _confirm_cost(case, yes: bool) -> float | None:
     if case.defaulted:
         print(f"fem-twin run: sections not in {case.source.name}, defaults used: " + ", ".join(
             f"[{s}]" for s in case.defaulted), file=sys.stderr)
-    cores, local = case.run.workers or os.cpu_count() or 1, case.run.scheduler in (None, "local")
+    machine, local = os.cpu_count() or 1, case.run.scheduler in (None, "local")
+    cores = case.run.workers or machine
     if local:                                   # more processes than cores share them
-        cores = min(cores, os.cpu_count() or 1)
+        cores = min(cores, machine)
     speed = slowdown(case.tribometer.ball, cores if local else 1)
     calibration = estimated_seconds(case, cores)
     seconds = estimated_seconds(case, cores, speed)

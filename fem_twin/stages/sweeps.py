@@ -132,17 +132,15 @@ def _run(requests, executor, progress: bool, desc: str, guided=()) -> list:
     (:func:`_guide_done`) or nothing else runs, none after a failure; the results of
     ``requests``.  The bar counts their finished points (checkpoint files, written as each
     point finishes)."""
-    if executor is None or len(requests) + len(guided) <= 1:
-        everything = [*requests, *guided]
-        bar = tqdm(everything, desc=desc, unit="task", disable=not progress or len(
-            everything) == 1)
-        return [_sweep_task((r, progress and len(everything) == 1)) for r in bar][
-            :len(requests)]
+    every = [*requests, *guided]
+    if executor is None or len(every) <= 1:
+        single = len(every) == 1                      # its own bar, by points
+        bar = tqdm(every, desc=desc, unit="task", disable=not progress or single)
+        return [_sweep_task((r, progress and single)) for r in bar][:len(requests)]
     order = sorted(range(len(requests)), key=lambda j: -sweep_cost(requests[j]))
     submitted = {j: executor.submit(_sweep_task, (requests[j], False)) for j in order}
     futures = [submitted[j] for j in range(len(requests))]
     running, waiting = list(futures), list(guided)
-    every = [*requests, *guided]
     total = sum(r.speeds.size for r in every)
     keys = {r.key for r in every if r.factors_key and r.checkpoint is not None}
     folders = {r.checkpoint for r in every if r.checkpoint is not None}
@@ -150,9 +148,10 @@ def _run(requests, executor, progress: bool, desc: str, guided=()) -> list:
         while (busy := wait(running, timeout=0.5).not_done) or waiting:
             if any(f.done() and f.exception() is not None for f in running):
                 waiting = []                                  # raised below
-            ready = [r for r in waiting if not busy or _guide_done(r)]
-            running += [executor.submit(_sweep_task, (r, False)) for r in ready]
-            waiting = [r for r in waiting if not any(r is q for q in ready)]
+            ready = [not busy or _guide_done(r) for r in waiting]
+            running += [executor.submit(_sweep_task, (r, False))
+                        for r, go in zip(waiting, ready) if go]
+            waiting = [r for r, go in zip(waiting, ready) if not go]
             done = sum(point_key(p) in keys for f in folders for p in point_files(f))
             bar.update(min(done, total) - bar.n)
         bar.update(total - bar.n)
