@@ -18,6 +18,7 @@ from fem_twin.cli import main
 from fem_twin.io.layout import RunLayout
 from fem_twin.micro import FlowFactors
 from fem_twin.stribeck.curve import read_stribeck_csv
+from fem_twin.stribeck.sweep import point_key, point_meta
 
 
 @pytest.mark.integration
@@ -182,6 +183,31 @@ def test_damaged_results_are_set_aside_and_recomputed(tmp_path):
         assert damaged.is_file()                                        # recomputed
     log = (out / "run.log").read_text()
     assert log.count("unreadable result") == 3
+
+
+@pytest.mark.integration
+def test_a_damaged_guide_point_of_a_finished_run_is_recomputed(tmp_path):
+    """On a 72^2 grid each sweep has a guide on its 36^2 level: a truncated point of a
+    guide (which no later point reads once every guided point is done) and one of a guided
+    sweep are set aside and recomputed on the rerun, which exits 0 with the same CSV, where
+    the task graph's summary read the guide's file unguarded."""
+    case = small_case(tmp_path)
+    case.write_text(case.read_text().replace("resolution = [48, 48]", "resolution = [72, 72]"))
+    out = tmp_path / "out"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    before = (out / "stribeck.csv").read_text()
+    folder = out / "stribeck" / "checkpoints"
+    guided = sorted(folder.glob("point_*.npz"))[1]
+    with np.load(guided) as data:
+        guide = json.loads(str(data["meta"]))["guided_by"]
+    damaged = [sorted(folder.glob(f"point_{guide}_*.npz"))[2], guided]
+    for path in damaged:
+        path.write_bytes(path.read_bytes()[:200])
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    assert (out / "stribeck.csv").read_text() == before
+    for path in damaged:
+        assert path.with_name(path.name + ".corrupt").is_file(), path
+        assert point_meta(path)[1]["made_for"]["key"] == point_key(path)     # recomputed
 
 
 @pytest.mark.integration

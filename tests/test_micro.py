@@ -692,3 +692,15 @@ def test_a_separations_instants_run_as_two_halves():
         for k in one:
             assert np.allclose(m[k], one[k], rtol=1e-13, atol=0)
             assert np.array_equal(m["half_" + k], half[k])
+
+
+def test_non_finite_cell_moments_are_reported_as_the_cells_failure(monkeypatch):
+    """A NaN the cells make is a SolverError naming the moment and h0, not an InputError
+    that blames the caller's FlowFactors."""
+    from fem_twin.errors import InputError, SolverError
+    from fem_twin.micro import sliding
+    monkeypatch.setattr(sliding, "mean_inverse_film", lambda gap, cut: np.nan)
+    pin, disk = rough_pair(16)
+    with pytest.raises(SolverError, match="non-finite s_c at h0 = 5e-07") as caught:
+        homogenise(pin, disk, [5e-7], n_steps=2, error_estimate=False)
+    assert not isinstance(caught.value, InputError)

@@ -29,10 +29,11 @@ def _antiderivative(h, cut):
 
 def _triangle_means(a, b, c, cut):
     """``G[a, b, c]`` [1/m] of each triangle's nodal films (arrays of one shape): half the
-    triangle's mean of ``1/h`` above ``cut``."""
+    triangle's mean of ``1/h`` above ``cut``, zero where no node is above it (a plastic
+    spot's raw gap is negative: the relative closeness takes ``|hi + lo|``)."""
     lo, mid, hi = np.sort(np.stack([a, b, c]), axis=0)
     spread = hi - lo
-    close = spread <= NEAR_EQUAL * (hi + lo) / 2
+    close = spread <= NEAR_EQUAL * np.abs(hi + lo) / 2
     mean = (a + b + c) / 3
     midpoint = np.where(mean > cut, 1 / np.where(mean > 0, mean, 1.0), 0.0) / 2
     G_lo, G_mid, G_hi = (_antiderivative(v, cut) for v in (lo, mid, hi))
@@ -44,7 +45,7 @@ def _triangle_means(a, b, c, cut):
         first_hi = np.where(hi - mid > 0, first_hi, slope)
         first_lo = np.where(mid - lo > 0, first_lo, slope)
         exact = (first_hi - first_lo) / np.where(close, 1.0, spread)
-    return np.where(close, midpoint, exact)
+    return np.where(hi <= cut, 0.0, np.where(close, midpoint, exact))
 
 
 def mean_inverse_film(gap, cut: float) -> float:

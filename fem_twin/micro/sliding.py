@@ -23,7 +23,7 @@ from .. import tables as T
 from ..checks import arguments, check_choices, check_ranges, setting
 from ..contact import contact_rate
 from ..contact import solve as contact_solve
-from ..errors import InputError
+from ..errors import InputError, SolverError
 from .cell_fv import CellSolverFV
 from .film import mean_inverse_film
 from .flow_factors import FlowFactors
@@ -345,7 +345,12 @@ def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
     """Eqs 11-16 from space-time averaged moments (see :meth:`CellSolver.moments`);
     ``prefix="half_"`` takes the averages over every other instant."""
     def get(key):
-        return np.array([m[prefix + key] for m in moments])
+        values = np.array([m[prefix + key] for m in moments])
+        bad = ~np.isfinite(values).reshape(len(values), -1).all(axis=1)
+        if bad.any():                                  # the cells' own failure, not input
+            raise SolverError(f"the cell problems gave a non-finite {prefix + key} at h0 = "
+                              f"{np.asarray(h0)[bad][0]:.4g} m; please report it")
+        return values
 
     h_m = get("h")
     spread = {}

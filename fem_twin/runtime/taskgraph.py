@@ -26,7 +26,7 @@ from ..micro import FlowFactors
 from ..micro.sampling import adaptive_separations
 from ..micro.sliding import factors_from_moments
 from ..micro.store import load_point
-from ..stribeck.sweep import GUIDED_BY, LEVEL_OF, point_files, point_key, point_meta
+from ..stribeck.sweep import GUIDED_BY, LEVEL_OF, point_files, point_key, readable_meta
 from .schedule import Task, critical_path, makespan
 
 
@@ -107,7 +107,9 @@ def sweep_tasks(folder, first, micro: tuple[str, ...], *, ball: bool = False,
     (:meth:`~fem_twin.case.Case.band_after_guides`)."""
     chains, points = defaultdict(list), []
     for path in point_files(folder):
-        scalars, meta = point_meta(path)
+        if (read := readable_meta(path)) is None:          # set aside: the next run redoes it
+            continue
+        scalars, meta = read
         if LEVEL_OF in meta:
             continue
         speed = meta.get("entrainment") if ball else scalars["speed"]

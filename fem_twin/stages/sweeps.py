@@ -16,7 +16,7 @@ from ..numerics.threads import worker_heap
 from ..runtime.cost import sweep_cost
 from ..stribeck import stribeck_sweep
 from ..stribeck.curve import joined
-from ..stribeck.sweep import point_file, point_files, point_key, point_meta
+from ..stribeck.sweep import checkpointed, point_file, point_files, point_key, readable_meta
 
 
 @dataclass(frozen=True)
@@ -48,7 +48,9 @@ def point_index(tasks) -> tuple[SweptPoint, ...]:
             continue
         found = []
         for path in point_files(task.checkpoint, task.key):
-            scalars, meta = point_meta(path)
+            if (read := readable_meta(path)) is None:
+                continue
+            scalars, meta = read
             found.append(SweptPoint(i, task.motion.sweep_speed(scalars["speed"], meta), path,
                                     meta))
         out += sorted(found, key=lambda p: -p.speed)
@@ -104,7 +106,7 @@ def missing_chains(sweep) -> list:
     (a first pass), else each run of missing speeds after the checkpointed point before it
     (a refinement's midpoints, side by side)."""
     key = sweep.key
-    have = [point_file(sweep.checkpoint, key, u).exists() for u in sweep.speeds]
+    have = [checkpointed(sweep.checkpoint, key, u) for u in sweep.speeds]
     if all(have):
         return []
     if not any(have):
@@ -123,7 +125,7 @@ def guided_points(request, guide: str) -> list:
     keep = 0 if kept == guide else request.keep_level
     return [replace(request, speeds=request.speeds[i:i + 1], guide=guide, fields=None,
                     keep_level=keep) for i in range(request.speeds.size)
-            if not point_file(request.checkpoint, key, request.speeds[i]).exists()]
+            if not checkpointed(request.checkpoint, key, request.speeds[i])]
 
 
 def _run(requests, executor, progress: bool, desc: str, guided=()) -> list:

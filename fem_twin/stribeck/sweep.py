@@ -57,6 +57,21 @@ def load_point(path, key: str, speed: float):
     return load_or_none(path, loader)
 
 
+def checkpointed(folder, key: str, speed: float) -> bool:
+    """Whether the point of the sweep ``key`` at ``speed`` is checkpointed in ``folder``:
+    its file exists and its metadata reads and names it; a damaged or foreign file is set
+    aside (:func:`fem_twin.io.checkpoint.load_or_none`) and the point counts as missing."""
+    def loader(path):
+        check_made_for(point_meta(path)[1], key, speed, path)
+        return True
+    return bool(load_or_none(point_file(folder, key, speed), loader))
+
+
+def readable_meta(path) -> tuple[dict, dict] | None:
+    """:func:`point_meta` of ``path``, or None where the file is damaged (then set aside)."""
+    return load_or_none(path, point_meta)
+
+
 def point_key(path) -> str:
     """The sweep key of a point checkpoint (:func:`point_file`)."""
     return Path(path).name.split("_")[1]
