@@ -21,13 +21,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 from scipy.optimize import brentq
 
 from .. import tables as T
-from ..checks import as_field, as_pair, number, plausible, setting
+from ..checks import as_field, as_pair, check_choices, number, plausible, setting
 from ..contact import solve as contact_solve
 from ..contact.elastic import elastic_operator
-from ..errors import InputError, NotConverged
+from ..errors import InputError, NotConverged, ReynoldsNotConverged
 from ..micro.sliding import CellSettings
 from ..numerics.anderson import Anderson
 from .cavitation import cavitation_model
@@ -41,8 +42,9 @@ __all__ = ["DeterministicNotConverged", "DeterministicResult", "DeterministicSet
 
 
 #: Anderson mixing of the film's deformation, viscosity and density (the micro-EHL
-#: coupling): depth and damping
-ANDERSON_DEPTH, ANDERSON_DAMPING = 6, 0.5
+#: coupling): depth and damping; a pass whose change is ``GROWTH`` times the smallest so
+#: far steps back (:class:`_Mixing`)
+ANDERSON_DEPTH, ANDERSON_DAMPING, GROWTH = 6, 0.5, 10.0
 
 
 class DeterministicNotConverged(NotConverged):
@@ -66,6 +68,10 @@ class DeterministicSettings:
                                      "film_on_contacts and thin_films)", unit="-")
     film_deforms: bool = setting(True, "the film pressure deforms the surfaces (False: the "
                                  "asperities feel their contact pressure alone)", unit="-")
+    sides: str = setting("open", "the pad's edges along x1 (x2 = 0 and L2) at ambient "
+                         "pressure, or walls that no flow crosses (a strip of a wide pad: "
+                         "an x2-invariant gap then gives the 1-D solution)",
+                         choices=("open", "sealed"))
     tol: float = setting(1e-7, "log load residual; the film's deformation per micrometre, "
                          "log viscosity and density ratio changes", unit="-")
     contact_tol: float = setting(1e-9, "tolerance of each contact solve", unit="-")
@@ -76,6 +82,7 @@ class DeterministicSettings:
         plausible("e_reduced [Pa]", self.e_reduced, "reduced_modulus")
         plausible("hardness [Pa]", self.hardness, "hardness")
         plausible("boundary_friction", self.boundary_friction, "friction")
+        check_choices(self)
         if not (0 < self.gap_floor < self.boundary_film < 1e-6 and 0 < self.tol < 1
                 and 0 < self.contact_tol < 1 and self.max_iter >= 2):
             raise InputError("DeterministicSettings: need 0 < gap_floor < boundary_film < 1 um, "
@@ -145,6 +152,7 @@ class _Pad:
     settings: DeterministicSettings
     area: np.ndarray = None
     boundary: np.ndarray = None
+    side_rows: object = None
     elastic: object = None
     p_con: np.ndarray | None = None
     phi: np.ndarray | None = None
@@ -153,55 +161,108 @@ class _Pad:
     def __post_init__(self):
         self.area = trapezoid_weights(self.shape.shape, self.spacing)
         self.boundary = np.zeros(self.shape.shape, bool)
-        self.boundary[[0, -1], :] = self.boundary[:, [0, -1]] = True
+        self.boundary[:, [0, -1]] = True
+        if self.settings.sides == "open":
+            self.boundary[[0, -1], :] = True
+        rows = np.ones(self.shape.shape)
+        rows[[0, -1], :] = 0.5
+        self.side_rows = sp.diags(rows.ravel())
         self.elastic = elastic_operator(self.shape.shape, self.spacing, self.settings.e_reduced)
         self.coupled = np.zeros((3, *self.shape.shape))
         self.coupled[2] = 1.0
 
-    def film(self, gap, mu, rho):
+    def film(self, gap, mu, rho, mass=None):
         """Reynolds with JFO on ``gap`` [m] at the viscosity ``mu`` and density ratio ``rho``
-        (fields): ``(p, theta)`` [Pa, -]."""
+        (fields): ``(p, theta)`` [Pa, -].  ``mass``: a time step's term ``(rate, source)``,
+        ``rate d(rho h (1 - theta))`` at each node [m^2/s] and the earlier content's inflow
+        ``source`` [m^3/s] (:mod:`.time_resolved`); None: steady."""
         model, dx = cavitation_model("switch"), self.spacing
         scale = (6 * self.lubricant.viscosity * self.speed * float(np.mean(dx))
                  / float(np.mean(gap)) ** 2)
         B = couette_matrix(rho * gap * self.speed / 2, np.zeros_like(gap), dx, "central")
+        if self.settings.sides == "sealed":            # the side rows' dual cells: half wide
+            B = self.side_rows @ B
+        options = {}
+        if mass is not None:
+            B = B + sp.diags((mass[0] * rho * gap).ravel())
+            options["source"] = mass[1]
         self.phi, _, _ = model.solve(fe_poiseuille(rho * gap ** 3 / (12 * mu), dx), B,
-                                     self.boundary, 0.0, scale, phi0=self.phi, tol=1e-10)
+                                     self.boundary, 0.0, scale, phi0=self.phi, tol=1e-10,
+                                     **options)
         return (v.reshape(gap.shape) for v in model.split(self.phi, scale))
 
-    def coupling(self, p) -> np.ndarray:
-        """The stacked unknowns the film pressure ``p`` [Pa] implies (eqs 20-24)."""
-        lub, clipped = self.lubricant, np.minimum(p, MAX_COEFFICIENT_PRESSURE)
+    def coupling(self, p, gap) -> np.ndarray:
+        """The stacked unknowns the film pressure ``p`` [Pa] implies (eqs 20-24) on ``gap``
+        [m]: in contact spots and boundary films (the gap at most ``boundary_film``, where
+        the twin has no film) the oil keeps its ambient viscosity and density, as the
+        cells' oil does everywhere, and takes the film's from twice that thickness on
+        (linear between: the map stays continuous in the gap)."""
+        lub, cut = self.lubricant, self.settings.boundary_film
+        film = np.clip(gap / cut - 1.0, 0.0, 1.0)
+        clipped = film * np.minimum(p, MAX_COEFFICIENT_PRESSURE)
         deform = self.elastic(p) / H_REF if self.settings.film_deforms else 0 * p
         return np.stack([deform, np.log(lub.viscosity_at(clipped) / lub.viscosity),
                          lub.density_ratio(clipped)])
 
-    def at(self, separation: float):
-        """The film and the contact at the rigid separation ``h_d`` [m]: a dict of fields
+    def at(self, separation: float, shape=None, mass=None):
+        """The film and the contact at the rigid separation ``h_d`` [m] (on ``shape``,
+        default the pad's; ``mass``: a time step's term, :meth:`film`): a dict of fields
         and loads.  Each pass solves the contact against the shape deformed by the film,
-        then the film; the film's deformation, viscosity and density are mixed (Anderson)
-        until they change by less than ``tol``."""
-        s, history, mixer = self.settings, [], Anderson(ANDERSON_DEPTH, ANDERSON_DAMPING)
+        then the film; the film's deformation, viscosity and density are mixed
+        (:class:`_Mixing`) until they change by less than ``tol``."""
+        s, history, mixing = self.settings, [], _Mixing()
+        shape = self.shape if shape is None else shape
         for _ in range(s.max_iter):
-            c = contact_solve(self.shape + H_REF * self.coupled[0], self.spacing,
+            c = contact_solve(shape + H_REF * self.coupled[0], self.spacing,
                               s.e_reduced, separation=separation, hardness=s.hardness,
                               gap_floor=s.gap_floor, initial_pressure=self.p_con,
                               tol=s.contact_tol)
             self.p_con = c.pressure if c.load > 0 else None
-            mu = self.lubricant.viscosity * np.exp(self.coupled[1])
-            p, theta = self.film(c.gap, mu, self.coupled[2])
-            change = self.coupling(p) - self.coupled
+            mu, rho = self.lubricant.viscosity * np.exp(self.coupled[1]), self.coupled[2]
+            try:
+                p, theta = self.film(c.gap, mu, rho, mass)
+            except ReynoldsNotConverged:               # an overshot iterate: step back
+                history.append(np.inf)
+                self.coupled, self.phi = mixing.back(), None
+                continue
+            change = self.coupling(p, c.gap) - self.coupled
             history.append(float(np.abs(change).max()))
             if history[-1] < s.tol:
                 break
-            self.coupled = mixer.step(self.coupled.ravel(), change.ravel()).reshape(
-                self.coupled.shape)
+            self.coupled = mixing.next(self.coupled, change, history[-1])
         else:
             raise DeterministicNotConverged("the film's deformation and viscosity did not "
                                             "settle with the contact", history)
-        return {"p": p, "theta": theta, "mu": mu, "p_con": c.pressure, "gap": c.gap,
+        return {"p": p, "theta": theta, "mu": mu, "rho": rho, "p_con": c.pressure, "gap": c.gap,
                 "film_load": float(np.sum(self.area * p)),
                 "contact_load": float(np.sum(self.area * c.pressure))}
+
+
+class _Mixing:
+    """Anderson mixing of the coupled fields, safeguarded: a pass whose change grows past
+    ``GROWTH`` times the smallest so far (or whose film does not solve) returns to the
+    iterate of that smallest change, and the mixing restarts there with half the damping
+    (micro-EHL squeeze spots, where eqs 23-24 and the deformation feed back strongly)."""
+
+    def __init__(self):
+        self.damping = ANDERSON_DAMPING
+        self.mixer = Anderson(ANDERSON_DEPTH, self.damping)
+        self.best = (np.inf, None, None)
+
+    def next(self, coupled, change, residual):
+        if residual < self.best[0]:
+            self.best = (residual, coupled.copy(), change.copy())
+        elif residual > GROWTH * self.best[0]:
+            return self.back()
+        return self.mixer.step(coupled.ravel(), change.ravel()).reshape(coupled.shape)
+
+    def back(self):
+        """The smallest change's iterate, moved by its damped change; the mixing restarted."""
+        if self.best[1] is None:
+            raise DeterministicNotConverged("the first film-contact pass did not solve", [])
+        self.damping /= 2
+        self.mixer = Anderson(ANDERSON_DEPTH, self.damping)
+        return self.best[1] + self.damping * self.best[2]
 
 
 def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant: Lubricant,
@@ -219,35 +280,65 @@ def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant:
     speed : the disk's U [m/s]
     initial : a neighbouring point whose separation starts the bracket of h_d
     """
+    s, dx, load, speed = _checked(shape, spacing, load, speed, lubricant, settings)
+    pad = _Pad(s, dx, speed, lubricant, settings)
+    h_d, st, history, _ = balance(pad, load, initial.separation if initial else None)
+    film = pad_friction(st["p"], st["gap"], st["theta"], st["mu"], dx, speed,
+                        settings.boundary_film)
+    return DeterministicResult(speed, load, float(h_d), st["film_load"], st["contact_load"],
+                               film, settings.boundary_friction * boundary_load(pad.area, st,
+                                                                                settings),
+                               dx, st["p"], st["p_con"], st["theta"], st["gap"],
+                               tuple(history))
+
+
+def _checked(shape, spacing, load, speed, lubricant, settings):
+    """The checked ``(shape, spacing, load, speed)`` of a deterministic point (SI)."""
     s = as_field("shape [m]", shape, 5)
     dx = as_pair("spacing [m]", spacing)
     plausible("spacing [m]", dx, "pitch")
     load, speed = number("load [N]", load, "load"), number("speed [m/s]", speed, "speed")
     if not isinstance(lubricant, Lubricant) or not isinstance(settings, DeterministicSettings):
         raise InputError("lubricant must be a Lubricant and settings DeterministicSettings")
-    pad = _Pad(s, dx, speed, lubricant, settings)
-    states, history = {}, []
+    return s, dx, load, speed
+
+
+def boundary_load(area, state: dict, settings: DeterministicSettings) -> float:
+    """The load the boundary shear acts on [N] (eq 32): the contact load and, with
+    ``film_on_boundary``, the film's where the gap is at most the boundary film; ``area``
+    the nodes' weights [m^2], ``state`` a solved instant's fields."""
+    load = state["contact_load"]
+    if settings.film_on_boundary:
+        thin = state["gap"] <= settings.boundary_film
+        load += float(np.sum(area * np.where(thin, np.maximum(state["p"], 0), 0)))
+    return load
+
+
+def balance(pad: _Pad, load: float, start: float | None = None):
+    """``(h_d, state, history, slope)``: the separation [m] at which ``pad`` carries
+    ``load`` [N] (Brent on the log of the load, bracketed from ``start``), its solved
+    state, the log load residual of each evaluation and ``d log W / d h_d`` [1/m] from the
+    evaluation nearest the root (the time-resolved solver's load updates)."""
+    states, history, settings = {}, [], pad.settings
+    std = float(np.std(pad.shape))
 
     def residual(h_d):
         states[h_d] = pad.at(h_d)
         history.append(np.log((states[h_d]["film_load"] + states[h_d]["contact_load"]) / load))
         return history[-1]
 
-    lo, hi = _bracket(residual, initial.separation if initial else 2 * float(np.std(s)),
-                      max(float(np.std(s)) / 4, 1e-9), settings.max_iter)
+    lo, hi = _bracket(residual, 2 * std if start is None else start, max(std / 4, 1e-9),
+                      settings.max_iter)
     h_d = brentq(residual, lo, hi, xtol=1e-15, rtol=1e-10, maxiter=settings.max_iter)
     if abs(residual(h_d)) > settings.tol:
         raise DeterministicNotConverged("the load balance missed its tolerance", history)
-    st = states[h_d]
-    film = pad_friction(st["p"], st["gap"], st["theta"], st["mu"], dx, speed,
-                        settings.boundary_film)
-    boundary_load = st["contact_load"]
-    if settings.film_on_boundary:
-        thin = st["gap"] <= settings.boundary_film
-        boundary_load += float(np.sum(pad.area * np.where(thin, np.maximum(st["p"], 0), 0)))
-    return DeterministicResult(speed, load, float(h_d), st["film_load"], st["contact_load"],
-                               film, settings.boundary_friction * boundary_load, dx,
-                               st["p"], st["p_con"], st["theta"], st["gap"], tuple(history))
+    near = min((h for h in states if h != h_d), key=lambda h: abs(h - h_d))
+    slope = (_log_load(states[near]) - _log_load(states[h_d])) / (near - h_d)
+    return h_d, states[h_d], history, slope
+
+
+def _log_load(state) -> float:
+    return float(np.log(state["film_load"] + state["contact_load"]))
 
 
 def _bracket(residual, start: float, step: float, max_iter: int):

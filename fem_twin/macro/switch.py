@@ -23,8 +23,10 @@ ROUND_OFF = 1e3 * np.finfo(float).eps
 
 
 def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=1e-10,
-                          max_iter=200, inexact=False, settle=0.0):
-    """Semismooth Newton on ``K p + B (1 - theta) = 0`` with the p-theta switch ``phi``.
+                          max_iter=200, inexact=False, settle=0.0, source=None):
+    """Semismooth Newton on ``K p + B (1 - theta) = f`` with the p-theta switch ``phi``
+    (``source`` f, each node's inflow [m^3/s]; default 0: a time step's earlier film
+    content, :mod:`fem_twin.macro.time_resolved`).
 
     Dirichlet nodes keep ``p = p_boundary``, ``theta = 0``.  ``phi0`` warm-starts the
     interior; ``inexact`` returns the iterate after ``max_iter`` steps instead of raising (a
@@ -45,6 +47,9 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
         phi[interior] = np.asarray(phi0, float).ravel()[interior]
     K, B = K.tocsr(), B.tocsr()
     couette_size = _absolute(B) @ np.ones(n)
+    f = None if source is None else np.asarray(source, float).ravel()[interior]
+    if f is not None:
+        couette_size[interior] += np.abs(f)
     floor = 1e-300 + 1e-12 * float(couette_size.max())
 
     def residual(phi):
@@ -52,6 +57,8 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
         pos = phi >= 0
         p = np.where(pos, phi, 0.0)
         r = (K @ p + B @ np.where(pos, 1.0, 1.0 + phi / scale))[interior]
+        if f is not None:
+            r -= f
         # each node's mass residual relative to the size of its own fluxes
         size = (_absolute(K) @ p)[interior] + couette_size[interior] + floor
         return r, pos, float(np.max(np.abs(r) / size))
