@@ -92,7 +92,7 @@ def bench_deterministic(tiles=V.TILES):
     for k, speed in enumerate(SPEEDS):
         share, order = V.to_zero(eps, [t[k].share - t[k].share_det for t in table])
         cf, _ = V.to_zero(eps, [t[k].cf_gap(cfb) for t in table])
-        note = (f"share - share,det {share:+.4f} (order {order:.2f}), C_f - C_f,det "
+        note = (f"share - share,det {share:+.4f} ({V.order_text(order)}), C_f - C_f,det "
                 f"{100 * cf:+.2f} % C_f,b")
         rows.append((f"eps -> 0 (speed {speed:.3g} m/s at eps 1/2)", 0.0, note))
     rows += _diagnostics(pad, 8, cfb, dets.get(8) or V.deterministic_sweep(pad, 8, SPEEDS))

@@ -7,6 +7,7 @@
                                               #  FEM_TWIN_AB_BASE and now, ~10 min,
                                               #  cores: the bundled case on 1, 2, all workers;
                                               #  deterministic: the mixed regime, ~20 min;
+                                              #  unsteady: both bodies rough, moving;
                                               #  estimates: each example's printed run
                                               #  time against its run, ~4 min, ~9 with
                                               #  FEM_TWIN_ESTIMATE_LOAD=1;
@@ -38,6 +39,7 @@ from defaults import bench_defaults  # noqa: E402
 from deterministic import bench_deterministic  # noqa: E402
 from estimates import bench_estimates  # noqa: E402
 from scale import bench_scale  # noqa: E402
+from unsteady import bench_unsteady  # noqa: E402
 
 
 def bench_topography():
@@ -601,13 +603,14 @@ GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": ben
           "estimate-paper": lambda: bench_estimate("paper.toml"),
           "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults,
           "deterministic": bench_deterministic, "ab": bench_ab,
-          "estimates": bench_estimates}
+          "estimates": bench_estimates, "unsteady": bench_unsteady}
 
 
 def main(argv):
     groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "estimate-paper",
                                                         "scale", "amg", "cores", "defaults",
-                                                        "deterministic", "ab", "estimates")]
+                                                        "deterministic", "ab", "estimates",
+                                                        "unsteady")]
     for name in groups:
         base, rows, *summary = GROUPS[name]()
         print(f"\n## {name}")

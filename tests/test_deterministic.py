@@ -190,6 +190,17 @@ def test_the_extrapolation_to_scale_separation_is_exact_on_a_power_law(order):
     assert limit == pytest.approx(0.3, abs=1e-12) and p == pytest.approx(order)
 
 
+def test_no_order_is_assumed_where_the_gaps_do_not_shrink_monotonically():
+    """A gap that changes sign between the pads (round 5's -3.50 -> +2.07 -> +1.04 % C_f,b
+    at eps = 1/4, 1/8, 1/16) shows no order: ``to_zero`` returns the finest value and
+    None, and the summary says so."""
+    from fem_twin.studies.verification import order_text, to_zero
+    limit, p = to_zero([1 / 4, 1 / 8, 1 / 16], [-3.50, 2.07, 1.04])
+    assert limit == 1.04 and p is None
+    assert to_zero([1 / 8, 1 / 16], [2.0, 1.0]) == (1.0, None)
+    assert order_text(None) == "order none observed" and order_text(1.5) == "order 1.50"
+
+
 def test_the_benchmarks_summary_line():
     """``benchmarks/run.py deterministic`` ends in exactly this line (issue 70's bar), from
     the worst point of the finest pad."""
@@ -198,3 +209,7 @@ def test_the_benchmarks_summary_line():
              Pair(16, 0.01, 0.899, 0.900, 2e-7, 2e-7, 1e-3, 1e-3, 0.1744, 0.1747)]
     assert summary(pairs, 0.19245) == ("mixed regime: worst |C_f - C_f,det| = 1.09 % C_f,b, "
                                        "worst |share - share,det| = 0.011, at 90 % asperity load")
+    assert summary(pairs, 0.19245, "both rough, unsteady", None).endswith(
+        "at 90 % asperity load, eps -> 0 order none observed")
+    assert summary(pairs, 0.19245, "both rough, unsteady", 1.234).startswith(
+        "both rough, unsteady: worst |C_f - C_f,det| = 1.09 % C_f,b")

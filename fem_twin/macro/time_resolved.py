@@ -4,16 +4,18 @@ with its time term, both bodies rough), where every production run lives
 (docs/accuracy.md, "Both bodies rough, the disk's roughness moving").
 
 The disk's roughness is periodic along x1 with ``m`` pixels; at step ``n`` it has moved by
-``n`` pixels, so ``dt = dx1 / U`` and one roughness period is ``m`` steps.  Each instant is
+``n`` pixels, so ``dt = dx1 / U`` and one roughness period is ``m`` steps (``substeps`` steps
+a pixel: ``dt = dx1 / (substeps U)``, the strip Fourier-shifted).  Each instant is
 the steady solver's problem (:mod:`.deterministic`: Reynolds with JFO, the CG-FFT contact
 with the hardness cap, the half-space deformed by the film and the contact pressure, eqs
 23-24 at the local pressure) plus the squeeze term ``d(rho h (1 - theta)) / dt`` of the
 transient, mass-conserving Reynolds equation, on the dual cells of the Couette flux, by the
 second-order BDF (``scheme="bdf2"``, default) or implicit Euler (``"backward"``, first
 order).  ``h_d`` is held over each period (the pin cannot follow a period of microseconds)
-and moved between periods by the steady solution's ``d log W / d h_d`` until the
-period-mean load balances; the run starts from the steady solution with the disk frozen
-at its first instant and ends when the period means repeat (:class:`TimeSettings`).
+and moved between periods by the secant of the period-mean log load (first the steady
+solution's ``d log W / d h_d``) until the period-mean load balances; the run starts from
+the steady solution with the disk frozen at its first instant and ends when the period
+means repeat (:class:`TimeSettings`).
 Friction on the pin: :func:`.deterministic.pad_friction` plus the film pressure on the
 disk's slopes (the pin's surface is the gap minus the disk's), and C_f,b times the
 boundary's load (eq 32)."""
@@ -57,7 +59,7 @@ class TimeSettings:
     step_tol: float = setting(1e-4, "each instant's film-contact iteration: the film's "
                               "deformation per micrometre, log viscosity and density ratio "
                               "change by less", "solver_tolerance")
-    period_tol: float = setting(1e-4, "the periodic state: the period means of C_f (over "
+    period_tol: float = setting(1e-3, "the periodic state: the period means of C_f (over "
                                 "C_f,b) and of the load share change by less, and the "
                                 "period-mean log load residual is below it",
                                 "solver_tolerance")
@@ -125,16 +127,28 @@ def solve_time_resolved(shape, disk, spacing, *, load: float, speed: float,
                replace(settings, tol=time.step_tol))
     march = _March(pad, s, z, load, SCHEMES[time.scheme], time.substeps)
     march.start(None if initial is None else initial.separation)
-    history, means = [], None
+    history, means, held = [], None, []
     for period in range(1, time.max_periods + 1):
         before, (residual, means) = means, march.period()
         change = np.inf if before is None else float(np.max(np.abs(means - before)))
         history.append((residual, change))
         if period >= time.min_periods and max(abs(residual), change) < time.period_tol:
             return march.result(period, tuple(history))
-        march.separation -= residual / march.slope
+        held.append((march.separation, residual))
+        march.separation -= residual / _slope_of(held, march.slope)
     raise DeterministicNotConverged(f"the period means did not repeat in {time.max_periods} "
                                     "periods", history)
+
+
+def _slope_of(held, steady: float) -> float:
+    """``d log W / d h_d`` [1/m] for the next separation: the secant of the last two
+    periods' ``(h_d, log load residual)`` where it agrees in sign with the steady start's
+    ``steady`` within a factor 4 (the transient's drift can spoil it), else ``steady``."""
+    if len(held) < 2 or held[-1][0] == held[-2][0]:
+        return steady
+    (h0, r0), (h1, r1) = held[-2:]
+    secant = (r1 - r0) / (h1 - h0)
+    return secant if 0.25 < secant / steady < 4 else steady
 
 
 class _March:

@@ -5,10 +5,14 @@ A crowned square pad carries a roughness cell (the composite ``disk - pin`` of a
 on the pin at rest; the disk smooth and sliding along +x1) tiled ``n`` times per side, so the
 wavelength ratio is ``eps = 1/n``.  :func:`fem_twin.macro.deterministic.solve_deterministic`
 solves it resolved; the twin solves the same pad with the flow factors of that cell
-(:func:`fem_twin.micro.homogenise`) on a macro grid.  The pad grows with ``n`` at a fixed
-mean pressure and crown, and the speed falls as ``1/n``: ``mu U L / (p h^2)`` and the load
-share are then the same problem at every ``eps`` (the macro deformation, ``p L / E'``, is
-below a picometre), and the film's friction coefficient scales as ``h / L``."""
+(:func:`fem_twin.micro.homogenise`) on a macro grid.  With both bodies rough (``RoughPad.disk``,
+the configuration of every run) the pin carries its cell tiled and the disk's cell slides
+over it, :func:`fem_twin.macro.time_resolved.solve_time_resolved` resolves it in time and the
+twin takes the unsteady cells of the pair (eq 8 with its time term, one pixel a step).
+The pad grows with ``n`` at a fixed mean pressure and crown, and the speed falls as
+``1/n``: ``mu U L / (p h^2)`` and the load share are then the same problem at every
+``eps`` (the macro deformation, ``p L / E'``, is below a picometre), and the film's
+friction coefficient scales as ``h / L``."""
 
 from __future__ import annotations
 
@@ -21,6 +25,7 @@ from ..errors import InputError
 from ..io.files import read_topography
 from ..macro import Lubricant, MacroSettings, solve_mixed
 from ..macro.deterministic import DeterministicSettings, solve_deterministic
+from ..macro.time_resolved import solve_time_resolved
 from ..micro import homogenise
 from ..topography import Topography, resample_cell
 from ..topography.prepare import prepare_patch
@@ -43,6 +48,8 @@ class RoughPad:
     crown : the form's rise from the centre to the edges' middle [m] (a paraboloid)
     mean_pressure : load over the pad's area [Pa]
     macro_nodes : the twin's macro grid per side
+    disk : (m, m) the disk's cell [m], zero mean, or None (the disk smooth); the pin's is
+        then ``disk - roughness``
     """
 
     roughness: np.ndarray
@@ -52,12 +59,19 @@ class RoughPad:
     crown: float = 1e-6
     mean_pressure: float = 1e6
     macro_nodes: int = 65
+    disk: np.ndarray | None = None
 
     def __post_init__(self):
-        r = np.asarray(self.roughness, float)
-        if r.ndim != 2 or r.shape[0] != r.shape[1] or not np.all(np.isfinite(r)):
-            raise InputError("roughness must be a finite square (m, m) cell [m]")
-        object.__setattr__(self, "roughness", r - r.mean())
+        for name in ("roughness", "disk"):
+            r = getattr(self, name)
+            if r is None:
+                continue
+            r = np.asarray(r, float)
+            if r.ndim != 2 or r.shape[0] != r.shape[1] or not np.all(np.isfinite(r)):
+                raise InputError(f"{name} must be a finite square (m, m) cell [m]")
+            object.__setattr__(self, name, r - r.mean())
+        if self.disk is not None and self.disk.shape != self.roughness.shape:
+            raise InputError("disk and roughness must be cells of one shape")
 
     def length(self, tiles: int) -> float:
         """The side of the pad of ``tiles`` cells a side [m]."""
@@ -78,6 +92,17 @@ class RoughPad:
         tiled = np.pad(np.tile(self.roughness, (tiles, tiles)), ((0, 1), (0, 1)), mode="wrap")
         return self.form(tiled.shape[0]) + tiled, (self.pitch, self.pitch)
 
+    def moving(self, tiles: int):
+        """``(shape, strip, spacing)`` of the time-resolved pad (both bodies rough): the
+        crown less the pin's tiled cell on ``tiles m + 1`` nodes a side, and the disk's cell
+        tiled across x2 as one period along x1 (:func:`~fem_twin.macro.time_resolved.disk_at`)."""
+        if self.disk is None:
+            raise InputError("the pad's disk is smooth: RoughPad.resolved is its pad")
+        pin = np.tile(self.disk - self.roughness, (tiles, tiles))
+        pin = np.pad(pin, ((0, 1), (0, 1)), mode="wrap")
+        strip = np.pad(np.tile(self.disk, (tiles, 1)), ((0, 1), (0, 0)), mode="wrap")
+        return self.form(pin.shape[0]) - pin, strip, (self.pitch, self.pitch)
+
     def macro(self, tiles: int):
         """``(gap, spacing)`` of the twin's pad: the crown on ``macro_nodes`` a side."""
         step = self.length(tiles) / (self.macro_nodes - 1)
@@ -85,19 +110,22 @@ class RoughPad:
 
 
 def patch_pad(pin: Topography, disk: Topography, pixels: int, lubricant: Lubricant,
-              **options) -> RoughPad:
+              moving: bool = False, **options) -> RoughPad:
     """The :class:`RoughPad` of a prepared patch pair (``disk`` flipped over ``pin``,
     :func:`fem_twin.topography.prepare.prepare_patch`) resampled periodically to ``pixels``
-    a side (:func:`fem_twin.topography.resample_cell`, as the micro stage does)."""
+    a side (:func:`fem_twin.topography.resample_cell`, as the micro stage does); ``moving``:
+    both bodies rough, the disk's roughness sliding (``RoughPad.disk``)."""
     low, up = resample_cell(pin, (pixels, pixels)), resample_cell(disk, (pixels, pixels))
-    return RoughPad(up.heights - low.heights, float(low.spacing[0]), lubricant, **options)
+    return RoughPad(up.heights - low.heights, float(low.spacing[0]), lubricant,
+                    disk=up.heights if moving else None, **options)
 
 
 def sample_pad(folder, pixels: int = 32, pair: int = 1, lubricant: Lubricant | None = None,
                **options) -> RoughPad:
     """The :class:`RoughPad` of patch pair ``pair`` of the bundled sample (``folder``: the
     repository's ``meshes/sample``), cut at 256 px as the bundled case does; ``lubricant``
-    default: the bundled case's oil at 24 C (0.066 Pa s, eqs 23-24 of Table 6)."""
+    default: the bundled case's oil at 24 C (0.066 Pa s, eqs 23-24 of Table 6); ``moving``
+    (an option of :func:`patch_pad`): both bodies rough."""
     folder = Path(folder)
     pin = prepare_patch(read_topography(folder / f"patch_{pair}_pin.npz"))
     disk = prepare_patch(read_topography(folder / f"patch_{pair}_disk.npz"), upper=True)
@@ -105,15 +133,19 @@ def sample_pad(folder, pixels: int = 32, pair: int = 1, lubricant: Lubricant | N
 
 
 def pad_factors(pad: RoughPad, h0, **cell):
-    """The twin's flow factors of the pad's cell at the separations ``h0`` [m]: the
-    roughness on the pin at rest, the disk smooth (one instant: a steady cell), with the
-    pad's materials and film cut-off; ``cell``: other :class:`~fem_twin.micro.CellSettings`."""
-    s = pad.settings
-    pin = Topography(-pad.roughness, (pad.pitch, pad.pitch))
-    disk = Topography(np.zeros_like(pad.roughness), (pad.pitch, pad.pitch))
-    return homogenise(pin, disk, h0, n_steps=1, e_reduced=s.e_reduced, hardness=s.hardness,
-                      boundary_film=s.boundary_film, gap_floor=s.gap_floor,
-                      error_estimate=False, **cell)
+    """The twin's flow factors of the pad's cell at the separations ``h0`` [m], with the
+    pad's materials and film cut-off: the roughness on the pin at rest, the disk smooth
+    (one instant: a steady cell), or, with ``pad.disk``, both rough and the disk's sliding
+    one pixel a step (eq 8 unsteady); ``cell``: other :class:`~fem_twin.micro.CellSettings`."""
+    s, dx = pad.settings, (pad.pitch, pad.pitch)
+    if pad.disk is None:
+        pin, disk, steps = -pad.roughness, np.zeros_like(pad.roughness), 1
+    else:
+        pin, disk, steps = pad.disk - pad.roughness, pad.disk, pad.roughness.shape[1]
+    return homogenise(Topography(pin, dx), Topography(disk, dx), h0,
+                      **{"n_steps": steps, **cell}, e_reduced=s.e_reduced,
+                      hardness=s.hardness, boundary_film=s.boundary_film,
+                      gap_floor=s.gap_floor, error_estimate=False)
 
 
 def pad_speeds(speeds, tiles: int) -> np.ndarray:
@@ -131,6 +163,21 @@ def deterministic_sweep(pad: RoughPad, tiles: int, speeds, settings=None) -> lis
         last = solve_deterministic(shape, dx, load=pad.load(tiles), speed=u,
                                    lubricant=pad.lubricant,
                                    settings=settings or pad.settings, initial=last)
+        out.append(last)
+    return out
+
+
+def time_resolved_sweep(pad: RoughPad, tiles: int, speeds, settings=None, time=None) -> list:
+    """:func:`~fem_twin.macro.time_resolved.solve_time_resolved` on the pad of ``tiles``
+    (both bodies rough) at each of ``speeds`` (given at two tiles), each started from the
+    one before; ``settings`` replace the pad's, ``time``: its
+    :class:`~fem_twin.macro.time_resolved.TimeSettings`."""
+    shape, strip, dx = pad.moving(tiles)
+    out, last = [], None
+    for u in pad_speeds(speeds, tiles):
+        last = solve_time_resolved(shape, strip, dx, load=pad.load(tiles), speed=u,
+                                   lubricant=pad.lubricant, settings=settings or pad.settings,
+                                   time=time, initial=last)
         out.append(last)
     return out
 
@@ -179,21 +226,34 @@ def compared(det: list, twin: list, tiles: int) -> list:
                  t.friction_coefficient) for d, t in zip(det, twin)]
 
 
-def summary(pairs, boundary_friction: float) -> str:
-    """The one line of ``benchmarks/run.py deterministic``: the largest C_f gap [% C_f,b] and
-    load-share gap over ``pairs`` (:class:`Pair`), and the largest resolved share [%]."""
+def summary(pairs, boundary_friction: float, label: str = "mixed regime",
+            order: float | None | bool = False) -> str:
+    """The one line of a benchmark group (``deterministic``: ``label`` "mixed regime";
+    ``unsteady``): the largest C_f gap [% C_f,b] and load-share gap over ``pairs``
+    (:class:`Pair`), the largest resolved share [%], and with ``order`` (not False) the
+    observed eps -> 0 order (:func:`order_text`)."""
     cf = max(abs(p.cf_gap(boundary_friction)) for p in pairs)
     share = max(abs(p.share - p.share_det) for p in pairs)
-    return (f"mixed regime: worst |C_f - C_f,det| = {100 * cf:.2f} % C_f,b, worst |share - "
+    line = (f"{label}: worst |C_f - C_f,det| = {100 * cf:.2f} % C_f,b, worst |share - "
             f"share,det| = {share:.3f}, at {100 * max(p.share_det for p in pairs):.0f} % "
             "asperity load")
+    return line if order is False else f"{line}, eps -> 0 {order_text(order)}"
 
 
-def to_zero(eps, values) -> tuple[float, float]:
-    """``(value at eps -> 0, observed order)`` from the values at the three finest ``eps``
-    (Richardson with the observed order, which is taken as 1 where the differences do not
-    shrink monotonically); from two values, first order."""
+def order_text(order: float | None) -> str:
+    """``"order 1.52"``, or ``"order none observed"`` for :func:`to_zero`'s None."""
+    return "order none observed" if order is None else f"order {order:.2f}"
+
+
+def to_zero(eps, values) -> tuple[float, float | None]:
+    """``(value at eps -> 0, observed order)`` from the values at the three finest ``eps``:
+    Richardson with the order their differences show where they shrink monotonically;
+    where they do not (a sign change, growth) or only two values are given, no order is
+    observed: ``(the finest value, None)``, nothing extrapolated (an assumed order is not a
+    measurement)."""
     e, v = np.asarray(eps, float), np.asarray(values, float)
+    if e.size < 1 or e.size != v.size:
+        raise InputError("to_zero: give as many values as eps, at least one")
     order = np.argsort(e)
     e, v = e[order], v[order]
     if len(e) >= 3:
@@ -201,7 +261,7 @@ def to_zero(eps, values) -> tuple[float, float]:
         if d1 * d2 > 0 and abs(d2) > abs(d1):
             p = np.log(abs(d2 / d1)) / np.log(e[2] / e[1])
             return float(v[0] - d1 / ((e[1] / e[0]) ** p - 1)), float(p)
-    return float(v[0] - (v[1] - v[0]) / (e[1] / e[0] - 1)), 1.0
+    return float(v[0]), None
 
 
 def with_settings(pad: RoughPad, **changes) -> RoughPad:
