@@ -18,7 +18,7 @@ from fem_twin.cli import main
 from fem_twin.io.layout import RunLayout
 from fem_twin.micro import FlowFactors
 from fem_twin.stribeck.curve import read_stribeck_csv
-from fem_twin.stribeck.sweep import point_key, point_meta
+from fem_twin.stribeck.sweep import GUIDED_BY, point_key, point_meta
 
 
 @pytest.mark.integration
@@ -197,9 +197,9 @@ def test_a_damaged_guide_point_of_a_finished_run_is_recomputed(tmp_path):
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
     before = (out / "stribeck.csv").read_text()
     folder = out / "stribeck" / "checkpoints"
-    guided = sorted(folder.glob("point_*.npz"))[1]
-    with np.load(guided) as data:
-        guide = json.loads(str(data["meta"]))["guided_by"]
+    metas = {path: point_meta(path)[1] for path in sorted(folder.glob("point_*.npz"))}
+    guided = next(path for path, meta in metas.items() if GUIDED_BY in meta)
+    guide = metas[guided][GUIDED_BY]
     damaged = [sorted(folder.glob(f"point_{guide}_*.npz"))[2], guided]
     for path in damaged:
         path.write_bytes(path.read_bytes()[:200])
