@@ -43,6 +43,9 @@ PINNED = {
     "15_sealed_pockets": (r"sealed: .* the floor from 0.5 to 2 nm moves it by up to ([\d.]+) %",
                           0.0, 3.0, "sealed, s_C hardly feels the gap floor (0.8 %; leaking "
                           "26 %)"),
+    "16_moving_roughness": (r"eps 1/8: worst \|C_f - C_f,det\| ([\d.]+) %", 0.0, 4.5,
+                            "the twin against the time-resolved pad, both rough, at eps 1/8 "
+                            "(2.95 %)"),
     "14_boundary_law": (r"shear_strength: ([\d.e+]+) ", 2.4e7, 3.6e7,
                         "the fitted tau_0 within 20 % of the truth, 30 MPa (33.3 MPa)"),
 }

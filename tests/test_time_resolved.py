@@ -223,3 +223,31 @@ def test_bad_inputs_are_refused_and_failures_keep_their_history():
                                                               period_tol=1e-15))
     again = pickle.loads(pickle.dumps(err.value))
     assert isinstance(again, DeterministicNotConverged) and again.history
+
+
+@pytest.mark.integration
+def test_the_unsteady_cells_meet_the_moving_rough_disk_in_full_film():
+    """Both bodies rough (sample pair 1 at 16 px), the disk's roughness sliding, no contact,
+    on a converging wedge (no macro cavity) at 2, 4, 8 cells a side: with the unsteady cells
+    of the pair (eq 8 with its time term) the twin's separation is within 0.2 % of the
+    time-resolved one at every eps (measured +0.08, +0.14, +0.01 %) and closer than with the
+    steady cells of the composite on the pin at rest (+0.23, +0.29, +0.16 %), by 0.1 % at
+    least; the film friction within 0.5 % (-0.27 .. -0.37 %, the micro-cavitation the cells
+    do not have)."""
+    from dataclasses import replace
+
+    from fem_twin.studies import verification as V
+    oil = Lubricant(0.066, roelands_alpha=0.0, dh_c2=1.0)
+    pad = V.sample_pad(ROOT / "meshes" / "sample", 16, moving=True, lubricant=oil)
+    pad = V.with_settings(replace(pad, profile="wedge"), film_deforms=False)
+    h0 = np.geomspace(1e-7, 3e-6, 30)
+    unsteady, steady = V.pad_factors(pad, h0), V.pad_factors(replace(pad, disk=None), h0)
+    for tiles in (2, 4, 8):
+        det = V.time_resolved_sweep(pad, tiles, [4.0])
+        assert det[0].load_share == 0
+        moving, = V.compared(det, V.twin_sweep(pad, tiles, [4.0], unsteady), tiles)
+        frozen, = V.compared(det, V.twin_sweep(pad, tiles, [4.0], steady), tiles)
+        gap = abs(moving.separation / moving.separation_det - 1)
+        assert gap < 2e-3
+        assert abs(frozen.separation / frozen.separation_det - 1) > gap + 1e-3
+        assert abs(moving.film / moving.film_det - 1) < 5e-3

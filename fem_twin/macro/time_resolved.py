@@ -81,10 +81,11 @@ class TimeResolvedResult(DeterministicResult):
     roughness period, its fields at the period's last instant, and ``instants``: each
     step's ``contact_load``, ``film_load``, ``film_friction``, ``boundary_force`` [N] over
     that period; ``periods`` run; ``history``: per period ``(log load residual, change of
-    the means)``."""
+    the means)``; ``frozen_separation``: the steady start's, the disk frozen [m]."""
 
     periods: int = 0
     instants: dict = field(default_factory=dict)
+    frozen_separation: float = 0.0
 
 
 def disk_at(disk, shift: float, nodes: int) -> np.ndarray:
@@ -115,7 +116,9 @@ def solve_time_resolved(shape, disk, spacing, *, load: float, speed: float,
     zero separation besides the disk); ``disk`` (ny, m): one period of the disk's heights
     along x1 [m], periodic; ``spacing`` (dx1, dx2) [m]; ``load`` [N]; ``speed``: the
     disk's U [m/s]; ``time``: :class:`TimeSettings`; ``initial``: a neighbouring point
-    whose separation starts the steady start's bracket.  Raises
+    whose separation starts the steady start's bracket (a time-resolved one's also moves
+    the first period from the steady start as far as its own periodic state lay from its
+    start).  Raises
     :class:`~fem_twin.macro.deterministic.DeterministicNotConverged` with the history
     when the period means do not repeat within ``time.max_periods``."""
     s, dx, load, speed = _checked(shape, spacing, load, speed, lubricant, settings)
@@ -126,7 +129,9 @@ def solve_time_resolved(shape, disk, spacing, *, load: float, speed: float,
     pad = _Pad(s + disk_at(z, 0, s.shape[1]), dx, speed, lubricant,
                replace(settings, tol=time.step_tol))
     march = _March(pad, s, z, load, SCHEMES[time.scheme], time.substeps)
-    march.start(None if initial is None else initial.separation)
+    offset = (initial.separation - initial.frozen_separation
+              if isinstance(initial, TimeResolvedResult) else 0.0)
+    march.start(None if initial is None else initial.separation, offset)
     history, means, held = [], None, []
     for period in range(1, time.max_periods + 1):
         before, (residual, means) = means, march.period()
@@ -162,15 +167,17 @@ class _March:
         self.dt = pad.spacing[0] / (pad.speed * substeps)
         self.slopes = _slope(disk, pad.spacing[0])
         self.warm = [None] * self.steps
-        self.separation = self.held = self.slope = None
+        self.separation = self.held = self.slope = self.frozen = None
         self.content = []                 # rho (1 - theta) and h of the latest steps, newest first
         self.last = None
 
-    def start(self, guess):
-        """The steady solution with the disk frozen at its first instant: the separation,
-        the load's slope and the film content before the first step."""
+    def start(self, guess, offset: float = 0.0):
+        """The steady solution with the disk frozen at its first instant: its separation
+        (the first period's moved by ``offset`` [m]), the load's slope and the film content
+        before the first step."""
         h_d, state, _, self.slope = balance(self.pad, self.load, guess)
-        self.separation = self.held = h_d
+        self.frozen = self.held = h_d
+        self.separation = h_d + offset
         self.content = [(state["rho"] * (1 - state["theta"]), state["gap"])] * (
             len(self.weights) - 1)
 
@@ -219,4 +226,5 @@ class _March:
             pad.speed, self.load, float(self.separation), float(i["film_load"].mean()),
             float(i["contact_load"].mean()), float(i["film_friction"].mean()),
             float(i["boundary_force"].mean()), pad.spacing, st["p"], st["p_con"],
-            st["theta"], st["gap"], history, periods=periods, instants=i)
+            st["theta"], st["gap"], history, periods=periods, instants=i,
+            frozen_separation=float(self.frozen))

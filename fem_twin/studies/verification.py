@@ -32,6 +32,8 @@ from ..topography.prepare import prepare_patch
 
 #: the pads' tile counts of ``benchmarks/run.py deterministic`` (eps = 1/2 .. 1/16)
 TILES = (2, 4, 8, 16)
+#: the pad's forms (``RoughPad.profile``)
+PROFILES = ("crown", "wedge")
 
 
 @dataclass(frozen=True)
@@ -50,6 +52,8 @@ class RoughPad:
     macro_nodes : the twin's macro grid per side
     disk : (m, m) the disk's cell [m], zero mean, or None (the disk smooth); the pin's is
         then ``disk - roughness``
+    profile : the form, ``"crown"`` (a paraboloid, its outlet half cavitates) or
+        ``"wedge"`` (a plane converging along x1 from ``2 crown`` to 0: no macro cavity)
     """
 
     roughness: np.ndarray
@@ -60,8 +64,11 @@ class RoughPad:
     mean_pressure: float = 1e6
     macro_nodes: int = 65
     disk: np.ndarray | None = None
+    profile: str = "crown"
 
     def __post_init__(self):
+        if self.profile not in PROFILES:
+            raise InputError(f"profile must be one of {PROFILES}, got {self.profile!r}")
         for name in ("roughness", "disk"):
             r = getattr(self, name)
             if r is None:
@@ -82,8 +89,11 @@ class RoughPad:
         return self.mean_pressure * self.length(tiles) ** 2
 
     def form(self, nodes: int) -> np.ndarray:
-        """The crown on ``nodes`` x ``nodes`` nodes spanning the pad [m], 0 at its centre."""
+        """The form on ``nodes`` x ``nodes`` nodes spanning the pad [m]: the crown, 0 at
+        its centre, or the wedge, 0 at its outlet."""
         xi = np.linspace(-1.0, 1.0, nodes)
+        if self.profile == "wedge":
+            return np.tile(self.crown * (1 - xi), (nodes, 1))
         return self.crown * (xi[None, :] ** 2 + xi[:, None] ** 2)
 
     def resolved(self, tiles: int):
