@@ -37,7 +37,7 @@ QUANTITIES = {
     "viscosity": (1e-5, 10.0, "Pa s (66 mPa s is 0.066)"),
     "density": (100.0, 2e4, "kg/m^3"),
     "pressure_viscosity": (0.0, 1e-7, "1/Pa (22 GPa^-1 is 22e-9)"),
-    "eyring_stress": (0.0, 1e9, "Pa (5 MPa is 5e6; 0: Newtonian)"),
+    "eyring_stress": (1e4, 1e9, "Pa (5 MPa is 5e6; 0: Newtonian)"),
     "modulus": (1e8, 2e12, "Pa (210 GPa is 210e9)"),
     "reduced_modulus": (1e8, 4e12, "Pa (231 GPa is 231e9)"),
     "solver_modulus": (1e8, 1e30, "Pa (231 GPa is 231e9; a rigid limit, 1e20, is allowed)"),
@@ -79,16 +79,21 @@ QUANTITIES = {
     "solver_tolerance": (1e-15, 0.1, "a relative tolerance (e.g. 1e-6)"),
     "adaptive_tolerance": (0.0, 0.5, "a fraction (1 % is 0.01; 0: off)"),
     "share": (1e-6, 0.999, "a fraction of C_f,b (0.5 % is 0.005)"),
-    "shear_strength": (0.0, 1e9, "Pa (a boundary film's tau_0, 10 MPa is 1e7)"),
+    "shear_strength": (1e4, 1e9, "Pa (a boundary film's tau_0, 10 MPa is 1e7; 0: none)"),
     "pressure_coefficient": (0.0, 1.0, "(Briscoe-Tabor's alpha, 0.1 is 0.1)"),
     "speed_coefficient": (-0.5, 0.5, "per decade of sliding speed (5 % is 0.05)"),
     "temperature_coefficient": (0.0, 0.1, "1/K (0.2 % per kelvin is 0.002)"),
 }
 
+#: quantities whose 0 switches a term off; any other value lies in the range, whose lower
+#: bound then catches a unit slip (5 MPa typed as 5.0)
+OFF_AT_ZERO = frozenset({"eyring_stress", "shear_strength"})
+
 
 def plausible(name: str, value, quantity: str):
     """``value`` (a number or an array of them) if finite and inside the plausible range of
-    ``quantity`` (:data:`QUANTITIES`); else :class:`InputError` naming ``name``."""
+    ``quantity`` (:data:`QUANTITIES`; 0 too for :data:`OFF_AT_ZERO`); else
+    :class:`InputError` naming ``name``."""
     lo, hi, unit = QUANTITIES[quantity]
     values = np.atleast_1d(np.asarray(value, dtype=float)) if _numeric(value) else None
     if values is None or values.size == 0:
@@ -96,7 +101,7 @@ def plausible(name: str, value, quantity: str):
     for v in values.ravel():
         if not math.isfinite(v):
             raise InputError(f"{name} = {v}: must be a finite number ({unit})")
-        if not lo <= v <= hi:
+        if not lo <= v <= hi and not (v == 0 and quantity in OFF_AT_ZERO):
             raise InputError(f"{name} = {v:g}: implausible; expected {lo:g} to {hi:g} {unit}")
     return value
 
@@ -245,15 +250,27 @@ def check_choices(settings) -> None:
 
 def check_ranges(settings) -> None:
     """Refuse a number of the dataclass ``settings`` outside the plausible range its
-    declaration names (:func:`setting`'s ``quantity``), or a fraction where the declared
-    default is a whole number, naming the class and the field; None and text (a pin's
-    "average") are the settings' own rules."""
-    from dataclasses import fields
+    declaration names (:func:`setting`'s ``quantity``), a fraction where the declared
+    default is a whole number, a flag that is not True or False, and None or text where
+    neither the default nor the declared type is, naming the class and the field; text
+    where the default is text (a pin's "average") is the settings' own rule."""
+    from dataclasses import MISSING, fields
     for f in fields(settings):
-        value = getattr(settings, f.name)
-        if not f.metadata.get("quantity") or value is None or isinstance(value, str):
+        value, default = getattr(settings, f.name), f.default
+        name, quantity = f"{type(settings).__name__}.{f.name}", f.metadata.get("quantity")
+        if isinstance(default, bool):
+            if not isinstance(value, (bool, np.bool_)):
+                raise InputError(f"{name}: expected true or false, got {value!r}")
             continue
-        name = f"{type(settings).__name__}.{f.name}"
+        if value is None or isinstance(value, str):
+            unset = default is None or default is MISSING or "None" in str(f.type)
+            if (value is None and unset) or (isinstance(value, str) and (
+                    unset or isinstance(default, str))):
+                continue
+            hint = QUANTITIES[quantity][2] if quantity else f"a value like {default!r}"
+            raise InputError(f"{name}: expected {hint}, got {value!r}")
+        if not quantity:
+            continue
         plausible(name, value, f.metadata["quantity"])
         if _whole(f.default) and not np.all(np.mod(np.asarray(value, float), 1) == 0):
             raise InputError(f"{name}: expected whole numbers, got {value!r}")

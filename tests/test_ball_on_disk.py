@@ -65,7 +65,8 @@ def test_ball_on_disk_stribeck_curve_from_ehl_to_boundary(tmp_path):
     ("slide_to_roll = 2.0", "slide_to_roll = 5.0", "slide_to_roll"),
     ("ball_radius = 9.525e-3", "ball_radius = 9.525", "ball_radius"),
     ("grid = 73", "grid = 5", "grid"),
-    ("eyring_stress = 5e6", "eyring_stress = -5e6", "eyring_stress")])
+    ("eyring_stress = 5e6", "eyring_stress = -5e6", "eyring_stress"),
+    ("eyring_stress = 5e6", "eyring_stress = 5.0", "eyring_stress = 5: implausible")])
 def test_ball_case_keys_are_validated_with_units(tmp_path, old, new, key):
     text = small_ball_case(tmp_path).read_text().replace("grid = 49", "grid = 73")
     assert old in text

@@ -73,9 +73,12 @@ def test_the_boundary_section_is_checked_before_any_work(tmp_path):
     text = text[:text.index("[boundary]")] + text[text.index("[sweep]"):]  # its own below
     cases = {'[boundary]\nshear_strength = 1e7\n': "unused by law",
              '[boundary]\nlaw = "shear"\nspeed_coefficient = 0.5\n': "speed factor falls",
-             '[boundary]\nlaw = "shear"\nshear_strength = 10\npressure_coefficient = 12\n':
+             '[boundary]\nlaw = "shear"\nshear_strength = 1e7\npressure_coefficient = 12\n':
                  "pressure_coefficient = 12: implausible",
-             '[boundary]\nlaw = "stick"\n': "law: one of"}
+             '[boundary]\nlaw = "stick"\n': "law: one of",
+             '[boundary]\nlaw = "shear"\nshear_strength = 10.0\n':     # 10 MPa typed as Pa
+                 "shear_strength = 10: implausible",
+             '[boundary]\nlaw = "shear"\npressure_coefficient = 0\n': "no shear at all"}
     for section, words in cases.items():
         (tmp_path / "case.toml").write_text(text + "\n" + section)
         with pytest.raises(CaseError, match=words):
@@ -89,6 +92,9 @@ def test_the_boundary_section_is_checked_before_any_work(tmp_path):
                                         'shear_strength = 2e7\npressure_coefficient = 0.1\n')
     case = load_case(tmp_path / "case.toml")
     assert case.boundary.shear_strength == 2e7
+    (tmp_path / "case.toml").write_text(text.replace("boundary_friction = ", "boundary_friction"
+                                                     " = 0.12 #") + '\n[boundary]\nlaw = "shear"\n')
+    assert load_case(tmp_path / "case.toml").boundary.pressure_coefficient == 0.12  # the case's
     from fem_twin.stages.requests import macro_settings
     assert macro_settings(case).boundary == case.boundary
     with pytest.raises(InputError, match="speed_coefficient"):

@@ -251,9 +251,12 @@ def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     assert speed.slowdown() == speed.Slowdown(*speed.BOUNDS[1:] * 2)
     monkeypatch.setenv("FEM_TWIN_SLOWDOWN", "0.5")            # forced: no probe
     assert speed.slowdown() == speed.Slowdown(0.5, 0.5)
-    monkeypatch.setenv("FEM_TWIN_SLOWDOWN", "fast")
-    with pytest.raises(ValueError, match="FEM_TWIN_SLOWDOWN"):
-        speed.slowdown()
+    for bad in ("fast", "nan", "-1", "0", "inf", "40"):       # refused, not clipped
+        monkeypatch.setenv("FEM_TWIN_SLOWDOWN", bad)
+        with pytest.raises(ValueError, match="FEM_TWIN_SLOWDOWN.*0.25 to 4"):
+            speed.slowdown()
+    with pytest.raises(ValueError, match="workers a whole number"):
+        speed.slowdown(workers="2")
     assert [duration(s) for s in (85, 250, 1529)] == ["85 s", "4.2 min", "25 min"]
 
 

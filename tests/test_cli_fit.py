@@ -96,7 +96,8 @@ def test_fit_the_rigs_thermal_resistance(tmp_path, capsys):
 def test_fit_validate_and_from_fit_refuse_what_they_cannot_use(tmp_path, capsys):
     """Checked against the case before any work, exit 2 and one line:
     a fit whose measured speeds lie outside the case's sweep (it returned the starting
-    values with a zero-width interval), a measured C_f below zero, a zero or negative
+    values with a zero-width interval), a measured C_f below zero, a predicted load 1000x
+    below the case's (kN typed as N), a zero or negative
     --radius, a fit.json with an implausible C_f,b (it ran and reported C_f up to 4.2)."""
     case = small_case(tmp_path)
     far = tmp_path / "far.csv"
@@ -112,6 +113,12 @@ def test_fit_validate_and_from_fit_refuse_what_they_cannot_use(tmp_path, capsys)
     assert main(["fit", str(case), str(negative), "-o", str(out), "--params",
                  "boundary_friction", "--no-progress"]) == 2
     assert "[0, 1]" in capsys.readouterr().err
+    good_curve = tmp_path / "ok.csv"
+    good_curve.write_text("speed,friction_coefficient\n0.1,0.05\n0.2,0.04\n0.5,0.03\n")
+    assert main(["fit", str(case), str(good_curve), "-o", str(out), "--params",   # kN as N
+                 "boundary_friction", "--predict-load", "0.15", "--no-progress"]) == 2
+    assert "more than 10x from the case's 150 N" in capsys.readouterr().err
+    assert not (out / "geometry").exists()
     (out / "stribeck.csv").parent.mkdir(parents=True, exist_ok=True)
     (out / "stribeck.csv").write_text("speed_m_s,hersey,friction_coefficient,viscosity_Pa_s\n"
                                       "0.1,1e-7,0.01,0.066\n1.0,1e-6,0.02,0.066\n")

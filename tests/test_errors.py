@@ -226,7 +226,7 @@ def test_every_numeric_setting_declares_a_plausible_range():
     (a unit slip) is refused with the field named."""
     from dataclasses import MISSING
 
-    from fem_twin.checks import QUANTITIES
+    from fem_twin.checks import OFF_AT_ZERO, QUANTITIES
     missing = [f"{cls.__name__}.{f.name}" for cls, f in _declared_settings()
                if not f.metadata.get("quantity") and not f.metadata.get("choices")
                and f.metadata.get("unit") not in UNRANGED_UNITS]
@@ -237,7 +237,8 @@ def test_every_numeric_setting_declares_a_plausible_range():
             continue
         lo, hi, _ = QUANTITIES[quantity]
         value = f.default if f.name != "pin" else 1
-        assert np.all((lo <= np.asarray(value, float)) & (np.asarray(value, float) <= hi)), (
+        off = quantity in OFF_AT_ZERO and np.all(np.asarray(value, float) == 0)
+        assert off or np.all((lo <= np.asarray(value, float)) & (np.asarray(value, float) <= hi)), (
             cls.__name__, f.name)
         if not f.metadata.get("section") and quantity not in ("pin_number",):
             slip = hi * 1000 if hi > 0 else lo * 1000
@@ -247,3 +248,25 @@ def test_every_numeric_setting_declares_a_plausible_range():
     from fem_twin.macro import MacroSettings
     with pytest.raises(InputError, match="max_iter: expected whole numbers"):
         MacroSettings(max_iter=10.5)
+
+
+def test_settings_refuse_text_none_and_truthy_flags_where_a_number_or_flag_goes():
+    """``check_ranges`` refused numbers out of range but let text and None through, which
+    failed later with a bare error, and took ``"no"`` for a flag (truthy)."""
+    from fem_twin.macro import BoundaryLaw, MacroSettings
+    from fem_twin.macro.deterministic import DeterministicSettings
+    from fem_twin.macro.thermal import ThermalSettings
+    from fem_twin.micro.sliding import CellSettings
+    for make, words in ((lambda: DeterministicSettings(film_deforms="no"), "true or false"),
+                        (lambda: BoundaryLaw(thin_films="yes"), "true or false"),
+                        (lambda: BoundaryLaw(shear_strength="10 MPa"), "10 MPa is 1e7"),
+                        (lambda: BoundaryLaw(pressure_coefficient=None), "alpha|got None"),
+                        (lambda: MacroSettings(tol="1e-6"), "tol"),
+                        (lambda: BoundaryLaw(shear_strength=10.0), "shear_strength = 10"),
+                        (lambda: ThermalSettings(bulk_resistance=None), "bulk_resistance"),
+                        (lambda: DeterministicSettings(max_iter=2.5), "whole numbers"),
+                        (lambda: DeterministicSettings(boundary_film=5e-7), "boundary_film")):
+        with pytest.raises(InputError, match=words):
+            make()
+    assert CellSettings(time_tol=0).time_tol is None                  # 0 and None: off
+    assert BoundaryLaw(law="shear", shear_strength=0.0).shear_strength == 0.0  # 0: none

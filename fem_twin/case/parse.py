@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import tomllib
+from dataclasses import replace
 from itertools import pairwise
 from pathlib import Path
 
@@ -69,7 +70,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     macro = _macro(data, where, tribometer, geometry)
     sweep = _sweep(data, where)
     thermal = _thermal(data, where, lubricant)
-    boundary = _boundary(data, where, thermal, sweep)
+    boundary = _boundary(data, where, thermal, sweep, tribometer)
     _disk_axis(tribometer, materials, geometry, where)
     run = read_table(data, "run", RunSpec, where)
     if run.workers < 0:
@@ -267,15 +268,24 @@ def _thermal(data, where, lubricant) -> ThermalSettings:
     return thermal
 
 
-def _boundary(data, where, thermal, sweep) -> BoundaryLaw:
-    """[boundary]: the shear law's keys only with ``law = "shear"``, a temperature term only
-    with the thermal model, a speed factor positive over the sweep's speeds."""
+def _boundary(data, where, thermal, sweep, tribometer) -> BoundaryLaw:
+    """[boundary]: the shear law's keys only with ``law = "shear"``, its alpha by default
+    the case's ``[tribometer] boundary_friction``, some shear (tau_0 or alpha), a
+    temperature term only with the thermal model, a speed factor positive over the sweep's
+    speeds."""
     boundary = read_table(data, "boundary", BoundaryLaw, where)
     given = set(data.get("boundary", {})) - {"law", "film_on_contacts", "thin_films"}
     if boundary.law == "constant" and given:
         raise CaseError(f"{where} [boundary] {', '.join(sorted(given))}: the shear law's, unused "
                         "by law = \"constant\" (eq 32 with [tribometer] boundary_friction); set "
                         "law = \"shear\" or remove them")
+    if boundary.law == "shear" and "pressure_coefficient" not in given:
+        boundary = replace(boundary, pressure_coefficient=tribometer.boundary_friction)
+    if boundary.law == "shear" and not (boundary.shear_strength or
+                                        boundary.pressure_coefficient):
+        raise CaseError(f"{where} [boundary]: shear_strength = pressure_coefficient = 0 leaves "
+                        "the asperities no shear at all; give tau_0 [Pa] (10 MPa is 1e7) or "
+                        "alpha (0.1), or law = \"constant\"")
     if boundary.temperature_coefficient and thermal.model == "none":
         raise CaseError(f"{where} [boundary] temperature_coefficient: the asperity spots' "
                         "flash rise comes from the thermal model; set [thermal] model = "
@@ -292,9 +302,9 @@ def _sweep(data, where) -> SweepSpec:
     if not 0 <= sweep.refine <= 4 or not 0 < sweep.refine_step < 1:
         raise CaseError(f"{where} [sweep]: refine is 0-4 passes, refine_step a fraction of "
                         "C_f,b in (0, 1)")
-    if not 0 < sweep.error_tolerance < 1:
-        raise CaseError(f"{where} [sweep] error_tolerance: a fraction of C_f,b in (0, 1), "
-                        f"e.g. 0.005, got {sweep.error_tolerance}")
+    if not 0 < sweep.error_tolerance <= 0.1:
+        raise CaseError(f"{where} [sweep] error_tolerance: a fraction of C_f,b in (0, 0.1] "
+                        f"(0.5 % is 0.005), got {sweep.error_tolerance}")
     if sweep.speed_min > sweep.speed_max or sweep.count < 1:
         raise CaseError(f"{where} [sweep]: need speed_min <= speed_max [m/s] and count >= 1")
     return sweep

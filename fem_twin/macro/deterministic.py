@@ -25,7 +25,7 @@ import scipy.sparse as sp
 from scipy.optimize import brentq
 
 from .. import tables as T
-from ..checks import as_field, as_pair, check_choices, number, plausible, setting
+from ..checks import as_field, as_pair, check_choices, check_ranges, number, plausible, setting
 from ..contact import solve as contact_solve
 from ..contact.elastic import elastic_operator
 from ..errors import InputError, NotConverged, ReynoldsNotConverged
@@ -55,13 +55,14 @@ class DeterministicNotConverged(NotConverged):
 class DeterministicSettings:
     """Materials and numerics of :func:`solve_deterministic` (SI units)."""
 
-    boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", unit="-")
+    boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", "friction")
     e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", "reduced_modulus")
     hardness: float = setting(T.HARDNESS, "the cap on the contact pressure", "hardness")
     boundary_film: float = setting(CellSettings.boundary_film, "films thinner than this "
-                                   "carry no wall shear (the cells' default)", unit="m")
+                                   "carry no wall shear (the cells' default)",
+                                   "boundary_film")
     gap_floor: float = setting(CellSettings.gap_floor, "the film in a contact spot (the "
-                               "cells' default)", unit="m")
+                               "cells' default)", "gap_floor")
     film_on_boundary: bool = setting(True, "the film's pressure where the gap is at most "
                                      "boundary_film (spots and boundary films) joins the "
                                      "boundary's load (the twin's [boundary] "
@@ -73,15 +74,13 @@ class DeterministicSettings:
                          "an x2-invariant gap then gives the 1-D solution)",
                          choices=("open", "sealed"))
     tol: float = setting(1e-7, "log load residual; the film's deformation per micrometre, "
-                         "log viscosity and density ratio changes", unit="-")
-    contact_tol: float = setting(1e-9, "tolerance of each contact solve", unit="-")
+                         "log viscosity and density ratio changes", "solver_tolerance")
+    contact_tol: float = setting(1e-9, "tolerance of each contact solve", "solver_tolerance")
     max_iter: int = setting(60, "load evaluations, and film-contact passes per evaluation",
-                            unit="-")
+                            "iterations")
 
     def __post_init__(self):
-        plausible("e_reduced [Pa]", self.e_reduced, "reduced_modulus")
-        plausible("hardness [Pa]", self.hardness, "hardness")
-        plausible("boundary_friction", self.boundary_friction, "friction")
+        check_ranges(self)
         check_choices(self)
         if not (0 < self.gap_floor < self.boundary_film < 1e-6 and 0 < self.tol < 1
                 and 0 < self.contact_tol < 1 and self.max_iter >= 2):

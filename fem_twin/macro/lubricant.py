@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import tables as T
-from ..checks import check
+from ..checks import check, plausible
 from ..errors import InputError
 
 
@@ -51,10 +51,9 @@ class Lubricant:
     def __post_init__(self):
         if self.eyring_stress is not None:
             check("Lubricant.eyring_stress", self.eyring_stress, "number")
-        if self.eyring_stress is not None and not (np.isfinite(self.eyring_stress)
-                                                   and self.eyring_stress > 0):
-            raise InputError(f"Lubricant.eyring_stress must be positive [Pa] or None, got "
-                             f"{self.eyring_stress}")
+            if self.eyring_stress == 0:
+                raise InputError("Lubricant.eyring_stress = 0: a Newtonian oil is None")
+            plausible("Lubricant.eyring_stress", self.eyring_stress, "eyring_stress")
         if self.piezoviscosity not in ("roelands", "barus"):
             raise InputError("Lubricant.piezoviscosity must be 'roelands' or 'barus', got "
                              f"{self.piezoviscosity!r}")

@@ -173,20 +173,32 @@ def _probe_in_step(kind, barrier, queue):
     queue.put(float(np.median(times)))
 
 
+def _forced(text: str) -> float:
+    """The slowdown ``FEM_TWIN_SLOWDOWN`` sets: a finite number within :data:`BOUNDS`."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = np.nan
+    if not BOUNDS[0] <= value <= BOUNDS[1]:
+        raise InputError(f"FEM_TWIN_SLOWDOWN = {text!r}: this machine's time over the "
+                         f"calibration machine's, a number from {BOUNDS[0]:g} to "
+                         f"{BOUNDS[1]:g} (2 is twice as slow)")
+    return value
+
+
 def slowdown(ball: bool = False, workers: int = 1) -> Slowdown:
     """This machine's time for the same work over the calibration machine's, now (about 2
     s to measure), each kernel's within :data:`BOUNDS`: the cells', and a pin's macro point
     or (``ball``) a ball's, each timed in ``workers`` processes at once (at most one a
     core; :func:`probe_together`); ``FEM_TWIN_SLOWDOWN`` (a number) sets both without
     measuring."""
+    if not isinstance(ball, bool) or isinstance(workers, bool) or not isinstance(
+            workers, (int, np.integer)) or workers < 1:
+        raise InputError(f"slowdown: ball is True or False and workers a whole number >= 1, "
+                         f"got ball={ball!r}, workers={workers!r}")
     forced = os.environ.get("FEM_TWIN_SLOWDOWN")
     if forced:
-        try:
-            both = float(np.clip(float(forced), *BOUNDS))
-        except ValueError:
-            raise InputError(f"FEM_TWIN_SLOWDOWN must be a number (this machine's time over "
-                             f"the calibration machine's), got {forced!r}") from None
-        return Slowdown(both, both)
+        return Slowdown(*(2 * [_forced(forced)]))
     processes = max(1, min(workers, os.cpu_count() or 1))
     seconds = {kind: probe_together(kind, processes)
                for kind in ("micro", "ball" if ball else "macro")}

@@ -107,13 +107,16 @@ class FitModel:
     def _law_force(self, c: StribeckCurve, at, speed, shear: dict):
         """The shear law's boundary force [N] (:mod:`fem_twin.macro.boundary`) from the
         curve's real contact area and asperity load, its spots' flash for the temperature
-        factor (``t = 1 / (1 + c_T dT)``, dT the untempered shear's flash)."""
+        factor (``t = 1 / (1 + c_T dT)``, dT the untempered shear's flash); the iterate's
+        tau_0 [Pa] enters the force directly (the optimiser passes through tau_0 below
+        the law's plausible floor, 10 kPa, on its way from 0)."""
         base = self.boundary or BoundaryLaw(law="shear", shear_strength=0.0,
                                             pressure_coefficient=self.boundary_friction)
-        law = replace(base, law="shear", **shear)
+        tau0 = shear.get("shear_strength", base.shear_strength)
+        law = replace(base, law="shear", **{k: v for k, v in shear.items()
+                                            if k != "shear_strength"})
         area, load = at(c.real_contact_area), at(c.asperity_load)
-        force = (law.shear_strength * area + law.pressure_coefficient * load) * \
-            law.speed_factor(speed)
+        force = (tau0 * area + law.pressure_coefficient * load) * law.speed_factor(speed)
         if law.temperature_coefficient:
             rise = at(c.spot_rise) * np.divide(force, area, out=np.zeros_like(force),
                                                where=area > 0)

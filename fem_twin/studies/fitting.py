@@ -107,6 +107,10 @@ def _tests(case: Case, curves) -> list[tuple[float, float]]:
     return out
 
 
+#: how far from the case's load [x] a fit's parameters are carried by ``--predict-load``
+LOAD_REACH = 10.0
+
+
 def _check_request(case: Case, params, paths, curves, tests, predict_at, predict_loads):
     """Everything a fit can be refused for, before the run."""
     check_parameters(params)
@@ -122,6 +126,10 @@ def _check_request(case: Case, params, paths, curves, tests, predict_at, predict
                          "of the fitted contact temperatures)")
     for load in predict_loads:
         plausible("--predict-load [N]", load, "load")
+        if not tr.load / LOAD_REACH <= load <= tr.load * LOAD_REACH:
+            raise InputError(f"--predict-load {load:g} N: more than {LOAD_REACH:g}x from the "
+                             f"case's {tr.load:g} N the fitted parameters were measured at "
+                             "(loads in N: 0.15 kN is 150)")
     if (predict_at or "temperature" in params) and len(set(lb.temperatures)) < 2:
         raise InputError("fitting or predicting a temperature needs viscosities at two "
                          "temperatures in [lubricant] (the Walther law of ASTM D341)")
@@ -249,6 +257,8 @@ def apply_fit(case: Case, result: dict) -> Case:
     thermal = replace(case.thermal, bulk_resistance=get("bulk_resistance",
                                                         case.thermal.bulk_resistance))
     shear = {k: result[k]["value"] for k in SHEAR if k in result}
+    if shear.get("shear_strength", 1e30) < QUANTITIES["shear_strength"][0]:
+        shear["shear_strength"] = 0.0          # below 10 kPa: no tau_0 the data can tell
     boundary = (replace(_shear_base(case), law="shear", **shear) if shear
                 else case.boundary)
     offset = temperature_offset(result)
