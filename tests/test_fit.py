@@ -110,6 +110,20 @@ def test_prediction_at_another_temperature_holds_the_twin(twin):
     assert np.all(p["cf_low"] < p["cf"]) and np.all(p["inside_simulated_range"])
     outside = np.maximum(p["cf_low"] - cf[45.0], cf[45.0] - p["cf_high"])
     assert outside.max() < 5e-3 * CFB
+    assert np.all(np.isnan(p["cf_err"]) == (sim[0.066].friction_error is None))
+
+
+def test_a_band_wider_than_the_friction_coefficient_is_clipped_and_marked(twin):
+    """A covariance far wider than the fit's (here 1e4 times) makes the linearised band
+    reach below C_f = 0 (issue 87: -0.040 to 0.074 around 0.017): it is clipped to [0, 1]
+    and marked, and the curves' missing error estimate stays missing (NaN), not 0."""
+    sim, cf = twin
+    out = fit_curves(FitModel((sim[0.066],), CFB, 150.0, LAW), [MeasuredCurve(SPEEDS, cf[35.0])],
+                     ["boundary_friction", "temperature"], start_temperatures=[35.0])
+    out["fit"]["covariance"] = (1e4 * np.asarray(out["fit"]["covariance"])).tolist()
+    p = predict(FitModel((sim[0.066],), CFB, 150.0, LAW), out, SPEEDS, 45.0, nominal=[35.0])
+    assert np.all(p["cf_low"] >= 0) and np.all(p["cf_high"] <= 1) and p["band_clipped"].any()
+    assert np.array_equal(p["band_clipped"], p["cf_low"] == 0)
 
 
 @pytest.fixture(scope="module")

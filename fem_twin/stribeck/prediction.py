@@ -20,7 +20,8 @@ def predict(model: FitModel, result: dict, speeds, temperature: float | None,
     curve of the nearest viscosity, or ``curve``, is rescaled (Hersey); without ``curve``
     the band adds the spread of all the simulated curves so rescaled (the Hersey collapse's
     own error, when there are two or more); it adds their C_f error estimates
-    (``cf_err``).  A fitted load share and thermal resistance move C_f along
+    (``cf_err``, NaN where the curves have none).  The band is clipped to C_f in [0, 1]
+    (``band_clipped`` marks where: the linearised band is wider than C_f).  A fitted load share and thermal resistance move C_f along
     ``model.share_curves`` and ``model.resistance_curves``."""
     names = result["fit"]["parameters"]
     x = np.array([result[n]["value"] for n in names])
@@ -46,10 +47,11 @@ def predict(model: FitModel, result: dict, speeds, temperature: float | None,
                      for i, step in enumerate(np.diag(np.maximum(1e-6 * np.abs(x), 1e-6)))],
                     axis=1)
     half = result["fit"]["t_factor"] * np.sqrt(np.einsum("ij,jk,ik->i", grad, cov, grad))
-    half = half + discretisation                  # the twin's own error (cf_err), when known
-    return {"speed_m_s": np.asarray(speeds, float), "cf": value, "cf_low": value - half,
-            "cf_high": value + half, "cf_err": discretisation,
-            "inside_simulated_range": inside}
+    half = half + np.nan_to_num(discretisation)  # the twin's own error (cf_err), when known
+    return {"speed_m_s": np.asarray(speeds, float), "cf": value,
+            "cf_low": np.maximum(value - half, 0.0), "cf_high": np.minimum(value + half, 1.0),
+            "cf_err": discretisation, "inside_simulated_range": inside,
+            "band_clipped": (value - half < 0) | (value + half > 1)}
 
 
 def _collapse_error(model: FitModel, cf, x) -> np.ndarray:
@@ -62,10 +64,10 @@ def _collapse_error(model: FitModel, cf, x) -> np.ndarray:
 
 def _error_at(model: FitModel, speeds) -> np.ndarray:
     """The simulated curves' C_f error estimate at ``speeds`` (the largest over the curves;
-    0 without estimates)."""
+    NaN without estimates: missing, not zero)."""
     curves = [c for c in model.curves if c.friction_error is not None]
     if not curves:
-        return np.zeros(np.shape(speeds))
+        return np.full(np.shape(speeds), np.nan)
     out = []
     for c in curves:
         order = np.argsort(c.speed)

@@ -369,12 +369,19 @@ def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=Non
 
 
 def _write_prediction(path, rows, viscosities=None) -> None:
-    """Predicted curves with their 95 % band (one block per curve)."""
+    """Predicted curves with their 95 % band (one block per curve); a warning names the
+    points whose band was clipped to [0, 1] or whose C_f lies outside it."""
     cat = lambda key: np.concatenate([r[key] for r in rows])  # noqa: E731
+    odd = cat("band_clipped") | (cat("cf") < 0) | (cat("cf") > 1)
+    if odd.any():
+        log.warning("%s: at %d of %d points the 95 %% band reaches beyond C_f in [0, 1] and "
+                    "is clipped there (band_clipped = 1): the fitted parameters do not "
+                    "pin C_f down at those speeds", Path(path).name, int(odd.sum()), odd.size)
     columns = {"speed_m_s": cat("speed_m_s"), "friction_coefficient": cat("cf"),
                "cf_low": cat("cf_low"), "cf_high": cat("cf_high"),
                "cf_err": np.concatenate([np.broadcast_to(r["cf_err"], r["cf"].shape)
-                                         for r in rows])}
+                                         for r in rows]),
+               "band_clipped": odd.astype(int)}
     if viscosities is not None:
         columns = {"viscosity_Pa_s": np.concatenate(
             [np.full(r["cf"].shape, mu) for r, mu in zip(rows, viscosities)]), **columns}
