@@ -21,8 +21,9 @@ def predict(model: FitModel, result: dict, speeds, temperature: float | None,
     the band adds the spread of all the simulated curves so rescaled (the Hersey collapse's
     own error, when there are two or more); it adds their C_f error estimates
     (``cf_err``, NaN where the curves have none).  The band is clipped to C_f in [0, 1]
-    (``band_clipped`` marks where: the linearised band is wider than C_f).  A fitted load share and thermal resistance move C_f along
-    ``model.share_curves`` and ``model.resistance_curves``."""
+    (``band_clipped`` marks where: the linearised band is wider than C_f).  A fitted
+    load share and thermal resistance move C_f along ``model.share_curves`` and
+    ``model.resistance_curves``."""
     names = result["fit"]["parameters"]
     x = np.array([result[n]["value"] for n in names])
     cov = np.asarray(result["fit"]["covariance"])
