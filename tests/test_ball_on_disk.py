@@ -66,7 +66,12 @@ def test_ball_on_disk_stribeck_curve_from_ehl_to_boundary(tmp_path):
     ("ball_radius = 9.525e-3", "ball_radius = 9.525", "ball_radius"),
     ("grid = 73", "grid = 5", "grid"),
     ("eyring_stress = 5e6", "eyring_stress = -5e6", "eyring_stress"),
-    ("eyring_stress = 5e6", "eyring_stress = 5.0", "eyring_stress = 5: implausible")])
+    ("eyring_stress = 5e6", "eyring_stress = 5.0", "eyring_stress = 5: implausible"),
+    ("ball_radius = 9.525e-3", "ball_radius = 9.525e-3\npin_diameter = 8e-3",
+     r"\[tribometer\] pin_diameter: a pin's setting, unused by a ball"),
+    ("grid = 73", "grid = 73\npin = 2", r"\[macro\] pin: a pin's setting"),
+    ("[micro]\nresolution", "[preprocessing]\nresolution = [48, 48]\n[micro]\nresolution",
+     r"\[preprocessing\] resolution: a pin's setting")])
 def test_ball_case_keys_are_validated_with_units(tmp_path, old, new, key):
     text = small_ball_case(tmp_path).read_text().replace("grid = 49", "grid = 73")
     assert old in text

@@ -3,6 +3,7 @@
 
 import csv
 import json
+import re
 
 import pytest
 from sample_cases import small_case
@@ -88,8 +89,10 @@ def test_fit_the_rigs_thermal_resistance(tmp_path, capsys):
     assert fit["boundary_friction"]["value"] == pytest.approx(0.15, rel=2e-3)
     assert "bulk_resistance" in capsys.readouterr().out
     iso = tmp_path / "iso.toml"
-    iso.write_text(case.read_text().replace('model = "flash"', 'model = "none"'))
+    iso.write_text(re.sub(r"\n(bulk_resistance|spot_radius) = .*", "", case.read_text()
+                          ).replace('model = "flash"', 'model = "none"'))
     assert main(["fit", str(iso), *files, "-o", str(tmp_path / "x"), "--params", params]) == 2
+    assert "needs the thermal twin" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
 
 

@@ -76,6 +76,8 @@ def test_case_validation(tmp_path):
      "implausible"),
     ("boundary_film = 10e-9", "boundary_film = 10e-9\ncontact_tol = 5", "contact_tol"),
     ("refine_step = 0.1", "refine_step = 10", "refine_step = 10: implausible"),
+    ('model = "flash"', 'model = "none"', r"\[thermal\] bulk_resistance, spot_radius: the "
+     "thermal model's, unused"),
     ("error_tolerance = 0.005", "error_tolerance = 0.5",                 # 0.5 % as 0.5
      r"error_tolerance: a fraction of C_f,b in \(0, 0.1\]"),
     ("load = 150.0", "load = 150.0\nkind = \"ball-on-disk\"",

@@ -113,7 +113,11 @@ UNUSED = {"pin-on-disk": {
                        '[tribometer] kind = "ball-on-disk" (a pin\'s grid is [preprocessing] '
                        "resolution)"},
     "ball-on-disk": {("tribometer", "sliding_radius"): "a pin's track, unused by a ball; a "
-                                                       "ball's is track_radius"}}
+                                                       "ball's is track_radius"} | {
+    key: "a pin's setting, unused by a ball (its macro gap is its sphere, on [macro] grid); "
+         "remove it, or set [tribometer] kind = \"pin-on-disk\""
+    for key in (("preprocessing", "resolution"), ("preprocessing", "level_radius"),
+                ("tribometer", "pin_diameter"), ("macro", "pin"), ("geometry", "pins"))}}
 
 
 def _tribometer(data, where) -> Tribometer:
@@ -253,8 +257,14 @@ def _macro(data, where, tribometer, geometry) -> MacroSpec:
 
 
 def _thermal(data, where, lubricant) -> ThermalSettings:
-    """[thermal]: the flash model needs the oil's viscosity at two temperatures."""
+    """[thermal]: the flash model needs the oil's viscosity at two temperatures; the
+    isothermal model (``"none"``) takes none of the model's keys."""
     thermal = read_table(data, "thermal", ThermalSettings, where)
+    unused = sorted(set(data.get("thermal", {})) - {"model"})
+    if thermal.model == "none" and unused:
+        raise CaseError(f"{where} [thermal] {', '.join(unused)}: the thermal model's, unused "
+                        "by model = \"none\" (isothermal at the oil's temperature); set "
+                        "model = \"flash\" or remove them")
     if thermal.model != "none" and len(set(lubricant.temperatures)) < 2:
         raise CaseError(f"{where} [thermal] model = \"{thermal.model}\": the film's viscosity "
                         "at its temperature needs [lubricant] viscosities at two temperatures "
