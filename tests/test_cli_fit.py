@@ -130,6 +130,18 @@ def test_fit_validate_and_from_fit_refuse_what_they_cannot_use(tmp_path, capsys)
     for radius in ("0", "-0.03"):
         assert main(["validate", str(out), str(good), "--rpm", "--radius", radius]) == 2
         assert "--radius" in capsys.readouterr().err
+    head = ("speed_m_s,hersey,friction_coefficient,viscosity_Pa_s,hydrodynamic_friction_N,"
+            "boundary_force_N,contact_load_fraction,h_d_m,iterations\n")
+    row = "{},1e-7,{},0.066,0.1,1.0,0.5,2e-7,3\n"
+    (out / "stribeck.csv").write_text(head + row.format(0.1, 0.05) + row.format(1.0, 0.02))
+    other_oil = tmp_path / "oil.csv"                   # its own column picks its curve
+    other_oil.write_text("speed,friction_coefficient,viscosity_Pa_s\n0.2,0.01,0.024\n"
+                         "0.5,0.02,0.024\n")
+    assert main(["validate", str(out), str(other_oil)]) == 2
+    assert "no curve at mu_0 = 0.024 Pa s" in capsys.readouterr().err
+    (out / "stribeck.csv").write_text(head + row.format(0.1, "nan") + row.format(1.0, 0.02))
+    assert main(["validate", str(out), str(tmp_path / "ok.csv")]) == 2
+    assert "holds a non-finite C_f" in capsys.readouterr().err
     fit = tmp_path / "fit.json"
     fit.write_text(json.dumps({"fit": {"parameters": ["boundary_friction"]},
                                "case": {"temperatures": [24.0, 50.0], "law": None},

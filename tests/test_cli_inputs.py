@@ -68,6 +68,8 @@ def test_case_validation(tmp_path):
     ("level_radius = 3e-3", "level_radius = 3", "level_radius"),
     ("workers = 0", "workers = -1", "workers"), ("workers = 0", "workers = 10000", "workers"),
     ("workers = 0", "workers = 0\nscheduler = 5", "scheduler"),
+    ("workers = 0", 'workers = 0\nscheduler = "Local"', "scheduler: a Dask scheduler's "
+     "address"),
     ("sliding_radius = 30e-3", "sliding_radius = 3e-3", "sliding_radius = 0.003 m: the "
      "disk's axis would lie under the pin's face"),
     ("holder_height = -1e-3", "holder_height = -1e-5", "holder_height = -1e-05 m: below"),
@@ -290,6 +292,20 @@ def test_report_names_a_damaged_summary(tmp_path, capsys, content):
     assert "summary.json" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("content, words", [
+    ("{broken", "Expecting property name"), ('{"fit": {"parameters": "boundary_friction"}, '
+                                             '"case": {"temperatures": [24.0]}}',
+                                             "fit.parameters must be a list of names")])
+def test_report_names_a_damaged_fit_with_its_fix(tmp_path, capsys, content, words):
+    """A damaged fit.json beside a run's summary: one line naming the file, what is wrong
+    (a string of parameters was reported letter by letter) and the fix, exit 2."""
+    (tmp_path / "summary.json").write_text("{}")
+    (tmp_path / "fit.json").write_text(content)
+    assert main(["report", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "fit.json" in err and words in err and "fem-twin fit again" in err, err
+
+
 @pytest.mark.parametrize("section, key, value, words", [
     ("thermal", "conductivity", 0.046, "conductivity.*W/\\(m K\\)"),   # kW typed as W
     ("thermal", "conductivity", 1e12, "conductivity"),
@@ -341,3 +357,19 @@ def test_a_torque_reading_needs_the_force_law(tmp_path):
     (tmp_path / "paper.toml").write_text(text.replace('friction = "pin"', 'friction = "paper"'))
     with pytest.raises(CaseError, match=r"reading = \"torque\".*friction = \"pin\""):
         load_case(tmp_path / "paper.toml")
+
+
+def test_validation_compares_like_with_like(tmp_path):
+    """``[validation] measured`` reads each CSV when the case is read: a test at another load
+    or oil than its curve's (its ``load_N`` or ``viscosity_Pa_s`` column, which fit reads)
+    is refused, where it was compared with the case's curve without a word."""
+    text = small_case(tmp_path).read_text()
+    for column, value, words in (("load_N", 100, "load 100 N"),
+                                 ("viscosity_Pa_s", 0.024, "viscosity 0.024 Pa s")):
+        (tmp_path / "m.csv").write_text(f"speed,friction_coefficient,{column}\n0.2,0.05,"
+                                        f"{value}\n0.5,0.04,{value}\n")
+        (tmp_path / "v.toml").write_text(text + '\n[validation]\nmeasured = ["m.csv"]\n')
+        with pytest.raises(CaseError, match=f"the test ran at {words}"):
+            load_case(tmp_path / "v.toml")
+    (tmp_path / "m.csv").write_text("speed,friction_coefficient,load_N\n0.2,0.05,150\n")
+    assert load_case(tmp_path / "v.toml").measured[0].name == "m.csv"

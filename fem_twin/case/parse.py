@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import tomllib
 from dataclasses import replace
 from itertools import pairwise
@@ -12,6 +13,8 @@ from ..checks import arguments, memory_shortfall
 from ..errors import InputError
 from ..macro.boundary import BoundaryLaw
 from ..macro.thermal import ThermalSettings
+from ..stribeck.curve import read_measured_csv
+from ..stribeck.validation import check_like_with_like
 from ..topography.prepare import MacroOptions
 from .sections import (
     SECTIONS,
@@ -76,8 +79,10 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     if run.workers < 0:
         raise CaseError(f"{where} [run] workers: a number of processes >= 0 (0: all cores), "
                         f"got {run.workers}")
-    if run.scheduler is not None and not isinstance(run.scheduler, str):
-        raise CaseError(f"{where} [run] scheduler: a Dask scheduler's address as a string "
+    if run.scheduler is not None and not (isinstance(run.scheduler, str) and (
+            run.scheduler == "local" or re.fullmatch(r"([a-z]+://)?[\w.\-]+:\d+",
+                                                     run.scheduler))):
+        raise CaseError(f"{where} [run] scheduler: a Dask scheduler's address "
                         f'("tcp://10.0.0.1:8786") or "local", got {run.scheduler!r}')
     most = WORKERS_PER_CORE * (os.cpu_count() or 1)
     if run.workers > most and run.scheduler in (None, "local"):
@@ -94,7 +99,8 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
                         "(3 mm is 3e-3)")
     if not geometry.patches:
         raise CaseError(f"{where} [geometry]: at least one roughness patch pair is required")
-    measured = _measured(data.get("validation", {}), base, where, lubricant)
+    measured = _measured(data.get("validation", {}), base, where, lubricant,
+                         tribometer.load)
     defaulted = tuple(name for name in SECTIONS if name != "geometry" and name not in data)
     return Case(name=str(data.get("name", source.stem if source else "case")),
                 geometry=geometry, preprocessing=preprocessing, tribometer=tribometer,
@@ -237,8 +243,9 @@ def _micro(data, where) -> MicroSpec:
         raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
                         "h0_count >= 2 and steps >= 1")
     if micro.boundary_film >= micro.h0_min:
-        raise CaseError(f"{where} [micro] boundary_film = {micro.boundary_film:g} m: below the "
-                        f"smallest separation h0_min = {micro.h0_min:g} m (10 nm is 10e-9)")
+        raise CaseError(f"{where} [micro] boundary_film = {micro.boundary_film:g} m: must lie "
+                        f"below the smallest separation h0_min = {micro.h0_min:g} m (10 nm is "
+                        "10e-9)")
     return micro
 
 
@@ -320,8 +327,9 @@ def _sweep(data, where) -> SweepSpec:
     return sweep
 
 
-def _measured(val, base, where, lubricant) -> tuple:
-    """[validation] measured: one CSV file (or "") per viscosity, resolved."""
+def _measured(val, base, where, lubricant, load: float) -> tuple:
+    """[validation] measured: one CSV file (or "") per viscosity, resolved, each read and
+    refused when it names another load or oil than the case's (its curve's)."""
     only(val, {"measured"}, f"{where} [validation]")
     measured = val.get("measured", [])
     if (not isinstance(measured, list) or len(measured) > len(lubricant.viscosities)
@@ -329,7 +337,12 @@ def _measured(val, base, where, lubricant) -> tuple:
         raise CaseError(f"{where} [validation] measured: a list of CSV files, one per viscosity "
                         "(\"\" for none)")
     measured = tuple((base / m).resolve() if m else None for m in measured)
-    for m in measured:
+    for m, mu in zip(measured, lubricant.viscosities):
         if m is not None and not m.is_file():
             raise CaseError(f"{where} [validation] measured: file not found: {m}")
+        if m is not None:
+            try:
+                check_like_with_like(read_measured_csv(m), load, mu, str(m))
+            except InputError as err:
+                raise CaseError(f"{where} [validation] measured: {err}") from None
     return measured

@@ -205,6 +205,7 @@ def validate(args):
     from ..macro.boundary import BOUNDARY_FRICTION
     from ..stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
     from ..stribeck.curve import read_stribeck_csv
+    from ..stribeck.validation import check_like_with_like
     if args.radius is not None:
         number("--radius [m]", args.radius, "length")
     run = RunLayout(args.run)
@@ -212,18 +213,24 @@ def validate(args):
     if not csv_path.is_file():
         raise MissingFile(f"{csv_path} not found: give the output folder of fem-twin run")
     curves = read_stribeck_csv(csv_path)
-    if args.viscosity is None:
+    measured = read_measured_csv(args.measured, unit="rpm" if args.rpm else "m/s")
+    mu = args.viscosity if args.viscosity is not None else measured.viscosity
+    if mu is None:
         curve = curves[0]
     else:
-        match = [c for c in curves if np.isclose(c.viscosity, args.viscosity, rtol=1e-6)]
+        match = [c for c in curves if np.isclose(c.viscosity, mu, rtol=1e-6)]
         if not match:
-            raise InputError(f"no curve at mu_0 = {args.viscosity} Pa s in {csv_path} (it has "
+            raise InputError(f"no curve at mu_0 = {mu:g} Pa s in {csv_path} (it has "
                              f"{[c.viscosity for c in curves]})")
         curve = match[0]
+    if not np.all(np.isfinite(curve.friction_coefficient)):
+        raise InputError(f"{csv_path}: the curve at mu_0 = {curve.viscosity:g} Pa s holds a "
+                         "non-finite C_f; run fem-twin run on the case again to rewrite it")
     case_file = _run_case_file(args.run)
     case = load_case(case_file) if case_file else None
     boundary = case.tribometer.boundary_friction if case else BOUNDARY_FRICTION
-    measured = read_measured_csv(args.measured, unit="rpm" if args.rpm else "m/s")
+    check_like_with_like(measured, case.tribometer.load if case else measured.load or 0.0,
+                         curve.viscosity, str(args.measured))
     if args.rpm:
         radius = args.radius if args.radius is not None else (
             case.tribometer.sliding_radius if case else None)

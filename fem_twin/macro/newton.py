@@ -232,8 +232,10 @@ def continuation(P: Problem, load: float, *, tol: float, max_iter: int, progress
             history += err.history
             factor = np.sqrt(factor)
             if factor < 1.02 or target == F:
-                raise MixedNotConverged("load continuation of the Newton coupling stalled "
-                                        f"at {F:.3g} N of {load:.3g} N", history) from err
+                raise MixedNotConverged(
+                    f"the Newton coupling did not converge at {target:.3g} N within max_iter "
+                    f"= {max_iter} iterations (the load continuation had carried {F:.3g} N "
+                    f"of {load:.3g} N; {err}); raise [macro] max_iter", history) from err
             target = min(load, F * factor)
             continue
         total += its

@@ -5,8 +5,23 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from ..io.table import write_csv
-from .curve import deviation_from_measured, plot_stribeck, read_measured_csv
+from .curve import MeasuredCurve, deviation_from_measured, plot_stribeck, read_measured_csv
+
+
+def check_like_with_like(measured: MeasuredCurve, load: float, viscosity: float,
+                         where: str) -> None:
+    """Refuse comparing a measured curve whose file names its test's ``load_N`` or
+    ``viscosity_Pa_s`` with a simulated one at another ``load`` [N] or ``viscosity``
+    [Pa s] (as ``fem-twin fit`` reads them: the twin must be run at the test's)."""
+    for what, test, sim, unit in (("load", measured.load, load, "N"),
+                                  ("viscosity", measured.viscosity, viscosity, "Pa s")):
+        if test is not None and not np.isclose(test, sim, rtol=1e-6):
+            raise InputError(f"{where}: the test ran at {what} {test:g} {unit} (its "
+                             f"{'load_N' if what == 'load' else 'viscosity_Pa_s'} column) "
+                             f"and the simulated curve is at {sim:g} {unit}; run the twin at "
+                             "the test's (or fem-twin fit, which sweeps it there)")
 
 
 def validate_curves(curves, measured, boundary_friction: float, labels, table, plot_of) -> list:

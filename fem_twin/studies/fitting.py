@@ -245,6 +245,9 @@ def apply_fit(case: Case, result: dict) -> Case:
     tr, lb = case.tribometer, case.lubricant
     params, made = result["fit"]["parameters"], result["case"]
     _check_models(case, params)
+    if "kind" not in made:
+        log.warning("the fit.json does not name the tribometer it was fitted on; its "
+                    "parameters are applied to this %s case as they are", tr.kind)
     if made.get("kind", tr.kind) != tr.kind:
         raise InputError(f"the fit was made on a {made['kind']} case and this is a {tr.kind} "
                          "case: its contact and kinematics differ; fit this tribometer's curves")
@@ -257,8 +260,6 @@ def apply_fit(case: Case, result: dict) -> Case:
     thermal = replace(case.thermal, bulk_resistance=get("bulk_resistance",
                                                         case.thermal.bulk_resistance))
     shear = {k: result[k]["value"] for k in SHEAR if k in result}
-    if shear.get("shear_strength", 1e30) < QUANTITIES["shear_strength"][0]:
-        shear["shear_strength"] = 0.0          # below 10 kPa: no tau_0 the data can tell
     boundary = (replace(_shear_base(case), law="shear", **shear) if shear
                 else case.boundary)
     offset = temperature_offset(result)
@@ -294,7 +295,8 @@ def read_fit(path) -> dict:
     try:
         result = json.loads(Path(path).read_text())
     except (OSError, ValueError) as err:
-        raise InputError(f"{path}: not a fit.json of fem-twin fit ({err})") from err
+        raise InputError(f"{path}: not a fit.json of fem-twin fit ({err}); run fem-twin fit "
+                         "again to rewrite it") from None
     return check_fit(result, str(path))
 
 
@@ -302,9 +304,15 @@ def check_fit(result, where: str = "fit") -> dict:
     """``result`` (a ``fit.json``'s content) with its fitted values as numbers, or
     :class:`InputError` naming ``where``: a known parameter set, values inside the case
     parser's ranges, a contact temperature within 100 K of the oil's."""
+    fit = result.get("fit") if isinstance(result, dict) else None
+    params = fit.get("parameters") if isinstance(fit, dict) else None
+    if not isinstance(params, list) or not all(isinstance(k, str) for k in params):
+        raise InputError(f"{where}: not a fit.json of fem-twin fit (its fit.parameters must "
+                         f"be a list of names, got {params!r}); run fem-twin fit again to "
+                         "rewrite it")
     try:
         result["case"]["temperatures"]
-        unknown = [k for k in result["fit"]["parameters"] if k not in PARAMETERS
+        unknown = [k for k in params if k not in PARAMETERS
                    and not re.fullmatch(r"temperature_[1-9][0-9]*", k)]
         values = {k: float(result[k]["value"]) for k in ("boundary_friction", "load_share",
                                                          "bulk_resistance", *SHEAR)
@@ -313,13 +321,16 @@ def check_fit(result, where: str = "fit") -> dict:
         law = None if offset is None else WaltherLaw(**result["case"]["law"])
         law is None or float(law.viscosity(20.0))
     except (ValueError, KeyError, TypeError, IndexError) as err:
-        raise InputError(f"{where}: not a fit.json of fem-twin fit ({err!r})") from err
+        raise InputError(f"{where}: not a fit.json of fem-twin fit ({err!r}); run fem-twin "
+                         "fit again to rewrite it") from err
     if unknown:
         raise InputError(f"{where}: unknown fitted parameter(s) {unknown}; fem-twin fit writes "
                          f"{', '.join(PARAMETERS)} and temperature_K")
     quantity = {"boundary_friction": "friction", "load_share": "load_share",
                 "bulk_resistance": "thermal_resistance", **{k: k for k in SHEAR}}
     for name, value in values.items():          # the case parser's ranges
+        if name == "shear_strength" and 0 <= value < QUANTITIES[name][0]:
+            value = 0.0                         # below 10 kPa: no tau_0 the data can tell
         plausible(f"{where} {name}", value, quantity[name])
         result[name]["value"] = value           # a number, whatever the file spelled
     if offset is not None and not -100.0 <= offset <= 100.0:

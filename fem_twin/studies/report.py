@@ -23,6 +23,7 @@ from ..io.figure import save_figure
 from ..io.files import read_topography
 from ..io.layout import RunLayout
 from ..io.render import render_views
+from .fitting import read_fit
 
 
 def write_report(outdir, path=None, *, render: bool = True) -> Path:
@@ -132,7 +133,7 @@ def fit_section(out: RunLayout) -> str:
     """``fem-twin fit``: the fitted parameters with their 95 % intervals, and the curves."""
     if not out.fit.is_file():
         return ""
-    fit = json.loads(out.fit.read_text())
+    fit = read_fit(out.fit)
     names = fit["fit"]["parameters"] + [k for k in fit if k.startswith("viscosity_")]
     text = "; ".join(f"{k} = {fit[k]['value']:.4g} (95 %: {fit[k]['low']:.4g} to "
                      f"{fit[k]['high']:.4g})" for k in names)
