@@ -113,6 +113,20 @@ def test_prediction_at_another_temperature_holds_the_twin(twin):
     assert np.all(np.isnan(p["cf_err"]) == (sim[0.066].friction_error is None))
 
 
+def test_a_run_fitted_at_its_own_speeds_counts_every_point(twin):
+    """The simulated curve itself, at its own 20 speeds, fitted with the oil's temperature:
+    every point counts, the top speed too (the Walther law gives mu(24 C) to 3e-15, which
+    put 2 m/s a hair above the curve's end and dropped it), and the fit returns the curve's
+    own C_f,b and temperature."""
+    sim, _ = twin
+    c = sim[0.066]
+    out = fit_curves(FitModel((c,), CFB, 150.0, LAW), [MeasuredCurve(c.speed,
+                     c.friction_coefficient)], ["boundary_friction", "temperature"],
+                     start_temperatures=[24.0])
+    assert out["fit"]["points_not_counted"] == [0] and not out["fit"]["warnings"]
+    assert out["boundary_friction"]["value"] == pytest.approx(CFB, rel=1e-4)   # lsq tolerance
+
+
 def test_a_band_wider_than_the_friction_coefficient_is_clipped_and_marked(twin):
     """A covariance far wider than the fit's (here 1e4 times) makes the linearised band
     reach below C_f = 0 (issue 87: -0.040 to 0.074 around 0.017): it is clipped to [0, 1]

@@ -51,6 +51,11 @@ UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
          "cf_max": ("1", "highest C_f of the single-patch sweeps")}
 
 
+#: log-speed tolerance [-] within which a measured speed counts as a simulated curve's end
+#: (a run's own top speed, rescaled by a viscosity ratio that is 1 to rounding)
+SPEED_MATCH = 1e-9
+
+
 @arguments(viscosity="numbers", speed="numbers", diameter="number", load="number")
 def hersey_number(viscosity, speed, diameter: float, load: float):
     """H = mu_0 U D / F_N,imp of eq 46 [-] (SI inputs)."""
@@ -346,7 +351,7 @@ def deviation_from_measured(curve: StribeckCurve, measured: MeasuredCurve,
     order = np.argsort(curve.speed)
     x = np.log(curve.speed[order])
     u = np.log(measured.speed)
-    inside = (u >= x[0]) & (u <= x[-1])
+    inside = (u >= x[0] - SPEED_MATCH) & (u <= x[-1] + SPEED_MATCH)
     sim = PchipInterpolator(x, curve.friction_coefficient[order])(np.clip(u, x[0], x[-1]))
     deviation = friction_deviation(sim, measured.friction_coefficient, boundary_friction)
     return np.where(inside, deviation, np.nan)

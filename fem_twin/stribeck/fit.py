@@ -23,7 +23,7 @@ from scipy.interpolate import PchipInterpolator
 from ..errors import InputError, NotConverged
 from ..macro.boundary import BoundaryLaw
 from ..macro.viscosity import WaltherLaw
-from .curve import MeasuredCurve, StribeckCurve
+from .curve import SPEED_MATCH, MeasuredCurve, StribeckCurve
 from .fit_statistics import correlation, covariance, interval
 
 #: the shear law's parameters a fit can identify (``[boundary]`` keys), with their bounds
@@ -96,7 +96,7 @@ class FitModel:
         order = np.argsort(c.speed)
         x = np.log(c.speed[order])
         u = np.log(np.asarray(speed, float) * viscosity / c.viscosity)
-        inside = (u >= x[0]) & (u <= x[-1])
+        inside = (u >= x[0] - SPEED_MATCH) & (u <= x[-1] + SPEED_MATCH)
         at = lambda a: PchipInterpolator(x, a[order])(np.clip(u, x[0], x[-1]))  # noqa: E731
         hd = at(c.hydrodynamic_friction)
         if shear is None:
