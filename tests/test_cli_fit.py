@@ -122,6 +122,12 @@ def test_fit_validate_and_from_fit_refuse_what_they_cannot_use(tmp_path, capsys)
                  "boundary_friction", "--predict-load", "0.15", "--no-progress"]) == 2
     assert "more than 10x from the case's 150 N" in capsys.readouterr().err
     assert not (out / "geometry").exists()
+    (tmp_path / "afile").write_text("")
+    for bad in (["--params", "bogus"], ["-o", str(tmp_path / "afile")]):   # before the banner
+        assert main(["fit", str(case), str(good_curve), "-o", str(out), "--params",
+                     "boundary_friction", "--no-progress", *bad]) == 2
+        err = capsys.readouterr().err
+        assert "estimated" not in err and err.count("\n") == 1, err
     (out / "stribeck.csv").parent.mkdir(parents=True, exist_ok=True)
     (out / "stribeck.csv").write_text("speed_m_s,hersey,friction_coefficient,viscosity_Pa_s\n"
                                       "0.1,1e-7,0.01,0.066\n1.0,1e-6,0.02,0.066\n")

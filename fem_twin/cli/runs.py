@@ -78,6 +78,7 @@ def run(args):
     if args.from_fit is not None:
         from ..studies.fitting import apply_fit, read_fit, run_from_fit
         fitted = apply_fit(case, read_fit(args.from_fit))        # checked before any work
+    _check_output(args.output)
     estimate = _confirm_cost(fitted, args.yes)
     if estimate is None:
         return 2
@@ -155,18 +156,31 @@ def _short_summary(summary: dict, out: Path) -> str:
     return "\n".join(lines)
 
 
+def _check_output(path) -> None:
+    """Refuse an output folder that is a file or that this user cannot write, before the
+    machine is measured or any work starts."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise InputError(f"-o {path}: a file, not a folder; give an output folder")
+    near = next((p for p in (path, *path.parents) if p.exists()), Path("."))
+    if near.is_dir() and not os.access(near, os.W_OK | os.X_OK):
+        raise InputError(f"-o {path}: {near} is not writable for this user; give another "
+                         "output folder")
+
+
 def fit(args):
     from ..case import load_case
-    from ..studies.fitting import fit_case
+    from ..studies.fitting import check_fit_request, fit_case
     if not args.case.is_file():
         raise MissingFile(f"case file not found: {args.case}")
     case = load_case(args.case)
+    params = [p.strip() for p in args.params.split(",") if p.strip()]
+    check_fit_request(case, args.measured, params, args.predict, args.predict_load)
+    _check_output(args.output)
     if _confirm_cost(case, args.yes) is None:
         return 2
-    result = fit_case(case, args.measured, args.output,
-                      [p.strip() for p in args.params.split(",") if p.strip()],
-                      predict_at=args.predict, predict_loads=args.predict_load,
-                      progress=not args.no_progress)
+    result = fit_case(case, args.measured, args.output, params, predict_at=args.predict,
+                      predict_loads=args.predict_load, progress=not args.no_progress)
     for name in result["fit"]["parameters"] + [k for k in result if k.startswith("viscosity_")]:
         v = result[name]
         print(f"fem-twin fit: {name} = {v['value']:.5g} (95 %: {v['low']:.5g} to "

@@ -53,10 +53,8 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), predict_loa
     or resumes the case into ``outdir``); a ``load_share`` fit then sweeps the first
     viscosity at :data:`LOAD_SHARES` (so a rerun resumes)."""
     params = list(params)
-    paths = [Path(p) for p in measured]
-    curves_measured = [read_measured_csv(p) for p in paths]      # checked before any work
-    tests = _tests(case, curves_measured)
-    _check_request(case, params, paths, curves_measured, tests, predict_at, predict_loads)
+    paths, curves_measured, tests = check_fit_request(case, measured, params, predict_at,
+                                                      predict_loads)
     lb = case.lubricant
     law = (WaltherLaw.through(lb.temperatures, lb.viscosities, lb.density)
            if len(set(lb.temperatures)) > 1 else None)
@@ -105,6 +103,18 @@ def _tests(case: Case, curves) -> list[tuple[float, float]]:
                              "per viscosity, in their order, or a viscosity_Pa_s column")
         out.append((c.load or case.tribometer.load, c.viscosity or mus[k]))
     return out
+
+
+def check_fit_request(case: Case, measured, params, predict_at=(), predict_loads=()):
+    """Read the ``measured`` CSVs and refuse whatever :func:`fit_case` cannot do with them,
+    before any work (the CLI calls it before it measures the machine): ``(paths, measured
+    curves, tests)``, the tests as ``(load [N], viscosity [Pa s])`` per curve."""
+    paths = [Path(p) for p in measured]
+    curves_measured = [read_measured_csv(p) for p in paths]
+    tests = _tests(case, curves_measured)
+    _check_request(case, list(params), paths, curves_measured, tests, predict_at,
+                   predict_loads)
+    return paths, curves_measured, tests
 
 
 #: how far from the case's load [x] a fit's parameters are carried by ``--predict-load``
