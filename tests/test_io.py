@@ -141,3 +141,26 @@ def test_a_stribeck_csv_of_before_the_boundary_force_rename_reads(tmp_path):
     path.write_text(path.read_text().replace("boundary_force_N", "boundary_friction_N"))
     old, = read_stribeck_csv(path)
     assert np.allclose(old.boundary_force, curve.boundary_force, rtol=1e-9, atol=0)
+
+
+def test_debris_of_interrupted_atomic_writes_is_removed(tmp_path):
+    """Kill -9 between atomic_path's temporary file and its rename leaves a hidden file
+    (``.results.nc.k3j2h1g0.nc``) that no resume removed: ``remove_debris``, which the run
+    calls once it holds its folder's lock, deletes every name atomic_path makes and
+    nothing else."""
+    from fem_twin.io.atomic import TEMPORARY, atomic_path, remove_debris
+    names = []
+    for target in (tmp_path / "results.nc", tmp_path / "fields" / "mu0.066_003.vtu",
+                   tmp_path / "stribeck" / "checkpoints" / "point_ab12_1.000000000e+00.npz"):
+        with atomic_path(target) as tmp:
+            names.append(tmp.name)
+            tmp.write_text("whole")
+        (target.parent / tmp.name).write_text("half")    # what a killed writer leaves behind
+    assert all(TEMPORARY.fullmatch(n) for n in names)
+    keep = [tmp_path / ".lock", tmp_path / "run.log", tmp_path / ".hidden_notes"]
+    for k in keep:
+        k.write_text("x")
+    assert remove_debris(tmp_path) == 3
+    assert all(k.is_file() for k in keep) and not [p for p in tmp_path.rglob(".*")
+                                                    if TEMPORARY.fullmatch(p.name)]
+    assert (tmp_path / "results.nc").read_text() == "whole"

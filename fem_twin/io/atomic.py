@@ -4,8 +4,13 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import tempfile
 from pathlib import Path
+
+#: the name :func:`atomic_path` gives its temporary file: ``.NAME.`` plus mkstemp's eight
+#: random characters plus a suffix
+TEMPORARY = re.compile(r"\..+\.[a-z0-9_]{8}(\.[A-Za-z0-9]+)?")
 
 
 @contextlib.contextmanager
@@ -29,3 +34,16 @@ def atomic_path(path, suffix: str | None = None):
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+
+
+def remove_debris(folder) -> int:
+    """Delete the temporary files of :func:`atomic_path` that an interrupted process (kill
+    -9, a full disk) left anywhere under ``folder``; the caller holds the folder (its run
+    lock), so no writer is using them.  Returns how many were removed."""
+    gone = 0
+    for path in Path(folder).rglob(".*"):
+        if path.is_file() and TEMPORARY.fullmatch(path.name):
+            with contextlib.suppress(FileNotFoundError):
+                path.unlink()
+                gone += 1
+    return gone

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..case import Case
 from ..errors import InputError, RunLocked
-from ..io.atomic import atomic_path
+from ..io.atomic import atomic_path, remove_debris
 from ..io.layout import RunLayout
 from ..io.writers import Writers
 from ..numerics.threads import executor_for, one_thread
@@ -197,6 +197,10 @@ def _lock(out: RunLayout):
         f.truncate()
         f.write(str(os.getpid()))
         f.flush()
+        gone = remove_debris(out.root)
+        if gone:
+            log.info("removed %d temporary file(s) an interrupted run left in %s", gone,
+                     out.root)
         yield
     finally:
         f.close()
