@@ -212,9 +212,10 @@ def test_a_damaged_guide_point_of_a_finished_run_is_recomputed(tmp_path):
 
 @pytest.mark.integration
 def test_a_lost_micro_checkpoint_does_not_recompute_the_sweep(tmp_path):
-    """Recomputing one lost h0 checkpoint may change the flow factors at
-    round-off (and the rerun removes the temporary files of interrupted atomic writes); the Stribeck points are keyed by the micro stage's inputs, not by those bits,
-    so none of them is recomputed and the CSV is the same."""
+    """Recomputing one lost h0 checkpoint may change the flow factors at round-off; the
+    Stribeck points are keyed by the micro stage's inputs, not by those bits, so none of
+    them is recomputed and the CSV is the same; the rerun removes the temporary files of
+    interrupted atomic writes."""
     case = small_case(tmp_path)
     out = tmp_path / "out"
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0

@@ -152,11 +152,34 @@ def test_bad_inputs_and_no_convergence_are_clear():
         solve_deterministic(bad, dx, load=1e-3, speed=1.0, lubricant=OIL, settings=RIGID)
     with pytest.raises(InputError):
         DeterministicSettings(boundary_film=1e-10)
+    with pytest.raises(InputError, match="height range"):          # um typed as m
+        solve_deterministic(shape * 1e6, dx, load=1e-3, speed=1.0, lubricant=OIL,
+                            settings=RIGID)
     with pytest.raises(DeterministicNotConverged) as err:
         solve_deterministic(shape, dx, load=1e-3, speed=1.0, lubricant=OIL,
                             settings=DeterministicSettings(max_iter=2))
     again = pickle.loads(pickle.dumps(err.value))
     assert isinstance(again, DeterministicNotConverged) and again.history
+
+
+def test_the_verification_pads_refuse_what_they_cannot_pose():
+    """Issue 87 item 7: a pad in micrometres, fractional or zero tile counts, no oil, and
+    a summary of no points are refused with the argument named, not as bare errors."""
+    from fem_twin.studies import verification as V
+    cell = np.random.default_rng(0).normal(0, 50e-9, (8, 8))
+    pad = V.RoughPad(cell, 1e-6, OIL)
+    for make, words in ((lambda: V.RoughPad(cell * 1e6, 1e-6, OIL), "roughness"),
+                        (lambda: V.RoughPad(cell, 1e-6, None), "Lubricant"),
+                        (lambda: V.RoughPad(cell, 1e-6, OIL, macro_nodes=64.5), "macro_nodes"),
+                        (lambda: V.pad_speeds([1.0], 0), "tiles"),
+                        (lambda: V.pad_speeds([1.0], 2.5), "tiles: expected a whole"),
+                        (lambda: V.pad_speeds("fast", 2), "speeds"),
+                        (lambda: pad.resolved(1.5), "tiles"),
+                        (lambda: V.summary([], 0.19), "at least one"),
+                        (lambda: V.to_zero([], []), "at least one")):
+        with pytest.raises(InputError, match=words):
+            make()
+    assert V.to_zero([0.25], [0.01]) == (0.01, None)      # one point: itself, no order
 
 
 def test_the_twin_meets_the_deterministic_pad():

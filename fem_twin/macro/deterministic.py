@@ -294,6 +294,8 @@ def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant:
 def _checked(shape, spacing, load, speed, lubricant, settings):
     """The checked ``(shape, spacing, load, speed)`` of a deterministic point (SI)."""
     s = as_field("shape [m]", shape, 5)
+    plausible("shape [m] (its height range: form plus roughness)", float(np.ptp(s)) or 1e-8,
+              "height")
     dx = as_pair("spacing [m]", spacing)
     plausible("spacing [m]", dx, "pitch")
     load, speed = number("load [N]", load, "load"), number("speed [m/s]", speed, "speed")

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import number, plausible
 from ..errors import InputError
 from ..io.files import read_topography
 from ..macro import Lubricant, MacroSettings, solve_mixed
@@ -34,6 +35,15 @@ from ..topography.prepare import prepare_patch
 TILES = (2, 4, 8, 16)
 #: the pad's forms (``RoughPad.profile``)
 PROFILES = ("crown", "wedge")
+
+
+def whole(name: str, value, quantity: str) -> int:
+    """``value`` as a plausible whole number of ``quantity`` (a tile or node count), or
+    :class:`InputError` naming ``name``."""
+    v = number(name, value, quantity)
+    if v != int(v):
+        raise InputError(f"{name}: expected a whole number, got {value!r}")
+    return int(v)
 
 
 @dataclass(frozen=True)
@@ -69,6 +79,14 @@ class RoughPad:
     def __post_init__(self):
         if self.profile not in PROFILES:
             raise InputError(f"profile must be one of {PROFILES}, got {self.profile!r}")
+        if not isinstance(self.lubricant, Lubricant) or not isinstance(
+                self.settings, DeterministicSettings):
+            raise InputError("RoughPad: lubricant must be a Lubricant and settings "
+                             "DeterministicSettings")
+        plausible("RoughPad.pitch [m]", self.pitch, "pitch")
+        plausible("RoughPad.crown [m]", self.crown, "height")
+        plausible("RoughPad.mean_pressure [Pa]", self.mean_pressure, "pressure_scale")
+        whole("RoughPad.macro_nodes", self.macro_nodes, "nodes")
         for name in ("roughness", "disk"):
             r = getattr(self, name)
             if r is None:
@@ -76,13 +94,15 @@ class RoughPad:
             r = np.asarray(r, float)
             if r.ndim != 2 or r.shape[0] != r.shape[1] or not np.all(np.isfinite(r)):
                 raise InputError(f"{name} must be a finite square (m, m) cell [m]")
+            plausible(f"RoughPad.{name} [m] (its height range)", float(np.ptp(r)) or 1e-8,
+                      "height")
             object.__setattr__(self, name, r - r.mean())
         if self.disk is not None and self.disk.shape != self.roughness.shape:
             raise InputError("disk and roughness must be cells of one shape")
 
     def length(self, tiles: int) -> float:
         """The side of the pad of ``tiles`` cells a side [m]."""
-        return tiles * self.roughness.shape[0] * self.pitch
+        return whole("tiles", tiles, "samples") * self.roughness.shape[0] * self.pitch
 
     def load(self, tiles: int) -> float:
         """The load [N] of the pad of ``tiles`` cells a side."""
@@ -99,6 +119,7 @@ class RoughPad:
     def resolved(self, tiles: int):
         """``(shape, spacing)`` of the deterministic pad: the crown plus the tiled cell on
         ``tiles m + 1`` nodes a side (the cell's period closed)."""
+        tiles = whole("tiles", tiles, "samples")
         tiled = np.pad(np.tile(self.roughness, (tiles, tiles)), ((0, 1), (0, 1)), mode="wrap")
         return self.form(tiled.shape[0]) + tiled, (self.pitch, self.pitch)
 
@@ -108,6 +129,7 @@ class RoughPad:
         tiled across x2 as one period along x1 (:func:`~fem_twin.macro.time_resolved.disk_at`)."""
         if self.disk is None:
             raise InputError("the pad's disk is smooth: RoughPad.resolved is its pad")
+        tiles = whole("tiles", tiles, "samples")
         pin = np.tile(self.disk - self.roughness, (tiles, tiles))
         pin = np.pad(pin, ((0, 1), (0, 1)), mode="wrap")
         strip = np.pad(np.tile(self.disk, (tiles, 1)), ((0, 1), (0, 0)), mode="wrap")
@@ -161,7 +183,8 @@ def pad_factors(pad: RoughPad, h0, **cell):
 def pad_speeds(speeds, tiles: int) -> np.ndarray:
     """The speeds [m/s] of the pad of ``tiles`` cells a side for ``speeds`` given at two
     tiles: ``U 2 / tiles``, the same ``mu U L`` at every eps."""
-    return np.asarray(speeds, float) * 2.0 / tiles
+    plausible("speeds [m/s]", speeds, "speed")
+    return np.atleast_1d(np.asarray(speeds, float)) * 2.0 / whole("tiles", tiles, "samples")
 
 
 def deterministic_sweep(pad: RoughPad, tiles: int, speeds, settings=None) -> list:
@@ -242,6 +265,8 @@ def summary(pairs, boundary_friction: float, label: str = "mixed regime",
     ``unsteady``): the largest C_f gap [% C_f,b] and load-share gap over ``pairs``
     (:class:`Pair`), the largest resolved share [%], and with ``order`` (not False) the
     observed eps -> 0 order (:func:`order_text`)."""
+    if not pairs:
+        raise InputError("summary: give at least one compared point (Pair)")
     cf = max(abs(p.cf_gap(boundary_friction)) for p in pairs)
     share = max(abs(p.share - p.share_det) for p in pairs)
     line = (f"{label}: worst |C_f - C_f,det| = {100 * cf:.2f} % C_f,b, worst |share - "
