@@ -150,10 +150,12 @@ def as_field(name: str, value, min_side: int = 2) -> np.ndarray:
     """``value`` as a finite 2D float array of at least ``min_side`` a side, or
     :class:`InputError` naming ``name`` (a gap, a map: SI units are the caller's)."""
     try:
+        if np.iscomplexobj(value):
+            raise TypeError
         field_ = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise InputError(f"{name}: expected a 2D array of numbers, got {type(value).__name__}"
-                         ) from None
+        raise InputError(f"{name}: expected a 2D array of real numbers, got "
+                         f"{type(value).__name__}") from None
     if field_.ndim != 2 or min(field_.shape) < min_side:
         raise InputError(f"{name}: expected a 2D array of at least {min_side} x {min_side}, "
                          f"got shape {field_.shape}")

@@ -270,3 +270,39 @@ def test_settings_refuse_text_none_and_truthy_flags_where_a_number_or_flag_goes(
             make()
     assert CellSettings(time_tol=0).time_tol is None                  # 0 and None: off
     assert BoundaryLaw(law="shear", shear_strength=0.0).shear_strength == 0.0  # 0: none
+
+
+def test_the_new_public_functions_check_their_arguments():
+    """Issue 87 item 7: each raised a bare error or returned NaN."""
+    from fem_twin.macro import BoundaryLaw, Lubricant, boundary_traction
+    from fem_twin.macro.point import OperatingPoint
+    from fem_twin.macro.thermal import ThermalSettings, face_flash
+    from fem_twin.macro.viscosity import WaltherLaw
+    from fem_twin.micro import FlowFactors
+    from fem_twin.runtime.machine import probe_seconds
+    gap = np.full((9, 9), 1e-6)
+    point = dict(load=10.0, speed=1.0, lubricant=Lubricant(0.066))
+    law = WaltherLaw.through([24.0, 50.0], [0.066, 0.024], 850.0)
+    ones = np.ones((4, 4))
+    for make, words in (
+            (lambda: law.viscosity(-500.0), "absolute zero"),
+            (lambda: probe_seconds("bogus"), "kind is one of"),
+            (lambda: probe_seconds("micro", repeats=0), "repeats"),
+            (lambda: face_flash(ones, ones > 0, (1e-5, 1e-5), 1.0, ThermalSettings()),
+             "pair"),
+            (lambda: boundary_traction(ones, ones, np.ones(3), 1.0, BoundaryLaw(), 0.1),
+             "one grid"),
+            (lambda: boundary_traction(ones, ones, 5 * ones, 1.0, BoundaryLaw(), 0.1),
+             r"\[0, 1\]"),
+            (lambda: boundary_traction(-ones, ones, ones / 2, 1.0, BoundaryLaw(), 0.1),
+             "not negative"),
+            (lambda: OperatingPoint(gap, (1e-5, 1e-5), FlowFactors.smooth(), **{
+                **point, "lubricant": None}), "Lubricant"),
+            (lambda: OperatingPoint(gap, (1e-5, 1e-5), FlowFactors.smooth(), **point,
+                                    settings=None), "MacroSettings"),
+            (lambda: OperatingPoint(gap, (1e-5, 1e-5), FlowFactors.smooth(), **point,
+                                    face=np.zeros((9, 9), bool)), "all False"),
+            (lambda: OperatingPoint(gap + 0j, (1e-5, 1e-5), FlowFactors.smooth(), **point),
+             "real numbers")):
+        with pytest.raises(InputError, match=words):
+            make()

@@ -107,6 +107,17 @@ def boundary_traction(contact_pressure, film_pressure, contact_fraction, sliding
     """The boundary shear ``tau_b`` [Pa] of ``law`` (module docstring) at each node, its
     temperature factor apart (:func:`spot_temperature_factor`); ``boundary_friction``:
     the constant law's C_f,b."""
+    try:
+        np.broadcast_shapes(*(np.shape(a) for a in (contact_pressure, film_pressure,
+                                                    contact_fraction, sliding_speed)))
+    except ValueError:
+        raise InputError("boundary_traction: the pressures, contact fraction and speed must "
+                         "share one grid (or be numbers)") from None
+    fraction = np.asarray(contact_fraction, float)
+    if np.any(fraction < 0) or np.any(fraction > 1) or np.any(
+            np.asarray(contact_pressure, float) < 0):
+        raise InputError("boundary_traction: contact_fraction lies in [0, 1] and the contact "
+                         "pressure [Pa] is not negative")
     load = asperity_load(contact_pressure, film_pressure, contact_fraction, law)
     if law.law == "constant":
         return boundary_friction * load

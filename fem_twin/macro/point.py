@@ -56,6 +56,13 @@ class OperatingPoint:
         face = np.ones(gap.shape, bool) if self.face is None else np.asarray(self.face, bool)
         if face.shape != gap.shape:
             raise InputError(f"face mask {face.shape} does not match the gap {gap.shape}")
+        if not face.any():
+            raise InputError("face mask: no node of the grid lies on the face (all False)")
+        if not isinstance(self.lubricant, Lubricant) or not isinstance(self.settings,
+                                                                       MacroSettings):
+            raise InputError("OperatingPoint: lubricant must be a Lubricant and settings "
+                             f"MacroSettings, got {type(self.lubricant).__name__} and "
+                             f"{type(self.settings).__name__}")
         values = dict(gap=gap, spacing=spacing, face=face,
                       load=number("load [N]", self.load, "load"))
         if self.entrainment is None or self.speed != 0:   # 0 with u_m: pure rolling

@@ -120,6 +120,9 @@ def face_flash(flux, face, spacing, speeds, settings: ThermalSettings) -> tuple:
     if np.shape(flux) != np.shape(face):
         raise InputError(f"face_flash: flux {np.shape(flux)} and face {np.shape(face)} must "
                          "share their grid")
+    if np.ndim(speeds) != 1 or np.size(speeds) != 2:
+        raise InputError(f"face_flash: speeds is the pair (pin, disk) [m/s], got {speeds!r}")
+    speeds = as_pair("face_flash: speeds [m/s]", speeds)
     q, f, dx = _coarse(np.where(face, flux, 0.0), face, spacing, settings.grid)
     pin, disk = (surface_temperature(q, dx, abs(u), settings.conductivity,
                                      settings.diffusivity)[f].mean() for u in speeds)

@@ -51,6 +51,9 @@ class WaltherLaw:
     def viscosity(self, temperature):
         """Dynamic viscosity [Pa s] at ``temperature`` [C] (finite numbers)."""
         check("WaltherLaw.viscosity: temperature [C]", temperature, "numbers")
+        if np.any(np.asarray(temperature, float) <= -KELVIN):
+            raise InputError(f"WaltherLaw.viscosity: temperature [C] above absolute zero "
+                             f"(-273.15 C; 24 C is 24.0), got {temperature!r}")
         x = np.log10(np.asarray(temperature, float) + KELVIN)
         nu = 10 ** 10 ** (self.a - self.b * x) - 0.7
         return nu * 1e-6 * self.density

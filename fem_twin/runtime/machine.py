@@ -65,6 +65,11 @@ class Slowdown:
 def probe_seconds(kind: str = "micro", repeats: int | None = None) -> float:
     """The best of ``repeats`` timings of the ``kind`` miniature (``"micro"``, ``"macro"``
     or ``"ball"``; one thread, as the workers; ``repeats`` None: :data:`REPEATS`) [s]."""
+    if kind not in REPEATS:
+        raise InputError(f"probe_seconds: kind is one of {sorted(REPEATS)}, got {kind!r}")
+    if repeats is not None and (isinstance(repeats, bool) or not isinstance(
+            repeats, (int, np.integer)) or repeats < 1):
+        raise InputError(f"probe_seconds: repeats is a whole number >= 1, got {repeats!r}")
     return min(_timings(kind, REPEATS[kind] if repeats is None else repeats))
 
 
