@@ -118,6 +118,14 @@ def boundary_traction(contact_pressure, film_pressure, contact_fraction, sliding
             np.asarray(contact_pressure, float) < 0):
         raise InputError("boundary_traction: contact_fraction lies in [0, 1] and the contact "
                          "pressure [Pa] is not negative")
+    return traction(contact_pressure, film_pressure, contact_fraction, sliding_speed, law,
+                    boundary_friction)
+
+
+def traction(contact_pressure, film_pressure, contact_fraction, sliding_speed,
+             law: BoundaryLaw, boundary_friction: float) -> np.ndarray:
+    """:func:`boundary_traction` without its checks, for the macro scale's own fields (an
+    error estimate's perturbed factors may step outside the physical ranges)."""
     load = asperity_load(contact_pressure, film_pressure, contact_fraction, law)
     if law.law == "constant":
         return boundary_friction * load

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..io.atomic import atomic_path
 from ..micro.rolling import at_slide_to_roll
-from .boundary import asperity_load, boundary_area, boundary_traction
+from .boundary import asperity_load, boundary_area, traction
 from .friction import disk_shear, hydrodynamic_shear
 from .kinematics import disk_velocity, rotations
 from .reynolds import trapezoid_weights
@@ -216,8 +216,8 @@ def pin_friction(film, how: Shearing):
                                     velocity=velocity)
     gauge = np.maximum(np.asarray(p_hd, float) - settings.ambient_pressure, 0.0)
     a_r = boundary_area(shear, settings.boundary)
-    tau_con = boundary_traction(p_con, gauge, a_r, speed * local, settings.boundary,
-                                settings.boundary_friction)
+    tau_con = traction(p_con, gauge, a_r, speed * local, settings.boundary,
+                       settings.boundary_friction)
     return (tau_hd, tau_con * along * (speed > 0),   # along the reading; 0: no sliding
             asperity_load(p_con, gauge, a_r, settings.boundary) * along, a_r * along)
 
