@@ -274,3 +274,40 @@ def test_a_sweep_longer_than_a_workers_share_runs_as_chains(monkeypatch):
     fields = [replace(task, fields="somewhere") for task in tasks]
     assert len(curves.chains(fields, 2)) == len(tasks)
     assert len(curves.chains(tasks, 1)) == len(tasks)
+
+
+@pytest.mark.integration
+def test_ctrl_c_on_a_local_cluster_ends_at_once_in_one_line(tmp_path):
+    """Ctrl-C reaches the whole process group: a LocalCluster's workers died of it, printed
+    their tracebacks and hung the cluster's close (the run lived on for minutes).  They
+    now ignore it; the run stops, closes them and exits 130 with one line.  The signal is
+    sent once the cluster computes (the first h0 checkpoint), not after a delay."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from sample_cases import small_case
+    pytest.importorskip("distributed")
+    case = small_case(tmp_path)
+    case.write_text(case.read_text().replace("workers = 1", 'workers = 2\nscheduler = "local"'))
+    out = tmp_path / "out"
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", FEM_TWIN_SLOWDOWN="1")
+    proc = subprocess.Popen([sys.executable, "-m", "fem_twin.cli", "run", str(case), "-o",
+                             str(out), "--no-progress"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
+    deadline = time.monotonic() + 300
+    while not list(out.glob("micro/*/checkpoints/*.json")) and proc.poll() is None:
+        assert time.monotonic() < deadline, "the micro stage never started"
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGINT)
+    try:
+        _, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        pytest.fail("the run hung after Ctrl-C")
+    lines = [ln for ln in err.splitlines() if "resource_tracker" not in ln
+             and "warnings.warn" not in ln]
+    assert proc.returncode == 130 and "interrupted" in lines[-1], err
+    assert "Traceback" not in err and len(lines) <= 2, err

@@ -12,8 +12,10 @@ fem_twin changes nothing.  ``FEM_TWIN_THREADS=N`` allows N threads instead.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import functools
+import logging
 import os
 import signal
 import sys
@@ -147,6 +149,25 @@ def executor_for(workers: int = 0, scheduler: str | None = None):
     stop_pool(pool)
 
 
+def _quiet_dask() -> None:
+    """Silence Dask's own logging in this process: the run says what ended it, in one line
+    (a closing cluster's workers warned of each cancelled task)."""
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+
+
+@contextmanager
+def _workers_ignore_ctrl_c():
+    """Start processes that ignore Ctrl-C (SIGINT; an ignored signal stays ignored in a
+    child): the terminal sends it to the whole process group, and a LocalCluster whose
+    workers died of it printed their tracebacks and hung its close.  The run alone stops,
+    then closes them; a Ctrl-C while they start (a few seconds) is lost."""
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
 @contextmanager
 def _dask_client(scheduler: str, workers: int):
     """A Dask client of the scheduler at the address ``scheduler``, or of a LocalCluster
@@ -154,10 +175,18 @@ def _dask_client(scheduler: str, workers: int):
     import dask
     from distributed import Client, LocalCluster
     if scheduler == "local":
-        with dask.config.set(DASK_CONFIG), \
-                LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                             dashboard_address=None) as cluster, Client(cluster) as client:
-            yield client
+        with dask.config.set(DASK_CONFIG):
+            with _workers_ignore_ctrl_c():
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
+                                       processes=True, dashboard_address=None)
+            with cluster, Client(cluster) as client:
+                try:
+                    yield client
+                except BaseException:           # Ctrl-C, a failed task: close in silence
+                    _quiet_dask()
+                    with contextlib.suppress(Exception):
+                        client.run(_quiet_dask)
+                    raise
         return
     try:
         client = Client(scheduler, timeout="5s")
