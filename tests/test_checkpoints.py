@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from fem_twin import Topography
+from fem_twin.errors import InputError
 from fem_twin.macro import Lubricant, MacroSettings
 from fem_twin.micro import homogenise
 from fem_twin.stribeck import SweepRequest, stribeck_sweep
@@ -68,10 +69,13 @@ def _changed(value):
         return (_changed(value[0]), *value[1:])
     if isinstance(value, str):
         return value + "x"
-    for f in fields(value):
+    for f in fields(value):                  # the first number whose change is plausible
         if isinstance(getattr(value, f.name), (int, float)) and not isinstance(
                 getattr(value, f.name), bool):
-            return replace(value, **{f.name: _changed(getattr(value, f.name))})
+            try:
+                return replace(value, **{f.name: _changed(getattr(value, f.name))})
+            except InputError:               # 0 -> 1e-9 Pa of a tau_0: below its range
+                continue
     raise AssertionError(f"no field to change in {value!r}")
 
 
