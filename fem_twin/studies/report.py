@@ -23,7 +23,7 @@ from ..io.figure import save_figure
 from ..io.files import read_topography
 from ..io.layout import RunLayout
 from ..io.render import render_views
-from .fitting import read_fit
+from .fit_file import read_fit
 
 
 def write_report(outdir, path=None, *, render: bool = True) -> Path:
