@@ -97,3 +97,32 @@ def bench_deterministic(tiles=V.TILES):
         rows.append((f"eps -> 0 (speed {speed:.3g} m/s at eps 1/2)", 0.0, note))
     rows += _diagnostics(pad, 8, cfb, dets.get(8) or V.deterministic_sweep(pad, 8, SPEEDS))
     return t_twin / len(SPEEDS), rows, V.summary(table[-1], cfb)
+
+
+#: the knee at two cells a side: 70 % to 22 % of the load on asperities at eps = 1/16
+KNEE = SPEEDS[2:5]
+
+
+def bench_deterministic_fine(tiles=(8, 16, 32)):
+    """The knee speeds at eps = 1/8, 1/16 and 1/32 (1025^2 nodes, about 20 min a point on
+    2 cores): the gaps and the order each speed observes (``to_zero``), so that the
+    eps -> 0 value is measured, not assumed.  Times per point, the baseline the first; the
+    last line is the summary at 1/32."""
+    pad = V.sample_pad(SAMPLE, PIXELS)
+    cfb = pad.settings.boundary_friction
+    factors = V.pad_factors(pad, H0)
+    rows, table = [], []
+    for n in tiles:
+        t0 = time.perf_counter()
+        det = V.deterministic_sweep(pad, n, KNEE)
+        t1 = time.perf_counter()
+        table.append(V.compared(det, V.twin_sweep(pad, n, KNEE, factors), n))
+        rows += [_row(p, cfb, (t1 - t0) / len(KNEE)) for p in table[-1]]
+    eps = [1 / n for n in tiles]
+    for k, speed in enumerate(KNEE):
+        cf, order = V.to_zero(eps, [t[k].cf_gap(cfb) for t in table])
+        share, share_order = V.to_zero(eps, [t[k].share - t[k].share_det for t in table])
+        rows.append((f"eps -> 0 (speed {speed:.3g} m/s at eps 1/2)", 0.0,
+                     f"C_f - C_f,det {100 * cf:+.2f} % C_f,b ({V.order_text(order)}), share "
+                     f"- share,det {share:+.4f} ({V.order_text(share_order)})"))
+    return rows[0][1], rows, V.summary(table[-1], cfb, "mixed regime at eps 1/32")

@@ -7,6 +7,8 @@
                                               #  FEM_TWIN_AB_BASE and now, ~10 min,
                                               #  cores: the bundled case on 1, 2, all workers;
                                               #  deterministic: the mixed regime, ~20 min;
+                                              #  deterministic-fine: its knee at eps 1/8 to
+                                              #  1/32, ~70 min;
                                               #  unsteady: both bodies rough, moving;
                                               #  estimates: each example's printed run
                                               #  time against its run, ~4 min, ~9 with
@@ -36,7 +38,7 @@ from amg import bench_amg  # noqa: E402
 from common import SAMPLE, best_of, macro_factors, macro_gap  # noqa: E402
 from cores import bench_cores  # noqa: E402
 from defaults import bench_defaults  # noqa: E402
-from deterministic import bench_deterministic  # noqa: E402
+from deterministic import bench_deterministic, bench_deterministic_fine  # noqa: E402
 from estimates import bench_estimates  # noqa: E402
 from scale import bench_scale  # noqa: E402
 from unsteady import bench_unsteady  # noqa: E402
@@ -603,6 +605,7 @@ GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": ben
           "estimate-paper": lambda: bench_estimate("paper.toml"),
           "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults,
           "deterministic": bench_deterministic, "ab": bench_ab,
+          "deterministic-fine": bench_deterministic_fine,
           "estimates": bench_estimates, "unsteady": bench_unsteady}
 
 
@@ -610,7 +613,7 @@ def main(argv):
     groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "estimate-paper",
                                                         "scale", "amg", "cores", "defaults",
                                                         "deterministic", "ab", "estimates",
-                                                        "unsteady")]
+                                                        "unsteady", "deterministic-fine")]
     for name in groups:
         base, rows, *summary = GROUPS[name]()
         print(f"\n## {name}")
