@@ -159,9 +159,7 @@ def _short_summary(summary: dict, out: Path) -> str:
 def _check_output(path) -> None:
     """Refuse an output folder that is a file or that this user cannot write, before the
     machine is measured or any work starts."""
-    path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise InputError(f"-o {path}: a file, not a folder; give an output folder")
+    path = RunLayout(path).root                   # a file: refused there
     near = next((p for p in (path, *path.parents) if p.exists()), Path("."))
     if near.is_dir() and not os.access(near, os.W_OK | os.X_OK):
         raise InputError(f"-o {path}: {near} is not writable for this user; give another "
