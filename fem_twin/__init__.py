@@ -10,6 +10,7 @@ that order: the case file, what a run costs, the results as data, the main job's
     1    topography, io
     2    contact
     3    micro
+    3.5  peers
     4    macro, fvm
     5    stribeck
     6.0  case
