@@ -10,6 +10,8 @@
                                               #  deterministic-fine: its knee at eps 1/8 to
                                               #  1/32, ~70 min;
                                               #  unsteady: both bodies rough, moving;
+                                              #  peers: the average-flow model beside the
+                                              #  twin and the deterministic pads, ~45 min;
                                               #  estimates: each example's printed run
                                               #  time against its run, ~4 min, ~9 with
                                               #  FEM_TWIN_ESTIMATE_LOAD=1;
@@ -40,6 +42,7 @@ from cores import bench_cores  # noqa: E402
 from defaults import bench_defaults  # noqa: E402
 from deterministic import bench_deterministic, bench_deterministic_fine  # noqa: E402
 from estimates import bench_estimates  # noqa: E402
+from peers import bench_peers  # noqa: E402
 from scale import bench_scale  # noqa: E402
 from unsteady import bench_unsteady  # noqa: E402
 
@@ -606,14 +609,15 @@ GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": ben
           "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults,
           "deterministic": bench_deterministic, "ab": bench_ab,
           "deterministic-fine": bench_deterministic_fine,
-          "estimates": bench_estimates, "unsteady": bench_unsteady}
+          "estimates": bench_estimates, "unsteady": bench_unsteady, "peers": bench_peers}
 
 
 def main(argv):
     groups = argv or [g for g in GROUPS if g not in ("micro-full", "estimate", "estimate-paper",
                                                         "scale", "amg", "cores", "defaults",
                                                         "deterministic", "ab", "estimates",
-                                                        "unsteady", "deterministic-fine")]
+                                                        "unsteady", "deterministic-fine",
+                                                        "peers")]
     for name in groups:
         base, rows, *summary = GROUPS[name]()
         print(f"\n## {name}")

@@ -153,6 +153,10 @@ class MicroSpec(CellSettings):
     (:class:`fem_twin.micro.CellSettings`, declared there once: time steps, method, squeeze
     term, adaptive instants, tolerances), the patches' resolution and the h0 candidates."""
 
+    model: str = setting("cells", "the flow factors: the cell problems on the measured "
+                         "patches (the twin), or the statistical average-flow model "
+                         "(Patir-Cheng, Greenwood-Tripp: a screening run in seconds, with no "
+                         "error bar; docs/peers.md)", choices=("cells", "average-flow"))
     resolution: tuple[int, int] = setting((128, 128), "patches resampled (periodically) to "
                                           "this grid, at least 8 each (the paper: its 256 px "
                                           "patches as cut; docs/accuracy.md, 'Cheaper "

@@ -23,6 +23,10 @@ BUNDLED_SECONDS = 87.0
 LONG_RUN_RATIO = 7.0
 #: that threshold in the calibration machine's seconds
 LONG_RUN_SECONDS = LONG_RUN_RATIO * BUNDLED_SECONDS
+#: how a screening run (``[micro] model = "average-flow"``) names its model
+SCREENING = ("the average-flow screening model (Patir-Cheng, Greenwood-Tripp): no cell "
+             "problems, no error bar on C_f; its gap to the deterministic reference is in "
+             "docs/peers.md")
 
 
 def _confirm_cost(case, yes: bool) -> float | None:
@@ -43,9 +47,11 @@ def _confirm_cost(case, yes: bool) -> float | None:
     seconds = estimated_seconds(case, cores, speed)
     on = {n: duration(estimated_seconds(case, n, speed)) for n in (16, 64)}
     mc = case.micro
+    cells = (f"{mc.h0_count} h0 x {mc.steps} steps"
+             f"{f' (adaptive h0, tolerance {mc.h0_tol:g})' if mc.h0_tol else ''}"
+             if mc.model == "cells" else SCREENING)
     print(f"fem-twin run: {len(case.geometry.patches)} patch pairs at {mc.resolution[0]}x"
-          f"{mc.resolution[1]}, {mc.h0_count} h0 x {mc.steps} steps"
-          f"{f' (adaptive h0, tolerance {mc.h0_tol:g})' if mc.h0_tol else ''}; "
+          f"{mc.resolution[1]}, {cells}; "
           f"{len(case.lubricant.viscosities)} x {case.sweep.count} speeds; estimated "
           f"{duration(seconds)} on {cores} cores, {on[16]} on 16 and {on[64]} on 64 (this "
           f"machine takes {speed} the calibration machine's time now)", file=sys.stderr)
@@ -138,7 +144,9 @@ def _short_summary(summary: dict, out: Path) -> str:
                      f"(Hamrock-Dowson, smooth: {film['hamrock_dowson_h_c_m'] * 1e9:.0f} nm, "
                      f"{film['hamrock_dowson_h_min_m'] * 1e9:.0f} nm)")
     err = stages["stribeck"].get("cf_error")
-    if err:
+    if stages.get("micro", {}).get("model") == "average-flow":
+        lines.append(f"  C_f by {SCREENING}")
+    elif err:
         lines.append(f"  C_f estimated discretisation error: at most "
                      f"{err['max_relative']:.2%} of C_f,b (" + ", ".join(
                          f"{k} {v:.2%}" for k, v in err["parts_max_relative"].items())

@@ -12,7 +12,8 @@ of half and twice the boundary film, times ``FILM_COUPLING`` (a model part; no s
 ``"total"`` sums the parts' magnitudes (a root sum of squares fell below the truth where
 the parts' errors add with one sign); ``"signed"`` keeps each part's sign.  A part that
 could not be estimated is NaN, left out of the total and named in ``"missing"``, with the
-reason in ``"failed"``.  Smooth factors have no micro parts (0)."""
+reason in ``"failed"``.  Smooth factors have no micro parts (0); a screening model's
+point (:attr:`FlowFactors.screening`) has no estimate at all (NaN, :data:`SCREENING`)."""
 
 from __future__ import annotations
 
@@ -45,6 +46,9 @@ H0_SPACING_RATIO = 4.0
 #: 1.8 times the re-evaluated change in the mixed regime (share above 0.1), at most 0.052 %
 #: C_f,b (docs/accuracy.md, "The boundary film where it matters")
 FILM_COUPLING = 2.0
+#: why a screening model's point (:attr:`FlowFactors.screening`) has no estimate
+SCREENING = ("the average-flow screening model: its C_f has no error bar, its gap to the "
+             "deterministic reference is measured in docs/peers.md")
 #: the parts of an estimate, in the order of the CSV and NetCDF outputs
 PARTS = ("macro", "time", "grid", "h0", "film")
 #: the fewest nodes a side of the grid the micro parts are solved on: there their sum is
@@ -71,6 +75,9 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
     coarsenings by two, finest first (:func:`.nested.solve_nested`'s levels after the
     first), which are then not solved again."""
     factors, settings, lubricant = point.factors, point.settings, point.lubricant
+    if factors.screening:                         # a statistical model: no error bar
+        return {**{part: np.nan for part in PARTS}, "total": np.nan,
+                "failed": [SCREENING]}
     solve = _Levels(result, point, levels)
     try:
         base = solve(1)

@@ -108,6 +108,13 @@ class FlowFactors:
     def __len__(self) -> int:
         return self.h0.size
 
+    @property
+    def screening(self) -> bool:
+        """True for a statistical model's factors (``meta["screening"]``,
+        :mod:`fem_twin.peers`): closed forms with no discretisation error of their own,
+        whose C_f carries no error bar (its model error is measured in docs/peers.md)."""
+        return bool(self.meta.get("screening", False))
+
     @classmethod
     def smooth(cls, h0_range=(1e-10, 1e-2)) -> "FlowFactors":
         """Factors of two perfectly smooth surfaces (the smooth limit of eqs 11-16):
@@ -339,6 +346,7 @@ def average(factors) -> FlowFactors:
                            for f in factors],
             "method": factors[0].meta.get("method"), "version": factors[0].meta.get("version"),
             "slide_to_roll": kinematics.pop(),
+            **({"screening": True} if any(f.screening for f in factors) else {}),
             "error_estimate": combine(f.meta.get("error_estimate") for f in factors),
             "variants": _average_variants(factors)}
     return FlowFactors(h0=h0, **mean, meta=meta)

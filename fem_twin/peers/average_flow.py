@@ -35,6 +35,9 @@ from .greenwood_tripp import Summits, contact_fraction, contact_pressure
 
 #: a body whose rms height is below this share of the pair's is taken as smooth (no gamma)
 SMOOTH_SHARE = 1e-3
+#: contact pressures and areas below this share of the largest are zero: they carry no load,
+#: and their tails would span 300 decades (denormal slopes in the interpolants)
+NO_LOAD = 1e-12
 #: the separations tabulated by default [m]: 1 nm to 10 um, 80 a decade (any pair's range of
 #: H = h / sigma, and one grid for every patch, so that their factors average)
 DEFAULT_H0 = np.geomspace(1e-9, 1e-5, 321)
@@ -112,13 +115,17 @@ def average_flow_factors(pin: Topography, disk: Topography, e_reduced: float, h0
     A[:, 0, 0], A[:, 1, 1] = phi_x * ratio ** 3, phi_y * ratio ** 3
     C = np.zeros((h.size, 2, 2))
     C[:, 0, 0], C[:, 1, 1] = fp_x, fp_y
-    meta = {"method": "average-flow", "model": "Patir-Cheng + Greenwood-Tripp",
+    meta = {"method": "average-flow", "model": "Patir-Cheng + Greenwood-Tripp", "screening": True,
             "sigma_m": sigma, "gamma": stats.gamma, "shares": list(stats.shares),
             "gammas": list(stats.gammas), "summits": asdict(stats.summits),
             "held_below_m": lo * sigma, "slide_to_roll": slide_to_roll}
+    p_con = contact_pressure(h, stats.summits, e_reduced)
+    area = contact_fraction(h, stats.summits)
+    for tail in (p_con, area):
+        tail[tail < NO_LOAD * tail.max()] = 0.0
     return FlowFactors(
-        h0=h, h_m=h_t, p_con=contact_pressure(h, stats.summits, e_reduced), A=A,
+        h0=h, h_m=h_t, p_con=p_con, A=A,
         b=np.stack([1 - slide_to_roll / 2 * sigma * phi_s / h_t, zero], axis=1), C=C,
         d=np.stack([slide_to_roll * (1 - s_c) / 6, zero], axis=1), friction_factor=s_c,
         pressure_friction=np.stack([fp_x, zero], axis=1),
-        contact_fraction=contact_fraction(h, stats.summits), meta=meta)
+        contact_fraction=area, meta=meta)

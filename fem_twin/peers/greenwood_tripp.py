@@ -67,8 +67,8 @@ class Summits:
         if not (m0 > 0 and m2 > 0 and m4 > 0):
             raise InputError("spectral moments must be positive (a rough surface)")
         alpha = m0 * m4 / m2 ** 2
-        return cls(density=m4 / (6 * np.pi * np.sqrt(3) * m2),
-                   radius=3 / 8 * np.sqrt(np.pi / m4),
+        return cls(density=float(m4 / (6 * np.pi * np.sqrt(3) * m2)),
+                   radius=float(3 / 8 * np.sqrt(np.pi / m4)),
                    spread=float(np.sqrt(max(1 - SUMMIT_VARIANCE / alpha, 0.0) * m0)),
                    mean=float(4 * np.sqrt(m0 / (np.pi * alpha))))
 

@@ -83,7 +83,8 @@ def cost_tasks(case) -> list[Task]:
     thermal = THERMAL_COST if case.thermal.model != "none" else 1.0
     point = _point_seconds(case) * thermal
     guide = GUIDE_COST * point if case.tribometer.ball else GUIDE_SECONDS * thermal
-    estimate = 1.0 if case.tribometer.ball else ESTIMATE_COST
+    estimate = (1.0 if case.tribometer.ball or case.micro.model == "average-flow"
+                else ESTIMATE_COST)                     # a screening run has no estimate
     count = case.sweep.count
     added = min(count, REFINED_SPEEDS[case.tribometer.ball]) * case.sweep.refine
     after, tasks, guides, again = tuple(t.name for t in micro), [], [], []
@@ -139,6 +140,8 @@ def _micro_tasks(case) -> list[Task]:
     """Per patch pair, its separations in :data:`H0_ROUNDS` rounds, each one task or two
     (its even and odd instants, :func:`~fem_twin.micro.schedule.halves`)."""
     mc = case.micro
+    if mc.model == "average-flow":                      # closed forms: no cells to solve
+        return []
     h0 = mc.h0_count
     if mc.h0_tol:
         a, k = ADAPTIVE_H0

@@ -43,6 +43,8 @@ def run_task_graph(case: Case, outdir) -> list[Task]:
 def patch_tasks(case: Case, out: RunLayout, k: int) -> list[Task]:
     """The h0 tasks of patch pair ``k``, round by round, then its coarse-cell pass."""
     ff = FlowFactors.load(out.patch_factors(k))
+    if ff.screening:                                     # closed forms: no cell tasks
+        return []
     folder, keys = out.patch_checkpoints(k), ff.meta["checkpoint_keys"]
     mc = case.micro
     h0 = mc.h0_candidates(ff.meta.get("h0_candidates"))

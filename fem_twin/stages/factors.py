@@ -19,6 +19,7 @@ from ..io.writers import Writers
 from ..micro import CellSettings, FlowFactors, average, homogenise
 from ..micro.output import plot_flow_factors
 from ..micro.store import prune_checkpoints
+from ..peers import average_flow_factors
 from ..topography import resample_cell
 
 log = logging.getLogger("fem_twin")
@@ -54,7 +55,8 @@ def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool
         plot_flow_factors, [*factors, mean], out.flow_factors_png,
         labels=[f"patch {i + 1}" for i in range(len(factors))] + ["average"])
     estimate = mean.meta.get("error_estimate", {})
-    return {"patches": len(factors), "h0_m": [float(h0[0]), float(h0[-1]), len(h0)],
+    return {"model": mc.model, "patches": len(factors),
+            "h0_m": [float(h0[0]), float(h0[-1]), len(h0)],
             "h0_solved": [len(f) for f in factors], "h0_tol": mc.h0_tol,
             "grid": list(mc.resolution), "steps": mc.steps,
             "time_derivative": mc.time_derivative,
@@ -75,6 +77,13 @@ def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> Flo
     up = read_topography(out.patch(i + 1, "up"))
     if low.shape != tuple(mc.resolution):
         low, up = resample_cell(low, mc.resolution), resample_cell(up, mc.resolution)
+    if mc.model == "average-flow":
+        settings = cell_settings(case)
+        ff = average_flow_factors(low, up, settings.e_reduced,
+                                  slide_to_roll=settings.slide_to_roll)
+        bar.update(len(h0))
+        ff.save(path)
+        return ff
     ff = homogenise(low, up, h0, settings=cell_settings(case), h0_tol=mc.h0_tol,
                     friction=case.macro.friction,
                     executor=executor,

@@ -1,5 +1,6 @@
 """Analysis of Stribeck curves: the patch scatter band (Figure 13), the speeds where a curve
-turns (for refinement) and the Hersey collapse of curves at several viscosities (eq 46)."""
+turns (for refinement), the Hersey collapse of curves at several viscosities (eq 46) and
+the knee, where the asperities carry half the load."""
 
 from __future__ import annotations
 
@@ -56,3 +57,20 @@ def hersey_collapse(curves, boundary_friction: float) -> float:
         devs.extend(np.abs(friction_deviation(c.friction_coefficient[ok], cf_ref[ok],
                                               boundary_friction)))
     return float(max(devs)) if devs else float("nan")
+
+
+#: the asperity share of the load that marks a curve's knee (:func:`knee_speed`)
+KNEE_SHARE = 0.5
+
+
+def knee_speed(curve, share: float = KNEE_SHARE) -> float:
+    """The sliding speed [m/s] where the asperities carry ``share`` of the load
+    (``contact_load_fraction``), linear in log speed between the points around it; NaN
+    where the curve does not cross it."""
+    order = np.argsort(curve.speed)
+    u, s = np.log(curve.speed[order]), np.asarray(curve.contact_load_fraction)[order] - share
+    cross = np.flatnonzero((s[:-1] >= 0) & (s[1:] < 0))
+    if not cross.size:
+        return float("nan")
+    i = cross[-1]
+    return float(np.exp(u[i] + (u[i + 1] - u[i]) * s[i] / (s[i] - s[i + 1])))

@@ -28,6 +28,7 @@ from ..macro import Lubricant, MacroSettings, solve_mixed
 from ..macro.deterministic import DeterministicSettings, solve_deterministic
 from ..macro.time_resolved import solve_time_resolved
 from ..micro import homogenise
+from ..peers import average_flow_factors
 from ..topography import Topography, resample_cell
 from ..topography.prepare import prepare_patch
 
@@ -178,6 +179,17 @@ def pad_factors(pad: RoughPad, h0, **cell):
                       **{"n_steps": steps, **cell}, e_reduced=s.e_reduced,
                       hardness=s.hardness, boundary_film=s.boundary_film,
                       gap_floor=s.gap_floor, error_estimate=False)
+
+
+def pad_average_flow(pad: RoughPad):
+    """The statistical peer's flow factors of the pad's cell
+    (:func:`fem_twin.peers.average_flow_factors`): the same bodies as :func:`pad_factors`
+    (the roughness on the pin, or both rough with ``pad.disk``), the pad's E'."""
+    dx = (pad.pitch, pad.pitch)
+    pin, disk = ((-pad.roughness, np.zeros_like(pad.roughness)) if pad.disk is None
+                 else (pad.disk - pad.roughness, pad.disk))
+    return average_flow_factors(Topography(pin, dx), Topography(disk, dx),
+                                pad.settings.e_reduced)
 
 
 def pad_speeds(speeds, tiles: int) -> np.ndarray:
