@@ -168,9 +168,84 @@ def test_average_flow_factors_of_a_pair():
     assert disk_rough.at(near).b[0, 0] > 1 > pin_rough.at(near).b[0, 0]
     stats = PairStatistics.from_cells(Topography(flat, DX), Topography(rough, DX))
     assert stats.shares == (0.0, 1.0) and stats.gammas[0] is None
-    assert np.allclose(disk_rough.p_con, contact_pressure(disk_rough.h0, stats.summits, e))
+    p = contact_pressure(disk_rough.h0, stats.summits, e)
+    assert np.allclose(disk_rough.p_con, np.where(p < 1e-12 * p.max(), 0.0, p))
     held = disk_rough.meta["held_below_m"]
     assert held >= 0.5 * stats.sigma
     h = disk_rough.h0[disk_rough.h0 < held]
     phi_x = disk_rough.A[: h.size, 0, 0] * (mean_gap(h, stats.sigma) / h) ** 3
     assert np.allclose(phi_x, phi_x[-1], rtol=1e-12)
+
+
+def test_knee_speed_reads_the_half_load_crossing():
+    """knee_speed: where contact_load_fraction crosses 0.5, linear in log speed (a share
+    falling as log speed rises crosses at the exact speed); NaN without a crossing."""
+    from fem_twin.stribeck.analysis import knee_speed
+    from fem_twin.stribeck.curve import StribeckCurve
+    speed = np.geomspace(2.0, 0.01, 12)
+    share = np.clip(0.5 - 0.3 * np.log(speed / 0.2), 0, 1)
+    n = speed.size
+    curve = StribeckCurve(speed=speed, hersey=speed, friction_coefficient=np.ones(n),
+                          viscosity=0.066, hydrodynamic_friction=np.ones(n),
+                          boundary_force=np.ones(n), contact_load_fraction=share,
+                          h_d=np.ones(n), iterations=np.ones(n))
+    assert knee_speed(curve) == pytest.approx(0.2, rel=1e-12)
+    assert np.isnan(knee_speed(curve, share=1.5))
+
+
+def test_a_screening_point_has_no_error_bar(factors):
+    """The peer's factors are flagged (FlowFactors.screening, kept by average), and a
+    point solved with them carries no discretisation estimate: NaN with the reason, no
+    extra solves."""
+    from fem_twin.macro import Lubricant, MacroSettings
+    from fem_twin.macro.estimate import SCREENING, friction_error
+    from fem_twin.macro.point import OperatingPoint
+    from fem_twin.micro import average
+    from sample_cases import macro_case
+    rough = gaussian_surface(64, (5, 5))
+    peer = average_flow_factors(Topography(rough, DX), Topography(np.zeros_like(rough), DX),
+                                2.3e11)
+    assert peer.screening and average([peer, peer]).screening and not factors.screening
+    gap, dx, face = macro_case(32)
+    point = OperatingPoint(gap=gap, spacing=dx, factors=peer, load=150.0, speed=1.0,
+                           lubricant=Lubricant(0.066), settings=MacroSettings(), face=face)
+    err = friction_error(None, point)
+    assert np.isnan(err["total"]) and err["failed"] == [SCREENING]
+
+
+def test_the_case_key_and_its_choices(tmp_path):
+    """[micro] model: "cells" by default, "average-flow" read, anything else refused with
+    the choices named."""
+    from fem_twin.case import CaseError, load_case
+    from sample_cases import small_case
+    path = small_case(tmp_path)
+    assert load_case(path).micro.model == "cells"
+    text = path.read_text().replace("[micro]", '[micro]\nmodel = "average-flow"')
+    path.write_text(text)
+    assert load_case(path).micro.model == "average-flow"
+    path.write_text(text.replace('"average-flow"', '"patir-cheng"'))
+    with pytest.raises(CaseError, match="average-flow"):
+        load_case(path)
+
+
+@pytest.mark.integration
+def test_a_screening_run(tmp_path):
+    """fem-twin run with [micro] model = "average-flow": no cell problems, the summary and
+    the banner name the model, every C_f has no error bar (cf_err NaN), and the curves
+    rise from full film to the boundary level."""
+    import csv
+    import json
+
+    from fem_twin.cli import main
+    from sample_cases import small_case
+    path = small_case(tmp_path)
+    path.write_text(path.read_text().replace("[micro]", '[micro]\nmodel = "average-flow"'))
+    out = tmp_path / "out"
+    assert main(["run", str(path), "-o", str(out), "--no-progress"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stages"]["micro"]["model"] == "average-flow"
+    assert not any((out / "micro").rglob("checkpoints"))
+    rows = list(csv.DictReader(open(out / "stribeck.csv")))
+    assert all(np.isnan(float(r["cf_err"])) for r in rows)
+    cf = [float(r["friction_coefficient"]) for r in rows if float(r["viscosity_Pa_s"]) == 0.066]
+    assert cf[-1] > 5 * min(cf)
