@@ -197,11 +197,12 @@ def test_a_screening_point_has_no_error_bar(factors):
     """The peer's factors are flagged (FlowFactors.screening, kept by average), and a
     point solved with them carries no discretisation estimate: NaN with the reason, no
     extra solves."""
+    from sample_cases import macro_case
+
     from fem_twin.macro import Lubricant, MacroSettings
     from fem_twin.macro.estimate import SCREENING, friction_error
     from fem_twin.macro.point import OperatingPoint
     from fem_twin.micro import average
-    from sample_cases import macro_case
     rough = gaussian_surface(64, (5, 5))
     peer = average_flow_factors(Topography(rough, DX), Topography(np.zeros_like(rough), DX),
                                 2.3e11)
@@ -216,8 +217,9 @@ def test_a_screening_point_has_no_error_bar(factors):
 def test_the_case_key_and_its_choices(tmp_path):
     """[micro] model: "cells" by default, "average-flow" read, anything else refused with
     the choices named."""
-    from fem_twin.case import CaseError, load_case
     from sample_cases import small_case
+
+    from fem_twin.case import CaseError, load_case
     path = small_case(tmp_path)
     assert load_case(path).micro.model == "cells"
     text = path.read_text().replace("[micro]", '[micro]\nmodel = "average-flow"')
@@ -236,8 +238,9 @@ def test_a_screening_run(tmp_path):
     import csv
     import json
 
-    from fem_twin.cli import main
     from sample_cases import small_case
+
+    from fem_twin.cli import main
     path = small_case(tmp_path)
     path.write_text(path.read_text().replace("[micro]", '[micro]\nmodel = "average-flow"'))
     out = tmp_path / "out"
