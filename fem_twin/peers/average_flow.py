@@ -66,7 +66,8 @@ class PairStatistics:
         bodies = [roughness_statistics(t) if t.rms_height() > SMOOTH_SHARE * pair.sigma
                   else None for t in (pin, disk)]
         var = np.array([0.0 if b is None else b.sigma ** 2 for b in bodies])
-        return cls(sigma=pair.sigma, gamma=pair.gamma, shares=tuple(float(v) for v in var / var.sum()),
+        shares = tuple(float(v) for v in var / var.sum())
+        return cls(sigma=pair.sigma, gamma=pair.gamma, shares=shares,
                    gammas=tuple(None if b is None else b.gamma for b in bodies),
                    summits=Summits.from_moments(*pair.moments))
 
