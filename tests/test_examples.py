@@ -46,6 +46,9 @@ PINNED = {
     "16_moving_roughness": (r"eps 1/8: worst \|C_f - C_f,det\| ([\d.]+) %", 0.0, 4.5,
                             "the twin against the time-resolved pad, both rough, at eps 1/8 "
                             "(2.95 %)"),
+    "17_average_flow": (r"eps 1/2, average flow: worst \|C_f - C_f,det\| ([\d.]+) %", 15.0,
+                        30.0, "the statistical model's gap on the pad, 5-8x the twin's (22.6 %; "
+                        "the twin 3.6 %)"),
     "14_boundary_law": (r"shear_strength: ([\d.e+]+) ", 2.4e7, 3.6e7,
                         "the fitted tau_0 within 20 % of the truth, 30 MPa (33.3 MPa)"),
 }
