@@ -49,6 +49,21 @@ def test_statistics_of_a_known_spectrum(lengths):
     assert np.allclose(st.m4, 12e-14 / length ** 4, rtol=0.01)
 
 
+def test_a_correlation_longer_than_the_cell_is_a_bound():
+    """Ridges along the sliding (a correlation length of 200 px along x1 on a 64 px
+    cell): the x1 length is the half cell and only a bound, gamma a lower bound; the peer
+    takes the tables' edge, 9, and says both in its notes."""
+    ridges = gaussian_surface(64, (200, 4))
+    st = roughness_statistics(Topography(ridges, DX))
+    assert st.bounded == (True, False) and st.gamma_bound == "lower"
+    assert st.lengths[0] == pytest.approx(32 * DX)
+    ff = average_flow_factors(Topography(ridges, DX), Topography(np.zeros_like(ridges), DX),
+                              2.3e11)
+    assert ff.meta["gamma"] == 9.0
+    assert any("only a bound (lower" in n for n in ff.meta["notes"])
+    assert any("tables' edge 9" in n for n in ff.meta["notes"])
+
+
 def test_summits_match_the_counted_ones():
     """McCool's summit density, mean height and spread against the local maxima (8
     neighbours) of a resolved isotropic Gaussian surface (10 px correlation, 512^2, about

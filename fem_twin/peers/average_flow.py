@@ -48,13 +48,16 @@ class PairStatistics:
     """What the statistical model reads from a patch pair (SI units): the composite rms
     ``sigma`` [m] and Peklenik number ``gamma`` [-], each body's variance ``shares``
     (pin, disk) [-] and ``gammas`` (None for a smooth body), and the composite ``summits``
-    (McCool's, from the equivalent isotropic moments)."""
+    (McCool's, from the equivalent isotropic moments).  A gamma the cell bounds (a
+    correlation longer than half the cell) or outside Patir and Cheng's tables is taken at
+    its bound or the tables' edge (1/9, 9), and ``notes`` say which."""
 
     sigma: float
     gamma: float
     shares: tuple[float, float]
     gammas: tuple[float | None, float | None]
     summits: Summits
+    notes: tuple[str, ...] = ()
 
     @classmethod
     def from_cells(cls, pin: Topography, disk: Topography) -> "PairStatistics":
@@ -67,9 +70,11 @@ class PairStatistics:
                   else None for t in (pin, disk)]
         var = np.array([0.0 if b is None else b.sigma ** 2 for b in bodies])
         shares = tuple(float(v) for v in var / var.sum())
-        return cls(sigma=pair.sigma, gamma=pair.gamma, shares=shares,
-                   gammas=tuple(None if b is None else b.gamma for b in bodies),
-                   summits=Summits.from_moments(*pair.moments))
+        notes = []
+        gammas = [_gamma(b, name, notes) if b is not None else None
+                  for b, name in ((pair, "pair"), *zip(bodies, ("pin", "disk")))]
+        return cls(sigma=pair.sigma, gamma=gammas[0], shares=shares, gammas=tuple(gammas[1:]),
+                   summits=Summits.from_moments(*pair.moments), notes=tuple(notes))
 
     def smallest_H(self) -> float:
         """The largest of the fits' smallest ``H`` over the gammas in use [-]."""
@@ -83,6 +88,18 @@ class PairStatistics:
             if gamma is not None:
                 out = out + sign * share * fit(H, gamma)
         return out
+
+
+def _gamma(stats, name: str, notes: list) -> float:
+    """``stats.gamma`` within Patir and Cheng's tables, with a note where it is a bound
+    or clipped."""
+    gamma = float(np.clip(stats.gamma, pc.GAMMAS[0], pc.GAMMAS[-1]))
+    if stats.gamma_bound != "exact":
+        notes.append(f"{name}: gamma {stats.gamma:.3g} is only a bound ({stats.gamma_bound}: "
+                     "a correlation length longer than half the cell)")
+    if gamma != stats.gamma:
+        notes.append(f"{name}: gamma {stats.gamma:.3g} taken at the tables' edge {gamma:.3g}")
+    return gamma
 
 
 def mean_gap(h, sigma: float) -> np.ndarray:
@@ -119,6 +136,7 @@ def average_flow_factors(pin: Topography, disk: Topography, e_reduced: float, h0
     meta = {"method": "average-flow", "model": "Patir-Cheng + Greenwood-Tripp", "screening": True,
             "sigma_m": sigma, "gamma": stats.gamma, "shares": list(stats.shares),
             "gammas": list(stats.gammas), "summits": asdict(stats.summits),
+            "notes": list(stats.notes),
             "held_below_m": lo * sigma, "slide_to_roll": slide_to_roll}
     p_con = contact_pressure(h, stats.summits, e_reduced)
     area = contact_fraction(h, stats.summits)

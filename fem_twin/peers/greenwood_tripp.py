@@ -65,7 +65,8 @@ class Summits:
         ``beta = (3/8) sqrt(pi / m4)``, ``alpha = m0 m4 / m2^2``,
         spread ``sqrt(1 - 0.8968/alpha) sqrt(m0)``, mean ``4 sqrt(m0 / (pi alpha))``."""
         if not (m0 > 0 and m2 > 0 and m4 > 0):
-            raise InputError("spectral moments must be positive (a rough surface)")
+            raise InputError("spectral moments must be positive: a surface flat along one "
+                             "direction (pure ridges) has no summits for Greenwood-Tripp")
         alpha = m0 * m4 / m2 ** 2
         return cls(density=float(m4 / (6 * np.pi * np.sqrt(3) * m2)),
                    radius=float(3 / 8 * np.sqrt(np.pi / m4)),

@@ -31,17 +31,27 @@ class RoughnessStatistics:
     lengths : ``(lambda_x1, lambda_x2)``, where the autocorrelation falls to 0.5 [m]
     m2, m4 : ``(along x1, along x2)``: the profiles' mean square slope [-] and curvature
     [1/m^2] (spectral moments; m0 = sigma^2)
+    bounded : ``(x1, x2)``: True where the autocorrelation stays above 0.5 over half the
+    cell, whose half is then the length (a lower bound of the true one)
     """
 
     sigma: float
     lengths: tuple[float, float]
     m2: tuple[float, float]
     m4: tuple[float, float]
+    bounded: tuple[bool, bool] = (False, False)
 
     @property
     def gamma(self) -> float:
         """Peklenik's number ``lambda_x1 / lambda_x2`` [-] (Patir and Cheng's gamma)."""
         return self.lengths[0] / self.lengths[1]
+
+    @property
+    def gamma_bound(self) -> str:
+        """What :attr:`gamma` is: ``"exact"``, an ``"upper"`` or a ``"lower"`` bound (one
+        length bounded by the cell), or ``"none"`` (both)."""
+        return {(False, False): "exact", (False, True): "upper", (True, False): "lower",
+                (True, True): "none"}[tuple(self.bounded)]
 
     @property
     def moments(self) -> tuple[float, float, float]:
@@ -52,9 +62,9 @@ class RoughnessStatistics:
 
 
 def roughness_statistics(topo: Topography) -> RoughnessStatistics:
-    """:class:`RoughnessStatistics` of a periodic, fully valid cell ``topo``; an
-    :class:`~fem_twin.errors.InputError` where the autocorrelation does not fall to 0.5
-    within half the cell along a direction (the cell is too small to give gamma)."""
+    """:class:`RoughnessStatistics` of a periodic, fully valid cell ``topo`` (where the
+    autocorrelation does not fall to 0.5 within half the cell along a direction, the half
+    cell is its length and ``bounded`` says so)."""
     if topo.mask is not None:
         raise InputError("roughness statistics need a fully valid cell: fill its defects "
                          "first (fem_twin.topography.fill_defects)")
@@ -66,21 +76,20 @@ def roughness_statistics(topo: Topography) -> RoughnessStatistics:
     k2 = 2 * np.pi * np.fft.fftfreq(z.shape[0], topo.spacing[1])[:, None]
     m2 = tuple(float(np.sum(power * k ** 2)) for k in (k1, k2))
     m4 = tuple(float(np.sum(power * k ** 4)) for k in (k1, k2))
-    lengths = (_half_length(acf[0, :], topo.spacing[0], "x1"),
-               _half_length(acf[:, 0], topo.spacing[1], "x2"))
-    return RoughnessStatistics(sigma=float(np.sqrt(np.sum(power))), lengths=lengths,
-                               m2=m2, m4=m4)
+    (l1, b1), (l2, b2) = (_half_length(acf[0, :], topo.spacing[0]),
+                          _half_length(acf[:, 0], topo.spacing[1]))
+    return RoughnessStatistics(sigma=float(np.sqrt(np.sum(power))), lengths=(l1, l2),
+                               m2=m2, m4=m4, bounded=(b1, b2))
 
 
-def _half_length(acf, dx: float, axis: str) -> float:
-    """The lag [m] where the circular autocorrelation ``acf`` (lag 0 first) first falls to
-    :data:`CORRELATION_LEVEL`, linear between pixels."""
+def _half_length(acf, dx: float) -> tuple[float, bool]:
+    """``(lag [m], bounded)``: where the circular autocorrelation ``acf`` (lag 0 first)
+    first falls to :data:`CORRELATION_LEVEL`, linear between pixels, or half the cell and
+    True where it does not."""
     half = acf[: acf.size // 2 + 1]
     below = np.flatnonzero(half <= CORRELATION_LEVEL)
     if not below.size:
-        raise InputError(f"the autocorrelation along {axis} stays above "
-                         f"{CORRELATION_LEVEL} over half the cell: the cell is too small "
-                         "for its correlation length (take a larger patch)")
+        return float((half.size - 1) * dx), True
     i = below[0]
     frac = (half[i - 1] - CORRELATION_LEVEL) / (half[i - 1] - half[i])
-    return float((i - 1 + frac) * dx)
+    return float((i - 1 + frac) * dx), False
