@@ -50,10 +50,10 @@ def test_statistics_of_a_known_spectrum(lengths):
 
 
 def test_a_correlation_longer_than_the_cell_is_a_bound():
-    """Ridges along the sliding (a correlation length of 200 px along x1 on a 64 px
+    """Ridges along the sliding (a correlation length of 48 px along x1 on a 64 px
     cell): the x1 length is the half cell and only a bound, gamma a lower bound; the peer
     takes the tables' edge, 9, and says both in its notes."""
-    ridges = gaussian_surface(64, (200, 4))
+    ridges = gaussian_surface(64, (48, 4))
     st = roughness_statistics(Topography(ridges, DX))
     assert st.bounded == (True, False) and st.gamma_bound == "lower"
     assert st.lengths[0] == pytest.approx(32 * DX)
