@@ -181,6 +181,7 @@ def test_average_flow_factors_of_a_pair():
     assert far.friction_factor[0] == pytest.approx(1, abs=1e-3)
     near = np.array([2e-7])
     assert disk_rough.at(near).b[0, 0] > 1 > pin_rough.at(near).b[0, 0]
+    assert np.all(pin_rough.friction_factor > 0)     # the held phi_fs stays below phi_f
     stats = PairStatistics.from_cells(Topography(flat, DX), Topography(rough, DX))
     assert stats.shares == (0.0, 1.0) and stats.gammas[0] is None
     p = contact_pressure(disk_rough.h0, stats.summits, e)

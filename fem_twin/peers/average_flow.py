@@ -124,8 +124,7 @@ def average_flow_factors(pin: Topography, disk: Topography, e_reduced: float, h0
     ratio = h / h_t
     phi_x, phi_y = pc.pressure_flow(H, stats.gamma), pc.pressure_flow_across(H, stats.gamma)
     phi_s = stats.per_body(pc.shear_flow, H)
-    s_c = (pc.couette_stress(np.maximum(h / sigma, 1e-6)) - stats.per_body(pc.shear_stress, H)
-           ) / ratio
+    s_c = (pc.couette_stress(H) - stats.per_body(pc.shear_stress, H)) / ratio
     fp_x = pc.pressure_stress(H, stats.gamma) * ratio
     fp_y = pc.pressure_stress(H, 1 / stats.gamma) * ratio
     zero = np.zeros_like(h)
