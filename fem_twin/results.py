@@ -9,7 +9,12 @@ Units are in each variable's ``units`` attribute, SI throughout.
 
 from __future__ import annotations
 
+import gc
 import json
+import os
+import re
+import sys
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -160,7 +165,7 @@ def write_netcdf(path, groups: dict, attrs: dict | None = None) -> Path:
     byte shuffle, lossless: faster and smaller than level 4 without it); the group None is
     the file's root."""
     path = Path(path)
-    with atomic_path(path) as tmp:
+    with atomic_path(path) as tmp, _write_errors(path):
         mode = "w"
         for name, ds in groups.items():
             ds = ds.copy()
@@ -169,6 +174,28 @@ def write_netcdf(path, groups: dict, attrs: dict | None = None) -> Path:
             ds.to_netcdf(tmp, mode=mode, group=name, engine=ENGINE, encoding=enc)
             mode = "a"
     return path
+
+
+@contextmanager
+def _write_errors(path):
+    """A failed NetCDF write as one :class:`OSError` with its errno (a full disk: ENOSPC):
+    h5py reports it as a RuntimeError or OSError whose text carries ``errno = N``, and the
+    HDF5 objects it frees afterwards print their own tracebacks (through
+    ``sys.excepthook`` and ``sys.unraisablehook``), which this drops for the write's
+    duration."""
+    hooks = sys.excepthook, sys.unraisablehook
+    sys.excepthook, sys.unraisablehook = (lambda *args: None), (lambda unraisable: None)
+    try:
+        yield
+    except (RuntimeError, OSError) as err:
+        found = re.search(r"errno = (\d+)", str(err))
+        gc.collect()                                    # the failed write's objects, quietly
+        if found is None:
+            raise
+        code = int(found.group(1))
+        raise OSError(code, f"{os.strerror(code)}: writing {path.name}") from None
+    finally:
+        sys.excepthook, sys.unraisablehook = hooks
 
 
 def open_run(outdir) -> RunResults:

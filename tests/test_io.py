@@ -164,3 +164,29 @@ def test_debris_of_interrupted_atomic_writes_is_removed(tmp_path):
     assert all(k.is_file() for k in keep) and not [p for p in tmp_path.rglob(".*")
                                                     if TEMPORARY.fullmatch(p.name)]
     assert (tmp_path / "results.nc").read_text() == "whole"
+
+
+def test_a_netcdf_write_on_a_full_disk_is_one_oserror(tmp_path):
+    """A NetCDF write that runs out of room (here a file-size limit, errno EFBIG) raises
+    one OSError with its errno, which the CLI reports as exit 4, prints none of h5py's
+    tracebacks, and leaves no temporary file."""
+    import subprocess
+    import sys
+    script = tmp_path / "full.py"
+    script.write_text(
+        "import resource, signal, sys\n"
+        "import numpy as np, xarray as xr\n"
+        "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+        "resource.setrlimit(resource.RLIMIT_FSIZE, (20000, 20000))\n"
+        "from fem_twin.results import write_netcdf\n"
+        "ds = xr.Dataset({'a': (('x',), np.random.default_rng(0).random(100000))})\n"
+        "try:\n"
+        "    write_netcdf(sys.argv[1], {None: ds})\n"
+        "except OSError as err:\n"
+        "    print('errno', err.errno)\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = subprocess.run([sys.executable, str(script), str(out / "results.nc")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.stdout.strip() == "errno 27" and proc.stderr == ""
+    assert list(out.iterdir()) == []
