@@ -112,7 +112,7 @@ def _curves(rows, keep):
             rows.append((f"{label}, mu_0 {twin.viscosity:g} Pa s", 0.0,
                          f"peer - twin at most {100 * gap[k]:+.1f} % C_f,b (at {at[k]:.3g} "
                          f"m/s); knee {knee_speed(twin):.3g} / {knee_speed(peer):.3g} m/s; "
-                         f"slowest C_f {twin.friction_coefficient.min():.4f} / "
+                         f"slowest C_f {twin.friction_coefficient[np.argmin(twin.speed)]:.4f} / "
                          f"{peer.friction_coefficient[np.argmin(peer.speed)]:.4f}"))
     return times
 
@@ -141,3 +141,31 @@ def bench_peers():
 def _seconds(value) -> str:
     """A run's wall time, or that it was read back."""
     return "read back" if value is None else f"{value:.0f} s"
+
+
+def draw(keep, path):
+    """The bundled pin's curves of both models from the runs kept in ``keep`` (C_f and the
+    asperities' share of the load against speed) into ``path``: the figure of
+    docs/peers.md (``python benchmarks/peers.py KEEP docs/_static/peers_bundled.png``)."""
+    import matplotlib.pyplot as plt
+    fig, (cf, share) = plt.subplots(1, 2, figsize=(10, 4), sharex=True)
+    for model, style in (("cells", "o-"), ("average-flow", "s--")):
+        curves = read_stribeck_csv(os.path.join(keep, f"peers_pin_on_disk_{model}",
+                                                "stribeck.csv"))
+        for curve, colour in zip(curves, ("C0", "C3")):
+            label = f"{'twin' if model == 'cells' else 'average flow'}, " \
+                    f"mu_0 {curve.viscosity:g} Pa s"
+            cf.plot(curve.speed, curve.friction_coefficient, style, color=colour, ms=4,
+                    label=label)
+            share.plot(curve.speed, curve.contact_load_fraction, style, color=colour, ms=4)
+    cf.set(xscale="log", xlabel="U [m/s]", ylabel="C_f", title="bundled pin")
+    share.axhline(0.5, color="grey", lw=0.8)
+    share.set(xscale="log", xlabel="U [m/s]", ylabel="asperity share of the load")
+    cf.legend(fontsize="small")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+if __name__ == "__main__":
+    import sys
+    draw(*sys.argv[1:3])
