@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import MissingFile
+from .errors import FileSystemError, MissingFile
 from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .macro.estimate import PARTS
@@ -178,11 +178,11 @@ def write_netcdf(path, groups: dict, attrs: dict | None = None) -> Path:
 
 @contextmanager
 def _write_errors(path):
-    """A failed NetCDF write as one :class:`OSError` with its errno (a full disk: ENOSPC):
-    h5py reports it as a RuntimeError or OSError whose text carries ``errno = N``, and the
-    HDF5 objects it frees afterwards print their own tracebacks (through
-    ``sys.excepthook`` and ``sys.unraisablehook``), which this drops for the write's
-    duration."""
+    """A failed NetCDF write as one :class:`FileSystemError` (an OSError) with its errno (a
+    full disk: ENOSPC): h5py reports it as a RuntimeError or OSError whose text carries
+    ``errno = N``, and the HDF5 objects it frees afterwards print their own tracebacks
+    (through ``sys.excepthook`` and ``sys.unraisablehook``), which this drops for the
+    write's duration."""
     hooks = sys.excepthook, sys.unraisablehook
     sys.excepthook, sys.unraisablehook = (lambda *args: None), (lambda unraisable: None)
     try:
@@ -193,7 +193,7 @@ def _write_errors(path):
         if found is None:
             raise
         code = int(found.group(1))
-        raise OSError(code, f"{os.strerror(code)}: writing {path.name}") from None
+        raise FileSystemError(code, f"{os.strerror(code)}: writing {path.name}") from None
     finally:
         sys.excepthook, sys.unraisablehook = hooks
 
