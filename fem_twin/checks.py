@@ -193,7 +193,7 @@ def check(name: str, value, kind) -> None:
     if isinstance(kind, list):
         if (isinstance(value, (str, bytes)) or not isinstance(value, Collection)
                 or len(value) == 0):
-            raise InputError(f"{name}: expected a non-empty list of {kind[0].__name__}")
+            raise InputError(f"{name}: expected a non-empty list of {_kind_name(kind[0])}")
         for item in value:
             check(name, item, kind[0])
     elif isinstance(kind, (type, tuple)):
@@ -220,6 +220,11 @@ def check(name: str, value, kind) -> None:
                              f"got {value!r}"[:200])
     else:
         raise InputError(f"{name}: unknown argument kind {kind!r}")
+
+
+def _kind_name(kind) -> str:
+    """A kind of :func:`check` in words: ``StribeckCurve``, ``lists of StribeckCurve``."""
+    return f"lists of {_kind_name(kind[0])}" if isinstance(kind, list) else kind.__name__
 
 
 def _numeric(value) -> bool:

@@ -20,12 +20,14 @@ from pathlib import Path
 
 import numpy as np
 
+from .checks import arguments
 from .errors import FileSystemError, MissingFile
 from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .macro.estimate import PARTS
 from .macro.result import FIELDS
-from .stribeck.curve import LEGACY, OPTIONAL, UNITS
+from .micro.flow_factors import FlowFactors
+from .stribeck.curve import LEGACY, OPTIONAL, UNITS, StribeckCurve
 
 ENGINE = "h5netcdf"
 #: ``fields.nc``'s variables and units: an operating point's fields
@@ -45,6 +47,7 @@ class RunResults:
     summary: dict
 
 
+@arguments(factors=[FlowFactors], labels=[str])
 def flow_factor_dataset(factors, labels):
     """Flow factors of several patches as a Dataset over (patch, h0), h0 the union of their
     samples: NaN where a patch's adaptive sample skipped an h0 (its interpolant,
@@ -85,6 +88,7 @@ def flow_factor_dataset(factors, labels):
     return ds
 
 
+@arguments(curves=[StribeckCurve], patch_curves=[[StribeckCurve]])
 def stribeck_dataset(curves, patch_curves=None):
     """Stribeck curves as a Dataset over (viscosity, speed) (NaN where a curve has no point);
     ``patch_curves``: optional single-patch curves [patch][viscosity] (same speeds), as
@@ -135,6 +139,7 @@ def stribeck_dataset(curves, patch_curves=None):
     return ds
 
 
+@arguments(sweeps=[tuple], origin="pair")
 def fields_dataset(sweeps, origin=(0.0, 0.0)):
     """Macro fields of the points of ``sweeps``, ``[(viscosity, {speed: MixedResult})]``
     (one entry per sweep, in the run's order), as a Dataset over (viscosity, speed, x2,
@@ -160,6 +165,7 @@ def fields_dataset(sweeps, origin=(0.0, 0.0)):
                        for k, v in fields.items()}, coords=coords)
 
 
+@arguments(path="path", groups=dict)
 def write_netcdf(path, groups: dict, attrs: dict | None = None) -> Path:
     """Datasets {group: Dataset} into one NetCDF-4 file, atomically (zlib level 1 after a
     byte shuffle, lossless: faster and smaller than level 4 without it); the group None is
@@ -198,6 +204,7 @@ def _write_errors(path):
         sys.excepthook, sys.unraisablehook = hooks
 
 
+@arguments(outdir="path")
 def open_run(outdir) -> RunResults:
     """The results of a run's output folder as xarray Datasets (loaded in memory; the fields
     lazily): what ``fem-twin run CASE -o OUTDIR`` wrote."""

@@ -80,6 +80,7 @@ class BoundaryLaw:
                              "0.05 is 5 %)")
 
 
+@arguments(law=BoundaryLaw)
 def boundary_area(shear, law: BoundaryLaw) -> np.ndarray:
     """a_r [-] from the shear factors ``shear`` (LocalFactors): the contact fraction, and
     with ``law.thin_films`` the films below the boundary film too, ``1 - film_fraction``
@@ -89,6 +90,7 @@ def boundary_area(shear, law: BoundaryLaw) -> np.ndarray:
     return np.clip(np.maximum(shear.contact_fraction, 1 - shear.film_fraction), 0.0, 1.0)
 
 
+@arguments(law=BoundaryLaw)
 def asperity_load(contact_pressure, film_pressure, contact_fraction,
                   law: BoundaryLaw) -> np.ndarray:
     """The asperities' mean normal stress ``p_con + p a_r`` [Pa]: the dry contact's pressure
@@ -122,6 +124,7 @@ def boundary_traction(contact_pressure, film_pressure, contact_fraction, sliding
                     boundary_friction)
 
 
+@arguments(law=BoundaryLaw)
 def traction(contact_pressure, film_pressure, contact_fraction, sliding_speed,
              law: BoundaryLaw, boundary_friction: float) -> np.ndarray:
     """:func:`boundary_traction` without its checks, for the macro scale's own fields (an
@@ -133,6 +136,7 @@ def traction(contact_pressure, film_pressure, contact_fraction, sliding_speed,
     return (shear + law.pressure_coefficient * load) * law.speed_factor(sliding_speed)
 
 
+@arguments(law=BoundaryLaw, rise_per_shear="number")
 def spot_temperature_factor(law: BoundaryLaw, rise_per_shear: float) -> float:
     """The shear law's temperature factor ``t = 1 - c_T dT`` where the spots' flash rise
     dT is itself the flash of the tempered shear: ``dT = G tau t`` (the flash is linear in

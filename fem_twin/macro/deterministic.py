@@ -25,7 +25,16 @@ import scipy.sparse as sp
 from scipy.optimize import brentq
 
 from .. import tables as T
-from ..checks import as_field, as_pair, check_choices, check_ranges, number, plausible, setting
+from ..checks import (
+    arguments,
+    as_field,
+    as_pair,
+    check_choices,
+    check_ranges,
+    number,
+    plausible,
+    setting,
+)
 from ..contact import solve as contact_solve
 from ..contact.elastic import elastic_operator
 from ..errors import InputError, NotConverged, ReynoldsNotConverged
@@ -122,6 +131,8 @@ class DeterministicResult:
         return (self.film_friction + self.boundary_force) / self.load
 
 
+@arguments(pressure="field", gap="field", cavity_fraction="numbers", viscosity="numbers",
+           spacing="pair", speed="number", boundary_film="number")
 def pad_friction(pressure, gap, cavity_fraction, viscosity, spacing, speed: float,
                  boundary_film: float) -> float:
     """The film's force on the pin along +x1 [N]: ``int mu U / h (1 - theta) dA`` over the

@@ -9,7 +9,7 @@ from dataclasses import KW_ONLY, dataclass, replace
 
 import numpy as np
 
-from ..checks import as_field, as_pair, number, plausible
+from ..checks import arguments, as_field, as_pair, number, plausible
 from ..errors import InputError
 from ..micro.flow_factors import FlowFactors
 from .lubricant import Lubricant
@@ -88,6 +88,7 @@ class OperatingPoint:
         return replace(self, gap=gap, spacing=spacing, face=face)
 
 
+@arguments(gap="field", spacing="pair")
 def coarsened(gap, spacing, face):
     """``(gap, spacing, face)`` on every other node of the grid [m] (``face`` None: None)."""
     return (np.asarray(gap)[::2, ::2], (2 * spacing[0], 2 * spacing[1]),

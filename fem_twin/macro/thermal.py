@@ -14,6 +14,7 @@ Walther law (:mod:`.viscosity`); each operating point is iterated to that temper
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import lru_cache
 
@@ -131,6 +132,7 @@ def face_flash(flux, face, spacing, speeds, settings: ThermalSettings) -> tuple:
     return float(pin * disk / (pin + disk)), float(disk / (pin + disk))
 
 
+@arguments(flux="number", speeds="pair", settings=ThermalSettings)
 def spot_flash(flux: float, speeds, settings: ThermalSettings, n: int = 24) -> float:
     """The mean flash temperature [K] of a circular asperity contact of radius
     ``settings.spot_radius`` carrying ``flux`` [W/m^2], shared as in :func:`face_flash`."""
@@ -206,6 +208,7 @@ class ContactThermal:
                        meta={**result.meta, "boundary_temperature_factor": t})
 
 
+@arguments(solve=Callable, thermal=ContactThermal, speeds="pair")
 def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
                   near: dict | None = None) -> tuple:
     """An operating point at the film temperature its own heat gives it.

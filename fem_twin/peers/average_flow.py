@@ -102,6 +102,7 @@ def _gamma(stats, name: str, notes: list) -> float:
     return gamma
 
 
+@arguments(h="numbers", sigma="number")
 def mean_gap(h, sigma: float) -> np.ndarray:
     """``h_T`` [m]: the mean of ``max(h + delta, 0)`` over Gaussian heights delta of rms
     ``sigma`` [m] at nominal separation ``h`` [m] (Patir and Cheng 1978, eq 19)."""

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special
 
+from ..checks import arguments, check
 from ..errors import InputError
 
 #: the summit heights' densities of :func:`tail_moment`
@@ -33,11 +34,13 @@ def tail_moment(H, n: float, density: str = "gaussian") -> np.ndarray:
     spread), for the standard normal density (parabolic cylinder function
     ``Gamma(n+1) exp(-H^2/4) D_{-n-1}(H) / sqrt(2 pi)``) or the exponential ``exp(-x)``
     (``Gamma(n+1) exp(-H)`` above 0)."""
+    check("tail_moment: H", H, "numbers")
+    check("tail_moment: n", n, "number")
     H = np.asarray(H, float)
     if density not in DENSITIES:
         raise InputError(f"density must be one of {DENSITIES}, got {density!r}")
-    if not n >= 0 or np.any(~np.isfinite(H)):
-        raise InputError("F_n needs n >= 0 and finite H")
+    if not n >= 0:
+        raise InputError(f"tail_moment: n = {n} must be >= 0")
     if density == "exponential":
         below = np.maximum(-H, 0.0)                    # heights start at 0
         return special.gamma(n + 1) * np.exp(-H) * special.gammaincc(n + 1, below)
@@ -64,6 +67,8 @@ class Summits:
         [1/m^2] of an isotropic surface: ``eta = m4 / (6 pi sqrt(3) m2)``,
         ``beta = (3/8) sqrt(pi / m4)``, ``alpha = m0 m4 / m2^2``,
         spread ``sqrt(1 - 0.8968/alpha) sqrt(m0)``, mean ``4 sqrt(m0 / (pi alpha))``."""
+        for name, m in (("m0", m0), ("m2", m2), ("m4", m4)):
+            check(f"Summits.from_moments: {name}", m, "number")
         if not (m0 > 0 and m2 > 0 and m4 > 0):
             raise InputError("spectral moments must be positive: a surface flat along one "
                              "direction (pure ridges) has no summits for Greenwood-Tripp")
@@ -83,6 +88,7 @@ class Summits:
         return self.density * self.radius * self.spread
 
 
+@arguments(h="numbers", summits=Summits, e_reduced="number")
 def contact_pressure(h, summits: Summits, e_reduced: float,
                      density: str = "gaussian") -> np.ndarray:
     """Greenwood-Tripp mean asperity pressure [Pa] at mean-plane separations ``h`` [m]
@@ -93,6 +99,7 @@ def contact_pressure(h, summits: Summits, e_reduced: float,
     return k * e_reduced * tail_moment(s.separation(h), 2.5, density)
 
 
+@arguments(h="numbers", summits=Summits)
 def contact_fraction(h, summits: Summits, density: str = "gaussian") -> np.ndarray:
     """Greenwood-Tripp real contact area over the nominal one [-] at ``h`` [m], at most 1."""
     a = np.pi ** 2 * summits.roughness_parameter ** 2 * tail_moment(

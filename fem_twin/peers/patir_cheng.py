@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import arguments, check
 from ..errors import InputError
 
 #: the tabulated Peklenik numbers
@@ -48,6 +49,7 @@ FILM_CUTOFF = 1.0 / 300.0
 
 def _bracket(gamma: float):
     """The two tabulated gammas around ``gamma`` and the weight of the upper one (ln)."""
+    check("Peklenik number gamma", gamma, "number")
     if not GAMMAS[0] * (1 - 1e-12) <= gamma <= GAMMAS[-1] * (1 + 1e-12):
         raise InputError(f"Peklenik number gamma = {gamma:.4g} lies outside Patir and "
                          f"Cheng's tables [1/9, 9]: their fits do not extrapolate")
@@ -58,9 +60,8 @@ def _bracket(gamma: float):
 
 def _in_range(H, lo: float, what: str, hold: bool) -> np.ndarray:
     """``H`` (array) checked against the fit's smallest ``lo``, or held there."""
+    check(f"{what}: H = h / sigma", H, "numbers")
     H = np.asarray(H, float)
-    if np.any(~np.isfinite(H)):
-        raise InputError(f"{what}: H = h / sigma must be finite")
     if hold:
         return np.maximum(H, lo)
     if np.any(H < lo * (1 - 1e-12)):
@@ -77,12 +78,14 @@ def _interpolated(one, H, gamma: float, lo_of, what: str, hold: bool) -> np.ndar
     return sum(weight * one(k, H) for k, weight in ((i, 1 - w), (j, w)) if weight > 0)
 
 
+@arguments(gamma="number")
 def pressure_flow_range(gamma: float) -> float:
     """The smallest H [-] of ``phi_x``'s fit at ``gamma`` (of both rows around it)."""
     i, j, w = _bracket(gamma)
     return float(max(PRESSURE[k, 2] for k, weight in ((i, 1 - w), (j, w)) if weight > 0))
 
 
+@arguments(gamma="number")
 def pressure_flow(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``phi_x(H, gamma)`` [-], the pressure flow factor along the sliding (1978, eq 25)."""
     def one(i, h):
@@ -91,11 +94,13 @@ def pressure_flow(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     return _interpolated(one, H, gamma, lambda i: PRESSURE[i, 2], "phi_x", hold)
 
 
+@arguments(gamma="number")
 def pressure_flow_across(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``phi_y(H, gamma) = phi_x(H, 1/gamma)`` [-], across the sliding (1978)."""
     return pressure_flow(H, 1.0 / gamma, hold=hold)
 
 
+@arguments(gamma="number")
 def shear_flow(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``Phi_s(H, gamma)`` [-] of one rough surface (1979, Table 1); the pair's
     ``phi_s = V1 Phi_s(gamma_1) - V2 Phi_s(gamma_2)`` (:func:`fem_twin.peers.average_flow`)."""
@@ -108,6 +113,7 @@ def shear_flow(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     return _interpolated(one, H, gamma, lambda i: SHEAR_MIN_H, "Phi_s", hold)
 
 
+@arguments(gamma="number")
 def shear_stress(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``Phi_fs(H, gamma)`` [-] of one rough surface (1979, Table 3), zero above H = 7."""
     def one(i, h):
@@ -118,6 +124,7 @@ def shear_stress(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     return _interpolated(one, H, gamma, lambda i: SHEAR_MIN_H, "Phi_fs", hold)
 
 
+@arguments(gamma="number")
 def pressure_stress(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``phi_fp(H, gamma)`` [-], the Poiseuille part of the mean wall shear (1979)."""
     def one(i, h):

@@ -65,7 +65,7 @@ class Slowdown:
 def probe_seconds(kind: str = "micro", repeats: int | None = None) -> float:
     """The best of ``repeats`` timings of the ``kind`` miniature (``"micro"``, ``"macro"``
     or ``"ball"``; one thread, as the workers; ``repeats`` None: :data:`REPEATS`) [s]."""
-    if kind not in REPEATS:
+    if not isinstance(kind, str) or kind not in REPEATS:
         raise InputError(f"probe_seconds: kind is one of {sorted(REPEATS)}, got {kind!r}")
     if repeats is not None and (isinstance(repeats, bool) or not isinstance(
             repeats, (int, np.integer)) or repeats < 1):
@@ -143,6 +143,10 @@ def probe_together(kind: str, processes: int) -> float:
     started together (a barrier), as the run's workers will share the machine: a load on
     another core then slows the probes as it slows the run [s] (the mean over processes
     of their repeats' median; one process: :func:`probe_seconds` itself)."""
+    if not isinstance(kind, str) or kind not in REPEATS:
+        raise InputError(f"probe_together: kind is one of {sorted(REPEATS)}, got {kind!r}")
+    if isinstance(processes, bool) or not isinstance(processes, (int, np.integer)):
+        raise InputError(f"probe_together: processes is a whole number, got {processes!r}")
     if processes <= 1:
         return probe_seconds(kind)
     ctx = multiprocessing.get_context()

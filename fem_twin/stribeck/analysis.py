@@ -8,15 +8,18 @@ from dataclasses import replace
 
 import numpy as np
 
-from .curve import friction_deviation
+from ..checks import arguments
+from .curve import StribeckCurve, friction_deviation
 
 
+@arguments(patch_curves=[[StribeckCurve]])
 def patch_band(patch_curves) -> list:
     """(cf_min, cf_max) per lubricant over single-patch curves [patch][lubricant]."""
     cf = np.array([[c.friction_coefficient for c in per_mu] for per_mu in patch_curves])
     return [(cf[:, k].min(axis=0), cf[:, k].max(axis=0)) for k in range(cf.shape[1])]
 
 
+@arguments(patch_curves=[[StribeckCurve]], fine=[StribeckCurve], coarse=[StribeckCurve])
 def defect_corrected(patch_curves, fine, coarse) -> list:
     """Single-patch curves swept on a coarsened macro grid H, each brought to the fine grid
     h by the average curve's relative grid change: ``C_f,i(h) ~ C_f,i(H) C_f(h) / C_f(H)``
@@ -33,6 +36,7 @@ def defect_corrected(patch_curves, fine, coarse) -> list:
     return out
 
 
+@arguments(curves=[StribeckCurve], step="number")
 def transition_speeds(curves, step: float) -> np.ndarray:
     """Geometric midpoints of neighbouring speeds between which C_f of any curve changes by
     more than ``step`` (where the Stribeck curve turns, from full film to boundary)."""
@@ -45,6 +49,7 @@ def transition_speeds(curves, step: float) -> np.ndarray:
     return np.unique(np.round(extra, 12))
 
 
+@arguments(curves=[StribeckCurve], boundary_friction="number")
 def hersey_collapse(curves, boundary_friction: float) -> float:
     """``max |C_f,dev|`` (eq 35, relative to ``boundary_friction`` = C_f,b) between the first curve
     and the others over the Hersey numbers where they overlap (the others' points, interpolated
@@ -63,6 +68,7 @@ def hersey_collapse(curves, boundary_friction: float) -> float:
 KNEE_SHARE = 0.5
 
 
+@arguments(curve=StribeckCurve, share="number")
 def knee_speed(curve, share: float = KNEE_SHARE) -> float:
     """The sliding speed [m/s] where the asperities carry ``share`` of the load
     (``contact_load_fraction``), linear in log speed between the points around it; NaN

@@ -21,13 +21,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..checks import number, plausible
+from ..checks import arguments, check, number, plausible
 from ..errors import InputError
 from ..io.files import read_topography
 from ..macro import Lubricant, MacroSettings, solve_mixed
 from ..macro.deterministic import DeterministicSettings, solve_deterministic
 from ..macro.time_resolved import solve_time_resolved
-from ..micro import homogenise
+from ..micro import FlowFactors, homogenise
 from ..peers import average_flow_factors
 from ..topography import Topography, resample_cell
 from ..topography.prepare import prepare_patch
@@ -142,6 +142,7 @@ class RoughPad:
         return self.form(self.macro_nodes), (step, step)
 
 
+@arguments(pin=Topography, disk=Topography, lubricant=Lubricant)
 def patch_pad(pin: Topography, disk: Topography, pixels: int, lubricant: Lubricant,
               moving: bool = False, **options) -> RoughPad:
     """The :class:`RoughPad` of a prepared patch pair (``disk`` flipped over ``pin``,
@@ -153,6 +154,7 @@ def patch_pad(pin: Topography, disk: Topography, pixels: int, lubricant: Lubrica
                     disk=up.heights if moving else None, **options)
 
 
+@arguments(folder="path", lubricant=Lubricant)
 def sample_pad(folder, pixels: int = 32, pair: int = 1, lubricant: Lubricant | None = None,
                **options) -> RoughPad:
     """The :class:`RoughPad` of patch pair ``pair`` of the bundled sample (``folder``: the
@@ -165,6 +167,7 @@ def sample_pad(folder, pixels: int = 32, pair: int = 1, lubricant: Lubricant | N
     return patch_pad(pin, disk, pixels, lubricant or Lubricant(0.066), **options)
 
 
+@arguments(pad=RoughPad, h0="numbers")
 def pad_factors(pad: RoughPad, h0, **cell):
     """The twin's flow factors of the pad's cell at the separations ``h0`` [m], with the
     pad's materials and film cut-off: the roughness on the pin at rest, the disk smooth
@@ -181,6 +184,7 @@ def pad_factors(pad: RoughPad, h0, **cell):
                       gap_floor=s.gap_floor, error_estimate=False)
 
 
+@arguments(pad=RoughPad)
 def pad_average_flow(pad: RoughPad):
     """The statistical peer's flow factors of the pad's cell
     (:func:`fem_twin.peers.average_flow_factors`): the same bodies as :func:`pad_factors`
@@ -199,6 +203,7 @@ def pad_speeds(speeds, tiles: int) -> np.ndarray:
     return np.atleast_1d(np.asarray(speeds, float)) * 2.0 / whole("tiles", tiles, "samples")
 
 
+@arguments(pad=RoughPad, settings=DeterministicSettings)
 def deterministic_sweep(pad: RoughPad, tiles: int, speeds, settings=None) -> list:
     """:func:`solve_deterministic` at each of ``speeds`` (given at two tiles,
     :func:`pad_speeds`), each started from the one before; ``settings`` replace the pad's."""
@@ -212,6 +217,7 @@ def deterministic_sweep(pad: RoughPad, tiles: int, speeds, settings=None) -> lis
     return out
 
 
+@arguments(pad=RoughPad, settings=DeterministicSettings)
 def time_resolved_sweep(pad: RoughPad, tiles: int, speeds, settings=None, time=None) -> list:
     """:func:`~fem_twin.macro.time_resolved.solve_time_resolved` on the pad of ``tiles``
     (both bodies rough) at each of ``speeds`` (given at two tiles), each started from the
@@ -227,6 +233,7 @@ def time_resolved_sweep(pad: RoughPad, tiles: int, speeds, settings=None, time=N
     return out
 
 
+@arguments(pad=RoughPad, factors=FlowFactors)
 def twin_sweep(pad: RoughPad, tiles: int, speeds, factors) -> list:
     """The twin's points (:func:`fem_twin.macro.solve_mixed`) on the same pad, loads and
     speeds, with ``factors`` of the pad's cell (:func:`pad_factors`); the face is the pad."""
@@ -264,6 +271,7 @@ class Pair:
         return (self.cf - self.cf_det) / boundary_friction
 
 
+@arguments(det=list, twin=list, tiles="number")
 def compared(det: list, twin: list, tiles: int) -> list:
     """The :class:`Pair` of each speed of two sweeps on the pad of ``tiles``."""
     return [Pair(tiles, d.speed, d.load_share, t.contact_load / t.normal_load, d.separation,
@@ -271,6 +279,7 @@ def compared(det: list, twin: list, tiles: int) -> list:
                  t.friction_coefficient) for d, t in zip(det, twin)]
 
 
+@arguments(pairs=[Pair], boundary_friction="number")
 def summary(pairs, boundary_friction: float, label: str = "mixed regime",
             order: float | None | bool = False) -> str:
     """The one line of a benchmark group (``deterministic``: ``label`` "mixed regime";
@@ -289,9 +298,12 @@ def summary(pairs, boundary_friction: float, label: str = "mixed regime",
 
 def order_text(order: float | None) -> str:
     """``"order 1.52"``, or ``"order none observed"`` for :func:`to_zero`'s None."""
+    if order is not None:
+        check("order_text: order", order, "number")
     return "order none observed" if order is None else f"order {order:.2f}"
 
 
+@arguments(eps="numbers", values="numbers")
 def to_zero(eps, values) -> tuple[float, float | None]:
     """``(value at eps -> 0, observed order)`` from the values at the three finest ``eps``:
     Richardson with the order their differences show where they shrink monotonically;
@@ -299,7 +311,7 @@ def to_zero(eps, values) -> tuple[float, float | None]:
     observed: ``(the finest value, None)``, nothing extrapolated (an assumed order is not a
     measurement)."""
     e, v = np.asarray(eps, float), np.asarray(values, float)
-    if e.size < 1 or e.size != v.size:
+    if e.ndim != 1 or e.size < 1 or e.shape != v.shape:
         raise InputError("to_zero: give as many values as eps, at least one")
     order = np.argsort(e)
     e, v = e[order], v[order]
@@ -311,6 +323,7 @@ def to_zero(eps, values) -> tuple[float, float | None]:
     return float(v[0]), None
 
 
+@arguments(pad=RoughPad)
 def with_settings(pad: RoughPad, **changes) -> RoughPad:
     """The pad with its deterministic settings changed (``film_deforms``, ``boundary_film``)."""
     return replace(pad, settings=replace(pad.settings, **changes))

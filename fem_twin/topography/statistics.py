@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..checks import arguments
 from ..errors import InputError
 from .core import Topography
 
@@ -61,6 +62,7 @@ class RoughnessStatistics:
                 float(np.sqrt(np.prod(self.m4))))
 
 
+@arguments(topo=Topography)
 def roughness_statistics(topo: Topography) -> RoughnessStatistics:
     """:class:`RoughnessStatistics` of a periodic, fully valid cell ``topo`` (where the
     autocorrelation does not fall to 0.5 within half the cell along a direction, the half
