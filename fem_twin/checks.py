@@ -207,7 +207,9 @@ def check(name: str, value, kind) -> None:
         if not (_numeric(value) and np.ndim(value) == 0 and math.isfinite(float(value))):
             raise InputError(f"{name}: expected one finite number, got {value!r}"[:200])
     elif kind == "numbers":
-        if not _numeric(value) or np.size(value) == 0 or not np.all(np.isfinite(value)):
+        if _numeric(value) and np.size(value) == 0:
+            raise InputError(f"{name}: expected at least one number, got none")
+        if not _numeric(value) or not np.all(np.isfinite(value)):
             raise InputError(f"{name}: expected finite numbers, got {type(value).__name__}")
     elif kind == "field":
         as_field(name, value)
@@ -278,6 +280,8 @@ def check_ranges(settings) -> None:
             raise InputError(f"{name}: expected {hint}, got {value!r}")
         if not quantity:
             continue
+        if not isinstance(default, tuple) and np.ndim(value) != 0:
+            raise InputError(f"{name}: expected one number, got {np.size(value)} values")
         plausible(name, value, f.metadata["quantity"])
         if _whole(f.default) and not np.all(np.mod(np.asarray(value, float), 1) == 0):
             raise InputError(f"{name}: expected whole numbers, got {value!r}")

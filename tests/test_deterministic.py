@@ -175,7 +175,7 @@ def test_the_verification_pads_refuse_what_they_cannot_pose():
                         (lambda: V.pad_speeds([1.0], 2.5), "tiles: expected a whole"),
                         (lambda: V.pad_speeds("fast", 2), "speeds"),
                         (lambda: pad.resolved(1.5), "tiles"),
-                        (lambda: V.summary([], 0.19), "at least one"),
+                        (lambda: V.summary([], 0.19), "non-empty list of Pair"),
                         (lambda: V.to_zero([], []), "at least one")):
         with pytest.raises(InputError, match=words):
             make()

@@ -316,3 +316,33 @@ def test_the_new_public_functions_check_their_arguments():
              "real numbers")):
         with pytest.raises(InputError, match=words):
             make()
+
+
+def test_unit_slips_and_impossible_values_of_the_round_six_functions():
+    """Issue 87's probe table: each call returned a result (NaN, or on a wrong scale)."""
+    from fem_twin import contact
+    from fem_twin.macro import BoundaryLaw, Lubricant
+    from fem_twin.peers import average_flow_factors
+    from fem_twin.stribeck import StribeckCurve
+    from fem_twin.stribeck.analysis import knee_speed
+    from fem_twin.studies.verification import RoughPad
+    from fem_twin.topography import Topography
+    rng = np.random.default_rng(1)
+    pin = Topography(1e-7 * rng.standard_normal((32, 32)), 1e-6)
+    flat = Topography(np.zeros((32, 32)), 1e-6)
+    two = np.ones(2)
+    curve = StribeckCurve(speed=np.array([0.01, 0.1]), hersey=two,
+                          friction_coefficient=np.array([0.1, 0.05]), viscosity=0.066,
+                          hydrodynamic_friction=two, boundary_force=two,
+                          contact_load_fraction=np.array([0.9, 0.1]), h_d=two, iterations=two)
+    for make, words in (
+            (lambda: average_flow_factors(pin, flat, 231.0), "e_reduced"),
+            (lambda: average_flow_factors(pin, flat, 231e9, h0=[0.5]), "h0"),
+            (lambda: average_flow_factors(pin, flat, 231e9, slide_to_roll=5.0), "slide_to_roll"),
+            (lambda: knee_speed(curve, share=1.5), "share"),
+            (lambda: RoughPad(None, 1e-6, Lubricant(0.066)), "roughness"),
+            (lambda: BoundaryLaw(pressure_coefficient=np.array([0.1, 0.2])), "one number"),
+            (lambda: contact.solve(1e6 * pin.heights, 1e-6, 231e9, load=1.0), "metres")):
+        with pytest.raises(InputError, match=words):
+            make()
+    assert knee_speed(curve) == pytest.approx(np.sqrt(0.01 * 0.1))

@@ -96,6 +96,20 @@ def test_tail_moments_against_closed_forms():
     assert tail_moment(-1.0, 2.5, "exponential") == pytest.approx(below, rel=1e-10)
 
 
+def test_tail_moments_deep_in_contact():
+    """Far below the mean summit (H < -10), where the parabolic cylinder function overflows
+    (F_5/2 was NaN, so a pad's contact fraction at a deep separation was NaN): the expansion
+    in 1/H^2 against quadrature to 1e-6, and the contact fraction capped at 1."""
+    for n in (1.5, 2.0, 2.5):
+        for h in (-10.5, -14.0, -40.0):
+            exact = quad(lambda x: max(x - h, 0.0) ** n * np.exp(-x ** 2 / 2) / np.sqrt(2 * np.pi),
+                         -40.0, 40.0, points=[0.0], epsrel=1e-13, limit=200)[0]
+            assert tail_moment(h, n) == pytest.approx(exact, rel=1e-6)
+    summits = Summits.from_moments(1e-14, 1e-3, 1e8)
+    assert contact_fraction(-1e-5, summits) == 1.0
+    assert np.isfinite(contact_pressure(-1e-5, summits, 231e9))
+
+
 def test_greenwood_tripp_against_greenwood_williamson():
     """With exponential summit heights, a summit pair's mean real pressure P/A is
     Greenwood and Williamson's closed form for summits of the pair's radius beta/2,
@@ -152,6 +166,8 @@ def test_fits_refuse_to_extrapolate():
         pc.pressure_flow(np.array([0.8]), 1 / 9)
     with pytest.raises(InputError, match="outside Patir and Cheng's tables"):
         pc.shear_flow(np.array([1.0]), 12.0)
+    with pytest.raises(InputError, match="outside Patir and Cheng's tables"):
+        pc.pressure_flow_across(np.array([1.0]), 0.0)
     held = pc.pressure_flow(np.array([0.2]), 1.0, hold=True)
     assert held == pytest.approx(pc.pressure_flow(np.array([0.5]), 1.0))
 
@@ -163,6 +179,8 @@ def test_mean_gap_against_quadrature():
                      -1e-6, 1e-6, points=[-h], epsabs=1e-20)[0]
         assert mean_gap(h, 1e-7) == pytest.approx(exact, rel=1e-8)
     assert mean_gap(1e-6, 1e-7) == pytest.approx(1e-6, rel=1e-12)
+    with pytest.raises(InputError, match="sigma"):
+        mean_gap(1e-7, 0.0)
 
 
 def test_average_flow_factors_of_a_pair():
@@ -195,7 +213,8 @@ def test_average_flow_factors_of_a_pair():
 
 def test_knee_speed_reads_the_half_load_crossing():
     """knee_speed: where contact_load_fraction crosses 0.5, linear in log speed (a share
-    falling as log speed rises crosses at the exact speed); NaN without a crossing."""
+    falling as log speed rises crosses at the exact speed); NaN without a crossing (a share
+    outside (0, 1) is refused: tests/test_errors.py)."""
     from fem_twin.stribeck.analysis import knee_speed
     from fem_twin.stribeck.curve import StribeckCurve
     speed = np.geomspace(2.0, 0.01, 12)
@@ -206,7 +225,8 @@ def test_knee_speed_reads_the_half_load_crossing():
                           boundary_force=np.ones(n), contact_load_fraction=share,
                           h_d=np.ones(n), iterations=np.ones(n))
     assert knee_speed(curve) == pytest.approx(0.2, rel=1e-12)
-    assert np.isnan(knee_speed(curve, share=1.5))
+    flat = StribeckCurve(**{**curve.__dict__, "contact_load_fraction": np.full(n, 0.2)})
+    assert np.isnan(knee_speed(flat))
 
 
 def test_a_screening_point_has_no_error_bar(factors):

@@ -50,6 +50,11 @@ class ContactResult:
     history: tuple
 
 
+#: the largest height range [m] of a contact's shape: a pin on its holder, 1 mm below
+#: the face, is 1e-3; micrometres typed as metres land far above
+MAX_RISE = 1e-2
+
+
 def solve(shape, spacing, e_reduced, *, load=None, separation=None, hardness=np.inf,
           periodic=False, p_min=0.0, gap_floor=1e-9, initial_pressure=None, tol=1e-10,
           max_iter=2000) -> ContactResult:
@@ -66,7 +71,10 @@ def solve(shape, spacing, e_reduced, *, load=None, separation=None, hardness=np.
     solves.  An iteration costs one or two single-precision FFT pairs on the loaded points
     (an exact double pair every ``_REFRESH``), against two double pairs in the textbook.
     """
-    as_field("shape [m]", shape)
+    rise = float(np.ptp(as_field("shape [m]", shape)))
+    if rise > MAX_RISE:
+        raise InputError(f"shape [m]: its height range {rise:.3g} m is above {MAX_RISE:g} m: "
+                         "heights must be given in metres (1 um is 1e-6)")
     plausible("spacing [m]", as_pair("spacing [m]", spacing), "pitch")
     plausible("reduced modulus e_reduced [Pa]", e_reduced, "reduced_modulus")
     if np.isfinite(hardness):                          # inf: purely elastic

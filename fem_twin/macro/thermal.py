@@ -208,7 +208,7 @@ class ContactThermal:
                        meta={**result.meta, "boundary_temperature_factor": t})
 
 
-@arguments(solve=Callable, thermal=ContactThermal, speeds="pair")
+@arguments(solve=Callable, speeds="pair")
 def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
                   near: dict | None = None) -> tuple:
     """An operating point at the film temperature its own heat gives it.

@@ -25,6 +25,9 @@ from ..errors import InputError
 
 #: the summit heights' densities of :func:`tail_moment`
 DENSITIES = ("gaussian", "exponential")
+#: below ``H = -DEEP`` :func:`tail_moment` takes its expansion in ``1/H^2`` (its next term
+#: is below 1e-7 relative there)
+DEEP = 10.0
 #: McCool's constant of the summit height variance, ``1 - 0.8968 / alpha``
 SUMMIT_VARIANCE = 0.8968
 
@@ -45,8 +48,12 @@ def tail_moment(H, n: float, density: str = "gaussian") -> np.ndarray:
         below = np.maximum(-H, 0.0)                    # heights start at 0
         return special.gamma(n + 1) * np.exp(-H) * special.gammaincc(n + 1, below)
     d, _ = special.pbdv(-n - 1, H)
-    with np.errstate(over="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         out = special.gamma(n + 1) * np.exp(-H ** 2 / 4) * d / np.sqrt(2 * np.pi)
+        a = -H                                         # deep in contact: E[(a + x)^n], a >> 1
+        deep = a ** n * (1 + n * (n - 1) / (2 * a ** 2)
+                         + n * (n - 1) * (n - 2) * (n - 3) / (8 * a ** 4))
+    out = np.where(H < -DEEP, deep, out)               # D_{-n-1} overflows there
     return np.where(H > 38, 0.0, out)                  # exp(-H^2/2) underflows there
 
 

@@ -97,6 +97,7 @@ def pressure_flow(H, gamma: float, *, hold: bool = False) -> np.ndarray:
 @arguments(gamma="number")
 def pressure_flow_across(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``phi_y(H, gamma) = phi_x(H, 1/gamma)`` [-], across the sliding (1978)."""
+    _bracket(gamma)
     return pressure_flow(H, 1.0 / gamma, hold=hold)
 
 

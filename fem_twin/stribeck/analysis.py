@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..checks import arguments
+from ..errors import InputError
 from .curve import StribeckCurve, friction_deviation
 
 
@@ -73,6 +74,8 @@ def knee_speed(curve, share: float = KNEE_SHARE) -> float:
     """The sliding speed [m/s] where the asperities carry ``share`` of the load
     (``contact_load_fraction``), linear in log speed between the points around it; NaN
     where the curve does not cross it."""
+    if not 0 < share < 1:
+        raise InputError(f"knee_speed: share is a fraction of the load in (0, 1), got {share}")
     order = np.argsort(curve.speed)
     u, s = np.log(curve.speed[order]), np.asarray(curve.contact_load_fraction)[order] - share
     cross = np.flatnonzero((s[:-1] >= 0) & (s[1:] < 0))

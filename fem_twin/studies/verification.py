@@ -90,8 +90,9 @@ class RoughPad:
         whole("RoughPad.macro_nodes", self.macro_nodes, "nodes")
         for name in ("roughness", "disk"):
             r = getattr(self, name)
-            if r is None:
+            if r is None and name == "disk":
                 continue
+            check(f"RoughPad.{name} [m]", r, "numbers")
             r = np.asarray(r, float)
             if r.ndim != 2 or r.shape[0] != r.shape[1] or not np.all(np.isfinite(r)):
                 raise InputError(f"{name} must be a finite square (m, m) cell [m]")
@@ -286,8 +287,6 @@ def summary(pairs, boundary_friction: float, label: str = "mixed regime",
     ``unsteady``): the largest C_f gap [% C_f,b] and load-share gap over ``pairs``
     (:class:`Pair`), the largest resolved share [%], and with ``order`` (not False) the
     observed eps -> 0 order (:func:`order_text`)."""
-    if not pairs:
-        raise InputError("summary: give at least one compared point (Pair)")
     cf = max(abs(p.cf_gap(boundary_friction)) for p in pairs)
     share = max(abs(p.share - p.share_det) for p in pairs)
     line = (f"{label}: worst |C_f - C_f,det| = {100 * cf:.2f} % C_f,b, worst |share - "
