@@ -88,7 +88,7 @@ def flow_factor_dataset(factors, labels):
     return ds
 
 
-@arguments(curves=[StribeckCurve], patch_curves=[[StribeckCurve]])
+@arguments(curves=[StribeckCurve], patch_curves=(list, tuple))
 def stribeck_dataset(curves, patch_curves=None):
     """Stribeck curves as a Dataset over (viscosity, speed) (NaN where a curve has no point);
     ``patch_curves``: optional single-patch curves [patch][viscosity] (same speeds), as
