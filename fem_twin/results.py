@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .checks import arguments
-from .errors import FileSystemError, MissingFile
+from .errors import FileSystemError, InputError, MissingFile
 from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .macro.estimate import PARTS
@@ -214,10 +214,23 @@ def open_run(outdir) -> RunResults:
     if not path.is_file():
         raise MissingFile(f"{path}: no results; run `fem-twin run CASE -o {outdir}` "
                                 "first")
-    load = lambda group: xr.load_dataset(path, group=group, engine=ENGINE)  # noqa: E731
-    fields = (xr.open_dataset(out.fields_nc, engine=ENGINE) if out.fields_nc.is_file()
-              else None)
-    summary = json.loads(out.summary.read_text()) if out.summary.is_file() else {}
-    stribeck = load("stribeck")
+    with _damaged(outdir):
+        fields = (xr.open_dataset(out.fields_nc, engine=ENGINE) if out.fields_nc.is_file()
+                  else None)
+        summary = json.loads(out.summary.read_text()) if out.summary.is_file() else {}
+        stribeck, factors = (xr.load_dataset(path, group=group, engine=ENGINE)
+                             for group in ("stribeck", "flow_factors"))
     stribeck = stribeck.rename({k: v for k, v in LEGACY.items() if k in stribeck.data_vars})
-    return RunResults(load("flow_factors"), stribeck, fields, summary)
+    return RunResults(factors, stribeck, fields, summary)
+
+
+@contextmanager
+def _damaged(outdir):
+    """A results file that cannot be read (truncated, not NetCDF, a damaged summary.json)
+    as one :class:`InputError` naming the fix."""
+    try:
+        yield
+    except (OSError, ValueError, KeyError) as err:
+        first = str(err).splitlines()[0] if str(err) else type(err).__name__
+        raise InputError(f"{outdir}: its results cannot be read ({first[:120]}); run the "
+                         "same `fem-twin run` command again to rewrite them") from None

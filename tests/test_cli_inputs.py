@@ -373,3 +373,54 @@ def test_validation_compares_like_with_like(tmp_path):
             load_case(tmp_path / "v.toml")
     (tmp_path / "m.csv").write_text("speed,friction_coefficient,load_N\n0.2,0.05,150\n")
     assert load_case(tmp_path / "v.toml").measured[0].name == "m.csv"
+
+
+def _finished_run(folder):
+    """A run folder as fem-twin run leaves it, reduced to what validate and open_run read:
+    stribeck.csv and a summary.json whose case file is gone."""
+    from fem_twin.stribeck import StribeckCurve, write_stribeck_csv
+    speed = np.geomspace(2.0, 0.01, 6)
+    one = np.ones(6)
+    curve = StribeckCurve(speed=speed, hersey=speed, friction_coefficient=0.1 - 0.02 * np.log10(
+        speed / 0.01) / 2.3, viscosity=0.066, hydrodynamic_friction=one, boundary_force=one,
+        contact_load_fraction=one / 2, h_d=one * 1e-7, iterations=one)
+    folder.mkdir()
+    write_stribeck_csv(folder / "stribeck.csv", [curve])
+    (folder / "summary.json").write_text(json.dumps({
+        "provenance": {"case_file": str(folder / "gone.toml")},
+        "stages": {"stribeck": {"load_N": 150.0}}}))
+    return folder
+
+
+def test_validate_reads_the_runs_load_where_its_case_file_is_gone(tmp_path, capsys):
+    """Probe 3.08: a run whose case file had moved (a relative path in summary.json, read
+    from another folder) took the measured curve's own load_N as the run's, and compared a
+    100 N test with the 150 N curve; the run's load is in its summary.json."""
+    run = _finished_run(tmp_path / "run")
+    (tmp_path / "m.csv").write_text("speed,friction_coefficient,load_N\n0.1,0.06,100\n"
+                                    "0.5,0.05,100\n")
+    assert main(["validate", str(run), str(tmp_path / "m.csv")]) == 2
+    assert "the test ran at load 100 N" in capsys.readouterr().err
+    (tmp_path / "m.csv").write_text("speed,friction_coefficient,load_N\n0.1,0.06,150\n"
+                                    "0.5,0.05,150\n")
+    assert main(["validate", str(run), str(tmp_path / "m.csv")]) == 0
+
+
+def test_an_output_folder_that_cannot_be_created_is_a_file_system_error(tmp_path, capsys):
+    """Probe n.87: ``-o`` under a file (or /proc) failed after the banner with exit 2 and the
+    bare errno text; it is exit 4 before any work, naming the folder."""
+    (tmp_path / "file").write_text("")
+    assert main(["run", str(ROOT / "examples" / "pin_on_disk.toml"), "-o",
+                 str(tmp_path / "file" / "out"), "--no-progress"]) == 4
+    err = capsys.readouterr().err
+    assert "cannot create the output folder" in err and "estimated" not in err
+
+
+def test_open_run_names_a_damaged_results_file(tmp_path):
+    """Probe n.98: a truncated results.nc raised h5py's OSError from open_run."""
+    from fem_twin.errors import InputError
+    from fem_twin.results import open_run
+    run = _finished_run(tmp_path / "run")
+    (run / "results.nc").write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(200))
+    with pytest.raises(InputError, match="cannot be read.*run the same"):
+        open_run(run)

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..checks import number
-from ..errors import InputError, MissingFile
+from ..errors import FileSystemError, InputError, MissingFile
 from ..io.layout import RunLayout
 
 #: the bundled case's estimate on 2 cores of the calibration machine [s]
@@ -172,6 +172,11 @@ def _check_output(path) -> None:
     if near.is_dir() and not os.access(near, os.W_OK | os.X_OK):
         raise InputError(f"-o {path}: {near} is not writable for this user; give another "
                          "output folder")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as err:                      # /proc, a read-only mount, a full disk
+        raise FileSystemError(err.errno, f"-o {path}: cannot create the output folder "
+                              f"({err.strerror}); give another") from None
 
 
 def fit(args):
@@ -249,7 +254,8 @@ def validate(args):
     case_file = _run_case_file(args.run)
     case = load_case(case_file) if case_file else None
     boundary = case.tribometer.boundary_friction if case else BOUNDARY_FRICTION
-    check_like_with_like(measured, case.tribometer.load if case else measured.load or 0.0,
+    check_like_with_like(measured, case.tribometer.load if case else _run_load(args.run,
+                                                                                measured),
                          curve.viscosity, str(args.measured))
     if args.rpm:
         radius = args.radius if args.radius is not None else (
@@ -274,6 +280,25 @@ def validate(args):
           f"max |C_f,dev| = {np.nanmax(np.abs(dev)):.2%} (eq 35, C_f,b = {boundary:.5g}) at "
           f"{inside.sum()} of {dev.size} measured speeds; {table}, {png.name}")
     return 0
+
+
+def _run_load(run: Path, measured) -> float:
+    """The imposed load [N] a run recorded (its case file gone): its summary.json's, or the
+    case its results.nc carries (older runs); else the measured curve's own (nothing to
+    compare)."""
+    import xarray as xr
+
+    from ..results import ENGINE
+    layout = RunLayout(run)
+    try:
+        return float(json.loads(layout.summary.read_text())["stages"]["stribeck"]["load_N"])
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    try:
+        with xr.open_dataset(layout.results, group="stribeck", engine=ENGINE) as ds:
+            return float(json.loads(ds.attrs["case"])["tribometer"]["load"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return measured.load or 0.0
 
 
 def _run_case_file(run: Path):

@@ -156,7 +156,7 @@ def band_curves(case: Case, request, curves, tasks, swept, executor=None,
 def _summary(case: Case, out: RunLayout, curves, band) -> dict:
     summary = {"curves": [{"viscosity_Pa_s": c.viscosity, "friction_coefficient_range": [
         float(c.friction_coefficient.min()), float(c.friction_coefficient.max())]}
-        for c in curves], "friction": case.macro.friction,
+        for c in curves], "friction": case.macro.friction, "load_N": case.tribometer.load,
         "files": [p.name for p in (out.stribeck_csv, out.stribeck_png("speed"),
                                    out.stribeck_png("hersey"), out.results, out.fields_nc,
                                    out.fields, *(out.fields_png(c.viscosity) for c in curves))]}

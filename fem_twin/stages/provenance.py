@@ -25,7 +25,8 @@ def provenance(case: Case) -> dict:
     digest = (hashlib.sha256(case.source.read_bytes()).hexdigest()[:16]
               if case.source is not None else None)
     return {"fem_twin_version": __version__, "git_commit": commit,
-            "case_file": str(case.source), "case_sha256": digest,
+            "case_file": (str(Path(case.source).resolve()) if case.source is not None
+                          else None), "case_sha256": digest,
             "started": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
 
 
