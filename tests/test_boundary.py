@@ -83,11 +83,15 @@ def test_the_boundary_section_is_checked_before_any_work(tmp_path):
         (tmp_path / "case.toml").write_text(text + "\n" + section)
         with pytest.raises(CaseError, match=words):
             load_case(tmp_path / "case.toml")
-    cold = text.replace('model = "flash"', 'model = "none"')
+    cold = "\n".join(line for line in text.replace('model = "flash"', 'model = "none"')
+                      .splitlines() if not line.startswith(("bulk_resistance", "spot_radius")))
+    (tmp_path / "case.toml").write_text(
+        cold + '\n[boundary]\nlaw = "shear"\ntemperature_coefficient = 0.02\n')
+    with pytest.raises(CaseError, match="the shear would fall by 52%"):
+        load_case(tmp_path / "case.toml")               # 26 K above T_ref at the 50 C oil
     (tmp_path / "case.toml").write_text(
         cold + '\n[boundary]\nlaw = "shear"\ntemperature_coefficient = 0.002\n')
-    with pytest.raises(CaseError, match="thermal model"):
-        load_case(tmp_path / "case.toml")
+    assert load_case(tmp_path / "case.toml").boundary.reference_temperature == 24.0
     (tmp_path / "case.toml").write_text(text + '\n[boundary]\nlaw = "shear"\n'
                                         'shear_strength = 2e7\npressure_coefficient = 0.1\n')
     case = load_case(tmp_path / "case.toml")
@@ -102,9 +106,10 @@ def test_the_boundary_section_is_checked_before_any_work(tmp_path):
 
 
 def test_the_temperature_term_reads_the_flash_of_the_tempered_shear(factors):
-    """With the thermal model, the shear law's temperature factor t and the asperity spots'
-    flash rise dT of the tempered shear satisfy t = 1 - c_T dT to rounding (the flash is
-    linear in the flux, so t = 1 / (1 + c_T G tau) is exact, no iteration), and the
+    """With the thermal model, the shear law's temperature factor t and the asperities'
+    temperature T_c (the film's plus the spots' flash of the tempered shear) satisfy
+    t = 1 - c_T (T_c - T_ref) to rounding (the flash is linear in the flux, so the closed
+    form t = (1 - c_T (T - T_ref)) / (1 + c_T G tau) is exact, no iteration), and the
     point's boundary friction is t times the untempered one's at the same film."""
     from fem_twin.macro.thermal import ContactThermal, ThermalSettings, thermal_point
     from fem_twin.macro.viscosity import WaltherLaw
@@ -121,7 +126,8 @@ def test_the_temperature_term_reads_the_flash_of_the_tempered_shear(factors):
                                          (0.0, 0.05))
     t = res.meta["boundary_temperature_factor"]
     assert 0.5 < t < 0.999
-    assert t == pytest.approx(1 - 0.01 * record["spot_flash_K"], rel=1e-9)
+    assert t == pytest.approx(1 - 0.01 * (record["asperity_C"] - law.reference_temperature),
+                              rel=1e-9)
     (cold,) = solve(film, None)
     assert res.boundary_force == pytest.approx(t * cold.boundary_force, rel=1e-9)
 
@@ -282,3 +288,34 @@ def test_films_below_the_boundary_film_join_the_boundary_area():
 def self_affine_patch(n, dx, seed):
     from fem_twin.topography.synthetic import self_affine
     return self_affine((n, n), (dx, dx), 0.8, 100e-9, rng=seed).heights
+
+
+@pytest.mark.parametrize("model", ["flash", "none"])
+def test_the_two_oils_boundary_forces_differ_by_their_temperatures(factors, model):
+    """Issue 84 item 1: the temperature term acts on the asperities' absolute temperature,
+    so the slow-end boundary force of the bundled case's two oils (24 and 50 C) differs by
+    the closed form's ratio ``t(50) / t(24)``, ``t = 1 - c_T (T_c - T_ref)``; with the
+    thermal model T_c is the point's asperity temperature (oil, bulk rise, face and spot
+    flash), isothermal the oil's.  With tau_0 = 0 the force is alpha t times the
+    asperities' load exactly.  The spot's flash alone (0.2-3 K) gave a ratio near 1."""
+    from fem_twin.macro.thermal import ContactThermal, ThermalSettings
+    from fem_twin.macro.viscosity import WaltherLaw
+    from fem_twin.stribeck.request import SweepRequest
+    from fem_twin.stribeck.sweep import _solve_point
+    gap, dx, face = macro_case(32)
+    law = BoundaryLaw(law="shear", pressure_coefficient=0.1, temperature_coefficient=0.005)
+    walther = WaltherLaw.through((24.0, 50.0), (0.066, 0.024), 875.0)
+    thermal = (ContactThermal(ThermalSettings(), walther) if model == "flash" else None)
+    forces = {}
+    for oil, mu in ((24.0, 0.066), (50.0, 0.024)):
+        request = SweepRequest(gap, dx, factors, [0.005], load=150.0, face=face,
+                               lubricant=Lubricant(mu), settings=MacroSettings(boundary=law),
+                               thermal=thermal, oil_temperature=None if thermal else oil)
+        res = _solve_point(request, 0.005, ())[0]
+        hot = res.meta["thermal"]["asperity_C"] if thermal else oil
+        t = 1 - 0.005 * (hot - 24.0)
+        assert res.boundary_force == pytest.approx(0.1 * t * res.asperity_load, rel=1e-9)
+        forces[oil] = (res.boundary_force / res.asperity_load, t)
+    ratio = forces[50.0][0] / forces[24.0][0]
+    assert ratio == pytest.approx(forces[50.0][1] / forces[24.0][1], rel=1e-9)
+    assert ratio < 1 - 0.005 * 25                       # the 26 K between the oils shows

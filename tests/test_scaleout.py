@@ -1,5 +1,6 @@
 """Scale-out: a small Stribeck sweep on a Dask LocalCluster equals the serial one."""
 
+import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -311,3 +312,34 @@ def test_ctrl_c_on_a_local_cluster_ends_at_once_in_one_line(tmp_path):
              and "warnings.warn" not in ln]
     assert proc.returncode == 130 and "interrupted" in lines[-1], err
     assert "Traceback" not in err and len(lines) <= 2, err
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` runs (a zombie, exited but not reaped, does not)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_a_local_worker_exits_when_its_parent_is_killed():
+    """Probe R.02: after kill -9 of a run, its idle pool workers lived on (two processes,
+    125-140 MB each, 40 minutes later); quiet_worker's watch ends them within seconds."""
+    import signal
+    import subprocess
+    import time
+    code = ("import os, time\n"
+            "from fem_twin.numerics.threads import process_pool\n"
+            "pool = process_pool(1)\n"
+            "print(pool.submit(os.getpid).result(), flush=True)\n"
+            "time.sleep(60)\n")
+    parent = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    worker = int(parent.stdout.readline())
+    parent.send_signal(signal.SIGKILL)
+    parent.wait()
+    deadline = time.monotonic() + 20             # ORPHAN_POLL is 1 s: 20x, for a loaded CI
+    while _running(worker) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert not _running(worker)

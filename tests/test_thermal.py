@@ -164,7 +164,7 @@ def test_a_first_step_along_the_neighbours_slope_lands_within_the_tolerance():
         law = SimpleNamespace(viscosity=lambda T: 0.066 * np.exp(-0.03 * (T - 24.0)),
                               temperature=lambda mu: 24.0 - np.log(mu / 0.066) / 0.03)
 
-        def tempered(self, result, factors, speeds):
+        def tempered(self, result, factors, speeds, temperature):
             return result
 
         def heat(self, result, speeds):

@@ -33,6 +33,9 @@ from .table import CaseError, int_pair, only, read_table
 #: local worker processes a case may ask for per core (``[run] workers``): more only add
 #: memory and switching
 WORKERS_PER_CORE = 4
+#: the largest fall of the boundary shear a temperature term may give at a case's hottest
+#: oil before any heat (the linear law is a local expansion about reference_temperature)
+FADED = 0.5
 
 
 @arguments(path="path")
@@ -73,7 +76,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
     macro = _macro(data, where, tribometer, geometry)
     sweep = _sweep(data, where)
     thermal = _thermal(data, where, lubricant)
-    boundary = _boundary(data, where, thermal, sweep, tribometer)
+    boundary = _boundary(data, where, lubricant, sweep, tribometer)
     _disk_axis(tribometer, materials, geometry, where)
     run = read_table(data, "run", RunSpec, where)
     if run.workers < 0:
@@ -285,11 +288,11 @@ def _thermal(data, where, lubricant) -> ThermalSettings:
     return thermal
 
 
-def _boundary(data, where, thermal, sweep, tribometer) -> BoundaryLaw:
+def _boundary(data, where, lubricant, sweep, tribometer) -> BoundaryLaw:
     """[boundary]: the shear law's keys only with ``law = "shear"``, its alpha by default
     the case's ``[tribometer] boundary_friction``, some shear (tau_0 or alpha), a
-    temperature term only with the thermal model, a speed factor positive over the sweep's
-    speeds."""
+    temperature term that leaves more than :data:`FADED` of the shear at the hottest oil,
+    a speed factor positive over the sweep's speeds."""
     boundary = read_table(data, "boundary", BoundaryLaw, where)
     given = set(data.get("boundary", {})) - {"law", "film_on_contacts", "thin_films"}
     if boundary.law == "constant" and given:
@@ -303,10 +306,14 @@ def _boundary(data, where, thermal, sweep, tribometer) -> BoundaryLaw:
         raise CaseError(f"{where} [boundary]: shear_strength = pressure_coefficient = 0 leaves "
                         "the asperities no shear at all; give tau_0 [Pa] (10 MPa is 1e7) or "
                         "alpha (0.1), or law = \"constant\"")
-    if boundary.temperature_coefficient and thermal.model == "none":
-        raise CaseError(f"{where} [boundary] temperature_coefficient: the asperity spots' "
-                        "flash rise comes from the thermal model; set [thermal] model = "
-                        "\"flash\" or remove it")
+    hottest = max(lubricant.temperatures) - boundary.reference_temperature
+    if boundary.temperature_coefficient * hottest >= FADED:
+        raise CaseError(f"{where} [boundary] temperature_coefficient = "
+                        f"{boundary.temperature_coefficient:g}: at the oil's "
+                        f"{max(lubricant.temperatures):g} C, {hottest:g} K above "
+                        f"reference_temperature, the shear would fall by "
+                        f"{boundary.temperature_coefficient * hottest:.0%} before any heat; "
+                        "a relative fall per kelvin (0.2 % is 0.002)")
     try:
         boundary.check_speeds(sweep.speed_min, sweep.speed_max)
     except InputError as err:

@@ -8,8 +8,9 @@ laws act on that load:
 - ``"constant"`` (eq 32): ``tau_b = C_f,b (p_con + p a_r)``;
 - ``"shear"`` (Briscoe and Tabor's ``tau = tau_0 + alpha p`` on the real contact area,
   activated in the sliding speed): ``tau_b = (tau_0 a_r + alpha (p_con + p a_r)) s(u)``
-  with ``s(u) = 1 + c_u log10(u / u_ref)``; its temperature factor ``1 - c_T dT`` follows
-  the asperity spots' flash rise dT, :func:`spot_temperature_factor`.
+  with ``s(u) = 1 + c_u log10(u / u_ref)``; its temperature factor ``1 - c_T (T_c - T_ref)``
+  follows the asperities' absolute temperature T_c (the oil's, the bulk rise, the face's
+  and the spot's flash), :func:`temperature_factor`.
 
 ``tau_0 = 0``, ``alpha = C_f,b`` and ``c_u = c_T = 0`` give the constant law exactly
 (docs/model.md, "Boundary friction").  a_r covers the films thinner than the cell's
@@ -47,8 +48,14 @@ class BoundaryLaw:
                                        "speed_coefficient")
     reference_speed: float = setting(1.0, "u_ref of the speed factor", "speed")
     temperature_coefficient: float = setting(0.0, "c_T, the shear's relative fall per kelvin "
-                                             "of the asperity spots' flash rise (the thermal "
-                                             "model's)", "temperature_coefficient")
+                                             "of the asperities' temperature above "
+                                             "reference_temperature (the oil's, and with the "
+                                             "thermal model its bulk rise and the face's and "
+                                             "spot's flash)", "temperature_coefficient")
+    reference_temperature: float = setting(24.0, "T_ref [C], where the shear law holds "
+                                           "without its temperature term (the oil "
+                                           "temperature of the plateau it was fitted on)",
+                                           "temperature_C")
     film_on_contacts: bool = setting(True, "the film's pressure on the contact spots joins "
                                      "the asperities' load, p_con + p a_r (false: the "
                                      "paper's p_con alone)", unit="true or false")
@@ -107,7 +114,7 @@ def asperity_load(contact_pressure, film_pressure, contact_fraction,
 def boundary_traction(contact_pressure, film_pressure, contact_fraction, sliding_speed,
                       law: BoundaryLaw, boundary_friction: float) -> np.ndarray:
     """The boundary shear ``tau_b`` [Pa] of ``law`` (module docstring) at each node, its
-    temperature factor apart (:func:`spot_temperature_factor`); ``boundary_friction``:
+    temperature factor apart (:func:`temperature_factor`); ``boundary_friction``:
     the constant law's C_f,b."""
     try:
         np.broadcast_shapes(*(np.shape(a) for a in (contact_pressure, film_pressure,
@@ -136,12 +143,17 @@ def traction(contact_pressure, film_pressure, contact_fraction, sliding_speed,
     return (shear + law.pressure_coefficient * load) * law.speed_factor(sliding_speed)
 
 
-@arguments(law=BoundaryLaw, rise_per_shear="number")
-def spot_temperature_factor(law: BoundaryLaw, rise_per_shear: float) -> float:
-    """The shear law's temperature factor ``t = 1 - c_T dT`` where the spots' flash rise
-    dT is itself the flash of the tempered shear: ``dT = G tau t`` (the flash is linear in
-    the flux), so ``t = 1 / (1 + c_T G tau)``; ``rise_per_shear`` is ``G tau`` [K], the
-    rise of the untempered shear (1 for the constant law)."""
-    if law.law == "constant" or law.temperature_coefficient == 0:
+@arguments(law=BoundaryLaw, temperature="number", rise_per_shear="number")
+def temperature_factor(law: BoundaryLaw, temperature: float, rise_per_shear: float = 0.0) -> float:
+    """The shear law's temperature factor ``t = 1 - c_T (T_c - T_ref)`` at the asperities'
+    temperature ``T_c = temperature + dT`` [C], ``temperature`` the film's (the oil's plus
+    the bulk rise and the face's flash) and dT the spots' flash of the tempered shear,
+    ``dT = G tau t`` (the flash is linear in the flux): so ``t = (1 - c_T (temperature -
+    T_ref)) / (1 + c_T G tau)``; ``rise_per_shear`` is ``G tau`` [K], the rise of the
+    untempered shear (0: no spot flash).  At least 0: a shear that would change sign is
+    none (the case parser refuses a c_T that reaches it at the case's oils)."""
+    c = law.temperature_coefficient
+    if law.law == "constant" or c == 0:
         return 1.0
-    return 1.0 / (1.0 + law.temperature_coefficient * max(rise_per_shear, 0.0))
+    base = 1.0 - c * (temperature - law.reference_temperature)
+    return max(base, 0.0) / (1.0 + c * max(rise_per_shear, 0.0))

@@ -24,7 +24,7 @@ import scipy.fft as fft
 from ..checks import arguments, as_pair, check_ranges, plausible, setting
 from ..contact.elastic import love_rectangle
 from ..errors import InputError, NotConverged
-from .boundary import BoundaryLaw, spot_temperature_factor
+from .boundary import BoundaryLaw, temperature_factor
 
 #: sub-samples a side of a cell for the moving part of the kernel (it varies over 2 kappa / U)
 SUBSAMPLES = 8
@@ -163,8 +163,8 @@ def _coarse(flux, face, spacing, most: int):
 class ContactThermal:
     """A run's thermal model: its ``settings``, the oil's viscosity-temperature ``law``
     (:class:`~.viscosity.WaltherLaw`; a curve's oil is at the temperature where the law
-    gives the curve's mu_0); a point's boundary law (its settings') reads the asperity
-    spots' flash in its temperature term (:meth:`tempered`)."""
+    gives the curve's mu_0); a point's boundary law (its settings') reads the film
+    temperature and the asperity spots' flash in its temperature term (:meth:`tempered`)."""
 
     settings: ThermalSettings
     law: object
@@ -191,21 +191,29 @@ class ContactThermal:
                 if fraction > 0 else 0.0)
         return spot_flash(flux, speeds, self.settings)
 
-    def tempered(self, result, factors, speeds):
+    def tempered(self, result, factors, speeds, temperature: float):
         """``result`` with its boundary shear times its shear law's temperature factor at
-        the spots' flash rise (:func:`~.boundary.spot_temperature_factor`; unchanged
-        without a temperature term)."""
+        the film ``temperature`` [C] and the spots' flash (:func:`~.boundary.temperature_factor`;
+        unchanged without a temperature term)."""
         law = BoundaryLaw(**result.meta.get("settings", {}).get("boundary", {}))
-        t = spot_temperature_factor(law, self.spot(result, factors, speeds))
-        if t == 1.0:
-            return result
-        lost = (1 - t) * result.boundary_force
-        return replace(result, boundary_force=t * result.boundary_force,
-                       friction_force=result.friction_force - lost,
-                       friction_coefficient=(result.friction_force - lost) / result.normal_load,
-                       shear_stress=result.shear_stress - (1 - t) * result.boundary_shear,
-                       boundary_shear=t * result.boundary_shear,
-                       meta={**result.meta, "boundary_temperature_factor": t})
+        return tempered(result, temperature_factor(law, temperature,
+                                                   self.spot(result, factors, speeds)))
+
+
+@arguments(t="number")
+def tempered(result, t: float):
+    """``result`` (a MixedResult) with its boundary shear and force times the temperature
+    factor ``t`` [-] (:func:`~.boundary.temperature_factor`), its friction with them;
+    ``result`` itself where ``t`` is 1."""
+    if t == 1.0:
+        return result
+    lost = (1 - t) * result.boundary_force
+    return replace(result, boundary_force=t * result.boundary_force,
+                   friction_force=result.friction_force - lost,
+                   friction_coefficient=(result.friction_force - lost) / result.normal_load,
+                   shear_stress=result.shear_stress - (1 - t) * result.boundary_shear,
+                   boundary_shear=t * result.boundary_shear,
+                   meta={**result.meta, "boundary_temperature_factor": t})
 
 
 @arguments(solve=Callable, speeds="pair")
@@ -231,7 +239,7 @@ def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
     for _ in range(s.max_iter):
         film = replace(lubricant, viscosity=float(law.viscosity(T)))
         levels = solve(film, previous)
-        levels = (thermal.tempered(levels[0], factors, speeds), *levels[1:])
+        levels = (thermal.tempered(levels[0], factors, speeds, T), *levels[1:])
         heat = thermal.heat(levels[0], speeds)
         target = oil + s.bulk_resistance * heat["power"] + heat["flash"]
         history.append(abs(target - T))

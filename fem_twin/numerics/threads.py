@@ -19,6 +19,8 @@ import logging
 import os
 import signal
 import sys
+import threading
+import time
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 
@@ -74,8 +76,21 @@ _HEAP_SET = False
 
 def quiet_worker() -> None:
     """Initializer of local worker processes: Ctrl-C reaches the parent alone, which stops
-    the pool (:func:`stop_pool`), instead of every idle worker printing a traceback."""
+    the pool (:func:`stop_pool`), instead of every idle worker printing a traceback; and a
+    worker whose parent is gone (kill -9, the OOM killer) exits within
+    :data:`ORPHAN_POLL` seconds instead of idling on with its memory."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    parent = os.getppid()
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(ORPHAN_POLL)
+        os._exit(1)                       # nobody reads its results; checkpoints are atomic
+    threading.Thread(target=watch, daemon=True, name="fem_twin-orphan-watch").start()
+
+
+#: how often a local worker checks that its parent still runs [s]
+ORPHAN_POLL = 1.0
 
 
 def run_jobs(executor, job, items):

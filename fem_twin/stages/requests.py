@@ -30,6 +30,7 @@ def sweep_request(case: Case, out: RunLayout, *, factors: FlowFactors | None = N
         gap, spacing, factors, case.sweep.speeds, load=case.tribometer.load,
         load_share=case.tribometer.load_share,
         lubricant=case.lubricant.lubricants()[0], motion=motion(case),
+        oil_temperature=oil_temperature(case),
         hersey_length=hersey_length(case), face=face, origin=origin,
         settings=macro_settings(case), thermal=contact_thermal(case),
         factors_key=factors_key, checkpoint=out.points)
@@ -37,8 +38,20 @@ def sweep_request(case: Case, out: RunLayout, *, factors: FlowFactors | None = N
 
 
 def per_viscosity(case: Case, request: SweepRequest) -> list[SweepRequest]:
-    """``request`` at each of the case's viscosities (``[lubricant] viscosities``)."""
-    return [replace(request, lubricant=lub) for lub in case.lubricant.lubricants()]
+    """``request`` at each of the case's viscosities (``[lubricant] viscosities``), at its
+    oil temperature (``[lubricant] temperatures``)."""
+    return [replace(request, lubricant=lub, oil_temperature=oil_temperature(case, k))
+            for k, lub in enumerate(case.lubricant.lubricants())]
+
+
+def oil_temperature(case: Case, k: int = 0) -> float | None:
+    """The oil temperature [C] of viscosity ``k`` where an isothermal twin's boundary law
+    reads it (a temperature term, ``[thermal] model = "none"``), else None: the thermal
+    model finds its own, and a point without the term does not depend on it (its
+    checkpoints' key stays)."""
+    if case.thermal.model != "none" or not case.boundary.temperature_coefficient:
+        return None
+    return float(case.lubricant.temperatures[k])
 
 
 def motion(case: Case) -> Sliding | RollingSliding:

@@ -102,14 +102,15 @@ class FitModel:
         if shear is None:
             return (hd + boundary_friction * at(c.boundary_force)
                     / self.boundary_friction) / load, inside
-        return (hd + self._law_force(c, at, speed, shear)) / load, inside
+        return (hd + self._law_force(c, at, speed, shear, viscosity)) / load, inside
 
-    def _law_force(self, c: StribeckCurve, at, speed, shear: dict):
+    def _law_force(self, c: StribeckCurve, at, speed, shear: dict, viscosity: float):
         """The shear law's boundary force [N] (:mod:`fem_twin.macro.boundary`) from the
-        curve's real contact area and asperity load, its spots' flash for the temperature
-        factor (``t = 1 / (1 + c_T dT)``, dT the untempered shear's flash); the iterate's
-        tau_0 [Pa] enters the force directly (the optimiser passes through tau_0 below
-        the law's plausible floor, 10 kPa, on its way from 0)."""
+        curve's real contact area and asperity load, the film temperature and the spots'
+        flash for the temperature factor (:func:`~fem_twin.macro.boundary.temperature_factor`,
+        dT the untempered shear's flash); the iterate's tau_0 [Pa] enters the force
+        directly (the optimiser passes through tau_0 below the law's plausible floor,
+        10 kPa, on its way from 0)."""
         base = self.boundary or BoundaryLaw(law="shear", shear_strength=0.0,
                                             pressure_coefficient=self.boundary_friction)
         tau0 = shear.get("shear_strength", base.shear_strength)
@@ -118,10 +119,24 @@ class FitModel:
         area, load = at(c.real_contact_area), at(c.asperity_load)
         force = (tau0 * area + law.pressure_coefficient * load) * law.speed_factor(speed)
         if law.temperature_coefficient:
-            rise = at(c.spot_rise) * np.divide(force, area, out=np.zeros_like(force),
-                                               where=area > 0)
-            force = force / (1 + law.temperature_coefficient * np.maximum(rise, 0.0))
+            rise = (0.0 if c.spot_rise is None else at(c.spot_rise) * np.divide(
+                force, area, out=np.zeros_like(force), where=area > 0))
+            c_t, hot = law.temperature_coefficient, self._film_temperature(c, at, viscosity)
+            force = (force * np.maximum(1 - c_t * (hot - law.reference_temperature), 0.0)
+                     / (1 + c_t * np.maximum(rise, 0.0)))
         return force
+
+    def _film_temperature(self, c: StribeckCurve, at, viscosity: float):
+        """The film temperature [C] of curve ``c``'s points read at the oil of ``viscosity``:
+        the curve's own (the thermal model's) moved by the two oils' difference, or the
+        oil's (isothermal); the reference temperature where the case gives no Walther law."""
+        oil = (lambda mu: float(self.law.temperature(mu))) if self.law is not None else None
+        if c.contact_temperature is not None and np.all(np.isfinite(c.contact_temperature)):
+            shift = oil(viscosity) - oil(c.viscosity) if oil else 0.0
+            return at(c.contact_temperature) + shift
+        if oil is None:
+            return (self.boundary or BoundaryLaw()).reference_temperature
+        return oil(viscosity)
 
 
 def check_parameters(params) -> None:
@@ -300,15 +315,17 @@ def _check_model(model: FitModel, measured, params, start_temperatures) -> None:
 
 def _check_columns(model: FitModel, params) -> None:
     """Refuse a shear-law fit on curves without the law's integrals (a run of an older
-    fem_twin) or, for its temperature term, without the spots' flash (an isothermal run)."""
+    fem_twin) or, for its temperature term, without a temperature that varies: the spots'
+    flash of the thermal model, or, isothermal, oils at two temperatures (a Walther law)."""
     needs = (("real_contact_area", "asperity_load") if set(params) & set(SHEAR) else ()) + (
-        ("spot_rise",) if "temperature_coefficient" in params else ())
+        ("spot_rise",) if "temperature_coefficient" in params and model.law is None else ())
     for name in needs:
         if any(getattr(c, name) is None for c in model.curves):
             raise InputError(f"fitting {', '.join(p for p in params if p in SHEAR)} needs each "
                              f"simulated curve's {name} (" + (
-                                 "a run with [thermal] model = \"flash\")" if name ==
-                                 "spot_rise" else "run the case again with this fem_twin)"))
+                                 "a run with [thermal] model = \"flash\"), or curves at "
+                                 "two oil temperatures" if name == "spot_rise" else
+                                 "run the case again with this fem_twin)"))
 
 
 def _sigma(m: MeasuredCurve):

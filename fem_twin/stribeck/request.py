@@ -71,10 +71,12 @@ class SweepRequest:
     ``factors``, the ``speeds`` [m/s] (fast to slow), the imposed ``load`` F_N,imp [N] of
     which the face carries ``load_share`` (eq 28 balances their product; C_f and the
     Hersey number refer to ``load``), the ``lubricant``, the ``motion``, D of the Hersey number
-    ``hersey_length`` [m] (eq 46), the pin ``face`` (None: the whole grid), the macro ``settings``
-    and a ``thermal`` model (None: isothermal).  ``factors_key``: a key of the factors' inputs,
-    hashed instead of their bits; ``checkpoint``: the points' folder; ``fields``: a VTU per
-    speed there (``origin`` [m]); ``error_estimate``: each point's C_f error;
+    ``hersey_length`` [m] (eq 46), the pin ``face`` (None: the whole grid), the macro
+    ``settings`` and a ``thermal`` model (None: isothermal, the boundary law's temperature
+    term at the ``oil_temperature`` [C], or at its reference where that is None).
+    ``factors_key``: a key of the factors' inputs, hashed instead of their bits;
+    ``checkpoint``: the points' folder; ``fields``: a VTU per speed there (``origin``
+    [m]); ``error_estimate``: each point's C_f error;
     ``keep_level``: keep each point's nested solve that many coarsenings down, which a
     sweep with ``guide`` (that level's key, :meth:`level_key`) starts from."""
 
@@ -91,6 +93,7 @@ class SweepRequest:
     face: np.ndarray | None = None
     settings: MacroSettings = MacroSettings()
     thermal: object = None
+    oil_temperature: float | None = None
     factors_key: str | None = None
     checkpoint: Path | None = None
     fields: Path | None = None

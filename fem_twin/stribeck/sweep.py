@@ -14,9 +14,10 @@ from ..checks import check
 from ..io.checkpoint import check_made_for, load_or_none, made_for
 from ..io.mesh import write_pvd
 from ..macro import MixedResult
+from ..macro.boundary import temperature_factor
 from ..macro.estimate import PARTS, friction_error
 from ..macro.nested import corrected, solve_nested
-from ..macro.thermal import thermal_point
+from ..macro.thermal import tempered, thermal_point
 from ..numerics.threads import one_thread
 from .curve import StribeckCurve, hersey_number
 from .request import SweepRequest
@@ -248,7 +249,11 @@ def _solve_point(request: SweepRequest, speed: float, previous):
         return solve_nested(replace(point, lubricant=lub), start or previous)
 
     if r.thermal is None:
-        return solve(r.lubricant, None)
+        levels = solve(r.lubricant, None)
+        if r.oil_temperature is None:
+            return levels
+        t = temperature_factor(r.settings.boundary, r.oil_temperature)
+        return (tempered(levels[0], t), *levels[1:])
     surfaces = point.surface_speeds
     start = time.perf_counter()
     levels, film, record = thermal_point(solve, r.lubricant, r.thermal, r.factors, surfaces,

@@ -152,10 +152,14 @@ def _check_models(case: Case, params) -> None:
     """Refuse (fitted) parameters the case's models do not read: a thermal one on an
     isothermal case, C_f,b on a shear-law case; for a fit before its run and for
     ``--from-fit`` alike."""
-    for name in ("bulk_resistance", "temperature_coefficient"):
-        if name in params and case.thermal.model == "none":
-            raise InputError(f"{name} needs the thermal twin and the case has [thermal] model "
-                             "= \"none\": set model = \"flash\", or fit without it")
+    if "bulk_resistance" in params and case.thermal.model == "none":
+        raise InputError("bulk_resistance needs the thermal twin and the case has [thermal] "
+                         "model = \"none\": set model = \"flash\", or fit without it")
+    if ("temperature_coefficient" in params and case.thermal.model == "none"
+            and len(set(case.lubricant.temperatures)) < 2):
+        raise InputError("temperature_coefficient needs a temperature that varies: the "
+                         "thermal twin ([thermal] model = \"flash\") or oils at two "
+                         "temperatures")
     if "boundary_friction" in params and case.boundary.law != "constant":
         raise InputError("boundary_friction is eq 32's constant C_f,b; the case's [boundary] "
                          "law = \"shear\" does not read it: fit the other parameters, or "
