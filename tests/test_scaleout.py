@@ -325,8 +325,9 @@ def _running(pid: int) -> bool:
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_a_local_worker_exits_when_its_parent_is_killed():
-    """Probe R.02: after kill -9 of a run, its idle pool workers lived on (two processes,
-    125-140 MB each, 40 minutes later); quiet_worker's watch ends them within seconds."""
+    """Probe R.02: after kill -9 of a run, its idle pool workers lived on (two processes of
+    122 and 139 MiB resident at a later check); quiet_worker's watch ends them within
+    seconds."""
     import signal
     import subprocess
     import time
