@@ -15,6 +15,8 @@
                                               #  estimates: each example's printed run
                                               #  time against its run, ~4 min, ~9 with
                                               #  FEM_TWIN_ESTIMATE_LOAD=1;
+                                              #  contact-area: the dry area against
+                                              #  the cell grid, ~2 min;
                                               #  only when named)
 """
 
@@ -38,6 +40,7 @@ sys.path.insert(0, HERE)
 from ab import bench_ab  # noqa: E402
 from amg import bench_amg  # noqa: E402
 from common import SAMPLE, best_of, macro_factors, macro_gap  # noqa: E402
+from contact_area import bench_contact_area  # noqa: E402
 from cores import bench_cores  # noqa: E402
 from defaults import bench_defaults  # noqa: E402
 from deterministic import bench_deterministic, bench_deterministic_fine  # noqa: E402
@@ -609,7 +612,8 @@ GROUPS = {"topography": bench_topography, "contact": bench_contact, "micro": ben
           "micro-full": lambda: bench_micro(full=True), "defaults": bench_defaults,
           "deterministic": bench_deterministic, "ab": bench_ab,
           "deterministic-fine": bench_deterministic_fine,
-          "estimates": bench_estimates, "unsteady": bench_unsteady, "peers": bench_peers}
+          "estimates": bench_estimates, "unsteady": bench_unsteady, "peers": bench_peers,
+          "contact-area": bench_contact_area}
 
 
 def main(argv):
@@ -617,7 +621,7 @@ def main(argv):
                                                         "scale", "amg", "cores", "defaults",
                                                         "deterministic", "ab", "estimates",
                                                         "unsteady", "deterministic-fine",
-                                                        "peers")]
+                                                        "peers", "contact-area")]
     for name in groups:
         base, rows, *summary = GROUPS[name]()
         print(f"\n## {name}")

@@ -268,7 +268,8 @@ def test_settings_refuse_text_none_and_truthy_flags_where_a_number_or_flag_goes(
     from fem_twin.macro.thermal import ThermalSettings
     from fem_twin.micro.sliding import CellSettings
     for make, words in ((lambda: DeterministicSettings(film_deforms="no"), "true or false"),
-                        (lambda: BoundaryLaw(thin_films="yes"), "true or false"),
+                        (lambda: BoundaryLaw(film_on_contacts="yes"), "true or false"),
+                        (lambda: BoundaryLaw(thin_films="yes"), "one of 'boundary'"),
                         (lambda: BoundaryLaw(shear_strength="10 MPa"), "10 MPa is 1e7"),
                         (lambda: BoundaryLaw(pressure_coefficient=None), "alpha|got None"),
                         (lambda: MacroSettings(tol="1e-6"), "tol"),

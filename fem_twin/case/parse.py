@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..checks import arguments, memory_shortfall
 from ..errors import InputError
-from ..macro.boundary import BoundaryLaw
+from ..macro.boundary import BoundaryLaw, thin_films_choice
 from ..macro.thermal import ThermalSettings
 from ..stribeck.curve import read_measured_csv
 from ..stribeck.validation import check_like_with_like
@@ -293,7 +293,10 @@ def _boundary(data, where, lubricant, sweep, tribometer) -> BoundaryLaw:
     the case's ``[tribometer] boundary_friction``, some shear (tau_0 or alpha), a
     temperature term that leaves more than :data:`FADED` of the shear at the hottest oil,
     a speed factor positive over the sweep's speeds."""
-    boundary = read_table(data, "boundary", BoundaryLaw, where)
+    table = data.get("boundary", {})
+    if "thin_films" in table:                          # true/false of older case files
+        table = {**table, "thin_films": thin_films_choice(table["thin_films"])}
+    boundary = read_table({"boundary": table}, "boundary", BoundaryLaw, where)
     given = set(data.get("boundary", {})) - {"law", "film_on_contacts", "thin_films"}
     if boundary.law == "constant" and given:
         raise CaseError(f"{where} [boundary] {', '.join(sorted(given))}: the shear law's, unused "

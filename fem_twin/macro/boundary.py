@@ -7,14 +7,17 @@ laws act on that load:
 
 - ``"constant"`` (eq 32): ``tau_b = C_f,b (p_con + p a_r)``;
 - ``"shear"`` (Briscoe and Tabor's ``tau = tau_0 + alpha p`` on the real contact area,
-  activated in the sliding speed): ``tau_b = (tau_0 a_r + alpha (p_con + p a_r)) s(u)``
-  with ``s(u) = 1 + c_u log10(u / u_ref)``; its temperature factor ``1 - c_T (T_c - T_ref)``
-  follows the asperities' absolute temperature T_c (the oil's, the bulk rise, the face's
-  and the spot's flash), :func:`temperature_factor`.
+  activated in the sliding speed): ``tau_b = (tau_0 a_c + alpha (p_con + p a_r)) s(u)``
+  with ``s(u) = 1 + c_u log10(u / u_ref)``, a_c the dry contact fraction; its temperature
+  factor ``1 - c_T (T_c - T_ref)`` follows the asperities' absolute temperature T_c (the
+  oil's, the bulk rise, the face's and the spot's flash), :func:`temperature_factor`.
 
 ``tau_0 = 0``, ``alpha = C_f,b`` and ``c_u = c_T = 0`` give the constant law exactly
-(docs/model.md, "Boundary friction").  a_r covers the films thinner than the cell's
-boundary film too (``thin_films``, :func:`boundary_area`): they are boundary films.
+(docs/model.md, "Boundary friction").  The films between the gap floor and the cell's
+boundary film (``thin_films``, :data:`THIN_FILMS`) join a_r, the area whose film pressure
+the asperities' load takes (``"boundary"``), or shear as confined viscous films
+(``"viscous"``, :func:`.friction.confined_shear`), or carry nothing (``"none"``); tau_0
+acts on the dry contact alone.
 """
 
 from __future__ import annotations
@@ -29,6 +32,18 @@ from ..tables import BOUNDARY_FRICTION
 
 #: the boundary laws: eq 32's constant C_f,b, or the shear strength of a boundary film
 LAWS = ("constant", "shear")
+#: what the films thinner than the boundary film carry: the boundary shear on their film
+#: pressure, a confined film's viscous shear, or nothing
+THIN_FILMS = ("boundary", "viscous", "none")
+
+
+def thin_films_choice(value):
+    """``[boundary] thin_films`` as one of :data:`THIN_FILMS`: the flag of case files and
+    run folders written before the choice, ``true`` and ``false``, read as ``"boundary"``
+    and ``"none"``; anything else unchanged (for the choice check)."""
+    if isinstance(value, (bool, np.bool_)):
+        return "boundary" if value else "none"
+    return value
 
 
 @dataclass(frozen=True)
@@ -59,11 +74,14 @@ class BoundaryLaw:
     film_on_contacts: bool = setting(True, "the film's pressure on the contact spots joins "
                                      "the asperities' load, p_con + p a_r (false: the "
                                      "paper's p_con alone)", unit="true or false")
-    thin_films: bool = setting(True, "films thinner than [micro] boundary_film join the "
-                               "contact spots' area a_r (they carry no film friction); "
-                               "false: they carry no shear at all", unit="true or false")
+    thin_films: str = setting("boundary", "films between [micro] gap_floor and boundary_film: "
+                              "their film pressure joins the asperities' load (boundary "
+                              "films; true in older case files), they shear as confined "
+                              "viscous films mu u / h, or they carry no shear (false)",
+                              choices=THIN_FILMS)
 
     def __post_init__(self):
+        object.__setattr__(self, "thin_films", thin_films_choice(self.thin_films))
         check_choices(self)
         check_ranges(self)
 
@@ -89,10 +107,11 @@ class BoundaryLaw:
 
 @arguments(law=BoundaryLaw)
 def boundary_area(shear, law: BoundaryLaw) -> np.ndarray:
-    """a_r [-] from the shear factors ``shear`` (LocalFactors): the contact fraction, and
-    with ``law.thin_films`` the films below the boundary film too, ``1 - film_fraction``
-    (at most 1: an error estimate's variant of the factors may overshoot)."""
-    if not law.thin_films or shear.film_fraction is None:
+    """a_r [-], the area whose film pressure the asperities carry, from the shear factors
+    ``shear`` (LocalFactors): the dry contact fraction, and with ``law.thin_films ==
+    "boundary"`` the films below the boundary film too, ``1 - film_fraction`` (at most 1:
+    an error estimate's variant of the factors may overshoot)."""
+    if law.thin_films != "boundary" or shear.film_fraction is None:
         return shear.contact_fraction
     return np.clip(np.maximum(shear.contact_fraction, 1 - shear.film_fraction), 0.0, 1.0)
 
@@ -114,8 +133,9 @@ def asperity_load(contact_pressure, film_pressure, contact_fraction,
 def boundary_traction(contact_pressure, film_pressure, contact_fraction, sliding_speed,
                       law: BoundaryLaw, boundary_friction: float) -> np.ndarray:
     """The boundary shear ``tau_b`` [Pa] of ``law`` (module docstring) at each node, its
-    temperature factor apart (:func:`temperature_factor`); ``boundary_friction``:
-    the constant law's C_f,b."""
+    temperature factor apart (:func:`temperature_factor`), for spots of dry
+    ``contact_fraction`` a_c [-] without thin films beside them (a_r = a_c);
+    ``boundary_friction``: the constant law's C_f,b."""
     try:
         np.broadcast_shapes(*(np.shape(a) for a in (contact_pressure, film_pressure,
                                                     contact_fraction, sliding_speed)))
@@ -127,19 +147,20 @@ def boundary_traction(contact_pressure, film_pressure, contact_fraction, sliding
             np.asarray(contact_pressure, float) < 0):
         raise InputError("boundary_traction: contact_fraction lies in [0, 1] and the contact "
                          "pressure [Pa] is not negative")
-    return traction(contact_pressure, film_pressure, contact_fraction, sliding_speed, law,
-                    boundary_friction)
+    load = asperity_load(contact_pressure, film_pressure, contact_fraction, law)
+    return traction(load, contact_fraction, sliding_speed, law, boundary_friction)
 
 
 @arguments(law=BoundaryLaw)
-def traction(contact_pressure, film_pressure, contact_fraction, sliding_speed,
-             law: BoundaryLaw, boundary_friction: float) -> np.ndarray:
-    """:func:`boundary_traction` without its checks, for the macro scale's own fields (an
-    error estimate's perturbed factors may step outside the physical ranges)."""
-    load = asperity_load(contact_pressure, film_pressure, contact_fraction, law)
+def traction(load, dry_fraction, sliding_speed, law: BoundaryLaw,
+             boundary_friction: float) -> np.ndarray:
+    """The boundary shear [Pa] on the asperities' ``load`` (:func:`asperity_load`) [Pa],
+    tau_0 on the ``dry_fraction`` a_c [-] of the dry contact; :func:`boundary_traction`
+    without its checks, for the macro scale's own fields (an error estimate's perturbed
+    factors may step outside the physical ranges)."""
     if law.law == "constant":
-        return boundary_friction * load
-    shear = law.shear_strength * np.asarray(contact_fraction, float)
+        return boundary_friction * np.asarray(load, float)
+    shear = law.shear_strength * np.asarray(dry_fraction, float)
     return (shear + law.pressure_coefficient * load) * law.speed_factor(sliding_speed)
 
 

@@ -12,9 +12,10 @@ Ambient and cavitation pressure 0 (gauge).  Each pass solves the contact against
 deformed by the film pressure, then the film on the contact's gap (floored at ``gap_floor``,
 as in the cells); the film's deformation, viscosity and density are mixed (Anderson) until
 they settle; ``h_d`` balances the load (Brent on the log of the load).  Friction on the pin
-(:func:`pad_friction`) plus ``C_f,b`` times the boundary's load (eq 32): the contact load
-and the film's where the gap is at most the boundary film (the twin's ``p a_r``); integrals
-by the trapezoidal rule."""
+(:func:`pad_friction`) plus the twin's boundary law (:class:`.boundary.BoundaryLaw`) node by
+node (:func:`boundary_force`): eq 32's ``C_f,b`` times the contact load and the film's where
+the gap is at most the boundary film (the twin's ``p a_r``), or the shear law with tau_0 on
+the resolved spots; integrals by the trapezoidal rule."""
 
 from __future__ import annotations
 
@@ -40,6 +41,7 @@ from ..contact.elastic import elastic_operator
 from ..errors import InputError, NotConverged, ReynoldsNotConverged
 from ..micro.sliding import CellSettings
 from ..numerics.anderson import Anderson
+from .boundary import BoundaryLaw, asperity_load, temperature_factor, traction
 from .cavitation import cavitation_model
 from .couette import couette_matrix
 from .lubricant import Lubricant
@@ -47,7 +49,7 @@ from .problem import MAX_COEFFICIENT_PRESSURE
 from .reynolds import fe_poiseuille, trapezoid_weights
 
 __all__ = ["DeterministicNotConverged", "DeterministicResult", "DeterministicSettings",
-           "pad_friction", "solve_deterministic"]
+           "boundary_force", "pad_friction", "solve_deterministic"]
 
 
 #: Anderson mixing of the film's deformation, viscosity and density (the micro-EHL
@@ -72,10 +74,11 @@ class DeterministicSettings:
                                    "boundary_film")
     gap_floor: float = setting(CellSettings.gap_floor, "the film in a contact spot (the "
                                "cells' default)", "gap_floor")
-    film_on_boundary: bool = setting(True, "the film's pressure where the gap is at most "
-                                     "boundary_film (spots and boundary films) joins the "
-                                     "boundary's load (the twin's [boundary] "
-                                     "film_on_contacts and thin_films)", unit="-")
+    boundary: BoundaryLaw = setting(BoundaryLaw(), "the boundary shear's law, the twin's "
+                                    "(fem_twin.macro.boundary), node by node on the "
+                                    "resolved spots", unit="a section")
+    temperature: float = setting(24.0, "the oil's temperature [C], where the shear law's "
+                                 "temperature factor is read (isothermal)", "temperature_C")
     film_deforms: bool = setting(True, "the film pressure deforms the surfaces (False: the "
                                  "asperities feel their contact pressure alone)", unit="-")
     sides: str = setting("open", "the pad's edges along x1 (x2 = 0 and L2) at ambient "
@@ -101,8 +104,8 @@ class DeterministicSettings:
 class DeterministicResult:
     """A converged deterministic point (SI units): ``separation`` h_d [m]; ``film_load``,
     ``contact_load``, ``load`` [N]; ``film_friction`` (wall shear and film pressure on the
-    pin), ``boundary_force`` (C_f,b times the contact load and, with ``film_on_boundary``,
-    the film's load where the gap is at most the boundary film) [N]; fields ``pressure``,
+    pin; with ``thin_films = "viscous"`` the confined films' too), ``boundary_force`` (the
+    boundary law over the resolved spots, :func:`boundary_force`) [N]; fields ``pressure``,
     ``contact_pressure`` [Pa], ``cavity_fraction`` [-], ``gap`` [m]; ``history``: the log
     load residual of each evaluation."""
 
@@ -127,7 +130,7 @@ class DeterministicResult:
 
     @property
     def friction_coefficient(self) -> float:
-        """C_f = (film friction + C_f,b contact load) / load (eq 34) [-]."""
+        """C_f = (film friction + boundary force) / load (eq 34) [-]."""
         return (self.film_friction + self.boundary_force) / self.load
 
 
@@ -294,10 +297,9 @@ def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant:
     pad = _Pad(s, dx, speed, lubricant, settings)
     h_d, st, history, _ = balance(pad, load, initial.separation if initial else None)
     film = pad_friction(st["p"], st["gap"], st["theta"], st["mu"], dx, speed,
-                        settings.boundary_film)
+                        viscous_cut(settings))
     return DeterministicResult(speed, load, float(h_d), st["film_load"], st["contact_load"],
-                               film, settings.boundary_friction * boundary_load(pad.area, st,
-                                                                                settings),
+                               film, boundary_force(pad.area, st, settings, speed),
                                dx, st["p"], st["p_con"], st["theta"], st["gap"],
                                tuple(history))
 
@@ -315,15 +317,27 @@ def _checked(shape, spacing, load, speed, lubricant, settings):
     return s, dx, load, speed
 
 
-def boundary_load(area, state: dict, settings: DeterministicSettings) -> float:
-    """The load the boundary shear acts on [N] (eq 32): the contact load and, with
-    ``film_on_boundary``, the film's where the gap is at most the boundary film; ``area``
-    the nodes' weights [m^2], ``state`` a solved instant's fields."""
-    load = state["contact_load"]
-    if settings.film_on_boundary:
-        thin = state["gap"] <= settings.boundary_film
-        load += float(np.sum(area * np.where(thin, np.maximum(state["p"], 0), 0)))
-    return load
+@arguments(area="field", state=dict, settings=DeterministicSettings, speed="number")
+def boundary_force(area, state: dict, settings: DeterministicSettings, speed: float) -> float:
+    """The boundary law's force [N] (eq 32 or the shear law, :mod:`.boundary`) node by
+    node on the resolved pad: the spots (``p_con > 0``, a_c = 1) carry ``p_con``, and with
+    ``film_on_contacts`` the film's pressure there and, under ``thin_films =
+    "boundary"``, where the gap is at most the boundary film; tau_0 on the spots alone;
+    the temperature factor at the oil's ``settings.temperature`` (isothermal).  ``area``: the
+    nodes' weights [m^2], ``state`` a solved instant's fields, ``speed`` the disk's."""
+    law, p_con = settings.boundary, state["p_con"]
+    spots = (p_con > 0).astype(float)
+    wet = state["gap"] <= settings.boundary_film if law.thin_films == "boundary" else spots > 0
+    load = asperity_load(p_con, np.maximum(state["p"], 0.0), wet, law)
+    tau = traction(load, spots, speed, law, settings.boundary_friction)
+    return float(np.sum(area * tau)) * temperature_factor(law, settings.temperature)
+
+
+def viscous_cut(settings: DeterministicSettings) -> float:
+    """The thinnest film [m] that carries the film's viscous shear: the boundary film, or
+    the gap floor where the confined films shear too (``thin_films = "viscous"``)."""
+    return settings.gap_floor if settings.boundary.thin_films == "viscous" else \
+        settings.boundary_film
 
 
 def balance(pad: _Pad, load: float, start: float | None = None):

@@ -114,6 +114,18 @@ def eyring_shear(newtonian, eyring_stress: float, shear=None) -> np.ndarray:
     return w * ((eyring_stress * np.arcsinh(local / eyring_stress)) @ _WEIGHTS)
 
 
+def confined_shear(viscosity, speed, shear, mean_gap, cavity_fraction,
+                   eyring_stress=None) -> np.ndarray:
+    """The Couette shear of the confined films between the gap floor and the boundary film
+    [Pa] (``[boundary] thin_films = "viscous"``): ``mu u <1/h>`` over them, ``mu u
+    thin_friction / h_m (1 - theta)`` with the factors ``shear`` (LocalFactors) at the
+    local sliding ``speed`` [m/s] and ``viscosity`` [Pa s] (the film's: no confinement
+    enhancement), Eyring-limited as ``tau_0 asinh(tau / tau_0)`` on the band's mean
+    (:func:`eyring_shear` without a spread; ``eyring_stress`` tau_0 [Pa] or None)."""
+    tau = viscosity * speed * shear.thin_friction / mean_gap * (1 - cavity_fraction)
+    return tau if eyring_stress is None else eyring_shear(tau, eyring_stress)
+
+
 def face_slope(gap, face, dx1: float) -> np.ndarray:
     """``d gap / dx1`` [-] on the pin ``face`` (bool grid; None: all), by central
     differences inside it and one-sided ones at its edge, zero off it."""

@@ -11,7 +11,7 @@ import numpy as np
 from ..io.atomic import atomic_path
 from ..micro.rolling import at_slide_to_roll
 from .boundary import asperity_load, boundary_area, traction
-from .friction import disk_shear, hydrodynamic_shear
+from .friction import confined_shear, disk_shear, hydrodynamic_shear
 from .kinematics import disk_velocity, rotations
 from .reynolds import trapezoid_weights
 
@@ -30,9 +30,10 @@ class MixedResult:
     ``h_d`` [m], ``friction_force`` F_T (eq 33) with its ``hydrodynamic_friction`` and
     ``boundary_force`` parts [N], ``friction_coefficient`` C_f (eq 34),
     ``contact_load`` (integral of p_con) [N]; the asperities' ``asperity_load`` (of
-    p_con + p a_r, :func:`.boundary.asperity_load`) [N] and ``real_contact_area`` (of a_r)
-    [m^2] over the face, each node weighted by the x1 share of its sliding direction (1
-    under uniform sliding): the integrals the boundary law reads along the load cell.
+    p_con + p a_r, :func:`.boundary.asperity_load`) [N] and ``real_contact_area`` (of the
+    dry contact fraction a_c, which tau_0 multiplies) [m^2] over the face, each node
+    weighted by the x1 share of its sliding direction (1 under uniform sliding): the
+    integrals the boundary law reads along the load cell.
     Fields (ny, nx): ``pressure`` p_hd, ``contact_pressure`` p_con [Pa], ``cavity_fraction``,
     ``h0``, ``mean_gap`` h_m, ``elastic_deformation`` h_el [m], ``viscosity`` [Pa s],
     ``density_ratio`` rho/rho_0, ``shear_stress`` tau_tot and its ``boundary_shear`` part
@@ -193,9 +194,10 @@ def pin_friction(film, how: Shearing):
     (``settings.reading``): on the pin along x1 (eqs 31-32, or the force on the pin:
     ``settings.friction``, :func:`.friction.hydrodynamic_shear`), or the disk's drag times
     ``|v|`` (its torque over the track radius, :func:`.friction.disk_shear`), sheared
-    ``how``; and the asperities' load field (:func:`.boundary.asperity_load`) [Pa] and
-    contact fraction a_r [-] the law reads, each weighted alike (the x1 share of the
-    sliding, or ``|v|``)."""
+    ``how``; and the asperities' load field (:func:`.boundary.asperity_load`) [Pa] and the
+    dry contact fraction a_c [-] the law reads, each weighted alike (the x1 share of the
+    sliding, or ``|v|``).  The confined films' viscous shear (``thin_films =
+    "viscous"``) joins the film's traction."""
     p_hd, theta, mu, h_m, p_con = (film.pressure, film.cavity_fraction, film.viscosity,
                                    film.mean_gap, film.contact_pressure)
     h0, face, velocity, settings = film.h0, film.face, how.velocity, how.settings
@@ -214,12 +216,16 @@ def pin_friction(film, how: Shearing):
                                     law=settings.friction, face=face,
                                     ambient_pressure=settings.ambient_pressure,
                                     velocity=velocity)
+    law = settings.boundary
+    if law.thin_films == "viscous":      # the confined films' viscous shear, along the sliding
+        tau_hd = tau_hd + confined_shear(mu, speed * local, shear, h_m, theta,
+                                         lubricant.eyring_stress) * along
     gauge = np.maximum(np.asarray(p_hd, float) - settings.ambient_pressure, 0.0)
-    a_r = boundary_area(shear, settings.boundary)
-    tau_con = traction(p_con, gauge, a_r, speed * local, settings.boundary,
+    load = asperity_load(p_con, gauge, boundary_area(shear, law), law)
+    tau_con = traction(load, shear.contact_fraction, speed * local, law,
                        settings.boundary_friction)
     return (tau_hd, tau_con * along * (speed > 0),   # along the reading; 0: no sliding
-            asperity_load(p_con, gauge, a_r, settings.boundary) * along, a_r * along)
+            load * along, shear.contact_fraction * along)
 
 
 def friction_with(result: MixedResult, factors, settings, lubricant) -> float:

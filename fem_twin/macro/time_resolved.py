@@ -17,8 +17,8 @@ solution's ``d log W / d h_d``) until the period-mean load balances; the run sta
 the steady solution with the disk frozen at its first instant and ends when the period
 means repeat (:class:`TimeSettings`).
 Friction on the pin: :func:`.deterministic.pad_friction` plus the film pressure on the
-disk's slopes (the pin's surface is the gap minus the disk's), and C_f,b times the
-boundary's load (eq 32)."""
+disk's slopes (the pin's surface is the gap minus the disk's), and the boundary law's
+force (:func:`.deterministic.boundary_force`)."""
 
 from __future__ import annotations
 
@@ -35,8 +35,9 @@ from .deterministic import (
     _checked,
     _Pad,
     balance,
-    boundary_load,
+    boundary_force,
     pad_friction,
+    viscous_cut,
 )
 from .lubricant import Lubricant
 
@@ -215,10 +216,10 @@ class _March:
         s, dx = pad.settings, pad.spacing
         flank = float(np.sum(pad.area * st["p"] * disk_at(self.slopes, shift, self.nodes)))
         film = pad_friction(st["p"], st["gap"], st["theta"], st["mu"], dx, pad.speed,
-                            s.boundary_film) + flank
+                            viscous_cut(s)) + flank
         return {"contact_load": st["contact_load"], "film_load": st["film_load"],
                 "film_friction": film,
-                "boundary_force": s.boundary_friction * boundary_load(pad.area, st, s)}
+                "boundary_force": boundary_force(pad.area, st, s, pad.speed)}
 
     def result(self, periods: int, history: tuple) -> TimeResolvedResult:
         i, st, pad = self.instants, self.last, self.pad

@@ -197,7 +197,8 @@ def _film_variant(factors, moments, k) -> FlowFactors:
     def get(key):
         return np.array([m[key][k] for m in moments])
 
-    out = {"friction_factor": get("s_c") * factors.h_m}
+    out = {"friction_factor": get("s_c") * factors.h_m,
+           "thin_friction": get("s_thin") * factors.h_m}
     if all("film_area" in m for m in moments):
         out.update(film_spread(get("film_area"), get("log_shear"), factors.h_m))
     return replace(factors, meta={}, **out)

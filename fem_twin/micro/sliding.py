@@ -251,13 +251,17 @@ def film_moments(contact, cell: dict, settings: CellSettings) -> dict:
     ``settings.boundary_film``, then half and twice it (:data:`FILM_CUTS`): contact spots
     carry the boundary shear (eq 32) instead, and thinner films near them are boundary
     films.  ``h3_g1_pin``: eq 14's ``<h^3 grad chi_1>`` with the pin at rest (``k`` times
-    the frame's), for the Poiseuille friction ``2 e1 - b``."""
+    the frame's), for the Poiseuille friction ``2 e1 - b``.  ``s_thin``: ``<1/h>`` over the
+    films between the gap floor and each cut, the confined films' Couette shear
+    (:attr:`FlowFactors.thin_friction`)."""
     k = 2 * frame_speed_ratio(settings)
     h_inv = np.array([mean_inverse_film(contact.raw_gap, c * settings.boundary_film)
                       for c in FILM_CUTS])
+    above_floor = mean_inverse_film(contact.raw_gap, settings.gap_floor)
     return {"p_con": float(contact.pressure.mean()),
             "contact_fraction": contact.contact_fraction,
-            "h3_g1_pin": k * cell["h3_g1"], "s_c": h_inv + 3 * k * k * cell["h3_g1g1"]}
+            "h3_g1_pin": k * cell["h3_g1"], "s_c": h_inv + 3 * k * k * cell["h3_g1g1"],
+            "s_thin": above_floor - h_inv}
 
 
 def frame_speed_ratio(settings: CellSettings) -> float:
@@ -362,7 +366,8 @@ def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
                        C=get("h_grad") / h_m[:, None, None], d=get("h_g1") * h_m[:, None],
                        friction_factor=get("s_c")[:, 0] * h_m,
                        pressure_friction=np.array([1.0, 0.0]) + get("h3_g1_pin") / h_m[:, None],
-                       contact_fraction=get("contact_fraction"), meta=meta)
+                       contact_fraction=get("contact_fraction"),
+                       thin_friction=get("s_thin")[:, 0] * h_m, meta=meta)
 
 
 def film_spread(film_area, log_shear, h_m) -> dict:

@@ -25,7 +25,9 @@ from ..checks import arguments, check, number, plausible
 from ..errors import InputError
 from ..io.files import read_topography
 from ..macro import Lubricant, MacroSettings, solve_mixed
+from ..macro.boundary import temperature_factor
 from ..macro.deterministic import DeterministicSettings, solve_deterministic
+from ..macro.thermal import tempered
 from ..macro.time_resolved import solve_time_resolved
 from ..micro import FlowFactors, homogenise
 from ..peers import average_flow_factors
@@ -241,11 +243,14 @@ def twin_sweep(pad: RoughPad, tiles: int, speeds, factors) -> list:
     gap, dx = pad.macro(tiles)
     s = pad.settings
     settings = MacroSettings(e_reduced=s.e_reduced, boundary_friction=s.boundary_friction,
-                             ambient_pressure=0.0, cavitation_pressure=0.0, tol=1e-7)
+                             boundary=s.boundary, ambient_pressure=0.0,
+                             cavitation_pressure=0.0, tol=1e-7)
     out, last = [], None
+    t = temperature_factor(s.boundary, s.temperature)       # the oil's, as the pad's
     for u in pad_speeds(speeds, tiles):
-        last = solve_mixed(gap, dx, factors, load=pad.load(tiles), speed=u,
-                           lubricant=pad.lubricant, settings=settings, initial=last)
+        last = tempered(solve_mixed(gap, dx, factors, load=pad.load(tiles), speed=u,
+                                    lubricant=pad.lubricant, settings=settings,
+                                    initial=last), t)
         out.append(last)
     return out
 

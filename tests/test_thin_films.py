@@ -1,0 +1,98 @@
+"""What the boundary law acts on (docs/model.md, "Boundary friction"): tau_0 on the dry
+contact alone, the confined films below the boundary film as boundary films, viscous
+films or nothing (``[boundary] thin_films``), in the twin and node by node in the
+deterministic reference."""
+
+import numpy as np
+import pytest
+from sample_cases import macro_case
+from test_deterministic import OIL, rough_pad
+
+from fem_twin import Topography
+from fem_twin.macro import BoundaryLaw, Lubricant, MacroSettings, solve_mixed
+from fem_twin.macro.deterministic import DeterministicSettings, solve_deterministic
+from fem_twin.macro.reynolds import trapezoid_weights
+from fem_twin.micro import homogenise
+
+SHEAR = BoundaryLaw(law="shear", shear_strength=50e6, pressure_coefficient=0.1)
+
+
+def test_the_confined_films_shear_is_their_mean_inverse_gap_on_a_cosine_cell():
+    """A cosine ridge (a = 0.2 um) over a flat, 3 nm apart at its crest, 256 px a period:
+    ``thin_friction / h_m`` is ``<1/h>`` over the films between the 1 nm floor and the
+    10 nm boundary film, whose closed form is ``(1/pi) int_theta*^pi dtheta / (H + a cos
+    theta)`` with ``cos theta* = (h_b - H) / a``; within 0.5 % (the cell integrates the
+    linear interpolant of the gap exactly, second order in the pixel; measured -0.27 %)."""
+    n, period, a, crest = 256, 100e-6, 0.2e-6, 3e-9
+    x = np.arange(n) * period / n
+    ridge = np.tile(a * np.cos(2 * np.pi * x / period), (4, 1))
+    h0 = a + crest                                   # the mean gap H: no contact
+    ff = homogenise(Topography(np.zeros_like(ridge), period / n), Topography(ridge, period / n),
+                    [h0], n_steps=1, error_estimate=False)
+    assert ff.p_con[0] == 0 and ff.h_m[0] == pytest.approx(h0, rel=1e-12)
+    start = np.arccos((10e-9 - h0) / a)
+    root = np.sqrt(h0 ** 2 - a ** 2)
+    closed = 2 / root * (np.pi / 2 - np.arctan(np.sqrt((h0 - a) / (h0 + a))
+                                               * np.tan(start / 2))) / np.pi
+    assert ff.thin_friction[0] / ff.h_m[0] == pytest.approx(closed, rel=5e-3)
+    assert ff.thin_friction[0] > 0.1 * ff.friction_factor[0]        # it matters here
+
+
+def test_tau0_acts_on_the_dry_contact_and_viscous_films_on_the_film(factors):
+    """At a slow point of the bundled pair (0.005 m/s, 150 N): the real contact area is
+    the dry contact fraction's integral; tau_0 multiplies it alone, so the shear law's
+    force is ``tau_0 A_r + alpha W`` to rounding whatever the thin films carry; the thin
+    films as viscous films leave the solution (pressure) bit for bit, add exactly their
+    Couette integral ``mu u thin_friction / h_m (1 - theta)`` (mu the film's) to the film
+    friction, and take their film pressure off the asperities' load."""
+    gap, dx, face = macro_case(32)
+    run = {t: solve_mixed(gap, dx, factors, load=150.0, speed=0.005, face=face,
+                          lubricant=Lubricant(0.066),
+                          settings=MacroSettings(boundary=BoundaryLaw(**{
+                              **SHEAR.__dict__, "thin_films": t})))
+           for t in ("boundary", "viscous", "none")}
+    weights = trapezoid_weights(face.shape, dx) * face
+    local = factors.at(run["none"].h0)
+    dry = float(np.sum(weights * local.contact_fraction))
+    for res in run.values():
+        assert res.real_contact_area == pytest.approx(dry, rel=1e-12)
+        assert res.boundary_force == pytest.approx(
+            50e6 * res.real_contact_area + 0.1 * res.asperity_load, rel=1e-12)
+    assert run["boundary"].asperity_load >= run["viscous"].asperity_load
+    assert run["viscous"].asperity_load == run["none"].asperity_load
+    v, n = run["viscous"], run["none"]
+    assert np.array_equal(v.pressure, n.pressure)
+    confined = v.viscosity * 0.005 * local.thin_friction / v.mean_gap * (1 - v.cavity_fraction)
+    assert v.hydrodynamic_friction - n.hydrodynamic_friction == pytest.approx(
+        float(np.sum(weights * confined)), rel=1e-9)
+    assert v.hydrodynamic_friction > n.hydrodynamic_friction
+
+
+@pytest.mark.parametrize("thin_films", ["boundary", "viscous", "none"])
+def test_the_deterministic_pad_takes_the_twins_boundary_law(thin_films):
+    """The resolved pad (2 x 2 cells of 16 px, flat, 10 MPa at 1 cm/s) under the shear law:
+    its boundary force is, node by node, tau_0 on the spots (p_con > 0) plus alpha on the
+    contact pressure and the film's where the gap is at most the boundary film (thin films
+    as boundary films) or on the spots alone; the constant law's is C_f,b times that load
+    (eq 32); viscous thin films raise the film friction and no other field."""
+    _, shape, dx = rough_pad(tiles=2, cell=16)
+    load = 10e6 * (32e-6) ** 2
+
+    def solve(law):
+        s = DeterministicSettings(e_reduced=2.3e11, hardness=1e9, boundary=law)
+        return solve_deterministic(shape, dx, load=load, speed=0.01, lubricant=OIL, settings=s)
+
+    shear = solve(BoundaryLaw(**{**SHEAR.__dict__, "thin_films": thin_films}))
+    area = trapezoid_weights(shape.shape, dx)
+    spots = shear.contact_pressure > 0
+    wet = shear.gap <= 10e-9 if thin_films == "boundary" else spots
+    asperity = np.sum(area * (shear.contact_pressure + np.maximum(shear.pressure, 0) * wet))
+    assert spots.any() and shear.load_share > 0.3
+    assert shear.boundary_force == pytest.approx(
+        50e6 * np.sum(area * spots) + 0.1 * asperity, rel=1e-12)
+    constant = solve(BoundaryLaw(thin_films=thin_films))
+    assert constant.boundary_force == pytest.approx(0.1924500897 * asperity, rel=1e-9)
+    if thin_films == "viscous":
+        plain = solve(BoundaryLaw(**{**SHEAR.__dict__, "thin_films": "none"}))
+        assert np.array_equal(plain.pressure, shear.pressure)
+        assert shear.film_friction > plain.film_friction
