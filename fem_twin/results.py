@@ -27,7 +27,7 @@ from .io.layout import RunLayout
 from .macro.estimate import PARTS
 from .macro.result import FIELDS
 from .micro.flow_factors import FlowFactors
-from .stribeck.curve import LEGACY, OPTIONAL, UNITS, StribeckCurve
+from .stribeck.curve import BOUNDARY_SHARE, LEGACY, OPTIONAL, UNITS, StribeckCurve
 
 ENGINE = "h5netcdf"
 #: ``fields.nc``'s variables and units: an operating point's fields
@@ -118,6 +118,11 @@ def stribeck_dataset(curves, patch_curves=None):
     if patch_curves:
         ds["patch_friction_coefficient"] = (("patch", "viscosity", "speed"), cf, {
             "units": "1", "long_name": "C_f with one patch's flow factors"})
+    share = np.full((mu.size, speed.size), np.nan)
+    for i, c in enumerate(curves):
+        share[i, np.searchsorted(speed, c.speed)] = c.boundary_share
+    ds[BOUNDARY_SHARE[0]] = (("viscosity", "speed"), share, {"units": BOUNDARY_SHARE[1],
+                                                             "long_name": BOUNDARY_SHARE[2]})
     for name, (_, unit, meaning) in OPTIONAL.items():
         if any(getattr(c, name) is not None for c in curves):
             v = np.full((mu.size, speed.size), np.nan)

@@ -96,3 +96,24 @@ def test_the_deterministic_pad_takes_the_twins_boundary_law(thin_films):
         plain = solve(BoundaryLaw(**{**SHEAR.__dict__, "thin_films": "none"}))
         assert np.array_equal(plain.pressure, shear.pressure)
         assert shear.film_friction > plain.film_friction
+
+
+def test_the_boundary_share_is_cf_s_sensitivity_to_the_boundary_level(factors, tmp_path):
+    """``boundary_share`` = F_b / F_T (stribeck.csv, results.nc) is the relative change of
+    C_f per relative change of C_f,b (the boundary force does not feed back into an
+    isothermal film): C_f,b raised 10 % raises C_f by 10 % times the share, to 1e-9."""
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
+    from fem_twin.stribeck.curve import write_stribeck_csv
+    gap, dx, face = macro_case(32)
+    curves = [stribeck_sweep(SweepRequest(gap, dx, factors, [0.3, 0.02], load=150.0,
+                                          face=face, lubricant=Lubricant(0.066),
+                                          settings=MacroSettings(boundary_friction=cfb)))
+              for cfb in (0.15, 0.165)]
+    share = curves[0].boundary_share
+    assert share[0] == 0 and 0.5 < share[1] < 1          # full film, then mixed
+    rise = curves[1].friction_coefficient / curves[0].friction_coefficient - 1
+    assert np.allclose(rise, 0.1 * share, rtol=1e-9, atol=0)
+    import csv
+    with open(write_stribeck_csv(tmp_path / "s.csv", curves[:1]), newline="") as f:
+        written = [float(r["boundary_share"]) for r in csv.DictReader(f)]
+    assert np.allclose(written, share, rtol=1e-12)

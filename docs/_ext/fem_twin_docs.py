@@ -72,7 +72,7 @@ def outputs() -> str:
     with their units, from the writers' own tables."""
     from fem_twin.macro.estimate import PARTS
     from fem_twin.results import FIELD_UNITS
-    from fem_twin.stribeck.curve import HEADERS, LEGACY, OPTIONAL, UNITS
+    from fem_twin.stribeck.curve import BOUNDARY_SHARE, HEADERS, LEGACY, OPTIONAL, UNITS
     lines = ["## `stribeck.csv`", "", "One row per point, curves one after another.", "",
              "| column | meaning |", "|---|---|"]
     for key, header in HEADERS.items():
@@ -81,7 +81,8 @@ def outputs() -> str:
         lines.append(f"| `{header}` | {meaning} |")
     lines += ["| `cf_err` | estimated discretisation error of C_f (both scales, "
               "{doc}`/accuracy`) |",
-              "| `cf_min`, `cf_max` | the patch scatter band (`[run] patch_band`) |"]
+              "| `cf_min`, `cf_max` | the patch scatter band (`[run] patch_band`) |",
+              f"| `{BOUNDARY_SHARE[0]}` | {BOUNDARY_SHARE[2]} |"]
     thermal = lambda key: " (`[thermal]`)" if "temperature" in key or "spot" in key else ""  # noqa: E731
     lines += [f"| `{header}` | {meaning}{thermal(key)} |"
               for key, (header, _, meaning) in OPTIONAL.items()]
@@ -91,6 +92,7 @@ def outputs() -> str:
               "| variable | unit | meaning |", "|---|---|---|"]
     lines += [f"| `{k}` | {u} | {m} |" for k, (u, m) in UNITS.items()]
     lines += [f"| `{k}` | {u} | {m}{thermal(k)} |" for k, (_, u, m) in OPTIONAL.items()]
+    lines += [f"| `{BOUNDARY_SHARE[0]}` | {BOUNDARY_SHARE[1]} | {BOUNDARY_SHARE[2]} |"]
     lines += ["| `cf_err` | 1 | estimated discretisation error of C_f |"]
     lines += [f"| `cf_err_{p}` | 1 | its {p} part |" for p in PARTS]
     lines += ["| `patch_friction_coefficient` | 1 | C_f with one patch's flow factors, over "

@@ -68,6 +68,13 @@ def friction_deviation(cf, cf_ref, boundary_friction: float):
     return (np.asarray(cf) - np.asarray(cf_ref)) / boundary_friction
 
 
+#: the derived column of the share of C_f that the boundary law sets: its CSV header and
+#: its unit and long name in ``results.nc``
+BOUNDARY_SHARE = ("boundary_share", "1", "share of F_T the boundary law sets, F_b / F_T: "
+                  "C_f's relative sensitivity d ln C_f / d ln (boundary level), the "
+                  "calibrated part; the rest, the film friction, is predicted")
+
+
 @dataclass(frozen=True, eq=False)
 class StribeckCurve:
     """C_f versus sliding speed at one viscosity; arrays ordered as computed (fast first).
@@ -103,6 +110,13 @@ class StribeckCurve:
     asperity_load: np.ndarray | None = None
     real_contact_area: np.ndarray | None = None
     spot_rise: np.ndarray | None = None
+
+    @property
+    def boundary_share(self) -> np.ndarray:
+        """F_b / F_T [-] at each point (:data:`BOUNDARY_SHARE`; NaN where F_T is 0)."""
+        total = self.hydrodynamic_friction + self.boundary_force
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(total != 0, self.boundary_force / total, np.nan)
 
     def at_hersey(self, hersey):
         """C_f interpolated (monotone cubic, PCHIP, in log H) at Hersey numbers inside this
@@ -153,6 +167,7 @@ def write_stribeck_csv(path, curves, band=None) -> Path:
     columns = {HEADERS[k]: np.concatenate([np.broadcast_to(getattr(c, k), c.speed.shape)
                                            for c in curves]) for k in COLUMNS}
     columns["iterations"] = columns["iterations"].astype(int)
+    columns[BOUNDARY_SHARE[0]] = np.concatenate([c.boundary_share for c in curves])
     if any(c.friction_error is not None for c in curves):
         columns["cf_err"] = np.concatenate([np.full(c.speed.shape, np.nan)
                                             if c.friction_error is None else c.friction_error
