@@ -25,6 +25,7 @@ from ..macro.boundary import BoundaryLaw
 from ..macro.viscosity import WaltherLaw
 from .curve import SPEED_MATCH, MeasuredCurve, StribeckCurve
 from .fit_statistics import correlation, covariance, interval
+from .identify import PAIR, check_separable, separability
 
 #: the shear law's parameters a fit can identify (``[boundary]`` keys), with their bounds
 SHEAR = {"shear_strength": (0.0, 5e8), "pressure_coefficient": (0.0, 1.0),
@@ -91,13 +92,19 @@ class FitModel:
             inside = inside & np.all([v[1] for v in values], axis=0)
         return cf, inside
 
-    def _at(self, c: StribeckCurve, speed, boundary_friction: float, viscosity: float,
-            shear: dict | None, load: float):
+    def reader(self, c: StribeckCurve, speed, viscosity: float):
+        """``(at, inside)``: ``at(values)`` reads a column of curve ``c`` at ``speed`` [m/s]
+        for the oil of ``viscosity`` [Pa s] (PCHIP in log speed at the Hersey-shifted
+        speeds, held at the ends), ``inside`` the mask of speeds within the curve's."""
         order = np.argsort(c.speed)
         x = np.log(c.speed[order])
         u = np.log(np.asarray(speed, float) * viscosity / c.viscosity)
         inside = (u >= x[0] - SPEED_MATCH) & (u <= x[-1] + SPEED_MATCH)
-        at = lambda a: PchipInterpolator(x, a[order])(np.clip(u, x[0], x[-1]))  # noqa: E731
+        return (lambda a: PchipInterpolator(x, a[order])(np.clip(u, x[0], x[-1])), inside)
+
+    def _at(self, c: StribeckCurve, speed, boundary_friction: float, viscosity: float,
+            shear: dict | None, load: float):
+        at, inside = self.reader(c, speed, viscosity)
         hd = at(c.hydrodynamic_friction)
         if shear is None:
             return (hd + boundary_friction * at(c.boundary_force)
@@ -194,6 +201,10 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     measured, dropped = _inside(model, measured, *unpack(x0))
     sigma = [_sigma(m) for m in measured]
     weighted = all(s is not None for s in sigma)
+    identified = None
+    if set(PAIR) <= set(params):                 # tau_0 and alpha: refused unless separable
+        identified = separability(model, measured, unpack(x0)[1], sigma)
+        check_separable(identified)
 
     def residuals(x):
         cfb, mus, share, resistance, shear = unpack(x)
@@ -218,6 +229,8 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     sol.x, sol.jac = low + sol.x * span, sol.jac / span
     out = _summary(model, measured, names, sol, weighted, unpack, (lower, upper))
     out["fit"]["points_not_counted"] = dropped
+    if identified is not None:
+        out["fit"]["identifiability"] = identified
     out["fit"]["warnings"] += [f"curve {k + 1}: {n} measured point(s) outside the simulated "
                                "speeds not counted" for k, n in enumerate(dropped) if n]
     check_misfit(out, names, sol.x, lower, upper)
