@@ -94,3 +94,32 @@ def test_the_identifiable_combination_s_intervals_hold_it_under_5_percent_noise(
         out = fit_curves(model, [noisy], ["pressure_coefficient"], start_temperatures=None)
         hits += out["pressure_coefficient"]["low"] < target < out["pressure_coefficient"]["high"]
     assert hits >= 34, hits
+
+
+def test_the_plateau_sets_the_boundary_level_and_the_rest_is_predicted():
+    """``--plateau``: C_f,b from the points where the twin's asperities carry 90 % of the
+    load (5 of 24 here), 2 % noise on a truth of 0.13: the interval holds 0.13, the 19
+    predicted points lie within 2 % C_f,b rms, and the band (of the mean: the fit's
+    interval and cf_err) holds the noiseless truth at every point; where the twin's film
+    friction is half the measured one (noiseless; a wrong viscosity or film law), the
+    predicted points' error shows it (rms C_f,dev above 0.5 % C_f,b and three times the
+    fitted ones'); anything but the boundary law is refused."""
+    from fem_twin.stribeck.plateau import fit_plateau
+    sim = curve(150.0, resolved)
+    model = FitModel((sim,), CFB, 150.0, None)
+    rng = np.random.default_rng(3)
+    noise = 1 + 0.02 * rng.standard_normal(SPEEDS.size)
+    right = (sim.hydrodynamic_friction + 0.13 * sim.asperity_load) / 150.0 * noise
+    out = fit_plateau(model, [MeasuredCurve(SPEEDS, right)], ["boundary_friction"])
+    p = out["plateau"]
+    assert (p["fitted"]["points"], p["predicted"]["points"]) == (5, 19)
+    assert out["boundary_friction"]["low"] < 0.13 < out["boundary_friction"]["high"]
+    assert p["predicted"]["rms_cf_dev"] < 0.02
+    row = p["rows"][0]                 # the band is the mean's: it holds the noiseless truth
+    truth = right / noise
+    assert np.all((np.array(row["cf_low"]) <= truth) & (truth <= np.array(row["cf_high"])))
+    off = (2 * sim.hydrodynamic_friction + 0.13 * sim.asperity_load) / 150.0
+    wrong = fit_plateau(model, [MeasuredCurve(SPEEDS, off)], ["boundary_friction"])["plateau"]
+    assert wrong["predicted"]["rms_cf_dev"] > max(3 * wrong["fitted"]["rms_cf_dev"], 0.005)
+    with pytest.raises(InputError, match="boundary law alone"):
+        fit_plateau(model, [MeasuredCurve(SPEEDS, right)], ["boundary_friction", "temperature"])

@@ -14,6 +14,7 @@ from ..case.sections import Geometry, LubricantSpec, MicroSpec, Tribometer
 from ..contact.levelling import level_pin
 from ..errors import NotConverged, RunLocked, SchedulerUnreachable
 from ..stribeck.fit import PARAMETERS
+from ..stribeck.plateau import PLATEAU_SHARE
 from ..topography.prepare import MacroOptions
 from . import runs, steps
 
@@ -176,6 +177,10 @@ def _add_case_commands(sub):
     ft.add_argument("--predict-load", type=float, nargs="+", default=[], metavar="L",
                     help="loads [N] of predicted curves, each case viscosity swept there, "
                          "with their 95 %% band (OUT/prediction_LN.csv)")
+    ft.add_argument("--plateau", type=float, nargs="?", const=PLATEAU_SHARE, default=None,
+                    metavar="SHARE", help="fit the boundary law to the points where the twin's "
+                    f"asperities carry SHARE of the load (default {PLATEAU_SHARE:g}) and "
+                    "predict the rest with nothing else fitted (Gelinck and Schipper)")
     ft.add_argument("--no-progress", action="store_true", help="no progress bars")
     ft.add_argument("--yes", action="store_true", help="start even if the run is long")
     ft.set_defaults(func=runs.fit)

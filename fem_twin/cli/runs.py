@@ -186,18 +186,27 @@ def fit(args):
         raise MissingFile(f"case file not found: {args.case}")
     case = load_case(args.case)
     params = [p.strip() for p in args.params.split(",") if p.strip()]
-    check_fit_request(case, args.measured, params, args.predict, args.predict_load)
+    check_fit_request(case, args.measured, params, args.predict, args.predict_load,
+                      args.plateau)
     _check_output(args.output)
     if _confirm_cost(case, args.yes) is None:
         return 2
     result = fit_case(case, args.measured, args.output, params, predict_at=args.predict,
-                      predict_loads=args.predict_load, progress=not args.no_progress)
+                      predict_loads=args.predict_load, plateau=args.plateau,
+                      progress=not args.no_progress)
     for name in result["fit"]["parameters"] + [k for k in result if k.startswith("viscosity_")]:
         v = result[name]
         print(f"fem-twin fit: {name} = {v['value']:.5g} (95 %: {v['low']:.5g} to "
               f"{v['high']:.5g})")
     print(f"  rms C_f,dev {result['fit']['rms_cf_dev']:.2%} over {result['fit']['points']} "
           f"points; {RunLayout(args.output).fit} and fit.png")
+    if "plateau" in result:
+        for role in ("fitted", "predicted"):
+            p = result["plateau"][role]
+            if p["points"]:
+                print(f"  {role}: {p['points']} points, rms C_f,dev {p['rms_cf_dev']:.2%}, "
+                      f"largest {p['max_abs_cf_dev']:.2%} of C_f,b, {p['inside_band']} inside "
+                      "their band")
     for warning in result["fit"]["warnings"]:
         print(f"  warning: {warning}")
     return 0

@@ -34,6 +34,7 @@ from ..stribeck.fit import (
     check_parameters,
     fit_curves,
 )
+from ..stribeck.plateau import check_plateau, fit_plateau, plot_plateau
 from ..stribeck.prediction import plot_fit, predict
 from .fit_file import check_fit, read_fit, temperature_offset
 
@@ -41,19 +42,21 @@ log = logging.getLogger("fem_twin")
 
 
 def fit_case(case: Case, measured, outdir, params, *, predict_at=(), predict_loads=(),
-             progress: bool = True, run=None) -> dict:
+             plateau: float | None = None, progress: bool = True, run=None) -> dict:
     """Fit ``params`` (case-file keys, :data:`~fem_twin.stribeck.fit.PARAMETERS`) of
     ``case`` to the ``measured`` CSV files: the K-th against the case's K-th viscosity at
     the case's load, or at the ``load_N`` and ``viscosity_Pa_s`` its file gives (the twin
     swept there, checkpointed in ``OUT/fit/``); ``predict_at``: oil temperatures [C] and
     ``predict_loads``: loads [N] of predicted curves (``OUT/prediction_TC.csv``,
     ``OUT/prediction_LN.csv``, C_f with its 95 % band,
-    :func:`~fem_twin.stribeck.prediction.predict`).  ``run``: the pipeline's ``run`` (runs
+    :func:`~fem_twin.stribeck.prediction.predict`); ``plateau``: the asperities' share of
+    the load from which the points fit the boundary law and the rest are predicted
+    (:mod:`fem_twin.stribeck.plateau`).  ``run``: the pipeline's ``run`` (runs
     or resumes the case into ``outdir``); a ``load_share`` fit then sweeps the first
     viscosity at :data:`LOAD_SHARES` (so a rerun resumes)."""
     params = list(params)
     paths, curves_measured, tests = check_fit_request(case, measured, params, predict_at,
-                                                      predict_loads)
+                                                      predict_loads, plateau)
     lb = case.lubricant
     law = (WaltherLaw.through(lb.temperatures, lb.viscosities, lb.density)
            if len(set(lb.temperatures)) > 1 else None)
@@ -71,8 +74,11 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), predict_loa
     nominal = [lb.temperatures[k] if c.viscosity is None else
                None if law is None else float(law.temperature(c.viscosity))
                for k, c in enumerate(curves_measured)]
-    result = fit_curves(model, curves_measured, params, verbose=progress,
-                        start_temperatures=nominal if "temperature" in params else None)
+    if plateau is not None:
+        result = fit_plateau(model, curves_measured, params, plateau)
+    else:
+        result = fit_curves(model, curves_measured, params, verbose=progress,
+                            start_temperatures=nominal if "temperature" in params else None)
     result["measured"] = [str(p) for p in paths]
     if shares or resistances:
         result["task_graph"] = fit_scaling(case, outdir)
@@ -81,7 +87,8 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), predict_loa
                       "law": None if law is None else vars(law)}
     with atomic_path(out.fit) as tmp:
         tmp.write_text(json.dumps(result, indent=2))
-    plot_fit(result, out.fit_png, labels=[f"{mu:g} Pa s, {load:g} N" for load, mu in tests])
+    (plot_fit if plateau is None else plot_plateau)(
+        result, out.fit_png, labels=[f"{mu:g} Pa s, {load:g} N" for load, mu in tests])
     for t in predict_at:
         _write_prediction(out.prediction(t), [predict(model, result, simulated[0].speed,
                                                       float(t), nominal=nominal)])
@@ -104,7 +111,8 @@ def _tests(case: Case, curves) -> list[tuple[float, float]]:
     return out
 
 
-def check_fit_request(case: Case, measured, params, predict_at=(), predict_loads=()):
+def check_fit_request(case: Case, measured, params, predict_at=(), predict_loads=(),
+                      plateau=None):
     """Read the ``measured`` CSVs and refuse whatever :func:`fit_case` cannot do with them,
     before any work (the CLI calls it before it measures the machine): ``(paths, measured
     curves, tests)``, the tests as ``(load [N], viscosity [Pa s])`` per curve."""
@@ -113,6 +121,8 @@ def check_fit_request(case: Case, measured, params, predict_at=(), predict_loads
     tests = _tests(case, curves_measured)
     _check_request(case, list(params), paths, curves_measured, tests, predict_at,
                    predict_loads)
+    if plateau is not None:
+        check_plateau(list(params), plateau)
     return paths, curves_measured, tests
 
 
