@@ -191,3 +191,26 @@ def test_measured_curves_at_two_loads_and_a_prediction_at_a_third(tmp_path, caps
     assert main(["fit", str(case), light, "-o", str(out), "--no-progress", "--params",
                  "shear_strength,pressure_coefficient"]) == 2
     assert "two or more loads" in capsys.readouterr().err
+
+
+@pytest.mark.integration
+def test_fit_the_plateau_and_predict_the_mixed_regime(tmp_path, capsys):
+    """`fem-twin fit --plateau 0.5`: C_f,b from the points where the twin's asperities
+    carry half the load, 0.15 recovered; the other points predicted from it, reported apart
+    (fit.json's plateau, the printed lines) and exact here (the measured curves are the
+    twin's own at 0.15); the temperature is refused with it before any work."""
+    case = small_case(tmp_path)
+    out = tmp_path / "o"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    files = measured_from_run(out, tmp_path, slice(None))
+    assert main(["fit", str(case), *files, "-o", str(out), "--no-progress", "--params",
+                 "boundary_friction", "--plateau", "0.5"]) == 0
+    fit = json.loads((out / "fit.json").read_text())
+    assert fit["boundary_friction"]["value"] == pytest.approx(0.15, rel=1e-3)
+    p = fit["plateau"]
+    assert p["fitted"]["points"] >= 2 and p["predicted"]["points"] >= 4
+    assert p["predicted"]["max_abs_cf_dev"] < 1e-3
+    assert "predicted:" in capsys.readouterr().out
+    assert main(["fit", str(case), *files, "-o", str(tmp_path / "x"), "--params",
+                 "boundary_friction,temperature", "--plateau"]) == 2
+    assert not (tmp_path / "x").exists()
