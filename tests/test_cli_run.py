@@ -39,7 +39,8 @@ def test_run_pipeline_to_stribeck_and_resume_after_interruption(tmp_path, monkey
         assert np.all(np.diff(speed) < 0)
         assert cf[-1] > 10 * cf.min()                      # rises toward boundary friction
         assert np.allclose([float(x["hersey"]) for x in r], mu * speed * 8e-3 / 150)
-    for name in ("stribeck_speed.png", "stribeck_hersey.png", "flow_factors.csv",
+    for name in ("stribeck_speed.png", "stribeck_hersey.png", "stribeck_parts.png",
+                 "flow_factors.csv",
                  "fields_mu0.066.png", "fields_mu0.024.png",
                  "summary.json", "run.log", "fields/stribeck_mu0.066.pvd"):
         assert (ref / name).is_file(), name

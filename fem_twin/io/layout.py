@@ -133,6 +133,11 @@ class RunLayout:
         return self.root / f"stribeck_{x}.png"
 
     @property
+    def parts_png(self) -> Path:
+        """C_f split into its film (predicted) and boundary (calibrated) parts."""
+        return self.root / "stribeck_parts.png"
+
+    @property
     def temperature_png(self) -> Path:
         """A thermal run's contact temperatures against speed."""
         return self.root / "contact_temperature.png"

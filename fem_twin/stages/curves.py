@@ -22,6 +22,7 @@ from ..stribeck import plot_stribeck, read_measured_csv, write_stribeck_csv
 from ..stribeck.accuracy import error_summary, range_summary
 from ..stribeck.analysis import defect_corrected, hersey_collapse, patch_band, transition_speeds
 from ..stribeck.curve import plot_temperatures
+from ..stribeck.parts import plot_parts
 from ..stribeck.sweep import LOAD_BELOW, point_files, point_key
 from ..stribeck.validation import validate_curves
 from .geometry import ball_contact, hersey_length
@@ -260,6 +261,9 @@ def plot_curves(case: Case, curves, band, out: RunLayout,
                      load=tr.load, speed_label=("entrainment speed $u_m$ [m/s], SRR "
                                                 f"{tr.slide_to_roll:g}" if tr.ball else
                                                 "sliding speed $U$ [m/s]"))
+    writers.write(plot_parts, curves, out.parts_png, labels=curve_labels(case, curves),
+                  bands=band, speed_label=("entrainment speed $u_m$ [m/s]" if tr.ball else
+                                           "sliding speed $U$ [m/s]"))
     if curves[0].contact_temperature is not None:
         writers.write(plot_temperatures, curves, out.temperature_png,
                       labels=curve_labels(case, curves))

@@ -111,12 +111,15 @@ FRICTION_LAWS = {"pin": "the force on the pin: wall shear and the film pressure 
 
 
 def stribeck_section(out: RunLayout, friction: str | None = None) -> str:
-    pngs = [out.stribeck_png("speed"), out.stribeck_png("hersey"), out.temperature_png]
+    pngs = [out.stribeck_png("speed"), out.stribeck_png("hersey"), out.parts_png,
+            out.temperature_png]
     law = FRICTION_LAWS.get(friction, "eq 31") if friction else "eq 31"
     text = ("Friction coefficient (eq 34) of the patch-average flow factors, the friction "
             f"being {law}, with the estimated "
             "discretisation error of each point as error bars; the shaded band spans the "
-            "single-patch curves (Figure 13), squares are measured curves; a thermal run "
+            "single-patch curves (Figure 13), squares are measured curves; C_f split into "
+            "its film part, which the twin predicts, and its boundary part, which the "
+            "boundary law's calibration sets (boundary_share); a thermal run "
             "adds the film's and the asperity contacts' temperatures.")
     body = figure_section("Stribeck curves (Figure 14)", pngs, text)
     fields, val = out.fields_pngs(), out.validation_pngs()
@@ -199,6 +202,8 @@ def caption(png: Path) -> str:
     stem = png.stem
     fixed = {"stribeck_speed": "C_f versus sliding speed U [m/s]",
              "stribeck_hersey": "C_f versus Hersey number (eq 46)",
+             "stribeck_parts": "C_f split into its film (predicted) and boundary "
+                               "(calibrated) parts, with the patch band",
              "flow_factors": "flow factors versus h0", "pin_centre_lines": "pin centre lines",
              "traction": "C_f versus the slide-to-roll ratio",
              "contact_temperature": "the film's and the asperity contacts' temperatures "
