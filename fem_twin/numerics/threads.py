@@ -21,7 +21,7 @@ import signal
 import sys
 import threading
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from contextlib import contextmanager
 
 from ..errors import InputError, SchedulerUnreachable
@@ -103,6 +103,43 @@ def run_jobs(executor, job, items):
         yield future.result()
 
 
+@contextmanager
+def side_threads():
+    """Daemon threads for work that waits on the process pool (each patch's cells, the
+    levelling beside them): ``submit(fn, *args)`` starts one and returns its Future,
+    ``map(fn, items)`` one per item.  Joined on a normal exit; on an exception (Ctrl-C)
+    left at once, so that the run's executor closes next and the process exits without
+    joining threads that wait on futures a terminated pool will never finish (Python
+    joins a ThreadPoolExecutor's threads at exit)."""
+    threads = _SideThreads()
+    yield threads
+    for future in threads.futures:
+        future.result()
+
+
+class _SideThreads:
+    """The executor of :func:`side_threads`: a daemon thread per task."""
+
+    def __init__(self):
+        self.futures = []
+
+    def submit(self, fn, *args) -> Future:
+        future = Future()
+
+        def run():
+            if future.set_running_or_notify_cancel():
+                try:
+                    future.set_result(fn(*args))
+                except BaseException as err:       # handed to the waiting thread
+                    future.set_exception(err)
+        threading.Thread(target=run, daemon=True, name="fem_twin-side").start()
+        self.futures.append(future)
+        return future
+
+    def map(self, fn, items):
+        return [f.result() for f in [self.submit(fn, item) for item in items]]
+
+
 def process_pool(workers: int) -> ProcessPoolExecutor:
     """A local pool of ``workers`` processes started by :func:`quiet_worker`."""
     return ProcessPoolExecutor(workers, initializer=quiet_worker)
@@ -171,11 +208,12 @@ def _quiet_dask() -> None:
 
 
 @contextmanager
-def _workers_ignore_ctrl_c():
+def workers_ignore_ctrl_c():
     """Start processes that ignore Ctrl-C (SIGINT; an ignored signal stays ignored in a
-    child): the terminal sends it to the whole process group, and a LocalCluster whose
-    workers died of it printed their tracebacks and hung its close.  The run alone stops,
-    then closes them; a Ctrl-C while they start (a few seconds) is lost."""
+    child) from birth: the terminal sends it to the whole process group, and a LocalCluster
+    or a probe whose workers died of it printed their tracebacks and hung its close.  The
+    run alone stops, then closes them; a Ctrl-C while they start (a few seconds) is lost.
+    The main thread only (Python's signal rule)."""
     before = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         yield
@@ -191,7 +229,7 @@ def _dask_client(scheduler: str, workers: int):
     from distributed import Client, LocalCluster
     if scheduler == "local":
         with dask.config.set(DASK_CONFIG):
-            with _workers_ignore_ctrl_c():
+            with workers_ignore_ctrl_c():
                 cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
                                        processes=True, dashboard_address=None)
             with cluster, Client(cluster) as client:

@@ -30,7 +30,7 @@ from ..errors import InputError, SolverError
 from ..macro import Lubricant, MacroSettings, solve_mixed
 from ..macro.point_contact import PointContact
 from ..micro import FlowFactors, homogenise
-from ..numerics.threads import one_thread, quiet_worker, worker_heap
+from ..numerics.threads import one_thread, quiet_worker, worker_heap, workers_ignore_ctrl_c
 from ..topography.synthetic import self_affine
 
 #: the miniatures' times on the calibration machine, the hour the estimate's costs were
@@ -153,8 +153,9 @@ def probe_together(kind: str, processes: int) -> float:
     barrier, queue = ctx.Barrier(processes), ctx.Queue()
     jobs = [ctx.Process(target=_probe_in_step, args=(kind, barrier, queue), daemon=True)
             for _ in range(processes)]
-    for job in jobs:
-        job.start()
+    with workers_ignore_ctrl_c():                 # Ctrl-C reaches the run alone
+        for job in jobs:
+            job.start()
     try:
         times = [queue.get(timeout=PROBE_TIMEOUT) for _ in jobs]
     except Empty:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import logging
 import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import fields
 
 import numpy as np
@@ -19,6 +18,7 @@ from ..io.writers import Writers
 from ..micro import CellSettings, FlowFactors, average, homogenise
 from ..micro.output import plot_flow_factors
 from ..micro.store import prune_checkpoints
+from ..numerics.threads import side_threads
 from ..peers import average_flow_factors
 from ..topography import resample_cell
 
@@ -43,7 +43,7 @@ def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool
         if executor is None:
             factors = [_patch_factors(case, out, i, h0, None, bar) for i in range(n)]
         else:
-            with ThreadPoolExecutor(n) as threads:
+            with side_threads() as threads:
                 factors = list(threads.map(
                     lambda i: _patch_factors(case, out, i, h0, executor, bar), range(n)))
     finally:

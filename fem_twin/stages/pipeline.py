@@ -16,7 +16,6 @@ import json
 import logging
 import os
 import time
-from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 
 import numpy as np
@@ -26,7 +25,7 @@ from ..errors import InputError, RunLocked
 from ..io.atomic import atomic_path, remove_debris
 from ..io.layout import RunLayout
 from ..io.writers import Writers
-from ..numerics.threads import executor_for, one_thread
+from ..numerics.threads import executor_for, one_thread, side_threads
 from ..stribeck import read_measured_csv
 from .curves import stribeck_curves
 from .factors import homogenise_patches
@@ -95,7 +94,7 @@ def _run_stages(case: Case, out: RunLayout, executor, progress, summary, last,
         log.info("stage %s done in %.1f s", name, summary["seconds"][name])
 
     stage("geometry", lambda: reconstruct_geometry(case, out, progress, executor))
-    with ThreadPoolExecutor(1) as beside:
+    with side_threads() as beside:
         levelling = beside.submit(stage, "levelling",
                                   lambda: level_pins(case, out, progress, executor))
         stage("micro", lambda: homogenise_patches(case, out, executor, progress,
