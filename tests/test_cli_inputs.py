@@ -25,7 +25,8 @@ def test_cli_reports_bad_input_clearly(tmp_path, capsys):
 def test_case_validation(tmp_path):
     pin = tmp_path / "pin.npz"
     write_topography(pin, Topography(np.zeros((8, 8)), 1e-3 / 8))
-    geo = '[geometry]\npins = ["pin.npz"]\npatches = [["pin.npz", "pin.npz"]]\n'
+    geo = ('[geometry]\npins = ["pin.npz"]\npatches = [["pin.npz", "pin.npz"]]\n'
+           "patch_shape = [8, 8]\n")
     (tmp_path / "ok.toml").write_text(geo)
     assert load_case(tmp_path / "ok.toml").geometry.pins == (pin.resolve(),)
     paper = load_case(ROOT / "examples" / "paper.toml")
@@ -48,6 +49,50 @@ def test_case_validation(tmp_path):
         (tmp_path / name).write_text(text)
         with pytest.raises(CaseError, match=match):
             load_case(tmp_path / name)
+
+
+@pytest.mark.parametrize("content", [b"PK\x03\x04" + bytes(296), b"", bytes(range(256)) * 8])
+def test_a_damaged_map_is_refused_when_the_case_is_read(tmp_path, capsys, content):
+    """A truncated, empty or random-bytes .npz in [geometry] is refused in one line naming
+    the file, before the banner and the machine measurement, without numpy's advice to
+    unpickle (probes C027-C029)."""
+    case = small_case(tmp_path)
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(content)
+    case.write_text(case.read_text().replace(str(ROOT / "meshes/sample/patch_2_pin.npz"),
+                                             str(bad)))
+    assert main(["run", str(case), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "bad.npz" in err and "patches" in err
+    assert "pickle" not in err and not (tmp_path / "out").exists()
+
+
+def test_a_patch_window_larger_than_its_map_is_refused_when_the_case_is_read(tmp_path):
+    """patch_shape at patch_start must fit every patch file, checked from the files'
+    headers when the case is read (probe C030)."""
+    case = small_case(tmp_path)
+    case.write_text(case.read_text().replace("patch_shape = [256, 256]",
+                                             "patch_shape = [4000, 4000]"))
+    with pytest.raises(CaseError, match=r"patch_shape = \[4000, 4000\].*576 x 768"):
+        load_case(case)
+
+
+@pytest.mark.parametrize("old,new,words", [
+    ("resolution = [48, 48]", "resolution = [4, 4]", r"resolution: .* at least 16 pixels"),
+    ("boundary_film = 10e-9", "boundary_film = 4e-8\nh0_min = 3e-8",
+     r"boundary_film = 4e-08 m is not below h0_min = 3e-08 m"),
+    ('law = "constant"', 'law = "shear"\nreference_temperature = 297.15',
+     r"reference_temperature = 297.15: more than 100 K .* not kelvin"),
+])
+def test_inconsistent_case_values_are_refused_saying_what_is_wrong(tmp_path, old, new, words):
+    """A macro grid too coarse for its error estimate (C402), a boundary film above h0_min
+    named as such (C520), a reference temperature in kelvin (C824)."""
+    case = small_case(tmp_path)
+    text = case.read_text()
+    assert old in text
+    case.write_text(text.replace(old, new).replace("h0_min = 1e-7 ", "#"))
+    with pytest.raises(CaseError, match=words):
+        load_case(case)
 
 
 @pytest.mark.parametrize("old,new,key", [

@@ -250,20 +250,40 @@ def test_a_screening_point_has_no_error_bar(factors):
     assert np.isnan(err["total"]) and err["failed"] == [SCREENING]
 
 
+def screening_case(tmp_path):
+    """The small case with ``[micro] model = "average-flow"`` and none of the cell
+    problems' keys (its [micro] holds the model and the resolution only)."""
+    import re
+
+    from sample_cases import small_case
+    path = small_case(tmp_path)
+    text = path.read_text()
+    start = text.index("[micro]")
+    end = text.index("\n[", start)
+    micro = "\n".join(line for line in text[start:end].splitlines()
+                      if re.match(r"(\[micro\]|resolution)", line))
+    path.write_text(text[:start] + micro + '\nmodel = "average-flow"\n' + text[end:])
+    return path
+
+
 def test_the_case_key_and_its_choices(tmp_path):
     """[micro] model: "cells" by default, "average-flow" read, anything else refused with
-    the choices named."""
+    the choices named; the cell problems' keys, unused by the statistical model, are
+    refused with it (probe S-AVGFLOW-steps)."""
     from sample_cases import small_case
 
     from fem_twin.case import CaseError, load_case
-    path = small_case(tmp_path)
-    assert load_case(path).micro.model == "cells"
-    text = path.read_text().replace("[micro]", '[micro]\nmodel = "average-flow"')
-    path.write_text(text)
+    assert load_case(small_case(tmp_path)).micro.model == "cells"
+    path = screening_case(tmp_path)
+    text = path.read_text()
     assert load_case(path).micro.model == "average-flow"
     path.write_text(text.replace('"average-flow"', '"patir-cheng"'))
     with pytest.raises(CaseError, match="average-flow"):
         load_case(path)
+    for key in ("steps = 64", "h0_tol = 0.02", "boundary_film = 1e-8"):
+        path.write_text(text.replace("[micro]", f"[micro]\n{key}"))
+        with pytest.raises(CaseError, match=f"{key.split()[0]}: the cell problems"):
+            load_case(path)
 
 
 @pytest.mark.integration
@@ -274,11 +294,8 @@ def test_a_screening_run(tmp_path):
     import csv
     import json
 
-    from sample_cases import small_case
-
     from fem_twin.cli import main
-    path = small_case(tmp_path)
-    path.write_text(path.read_text().replace("[micro]", '[micro]\nmodel = "average-flow"'))
+    path = screening_case(tmp_path)
     out = tmp_path / "out"
     assert main(["run", str(path), "-o", str(out), "--no-progress"]) == 0
     summary = json.loads((out / "summary.json").read_text())

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..checks import arguments, memory_shortfall
 from ..errors import InputError
+from ..io.files import topography_shape
 from ..macro.boundary import BoundaryLaw, thin_films_choice
 from ..macro.thermal import ThermalSettings
 from ..stribeck.curve import read_measured_csv
@@ -36,6 +37,15 @@ WORKERS_PER_CORE = 4
 #: the largest fall of the boundary shear a temperature term may give at a case's hottest
 #: oil before any heat (the linear law is a local expansion about reference_temperature)
 FADED = 0.5
+#: the largest distance [K] of [boundary] reference_temperature from every oil temperature:
+#: farther, it is a kelvin value typed as Celsius (24 C is 24.0, not 297.15)
+REFERENCE_REACH = 100.0
+#: the fewest pixels a side of the macro grid ([preprocessing] resolution): its error
+#: estimate solves the grid coarsened by two
+MACRO_SIDE = 16
+#: the [micro] keys the statistical model (model = "average-flow") reads; the cell
+#: problems' others are refused with it
+STATISTICAL_KEYS = frozenset({"model", "resolution", "slide_to_roll"})
 
 
 @arguments(path="path")
@@ -70,6 +80,7 @@ def parse_case(data: dict, base: Path = Path("."), source: Path | None = None) -
         raise CaseError(f"{where} [tribometer] ball_radius: the measured cap's fitted sphere "
                         "gives the radius ([geometry] ball); remove one of the two")
     preprocessing = _preprocessing(data, where)
+    _maps(geometry, preprocessing.sliding_direction, where)
     lubricant = _lubricant(data, where)
     materials = read_table(data, "materials", Materials, where, positive=True)
     micro = _micro(data, where)
@@ -175,6 +186,27 @@ def _geometry(data, base, where, ball) -> Geometry:
     return geometry
 
 
+def _maps(geometry: Geometry, direction: str, where: str) -> None:
+    """Refuse a map of [geometry] that does not open as a topography, and a patch window
+    (patch_shape at patch_start, in the frame turned to ``direction``) that does not fit
+    a patch file: before any work (:func:`~fem_twin.io.files.topography_shape`)."""
+    patches = {path for pair in geometry.patches for path in pair}
+    for key, paths in (("pins", geometry.pins), ("disks", geometry.disks),
+                       ("patches", sorted(patches)), ("ball", [geometry.ball] * bool(
+                           geometry.ball))):
+        for path in paths:
+            try:
+                shape = topography_shape(path)
+            except InputError as err:
+                raise CaseError(f"{where} [geometry] {key}: {err}") from None
+            rows, cols = shape[::-1] if direction in ("+x2", "-x2") else shape
+            (ny, nx), (r0, c0) = geometry.patch_shape, geometry.patch_start
+            if key == "patches" and (r0 + ny > rows or c0 + nx > cols):
+                raise CaseError(f"{where} [geometry] patch_shape = {[ny, nx]} at patch_start "
+                                f"= {[r0, c0]}: does not fit {path.name}, {rows} x {cols} "
+                                "pixels (along the sliding direction); cut a smaller patch")
+
+
 def _files(base: Path, where: str):
     """The reader of ``[geometry]``'s file settings, by their declared unit ("file path",
     "file paths", "file path pairs"): paths relative to ``base`` resolved, each existing."""
@@ -203,6 +235,10 @@ def _preprocessing(data, where) -> MacroOptions:
     """[preprocessing]: the macro geometry's options, lengths in metres."""
     opts = read_table(data, "preprocessing", MacroOptions, where)
     rows, cols = int_pair(list(opts.resolution), f"{where} [preprocessing] resolution")
+    if min(rows, cols) < MACRO_SIDE:
+        raise CaseError(f"{where} [preprocessing] resolution: [rows, columns] of at least "
+                        f"{MACRO_SIDE} pixels each (the error estimate solves the macro grid "
+                        f"coarsened by two), got {[rows, cols]}")
     short = memory_shortfall(rows * cols, "macro")
     if short:
         raise CaseError(f"{where} [preprocessing] resolution: {short}")
@@ -246,9 +282,14 @@ def _micro(data, where) -> MicroSpec:
         raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
                         "h0_count >= 2 and steps >= 1")
     if micro.boundary_film >= micro.h0_min:
-        raise CaseError(f"{where} [micro] boundary_film = {micro.boundary_film:g} m: must lie "
-                        f"below the smallest separation h0_min = {micro.h0_min:g} m (10 nm is "
-                        "10e-9)")
+        raise CaseError(f"{where} [micro] boundary_film = {micro.boundary_film:g} m is not "
+                        f"below h0_min = {micro.h0_min:g} m: the boundary film must be thinner "
+                        "than the smallest separation (10 nm is 10e-9)")
+    unread = sorted(set(data.get("micro", {})) - STATISTICAL_KEYS)
+    if micro.model == "average-flow" and unread:
+        raise CaseError(f"{where} [micro] {', '.join(unread)}: the cell problems' setting(s), "
+                        "unused by model = \"average-flow\" (its factors are closed forms of "
+                        "the patches' statistics); remove them, or set model = \"cells\"")
     return micro
 
 
@@ -309,7 +350,14 @@ def _boundary(data, where, lubricant, sweep, tribometer) -> BoundaryLaw:
         raise CaseError(f"{where} [boundary]: shear_strength = pressure_coefficient = 0 leaves "
                         "the asperities no shear at all; give tau_0 [Pa] (10 MPa is 1e7) or "
                         "alpha (0.1), or law = \"constant\"")
-    hottest = max(lubricant.temperatures) - boundary.reference_temperature
+    reference = boundary.reference_temperature
+    if "reference_temperature" in given and min(
+            abs(t - reference) for t in lubricant.temperatures) > REFERENCE_REACH:
+        raise CaseError(f"{where} [boundary] reference_temperature = {reference:g}: more than "
+                        f"{REFERENCE_REACH:g} K from every oil temperature "
+                        f"{list(lubricant.temperatures)} C; it is in degrees Celsius, not "
+                        "kelvin (24 C is 24.0, not 297.15)")
+    hottest = max(lubricant.temperatures) - reference
     if boundary.temperature_coefficient * hottest >= FADED:
         raise CaseError(f"{where} [boundary] temperature_coefficient = "
                         f"{boundary.temperature_coefficient:g}: at the oil's "

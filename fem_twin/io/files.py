@@ -117,7 +117,51 @@ def _write_npz(path: Path, topo: Topography, height_scale):
             zf.writestr(info, buf.getvalue())
 
 
+def topography_shape(path) -> tuple[int, int]:
+    """The ``(rows, columns)`` of the height map in ``path``: of a ``.npz`` or ``.npy``
+    from its array header, without reading the heights (a case file's maps, checked when it
+    is read); of another format by reading it.  :class:`TopographyFileError` for a file
+    that does not open as a topography."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".npz", ".npy"):
+        return read_topography(path).shape
+    try:
+        if suffix == ".npy":
+            with open(path, "rb") as f:
+                return _header_shape(path, f)
+        with zipfile.ZipFile(path) as archive, archive.open("heights.npy") as f:
+            return _header_shape(path, f)
+    except KeyError:
+        raise TopographyFileError(f"{path}: .npz has no 'heights' array") from None
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as err:
+        raise TopographyFileError(f"cannot read topography from {path}: not a {suffix} of "
+                                  f"heights, or damaged ({err})") from err
+
+
+def _header_shape(path: Path, f) -> tuple[int, int]:
+    """The shape in the .npy header at ``f``'s position: a 2D array's."""
+    version = np.lib.format.read_magic(f)
+    read = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+            else np.lib.format.read_array_header_2_0)
+    shape, _, _ = read(f)
+    if len(shape) != 2:
+        raise TopographyFileError(f"{path}: heights of shape {shape}, not a 2D map")
+    return shape
+
+
 def _read_npz(path: Path, spacing, scale) -> Topography:
+    try:
+        return _read_npz_data(path, spacing, scale)
+    except ValueError as err:
+        if "pickle" not in str(err):
+            raise
+        # numpy's hint to unpickle is no advice here
+        raise TopographyFileError(f"cannot read topography from {path}: not a .npz of "
+                                  "heights (it holds Python objects or is damaged)") from err
+
+
+def _read_npz_data(path: Path, spacing, scale) -> Topography:
     with np.load(path, allow_pickle=False) as data:
         if "heights" not in data:
             raise TopographyFileError(f"{path}: .npz has no 'heights' array "

@@ -26,7 +26,8 @@ class MacroOptions:
                              "unfiltered; the paper's calibrated value is 9)", "fwhm_px")
     clip: float = setting(20e-6, "heights clipped to +-clip", "height")
     resolution: tuple[int, int] | None = setting(
-        (256, 256), "rows and columns of the virtual geometry (the macro grid)", "pixels")
+        (256, 256), "rows and columns of the virtual geometry (the macro grid), at least 16 "
+        "each in a case file (its error estimate solves the grid coarsened by two)", "pixels")
     resample_method: str = setting("linear", "resampling interpolation",
                                    choices=("linear", "cubic"))
     truncation: float = setting(-20e-6, "below this height a pin pixel belongs to the "
