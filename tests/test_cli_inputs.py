@@ -469,3 +469,77 @@ def test_open_run_names_a_damaged_results_file(tmp_path):
     (run / "results.nc").write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(200))
     with pytest.raises(InputError, match="cannot be read.*run the same"):
         open_run(run)
+
+
+@pytest.mark.parametrize("argv", [["sample", "-o", "{blocked}/sample"],
+                                  ["example", "{blocked}/example"]])
+def test_a_destination_that_cannot_be_written_is_a_file_system_error(tmp_path, capsys, argv):
+    """Probes H19, H20 (and P04, below): a folder or file that cannot be written was exit 2
+    with the atomic writer's temporary name; it is exit 4 naming the real path."""
+    (tmp_path / "file").write_text("")
+    argv = [a.format(blocked=tmp_path / "file") for a in argv]
+    assert main(argv) == 4
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(tmp_path / "file") in err and "/." not in err
+
+
+def test_a_report_that_cannot_be_written_is_a_file_system_error(tmp_path, capsys):
+    """Probe P04: report -o an unwritable place named its temporary file, with exit 2."""
+    from fem_twin.io.atomic import atomic_path
+    target = tmp_path / "file" / "report.html"
+    (tmp_path / "file").write_text("")
+    with pytest.raises(OSError, match=f"cannot write {target}") as err, atomic_path(target):
+        pass
+    assert not isinstance(err.value, FileNotFoundError | NotADirectoryError)
+    from fem_twin.cli.main import _report
+    assert _report("report", err.value) == 4
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["topography", "refine", "{patch}", "{out}", "--factor", "1000"], "factor = 1000"),
+    (["topography", "resample", "{patch}", "{out}", "--shape", "100000", "100000"],
+     "GiB"),
+    (["topography", "filter", "{patch}", "{out}", "--fwhm", "9e-6"], "fwhm_px = 9e-06"),
+    (["topography", "level", "{patch}", "{out}", "--radius", "-1"], "radius = -1 m"),
+    (["topography", "info", "{empty}", "--spacing", "1e-6"], "no numbers"),
+    (["topography", "info", "{table}", "--spacing", "-1e-6"], "spacing must be positive"),
+    (["homogenise", "run", "{patch}", "{patch}", "-o", "{out}", "--workers", "-1"],
+     "--workers = -1"),
+    (["homogenise", "run", "{patch}", "{patch}", "-o", "{out}", "--h0", "1", "0", "5"],
+     r"--h0 MIN MAX \[m\] = 1: implausible"),
+    (["homogenise", "average", "-o", "{out}", "{trunc}"], "trunc.npz: cannot read flow"),
+    (["macro", "point", "{pin}", "{trunc}", "-o", "{out}", "--speed", "0.1"],
+     "trunc.npz: cannot read flow"),
+    (["macro", "point", "{pin}", "{trunc}", "-o", "{out}", "--speed", "0.1", "--diameter",
+      "8"], r"--diameter \[m\] = 8: implausible"),
+    (["contact", "level", "{pin}", "{out}"], "pin_1.npz: 15334 invalid pixels.*prepare-pin"),
+])
+def test_stage_commands_refuse_bad_values_in_one_line(tmp_path, capsys, argv, words):
+    """Probes Y28, Y31 (refused before allocating), Y27, Y24, Y06 (numpy's warning
+    suppressed), Y09, H07, H05, H09, H11 (a damaged flow-factor file: exit 2 naming it, not
+    an internal error), H15b, H02c: exit 2, one line naming the option."""
+    import re
+    import warnings
+    (tmp_path / "empty.txt").write_text("")
+    (tmp_path / "table.txt").write_text("1 2\n3 4\n")
+    (tmp_path / "trunc.npz").write_bytes(b"PK\x03\x04" + bytes(296))
+    names = {"patch": ROOT / "meshes/sample/patch_1_pin.npz", "out": tmp_path / "out.npz",
+             "pin": ROOT / "meshes/sample/pin_1.npz", "empty": tmp_path / "empty.txt",
+             "trunc": tmp_path / "trunc.npz", "table": tmp_path / "table.txt"}
+    with warnings.catch_warnings():              # a warning would print its source lines
+        warnings.simplefilter("error")
+        assert main([a.format(**names) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and re.search(words, err), err
+
+
+def test_negative_numbers_in_exponent_form_are_values(tmp_path, capsys):
+    """Probes Y23, Y23b: ``--lower -2e-05`` was read as an option ("expected one
+    argument")."""
+    out = tmp_path / "clipped.npz"
+    assert main(["topography", "clip", str(ROOT / "meshes/sample/patch_1_pin.npz"), str(out),
+                 "--lower", "-2e-05", "--upper", "2e-05"]) == 0
+    assert read_topography(out).heights.min() >= -2e-5
+    assert main(["topography", "clip", str(ROOT / "meshes/sample/patch_1_pin.npz"), str(out),
+                 "--lower", "1e-6", "--upper", "-1e-6"]) == 2
+    assert "lower < upper" in capsys.readouterr().err

@@ -6,6 +6,7 @@ import argparse
 import inspect
 import logging
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -102,12 +103,18 @@ class _Formatter(argparse.HelpFormatter):
         return f"{text} (default: %(default)s)"
 
 
+#: a negative number, also in exponent form (-2e-05), read as a value, not as an option
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+
+
 class _Parser(argparse.ArgumentParser):
-    """Every (sub)command shows the defaults of its options in ``--help``."""
+    """Every (sub)command shows the defaults of its options in ``--help`` and reads a
+    negative number in exponent form as a value (argparse's own pattern has no exponent)."""
 
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", _Formatter)
         super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -276,7 +283,7 @@ def _add_homogenise(sub):
                          "interpolant needs to miss the others by less than this fraction "
                          "(e.g. 0.005; default: every value)")
     hr.add_argument("--workers", type=int, default=os.cpu_count() or 1,
-                    help="processes over h0 values (default: all cores)")
+                    help="processes over h0 values (0: one per core; default: all cores)")
     hr.add_argument("--fields", type=float, nargs="*", default=(), metavar="H0",
                     help="also write the cell fields (VTU/PVD) at these h0 [m]")
     hr.add_argument("--no-progress", action="store_true", help="no progress bar")

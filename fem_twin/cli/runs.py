@@ -323,7 +323,7 @@ def example(args):
     from importlib.resources import files
 
     from ..io.samples import generate
-    args.folder.mkdir(parents=True, exist_ok=True)
+    _check_output(args.folder)
     case = args.folder / "pin_on_disk.toml"
     case.write_text(files("fem_twin.cases").joinpath("pin_on_disk.toml").read_text())
     generate(args.folder / "meshes" / "sample")

@@ -4,9 +4,11 @@ sample); the parser is in :mod:`fem_twin.cli`."""
 from __future__ import annotations
 
 import json
+import os
 
 import numpy as np
 
+from ..checks import number, plausible
 from ..errors import InputError
 from ..io.layout import RunLayout
 
@@ -67,15 +69,26 @@ def topography(args):
 
 def contact_level(args):
     from ..contact.levelling import level_pin
-    from ..io.files import read_topography, write_topography
-    pin = read_topography(args.pin)
-    disk = read_topography(args.disk) if args.disk else None
+    from ..io.files import write_topography
+    pin = _prepared(args.pin, "prepare-pin")
+    disk = _prepared(args.disk, "prepare-disk") if args.disk else None
     res = level_pin(pin, disk, load=args.load, method=args.method)
     write_topography(args.output, res.pin)
     print(json.dumps({"tilt_rad": res.tilt, "residuals": res.residuals,
                       "contact_solves": len(res.history),
                       "contact_fraction": res.contact.contact_fraction}, indent=2))
     return 0
+
+
+def _prepared(path, step: str):
+    """The topography in ``path``, refused naming the file and the ``fem-twin topography
+    STEP`` that prepares it where it holds invalid pixels (a raw map)."""
+    from ..io.files import read_topography
+    topo = read_topography(path)
+    if not topo.valid.all() or not np.all(np.isfinite(topo.heights)):
+        raise InputError(f"{path}: {int((~topo.valid).sum())} invalid pixels, a raw map; "
+                         f"prepare it first: fem-twin topography {step} {path} PREPARED.npz")
+    return topo
 
 
 def contact_average(args):
@@ -101,13 +114,15 @@ def homogenise_run(args):
     from ..io.files import read_topography
     from ..micro import CellSettings, homogenise
     from ..micro.output import write_cell_fields
-    pin, disk = read_topography(args.pin), read_topography(args.disk)
     lo, hi, n = args.h0
+    plausible("--h0 MIN MAX [m]", [lo, hi], "separation")
     if int(n) != n or n < 1:
         raise InputError(f"the number of h0 values must be a positive integer, got {n}")
+    workers = int(number("--workers", args.workers, "workers")) or os.cpu_count() or 1
+    pin, disk = read_topography(args.pin), read_topography(args.disk)
     settings = CellSettings(**{k: getattr(args, k) for k in CELL_OPTIONS})
     ff = homogenise(pin, disk, np.geomspace(lo, hi, int(n)), settings=settings,
-                    h0_tol=args.h0_tol, workers=args.workers,
+                    h0_tol=args.h0_tol, workers=workers,
                     checkpoint=args.output / "checkpoints", progress=not args.no_progress,
                     patch_id=f"{args.pin.stem}/{args.disk.stem}")
     _write_factors(args.output, ff)
@@ -150,6 +165,7 @@ def macro_point(args):
     from ..io.files import read_topography
     from ..macro import Lubricant, MacroSettings, solve_mixed
     from ..micro import FlowFactors
+    number("--diameter [m]", args.diameter, "pin_diameter")
     pin = read_topography(args.pin)
     upper = read_topography(args.disk).heights if args.disk else 0.0 * pin.heights
     if np.shape(upper) != pin.shape:

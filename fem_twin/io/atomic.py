@@ -8,6 +8,8 @@ import re
 import tempfile
 from pathlib import Path
 
+from ..errors import FileSystemError
+
 #: the name :func:`atomic_path` gives its temporary file: ``.NAME.`` plus mkstemp's eight
 #: random characters plus a suffix
 TEMPORARY = re.compile(r"\..+\.[a-z0-9_]{8}(\.[A-Za-z0-9]+)?")
@@ -21,19 +23,31 @@ def atomic_path(path, suffix: str | None = None):
     extension see the right one.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",
-                               suffix=path.suffix if suffix is None else suffix)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",
+                                   suffix=path.suffix if suffix is None else suffix)
+    except OSError as err:           # /proc, a read-only mount: the path's, not the temporary's
+        raise _unwritable(path, err) from None
     os.close(fd)
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(tmp, 0o666 & ~umask)   # mkstemp creates 0600; give the file ordinary permissions
     try:
         yield Path(tmp)
-        os.replace(tmp, path)
+        try:
+            os.replace(tmp, path)
+        except OSError as err:
+            raise _unwritable(path, err) from None
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+
+
+def _unwritable(path: Path, err: OSError) -> FileSystemError:
+    """The error of a file that cannot be written at ``path`` (exit 4), naming it."""
+    return FileSystemError(err.errno, f"cannot write {path} ({err.strerror}); give another "
+                           "place")
 
 
 def remove_debris(folder) -> int:

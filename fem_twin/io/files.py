@@ -13,6 +13,7 @@ from __future__ import annotations
 import io
 import json
 import re
+import warnings
 import zipfile
 from pathlib import Path
 
@@ -199,8 +200,10 @@ def _read_ascii(path: Path, spacing, scale) -> Topography:
     text = path.read_text(errors="strict")
     header = re.search(r"spacing = (\S+) (\S+); origin = (\S+) (\S+)", text)
     try:
-        data = np.loadtxt(io.StringIO(text), ndmin=2,
-                          delimiter="," if path.suffix.lower() == ".csv" else None)
+        with warnings.catch_warnings():          # an empty file: refused below, in one line
+            warnings.simplefilter("ignore", UserWarning)
+            data = np.loadtxt(io.StringIO(text), ndmin=2,
+                              delimiter="," if path.suffix.lower() == ".csv" else None)
     except ValueError as err:
         raise TopographyFileError(f"{path}: not a table of heights (expected rows of numbers, "
                                   f"optionally after '#' comment lines): {err}") from err

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.ndimage as ndi
 
-from ..checks import arguments
+from ..checks import arguments, plausible
 from ..errors import InputError
 from .core import Topography
 
@@ -28,10 +28,14 @@ def gaussian_filter(topo: Topography, fwhm_px: float) -> Topography:
 
     ``sigma = fwhm_px / (2 sqrt(2 ln 2))`` along both axes (in pixels), kernel truncated at
     6 sigma, edges mirrored.  Invalid pixels are excluded by normalised convolution and stay
-    invalid.  ``fwhm_px = 0`` returns the topography unchanged (the paper's "unfiltered").
+    invalid.  ``fwhm_px = 0`` returns the topography unchanged (the paper's "unfiltered");
+    a width is else at least 1 pixel, at most 200 (``[preprocessing] fwhm_px``'s range: a
+    width in metres, 9e-6, is refused).
     """
-    if not np.isfinite(fwhm_px) or fwhm_px < 0:
-        raise InputError(f"fwhm_px must be >= 0 pixels, got {fwhm_px}")
+    plausible("gaussian_filter: fwhm_px [pixels]", fwhm_px, "fwhm_px")
+    if 0 < fwhm_px < 1:
+        raise InputError(f"gaussian_filter: fwhm_px = {fwhm_px:g}: the filter width is in "
+                         "pixels (0: no filter, else at least 1; the paper's is 9)")
     if fwhm_px == 0:
         return topo
     sigma = fwhm_px / FWHM_PER_SIGMA

@@ -52,6 +52,9 @@ def zero_mean(topo: Topography, mask: np.ndarray | None = None) -> Topography:
 @arguments(topo=Topography, radius="number", centre="pair")
 def radial_mask(topo: Topography, radius: float, centre=(0.0, 0.0)) -> np.ndarray:
     """True for pixels within ``radius`` [m] of ``centre`` (x1, x2) [m]."""
+    if radius <= 0:
+        raise InputError(f"radial_mask: radius = {radius:g} m: a positive radius in metres "
+                         "(3 mm is 3e-3)")
     x1, x2 = topo.coordinates()
     return (x1 - centre[0]) ** 2 + (x2 - centre[1]) ** 2 <= radius ** 2
 

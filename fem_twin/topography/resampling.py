@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.ndimage as ndi
 
-from ..checks import arguments
+from ..checks import arguments, memory_shortfall
 from ..errors import InputError
 from .core import Topography
 
@@ -43,7 +43,9 @@ def refine(topo: Topography, factor: int, method: str = "linear") -> Topography:
     if int(factor) != factor or factor < 1:
         raise InputError(f"refinement factor must be a positive integer, got {factor}")
     ny, nx = topo.shape
-    return resample(topo, (factor * (ny - 1) + 1, factor * (nx - 1) + 1), method)
+    shape = (int(factor) * (ny - 1) + 1, int(factor) * (nx - 1) + 1)
+    _fits(shape, f"refine: factor = {factor}")
+    return resample(topo, shape, method)
 
 
 @arguments(topo=Topography, shape="shape")
@@ -72,4 +74,13 @@ def _target(topo: Topography, shape, name: str) -> tuple[int, int]:
     ny, nx = (int(v) for v in shape)
     if ny < 2 or nx < 2:
         raise InputError(f"target shape must be at least 2 x 2, got {shape}")
+    _fits((ny, nx), f"{name}: shape")
     return ny, nx
+
+
+def _fits(shape, name: str) -> None:
+    """Refuse a resampled map of ``shape`` pixels this machine's memory cannot hold
+    (:func:`~fem_twin.checks.memory_shortfall`), naming ``name``, before allocating it."""
+    short = memory_shortfall(shape[0] * shape[1], "map")
+    if short:
+        raise InputError(f"{name}: a {shape[0]} x {shape[1]} pixel map; {short}")
