@@ -52,6 +52,8 @@ QUANTITIES = {
                       "30e-3; far: uniform sliding)"),
     "fwhm_px": (0.0, 200.0, "pixels (0 or at least 1)"),
     "temperature_C": (-40.0, 300.0, "degrees Celsius, not kelvin (24 C is 24.0, not 297.15)"),
+    "film_temperature_C": (-273.15, 1000.0, "degrees Celsius of a heated film (an oil "
+                           "decomposes far below 1000 C)"),
     "conductivity": (0.1, 500.0, "W/(m K) (steel: 46)"),
     "diffusivity": (1e-8, 1e-3, "m^2/s (steel: 12 mm^2/s is 1.2e-5)"),
     "spot_radius": (0.0, 1e-3, "m (5 um is 5e-6)"),
@@ -131,6 +133,15 @@ def number(name: str, value, quantity: str) -> float:
     :class:`InputError` naming ``name``: an array where a number goes is refused."""
     check(name, value, "number")
     return float(plausible(name, value, quantity))
+
+
+def whole(name: str, value, quantity: str) -> int:
+    """``value`` as one plausible whole number of ``quantity`` (a tile, node or worker
+    count; :func:`number`), or :class:`InputError` naming ``name``."""
+    v = number(name, value, quantity)
+    if v != int(v):
+        raise InputError(f"{name}: expected a whole number, got {value!r}")
+    return int(v)
 
 
 def as_pair(name: str, value) -> tuple[float, float]:

@@ -131,17 +131,26 @@ def stribeck_dataset(curves, patch_curves=None):
                     v[i, np.searchsorted(speed, c.speed)] = getattr(c, name)
             ds[name] = (("viscosity", "speed"), v, {"units": unit, "long_name": meaning})
     if any(c.friction_error is not None for c in curves):
-        parts = {"cf_err": "total"} | {f"cf_err_{p}": p for p in PARTS}
+        parts = {"cf_err": "total"} | ({f"cf_err_{p}": p for p in PARTS} if any(
+            c.friction_error_parts for c in curves) else {})   # a CSV's curves: total only
         for name, part in parts.items():
             v = np.full((mu.size, speed.size), np.nan)
             for i, c in enumerate(curves):
-                if c.friction_error is not None:
-                    v[i, np.searchsorted(speed, c.speed)] = (
-                        c.friction_error if part == "total" else c.friction_error_parts[part])
+                value = _error_part(c, part)
+                if value is not None:
+                    v[i, np.searchsorted(speed, c.speed)] = value
             ds[name] = (("viscosity", "speed"), v, {
                 "units": "1", "long_name": f"estimated discretisation error of C_f, {part}"
                 + (" (fem_twin.macro.estimate)" if part == "total" else " part")})
     return ds
+
+
+def _error_part(curve, part: str):
+    """The estimated C_f error of ``curve`` [-] in total or its ``part``, or None where the
+    curve has none (a curve read back from a CSV keeps the total only)."""
+    if part == "total":
+        return curve.friction_error
+    return (curve.friction_error_parts or {}).get(part)
 
 
 @arguments(sweeps=[tuple], origin="pair")

@@ -6,6 +6,7 @@ import pickle
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from fem_twin import Topography, contact, errors
 from fem_twin.errors import FemTwinError, InputError
@@ -347,3 +348,126 @@ def test_unit_slips_and_impossible_values_of_the_round_six_functions():
         with pytest.raises(InputError, match=words):
             make()
     assert knee_speed(curve) == pytest.approx(np.sqrt(0.01 * 0.1))
+
+
+def _round_five_api_probes():
+    """``(probe id, call, words)`` of issue 87's API probes that returned a result, raised a
+    bare error or named neither the argument nor its unit."""
+    from fem_twin.macro.boundary import (
+        BoundaryLaw,
+        asperity_load,
+        boundary_area,
+        boundary_traction,
+        temperature_factor,
+    )
+    from fem_twin.macro.deterministic import DeterministicSettings, pad_friction
+    from fem_twin.macro.lubricant import Lubricant
+    from fem_twin.macro.thermal import ThermalSettings, face_flash, spot_flash
+    from fem_twin.macro.time_resolved import disk_at, solve_time_resolved
+    from fem_twin.macro.viscosity import WaltherLaw
+    from fem_twin.peers import Summits, average_flow_factors, contact_pressure, mean_gap
+    from fem_twin.peers import patir_cheng as pc
+    from fem_twin.runtime import machine
+    from fem_twin.studies import verification as V
+    from fem_twin.topography.statistics import RoughnessStatistics, roughness_statistics
+    rng = np.random.default_rng(0)
+    pin = Topography(1e-7 * rng.standard_normal((32, 32)), 1e-6)
+    disk = Topography(1e-7 * rng.standard_normal((32, 32)), 1e-6)
+    summits = Summits.from_moments(1e-13, 1e-2, 1e9)
+    law = BoundaryLaw(law="shear", shear_strength=1e7, pressure_coefficient=0.1,
+                      temperature_coefficient=0.002)
+    zeros, micron = np.zeros((5, 5)), np.full((5, 5), 1e-6)
+    x = np.linspace(-1, 1, 17)
+    gap = 1e-6 * (x[None, :] ** 2 + x[:, None] ** 2)
+    face, flux = np.ones((8, 8), bool), np.full((8, 8), 1e6)
+    pad = V.RoughPad(roughness=0.2e-6 * rng.standard_normal((8, 8)), pitch=2e-6,
+                     lubricant=Lubricant(0.066))
+    pair = V.Pair(2, 0.1, 0.5, 0.5, 1e-6, 1e-6, 0.1, 0.1, 0.1, 0.1)
+    sample = ROOT / "meshes" / "sample"
+    return [
+        ("A031", lambda: average_flow_factors(pin, disk, 231e9, h0=[[1e-7, 2e-7]] * 2), "h0"),
+        ("A040", lambda: Summits(-1.0, 1e-5, 1e-7, 0.0), "Summits.density"),
+        ("A041", lambda: Summits("a", 1e-5, 1e-7, 0.0), "Summits.density"),
+        ("A042", lambda: Summits(1e10, 1e-5, float("nan"), 0.0), "Summits.spread"),
+        ("A058", lambda: Summits(1e10, 0.0, 1e-7, 0.0), "Summits.radius"),
+        ("A043", lambda: contact_pressure([1e-7], summits, 231.0), r"e_reduced \[Pa\]"),
+        ("A044", lambda: contact_pressure([1e-7], summits, -231e9), r"e_reduced \[Pa\]"),
+        ("A004", lambda: mean_gap([1e-6], 1.0), r"sigma.*\[m\]"),
+        ("A009", lambda: mean_gap([1.0], 1e-7), r"h \[m\]"),
+        ("A069", lambda: pc.pressure_flow([1.0], 1.0, hold="yes"), "hold: expected bool"),
+        ("A085", lambda: RoughnessStatistics(1e-6, (1e-5, 0.0), (1.0, 1.0), (1.0, 1.0)),
+         "lengths"),
+        ("A088", lambda: RoughnessStatistics(-1.0, (1e-5, 1e-5), (1.0, 1.0), (1.0, 1.0)),
+         "sigma"),
+        ("A080", lambda: roughness_statistics(Topography(np.zeros((32, 32)), (1e-6, 1e-6))),
+         "flat cell"),
+        ("A113", lambda: boundary_traction(1e6, 0.0, 0.5, 1.0, BoundaryLaw(), 12.0),
+         "boundary_friction = 12: implausible"),
+        ("A114", lambda: boundary_traction(1e6, 0.0, 0.5, 1.0, BoundaryLaw(), -0.12),
+         "boundary_friction"),
+        ("A119", lambda: temperature_factor(law, 297.15), "not kelvin"),
+        ("A121", lambda: temperature_factor(law, 50.0, rise_per_shear=-5.0),
+         r"rise_per_shear = -5 K"),
+        ("A124", lambda: boundary_area(None, BoundaryLaw()), "boundary_area: shear"),
+        ("A126", lambda: asperity_load("1e6", 1e5, 0.5, law=BoundaryLaw()),
+         "contact_pressure"),
+        ("A146", lambda: face_flash(flux, ~face, (1e-5, 1e-5), (0.0, 1.0), ThermalSettings()),
+         "face has no node"),
+        ("A151", lambda: face_flash(-flux, face, (1e-5, 1e-5), (0.0, 1.0), ThermalSettings()),
+         r"flux \[W/m\^2\]"),
+        ("A154", lambda: spot_flash(1e6, (0.0, 1.0), ThermalSettings(), n=0), "spot_flash: n"),
+        ("A162", lambda: WaltherLaw.through([24.0, 50.0], [0.066, 0.024], 850.0).viscosity(1e6),
+         r"temperature \[C\]"),
+        ("A166", lambda: WaltherLaw(float("nan"), 1.0, 850.0), "WaltherLaw.a"),
+        ("A195", lambda: pad_friction(zeros, np.ones((6, 6)), zeros, 0.066, (1e-5, 1e-5), 0.1,
+                                      1e-8), "one grid"),
+        ("A196", lambda: pad_friction(zeros, micron, zeros, 0.066, (1e-5, 1e-5), 0.1, -1e-8),
+         r"boundary_film \[m\]"),
+        ("A197", lambda: pad_friction(zeros, micron, zeros, -0.066, (1e-5, 1e-5), 0.1, 1e-8),
+         r"viscosity \[Pa s\]"),
+        ("A198", lambda: pad_friction(zeros, micron, zeros + 3, 0.066, (1e-5, 1e-5), 0.1,
+                                      1e-8), "cavity_fraction"),
+        ("A199", lambda: pad_friction(zeros, micron, zeros, 0.066, (0.0, 1e-5), 0.1, 1e-8),
+         r"spacing \[m\]"),
+        ("A215", lambda: disk_at(np.zeros((9, 9)), float("nan"), 9), "shift"),
+        ("A216", lambda: disk_at(np.zeros((9, 9)), 0.5, 0), "nodes"),
+        ("A217", lambda: disk_at(None, 0.5, 9), "disk"),
+        ("A221", lambda: solve_time_resolved(
+            gap, np.full((17, 17), 1.0), (1e-5, 1e-5), load=1.0, speed=0.1,
+            lubricant=Lubricant(0.066), settings=DeterministicSettings()), "disk"),
+        ("A250", lambda: V.summary([pair], 0.0), "boundary_friction"),
+        ("A252", lambda: V.compared([1, 2], [3, 4], 2), "compared: det"),
+        ("A253", lambda: V.compared([], [], 2.5), "tiles"),
+        ("A254", lambda: V.with_settings(pad, bogus=1), "bogus: not a setting"),
+        ("A257", lambda: V.sample_pad(sample, pixels=32.5), "pixels"),
+        ("A264", lambda: V.sample_pad(sample, pixels=0), "pixels"),
+        ("A306", lambda: machine.probe_together("micro", 0), "processes"),
+    ]
+
+
+@pytest.mark.parametrize("probe", range(len(_round_five_api_probes())))
+def test_the_round_five_api_probes_raise_input_errors_naming_the_argument(probe):
+    """Issue 87's bad API probes: each is an InputError naming the argument (and its unit
+    where it has one), with no numpy warning on the way."""
+    import warnings
+    ident, make, words = _round_five_api_probes()[probe]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InputError, match=words):
+            make()
+
+
+def test_curves_read_back_from_a_csv_make_a_dataset():
+    """Probes A290, A291: curves of stribeck.csv carry the total C_f error without its
+    parts, and stribeck_dataset raised TypeError on them."""
+    from fem_twin.results import stribeck_dataset
+    from fem_twin.stribeck import StribeckCurve
+    two = np.ones(2)
+    curve = StribeckCurve(speed=np.array([0.01, 0.1]), hersey=two,
+                          friction_coefficient=np.array([0.1, 0.05]), viscosity=0.066,
+                          hydrodynamic_friction=two, boundary_force=two,
+                          contact_load_fraction=np.array([0.9, 0.1]), h_d=two,
+                          iterations=two, friction_error=np.array([1e-4, 2e-4]))
+    ds = stribeck_dataset([curve])
+    assert ds["cf_err"].values.tolist() == [[1e-4, 2e-4]]
+    assert stribeck_dataset([curve], patch_curves=[[curve]])["cf_max"].shape == (1, 2)

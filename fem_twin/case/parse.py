@@ -12,7 +12,7 @@ from pathlib import Path
 from ..checks import arguments, memory_shortfall
 from ..errors import InputError
 from ..io.files import topography_shape
-from ..macro.boundary import BoundaryLaw, thin_films_choice
+from ..macro.boundary import FADED, BoundaryLaw, thin_films_choice
 from ..macro.thermal import ThermalSettings
 from ..stribeck.curve import read_measured_csv
 from ..stribeck.validation import check_like_with_like
@@ -34,9 +34,6 @@ from .table import CaseError, int_pair, only, read_table
 #: local worker processes a case may ask for per core (``[run] workers``): more only add
 #: memory and switching
 WORKERS_PER_CORE = 4
-#: the largest fall of the boundary shear a temperature term may give at a case's hottest
-#: oil before any heat (the linear law is a local expansion about reference_temperature)
-FADED = 0.5
 #: the largest distance [K] of [boundary] reference_temperature from every oil temperature:
 #: farther, it is a kelvin value typed as Celsius (24 C is 24.0, not 297.15)
 REFERENCE_REACH = 100.0

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import arguments, check_choices, check_ranges, setting
+from ..checks import arguments, check_choices, check_ranges, plausible, setting
 from ..errors import InputError
 from ..tables import BOUNDARY_FRICTION
 
@@ -35,6 +35,10 @@ LAWS = ("constant", "shear")
 #: what the films thinner than the boundary film carry: the boundary shear on their film
 #: pressure, a confined film's viscous shear, or nothing
 THIN_FILMS = ("boundary", "viscous", "none")
+#: the largest fall of the boundary shear the temperature term may give before any heat
+#: (the linear law is a local expansion about reference_temperature): the case parser's
+#: limit at the hottest oil, :func:`temperature_factor`'s at its temperature
+FADED = 0.5
 
 
 def thin_films_choice(value):
@@ -111,12 +115,15 @@ def boundary_area(shear, law: BoundaryLaw) -> np.ndarray:
     ``shear`` (LocalFactors): the dry contact fraction, and with ``law.thin_films ==
     "boundary"`` the films below the boundary film too, ``1 - film_fraction`` (at most 1:
     an error estimate's variant of the factors may overshoot)."""
+    if not all(hasattr(shear, name) for name in ("contact_fraction", "film_fraction")):
+        raise InputError("boundary_area: shear: expected the shear factors at the nodes "
+                         f"(FlowFactors.at(h0)), got {type(shear).__name__}")
     if law.thin_films != "boundary" or shear.film_fraction is None:
         return shear.contact_fraction
     return np.clip(np.maximum(shear.contact_fraction, 1 - shear.film_fraction), 0.0, 1.0)
 
 
-@arguments(law=BoundaryLaw)
+@arguments(contact_pressure="numbers", film_pressure="numbers", law=BoundaryLaw)
 def asperity_load(contact_pressure, film_pressure, contact_fraction,
                   law: BoundaryLaw) -> np.ndarray:
     """The asperities' mean normal stress ``p_con + p a_r`` [Pa]: the dry contact's pressure
@@ -135,7 +142,10 @@ def boundary_traction(contact_pressure, film_pressure, contact_fraction, sliding
     """The boundary shear ``tau_b`` [Pa] of ``law`` (module docstring) at each node, its
     temperature factor apart (:func:`temperature_factor`), for spots of dry
     ``contact_fraction`` a_c [-] without thin films beside them (a_r = a_c);
-    ``boundary_friction``: the constant law's C_f,b."""
+    ``boundary_friction``: the constant law's C_f,b (a friction coefficient; unread by the
+    shear law)."""
+    if law.law == "constant":
+        plausible("boundary_traction: boundary_friction", boundary_friction, "friction")
     try:
         np.broadcast_shapes(*(np.shape(a) for a in (contact_pressure, film_pressure,
                                                     contact_fraction, sliding_speed)))
@@ -171,8 +181,31 @@ def temperature_factor(law: BoundaryLaw, temperature: float, rise_per_shear: flo
     the bulk rise and the face's flash) and dT the spots' flash of the tempered shear,
     ``dT = G tau t`` (the flash is linear in the flux): so ``t = (1 - c_T (temperature -
     T_ref)) / (1 + c_T G tau)``; ``rise_per_shear`` is ``G tau`` [K], the rise of the
-    untempered shear (0: no spot flash).  At least 0: a shear that would change sign is
-    none (the case parser refuses a c_T that reaches it at the case's oils)."""
+    untempered shear (0: no spot flash).  Refused, naming the argument: a ``temperature``
+    outside -40 to 300 C, a negative ``rise_per_shear``, and a temperature at which the
+    linear law alone takes :data:`FADED` (half) of the shear or more, as the case parser
+    refuses at the case's hottest oil (297.15, kelvin typed as C, with c_T = 0.002 about
+    24 C); the film's own heat may take it further (:func:`heated_factor`)."""
+    plausible("temperature_factor: temperature [C]", temperature, "temperature_C")
+    if rise_per_shear < 0:
+        raise InputError(f"temperature_factor: rise_per_shear = {rise_per_shear:g} K: the "
+                         "spots' flash of the untempered shear, not negative (0: none)")
+    fall = law.temperature_coefficient * (temperature - law.reference_temperature)
+    if law.law == "shear" and fall >= FADED:
+        raise InputError(f"temperature_factor: temperature = {temperature:g} C lies "
+                         f"{temperature - law.reference_temperature:g} K above "
+                         f"reference_temperature = {law.reference_temperature:g} C, where "
+                         f"c_T = {law.temperature_coefficient:g} takes {fall:.0%} of the shear "
+                         "before any heat; temperatures are in degrees Celsius, not kelvin "
+                         "(24 C is 24.0, not 297.15)")
+    return heated_factor(law, temperature, rise_per_shear)
+
+
+@arguments(law=BoundaryLaw, temperature="number", rise_per_shear="number")
+def heated_factor(law: BoundaryLaw, temperature: float, rise_per_shear: float) -> float:
+    """:func:`temperature_factor` without its range checks, at a film's own ``temperature`` [C]
+    in the thermal loop (its heat may take the shear further): at least 0, a shear that
+    would change sign is none."""
     c = law.temperature_coefficient
     if law.law == "constant" or c == 0:
         return 1.0

@@ -141,8 +141,21 @@ def pad_friction(pressure, gap, cavity_fraction, viscosity, spacing, speed: floa
     """The film's force on the pin along +x1 [N]: ``int mu U / h (1 - theta) dA`` over the
     films thicker than ``boundary_film`` [m] plus ``int (h / 2) dp/dx1 dA``, which is the
     pin's wall shear and the film pressure on its surface (``-(h/2) dp/dx1 - p dh/dx1``)
-    integrated by parts with ``p = 0`` on the edge; trapezoidal rule, central differences."""
+    integrated by parts with ``p = 0`` on the edge; trapezoidal rule, central differences;
+    ``cavity_fraction`` theta [-] in [0, 1] and ``viscosity`` [Pa s] numbers or fields of the
+    pressure's grid, the ``spacing`` [m] a plausible pitch."""
     h, p = np.asarray(gap, float), np.asarray(pressure, float)
+    for name, value in (("gap", h), ("cavity_fraction", cavity_fraction),
+                        ("viscosity", viscosity)):
+        if np.ndim(value) and np.shape(value) != p.shape:
+            raise InputError(f"pad_friction: {name} {np.shape(value)} and pressure {p.shape} "
+                             "must share one grid")
+    if np.any(np.abs(np.asarray(cavity_fraction) - 0.5) > 0.5 + 1e-9):
+        raise InputError("pad_friction: cavity_fraction is theta, a fraction in [0, 1]")
+    if not np.all(np.asarray(viscosity) > 0):
+        raise InputError("pad_friction: viscosity [Pa s] is positive (66 mPa s is 0.066)")
+    plausible("pad_friction: spacing [m]", spacing, "pitch")
+    plausible("pad_friction: boundary_film [m]", boundary_film, "boundary_film")
     dp1 = np.gradient(p, spacing[0], axis=1)
     shear = np.where(h > boundary_film, viscosity * speed / h, 0.0) * (1 - cavity_fraction)
     return float(np.sum(trapezoid_weights(h.shape, spacing) * (shear + h / 2 * dp1)))

@@ -24,7 +24,7 @@ import scipy.fft as fft
 from ..checks import arguments, as_pair, check_ranges, plausible, setting
 from ..contact.elastic import love_rectangle
 from ..errors import InputError, NotConverged
-from .boundary import BoundaryLaw, temperature_factor
+from .boundary import BoundaryLaw, heated_factor
 
 #: sub-samples a side of a cell for the moving part of the kernel (it varies over 2 kappa / U)
 SUBSAMPLES = 8
@@ -123,6 +123,12 @@ def face_flash(flux, face, spacing, speeds, settings: ThermalSettings) -> tuple:
                          "share their grid")
     if np.ndim(speeds) != 1 or np.size(speeds) != 2:
         raise InputError(f"face_flash: speeds is the pair (pin, disk) [m/s], got {speeds!r}")
+    if not np.any(np.asarray(face, bool)):
+        raise InputError("face_flash: face has no node: the face is where the heat enters "
+                         "(True on the contact's nodes)")
+    if np.any(np.asarray(flux)[np.asarray(face, bool)] < 0):
+        raise InputError("face_flash: flux [W/m^2] is the frictional heat entering the face, "
+                         "not negative")
     speeds = as_pair("face_flash: speeds [m/s]", speeds)
     q, f, dx = _coarse(np.where(face, flux, 0.0), face, spacing, settings.grid)
     pin, disk = (surface_temperature(q, dx, abs(u), settings.conductivity,
@@ -135,7 +141,11 @@ def face_flash(flux, face, spacing, speeds, settings: ThermalSettings) -> tuple:
 @arguments(flux="number", speeds="pair", settings=ThermalSettings)
 def spot_flash(flux: float, speeds, settings: ThermalSettings, n: int = 24) -> float:
     """The mean flash temperature [K] of a circular asperity contact of radius
-    ``settings.spot_radius`` carrying ``flux`` [W/m^2], shared as in :func:`face_flash`."""
+    ``settings.spot_radius`` carrying ``flux`` [W/m^2], shared as in :func:`face_flash`,
+    on ``n`` x ``n`` nodes (8 to 4096)."""
+    plausible("spot_flash: n [nodes a side]", n, "nodes")
+    if n != int(n):
+        raise InputError(f"spot_flash: n: nodes a side, a whole number, got {n!r}")
     a = settings.spot_radius
     if a == 0 or flux <= 0:
         return 0.0
@@ -196,8 +206,8 @@ class ContactThermal:
         the film ``temperature`` [C] and the spots' flash (:func:`~.boundary.temperature_factor`;
         unchanged without a temperature term)."""
         law = BoundaryLaw(**result.meta.get("settings", {}).get("boundary", {}))
-        return tempered(result, temperature_factor(law, temperature,
-                                                   self.spot(result, factors, speeds)))
+        return tempered(result, heated_factor(law, temperature,
+                                              self.spot(result, factors, speeds)))
 
 
 @arguments(t="number")

@@ -26,7 +26,15 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..checks import as_field, check_choices, check_ranges, setting
+from ..checks import (
+    arguments,
+    as_field,
+    check_choices,
+    check_ranges,
+    plausible,
+    setting,
+    whole,
+)
 from ..errors import InputError
 from .deterministic import (
     DeterministicNotConverged,
@@ -89,17 +97,20 @@ class TimeResolvedResult(DeterministicResult):
     frozen_separation: float = 0.0
 
 
+@arguments(shift="number")
 def disk_at(disk, shift: float, nodes: int) -> np.ndarray:
     """The disk's heights [m] over the pad's ``nodes`` columns moved by ``shift`` pixels
     along +x1: the periodic strip ``disk`` (ny, m), whose column ``(j - shift) mod m`` lies
     over column ``j`` (a fraction of a pixel by the Fourier shift of the strip)."""
+    nodes = whole("disk_at: nodes", nodes, "samples")
+    disk = as_field("disk_at: disk [m]", disk, 1)
     m = disk.shape[1]
-    whole = int(np.floor(shift))
-    if shift != whole:
+    pixels = int(np.floor(shift))
+    if shift != pixels:
         k = np.fft.rfftfreq(m)
-        disk = np.fft.irfft(np.fft.rfft(disk, axis=1) * np.exp(-2j * np.pi * k * (shift - whole)),
+        disk = np.fft.irfft(np.fft.rfft(disk, axis=1) * np.exp(-2j * np.pi * k * (shift - pixels)),
                             n=m, axis=1)
-    return disk[:, (np.arange(nodes) - whole) % m]
+    return disk[:, (np.arange(nodes) - pixels) % m]
 
 
 def _slope(disk, dx1: float) -> np.ndarray:
@@ -124,6 +135,7 @@ def solve_time_resolved(shape, disk, spacing, *, load: float, speed: float,
     when the period means do not repeat within ``time.max_periods``."""
     s, dx, load, speed = _checked(shape, spacing, load, speed, lubricant, settings)
     z = as_field("disk [m]", disk, 2)
+    plausible("disk [m] (its largest height)", float(np.max(np.abs(z))) or 1e-8, "height")
     time = TimeSettings() if time is None else time
     if not isinstance(time, TimeSettings) or z.shape[0] != s.shape[0]:
         raise InputError("time must be TimeSettings and disk (ny, m) with the pad's ny rows")

@@ -29,6 +29,14 @@ class WaltherLaw:
     b: float
     density: float
 
+    def __post_init__(self):
+        for name in ("a", "b"):
+            check(f"WaltherLaw.{name}", getattr(self, name), "number")
+        if not self.b > 0:
+            raise InputError(f"WaltherLaw.b = {self.b!r}: positive (an oil thins as it warms; "
+                             "WaltherLaw.through fits it to measured viscosities)")
+        plausible("WaltherLaw.density [kg/m^3]", self.density, "density")
+
     @classmethod
     def through(cls, temperatures, viscosities, density: float) -> "WaltherLaw":
         """The law through measured dynamic viscosities [Pa s] at temperatures [C] (two or
@@ -54,6 +62,7 @@ class WaltherLaw:
         if np.any(np.asarray(temperature, float) <= -KELVIN):
             raise InputError(f"WaltherLaw.viscosity: temperature [C] above absolute zero "
                              f"(-273.15 C; 24 C is 24.0), got {temperature!r}")
+        plausible("WaltherLaw.viscosity: temperature [C]", temperature, "film_temperature_C")
         x = np.log10(np.asarray(temperature, float) + KELVIN)
         nu = 10 ** 10 ** (self.a - self.b * x) - 0.7
         return nu * 1e-6 * self.density

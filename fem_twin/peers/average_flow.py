@@ -25,7 +25,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy import special
 
-from ..checks import arguments, plausible
+from ..checks import QUANTITIES, arguments, plausible
 from ..errors import InputError
 from ..micro.flow_factors import FlowFactors
 from ..topography import Topography
@@ -106,9 +106,11 @@ def _gamma(stats, name: str, notes: list) -> float:
 def mean_gap(h, sigma: float) -> np.ndarray:
     """``h_T`` [m]: the mean of ``max(h + delta, 0)`` over Gaussian heights delta of rms
     ``sigma`` [m] at nominal separation ``h`` [m] (Patir and Cheng 1978, eq 19)."""
-    if not sigma > 0:
-        raise InputError(f"mean_gap: sigma is the composite rms roughness [m], positive, got "
-                         f"{sigma!r}")
+    plausible("mean_gap: sigma, the composite rms roughness [m]", sigma, "separation")
+    farthest = QUANTITIES["separation"][1]
+    if np.any(np.abs(np.asarray(h, float)) > farthest):
+        raise InputError(f"mean_gap: h [m] reaches {np.max(np.abs(h)):g} m: implausible; "
+                         f"separations within +-{farthest:g} m (0.1 um is 1e-7)")
     H = np.asarray(h, float) / sigma
     return sigma * (H * special.ndtr(H) + np.exp(-H ** 2 / 2) / np.sqrt(2 * np.pi))
 
@@ -121,6 +123,9 @@ def average_flow_factors(pin: Topography, disk: Topography, e_reduced: float, h0
     (default :data:`DEFAULT_H0`), ``e_reduced`` E' [Pa], ``slide_to_roll`` SRR."""
     plausible("average_flow_factors: e_reduced [Pa]", e_reduced, "reduced_modulus")
     plausible("average_flow_factors: slide_to_roll", slide_to_roll, "slide_to_roll")
+    if h0 is not None and np.ndim(h0) > 1:
+        raise InputError(f"average_flow_factors: h0 [m]: expected a list of separations, got "
+                         f"shape {np.shape(h0)}")
     if h0 is not None:
         plausible("average_flow_factors: h0 [m]", h0, "separation")
     stats = PairStatistics.from_cells(pin, disk)

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special
 
-from ..checks import arguments, check
+from ..checks import arguments, check, plausible
 from ..errors import InputError
 
 #: the summit heights' densities of :func:`tail_moment`
@@ -68,6 +68,16 @@ class Summits:
     spread: float
     mean: float
 
+    def __post_init__(self):
+        for name in ("density", "radius", "spread", "mean"):
+            check(f"Summits.{name}", getattr(self, name), "number")
+        for name, unit in (("density", "summits per m^2, 1e10 is 1e4 per mm^2"),
+                           ("radius", "m, a summit's radius of curvature (20 um is 20e-6)"),
+                           ("spread", "m, the summit heights' rms (0.1 um is 1e-7)")):
+            if not getattr(self, name) > 0:
+                raise InputError(f"Summits.{name} = {getattr(self, name)!r}: must be positive "
+                                 f"({unit})")
+
     @classmethod
     def from_moments(cls, m0: float, m2: float, m4: float) -> "Summits":
         """McCool (1986) from the profile moments ``m0`` [m^2], ``m2`` [-], ``m4``
@@ -100,6 +110,7 @@ def contact_pressure(h, summits: Summits, e_reduced: float,
                      density: str = "gaussian") -> np.ndarray:
     """Greenwood-Tripp mean asperity pressure [Pa] at mean-plane separations ``h`` [m]
     (``e_reduced``: E' of eq 22 [Pa])."""
+    plausible("contact_pressure: e_reduced [Pa]", e_reduced, "reduced_modulus")
     s = summits
     k = 8 * np.sqrt(2) * np.pi / 15 * s.roughness_parameter ** 2 * np.sqrt(s.spread
                                                                               / s.radius)

@@ -85,7 +85,7 @@ def pressure_flow_range(gamma: float) -> float:
     return float(max(PRESSURE[k, 2] for k, weight in ((i, 1 - w), (j, w)) if weight > 0))
 
 
-@arguments(gamma="number")
+@arguments(gamma="number", hold=bool)
 def pressure_flow(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``phi_x(H, gamma)`` [-], the pressure flow factor along the sliding (1978, eq 25)."""
     def one(i, h):
@@ -94,14 +94,14 @@ def pressure_flow(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     return _interpolated(one, H, gamma, lambda i: PRESSURE[i, 2], "phi_x", hold)
 
 
-@arguments(gamma="number")
+@arguments(gamma="number", hold=bool)
 def pressure_flow_across(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``phi_y(H, gamma) = phi_x(H, 1/gamma)`` [-], across the sliding (1978)."""
     _bracket(gamma)
     return pressure_flow(H, 1.0 / gamma, hold=hold)
 
 
-@arguments(gamma="number")
+@arguments(gamma="number", hold=bool)
 def shear_flow(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``Phi_s(H, gamma)`` [-] of one rough surface (1979, Table 1); the pair's
     ``phi_s = V1 Phi_s(gamma_1) - V2 Phi_s(gamma_2)`` (:func:`fem_twin.peers.average_flow`)."""
@@ -114,7 +114,7 @@ def shear_flow(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     return _interpolated(one, H, gamma, lambda i: SHEAR_MIN_H, "Phi_s", hold)
 
 
-@arguments(gamma="number")
+@arguments(gamma="number", hold=bool)
 def shear_stress(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``Phi_fs(H, gamma)`` [-] of one rough surface (1979, Table 3), zero above H = 7."""
     def one(i, h):
@@ -125,7 +125,7 @@ def shear_stress(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     return _interpolated(one, H, gamma, lambda i: SHEAR_MIN_H, "Phi_fs", hold)
 
 
-@arguments(gamma="number")
+@arguments(gamma="number", hold=bool)
 def pressure_stress(H, gamma: float, *, hold: bool = False) -> np.ndarray:
     """``phi_fp(H, gamma)`` [-], the Poiseuille part of the mean wall shear (1979)."""
     def one(i, h):

@@ -145,9 +145,11 @@ def probe_together(kind: str, processes: int) -> float:
     of their repeats' median; one process: :func:`probe_seconds` itself)."""
     if not isinstance(kind, str) or kind not in REPEATS:
         raise InputError(f"probe_together: kind is one of {sorted(REPEATS)}, got {kind!r}")
-    if isinstance(processes, bool) or not isinstance(processes, (int, np.integer)):
-        raise InputError(f"probe_together: processes is a whole number, got {processes!r}")
-    if processes <= 1:
+    if (isinstance(processes, bool) or not isinstance(processes, (int, np.integer))
+            or processes < 1):
+        raise InputError(f"probe_together: processes is a whole number >= 1, got "
+                         f"{processes!r}")
+    if processes == 1:
         return probe_seconds(kind)
     ctx = multiprocessing.get_context()
     barrier, queue = ctx.Barrier(processes), ctx.Queue()

@@ -16,17 +16,21 @@ friction coefficient scales as ``h / L``."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
 
-from ..checks import arguments, check, number, plausible
+from ..checks import arguments, check, plausible, whole
 from ..errors import InputError
 from ..io.files import read_topography
-from ..macro import Lubricant, MacroSettings, solve_mixed
+from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
 from ..macro.boundary import temperature_factor
-from ..macro.deterministic import DeterministicSettings, solve_deterministic
+from ..macro.deterministic import (
+    DeterministicResult,
+    DeterministicSettings,
+    solve_deterministic,
+)
 from ..macro.thermal import tempered
 from ..macro.time_resolved import solve_time_resolved
 from ..micro import FlowFactors, homogenise
@@ -38,15 +42,6 @@ from ..topography.prepare import prepare_patch
 TILES = (2, 4, 8, 16)
 #: the pad's forms (``RoughPad.profile``)
 PROFILES = ("crown", "wedge")
-
-
-def whole(name: str, value, quantity: str) -> int:
-    """``value`` as a plausible whole number of ``quantity`` (a tile or node count), or
-    :class:`InputError` naming ``name``."""
-    v = number(name, value, quantity)
-    if v != int(v):
-        raise InputError(f"{name}: expected a whole number, got {value!r}")
-    return int(v)
 
 
 @dataclass(frozen=True)
@@ -152,6 +147,7 @@ def patch_pad(pin: Topography, disk: Topography, pixels: int, lubricant: Lubrica
     :func:`fem_twin.topography.prepare.prepare_patch`) resampled periodically to ``pixels``
     a side (:func:`fem_twin.topography.resample_cell`, as the micro stage does); ``moving``:
     both bodies rough, the disk's roughness sliding (``RoughPad.disk``)."""
+    pixels = whole("pixels", pixels, "pixels")
     low, up = resample_cell(pin, (pixels, pixels)), resample_cell(disk, (pixels, pixels))
     return RoughPad(up.heights - low.heights, float(low.spacing[0]), lubricant,
                     disk=up.heights if moving else None, **options)
@@ -279,7 +275,14 @@ class Pair:
 
 @arguments(det=list, twin=list, tiles="number")
 def compared(det: list, twin: list, tiles: int) -> list:
-    """The :class:`Pair` of each speed of two sweeps on the pad of ``tiles``."""
+    """The :class:`Pair` of each speed of two sweeps on the pad of ``tiles``: ``det`` the
+    deterministic results (:func:`deterministic_sweep`), ``twin`` the twin's
+    (:func:`twin_sweep`), a whole number of ``tiles``."""
+    tiles = whole("compared: tiles", tiles, "samples")
+    for name, results, kind in (("det", det, DeterministicResult), ("twin", twin, MixedResult)):
+        check(f"compared: {name}", results, list)
+        for r in results:
+            check(f"compared: {name}", r, kind)
     return [Pair(tiles, d.speed, d.load_share, t.contact_load / t.normal_load, d.separation,
                  t.h_d, d.film_friction, t.hydrodynamic_friction, d.friction_coefficient,
                  t.friction_coefficient) for d, t in zip(det, twin)]
@@ -291,7 +294,9 @@ def summary(pairs, boundary_friction: float, label: str = "mixed regime",
     """The one line of a benchmark group (``deterministic``: ``label`` "mixed regime";
     ``unsteady``): the largest C_f gap [% C_f,b] and load-share gap over ``pairs``
     (:class:`Pair`), the largest resolved share [%], and with ``order`` (not False) the
-    observed eps -> 0 order (:func:`order_text`)."""
+    observed eps -> 0 order (:func:`order_text`); ``boundary_friction`` C_f,b, a friction
+    coefficient."""
+    plausible("summary: boundary_friction", boundary_friction, "friction")
     cf = max(abs(p.cf_gap(boundary_friction)) for p in pairs)
     share = max(abs(p.share - p.share_det) for p in pairs)
     line = (f"{label}: worst |C_f - C_f,det| = {100 * cf:.2f} % C_f,b, worst |share - "
@@ -329,5 +334,11 @@ def to_zero(eps, values) -> tuple[float, float | None]:
 
 @arguments(pad=RoughPad)
 def with_settings(pad: RoughPad, **changes) -> RoughPad:
-    """The pad with its deterministic settings changed (``film_deforms``, ``boundary_film``)."""
+    """The pad with its deterministic settings changed (``film_deforms``, ``boundary_film``,
+    any field of :class:`~fem_twin.macro.deterministic.DeterministicSettings`)."""
+    unknown = sorted(set(changes) - {f.name for f in fields(DeterministicSettings)})
+    if unknown:
+        raise InputError(f"with_settings: {', '.join(unknown)}: not a setting of "
+                         "DeterministicSettings ("
+                         f"{', '.join(f.name for f in fields(DeterministicSettings))})")
     return replace(pad, settings=replace(pad.settings, **changes))

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import arguments
+from ..checks import arguments, as_pair, check
 from ..errors import InputError
 from .core import Topography
 
@@ -41,6 +41,19 @@ class RoughnessStatistics:
     m2: tuple[float, float]
     m4: tuple[float, float]
     bounded: tuple[bool, bool] = (False, False)
+
+    def __post_init__(self):
+        check("RoughnessStatistics.sigma", self.sigma, "number")
+        if self.sigma < 0:
+            raise InputError(f"RoughnessStatistics.sigma = {self.sigma!r}: an rms height [m], "
+                             "not negative (0.1 um is 1e-7)")
+        for name, unit in (("lengths", "m, positive (10 um is 1e-5)"), ("m2", "[-], >= 0"),
+                           ("m4", "1/m^2, >= 0")):
+            pair = as_pair(f"RoughnessStatistics.{name}", getattr(self, name))
+            if not all(np.isfinite(pair)) or min(pair) < 0 or (name == "lengths"
+                                                               and min(pair) == 0):
+                raise InputError(f"RoughnessStatistics.{name} = {getattr(self, name)!r}: "
+                                 f"two finite numbers ({unit})")
 
     @property
     def gamma(self) -> float:
@@ -72,6 +85,10 @@ def roughness_statistics(topo: Topography) -> RoughnessStatistics:
                          "first (fem_twin.topography.fill_defects)")
     z = topo.heights - topo.heights.mean()
     power = np.abs(np.fft.fft2(z)) ** 2 / z.size ** 2          # sum = m0 (Parseval)
+    if not np.sum(power) > 0:
+        raise InputError("roughness_statistics: a flat cell (sigma = 0) has no roughness to "
+                         "describe: no autocorrelation, no summits (a smooth body adds none "
+                         "to a pair's statistics)")
     acf = np.real(np.fft.ifft2(power))
     acf = acf / acf[0, 0]
     k1 = 2 * np.pi * np.fft.fftfreq(z.shape[1], topo.spacing[0])[None, :]
