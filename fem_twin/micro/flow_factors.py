@@ -13,6 +13,7 @@ and loads from ``.npz`` with its metadata, averages over patches, and interpolat
 from __future__ import annotations
 
 import json
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -169,7 +170,7 @@ class FlowFactors:
                     raise InputError(f"missing {missing}")
                 return cls(**{k: z[k] for k in ARRAYS if k in z},
                            meta=json.loads(str(z["meta"])))
-        except (OSError, EOFError, ValueError, KeyError) as err:
+        except (OSError, EOFError, ValueError, KeyError, zipfile.BadZipFile) as err:
             raise InputError(f"{path}: cannot read flow factors ({err})") from err
 
     def write_csv(self, path) -> Path:
