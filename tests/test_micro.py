@@ -353,11 +353,13 @@ def test_variants_carry_each_estimated_error():
     for kind in ("film_thin", "film_thick"):
         assert all(np.array_equal(getattr(v[kind], k), getattr(ff, k)) for k in ARRAYS
                    if k not in ("friction_factor", "film_fraction", "log_friction",
-                                "thin_friction"))
+                                "thin_friction", "thin_area"))
     assert np.all(v["film_thin"].film_fraction >= ff.film_fraction)
     # the confined films below the cut: a thinner cut leaves fewer of them
     assert np.all(v["film_thin"].thin_friction <= ff.thin_friction)
     assert np.all(v["film_thick"].thin_friction >= ff.thin_friction)
+    assert np.all(v["film_thin"].thin_area <= ff.thin_area)
+    assert np.all(v["film_thick"].thin_area >= ff.thin_area)
     assert np.all(v["film_thin"].friction_factor >= ff.friction_factor)
     assert np.all(v["film_thick"].friction_factor <= ff.friction_factor)
     assert max(np.abs(v[k].friction_factor - ff.friction_factor).max() for k in (

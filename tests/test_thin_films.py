@@ -21,8 +21,9 @@ def test_the_confined_films_shear_is_their_mean_inverse_gap_on_a_cosine_cell():
     """A cosine ridge (a = 0.2 um) over a flat, 3 nm apart at its crest, 256 px a period:
     ``thin_friction / h_m`` is ``<1/h>`` over the films between the 1 nm floor and the
     10 nm boundary film, whose closed form is ``(1/pi) int_theta*^pi dtheta / (H + a cos
-    theta)`` with ``cos theta* = (h_b - H) / a``; within 0.5 % (the cell integrates the
-    linear interpolant of the gap exactly, second order in the pixel; measured -0.27 %)."""
+    theta)`` with ``cos theta* = (h_b - H) / a``, and their share ``thin_area`` is ``1 -
+    theta* / pi``; within 0.5 % (the cell integrates the linear interpolant of the gap
+    exactly, second order in the pixel; measured -0.27 % for the mean)."""
     n, period, a, crest = 256, 100e-6, 0.2e-6, 3e-9
     x = np.arange(n) * period / n
     ridge = np.tile(a * np.cos(2 * np.pi * x / period), (4, 1))
@@ -35,6 +36,7 @@ def test_the_confined_films_shear_is_their_mean_inverse_gap_on_a_cosine_cell():
     closed = 2 / root * (np.pi / 2 - np.arctan(np.sqrt((h0 - a) / (h0 + a))
                                                * np.tan(start / 2))) / np.pi
     assert ff.thin_friction[0] / ff.h_m[0] == pytest.approx(closed, rel=5e-3)
+    assert ff.thin_area[0] == pytest.approx(1 - start / np.pi, rel=5e-3)   # their share
     assert ff.thin_friction[0] > 0.1 * ff.friction_factor[0]        # it matters here
 
 
@@ -43,8 +45,9 @@ def test_tau0_acts_on_the_dry_contact_and_viscous_films_on_the_film(factors):
     the dry contact fraction's integral; tau_0 multiplies it alone, so the shear law's
     force is ``tau_0 A_r + alpha W`` to rounding whatever the thin films carry; the thin
     films as viscous films leave the solution (pressure) bit for bit, add exactly their
-    Couette integral ``mu u thin_friction / h_m (1 - theta)`` (mu the film's) to the film
-    friction, and take their film pressure off the asperities' load."""
+    Couette integral ``mu u thin_friction / h_m (1 - theta)`` (mu the film's), limited by
+    the law's ``alpha p`` over their area ``thin_area`` (both bind somewhere on this face),
+    to the film friction, and take their film pressure off the asperities' load."""
     gap, dx, face = macro_case(32)
     run = {t: solve_mixed(gap, dx, factors, load=150.0, speed=0.005, face=face,
                           lubricant=Lubricant(0.066),
@@ -63,9 +66,12 @@ def test_tau0_acts_on_the_dry_contact_and_viscous_films_on_the_film(factors):
     v, n = run["viscous"], run["none"]
     assert np.array_equal(v.pressure, n.pressure)
     confined = v.viscosity * 0.005 * local.thin_friction / v.mean_gap * (1 - v.cavity_fraction)
+    gauge = np.maximum(v.pressure - MacroSettings().ambient_pressure, 0.0)
+    limit = 0.1 * gauge * local.thin_area                 # alpha p over the films' area
     assert v.hydrodynamic_friction - n.hydrodynamic_friction == pytest.approx(
-        float(np.sum(weights * confined)), rel=1e-9)
+        float(np.sum(weights * np.minimum(confined, limit))), rel=1e-9)
     assert v.hydrodynamic_friction > n.hydrodynamic_friction
+    assert np.any(confined[face] > limit[face]) and np.any(confined[face] < limit[face])
 
 
 @pytest.mark.parametrize("thin_films", ["boundary", "viscous", "none"])
@@ -117,3 +123,19 @@ def test_the_boundary_share_is_cf_s_sensitivity_to_the_boundary_level(factors, t
     with open(write_stribeck_csv(tmp_path / "s.csv", curves[:1]), newline="") as f:
         written = [float(r["boundary_share"]) for r in csv.DictReader(f)]
     assert np.allclose(written, share, rtol=1e-12)
+
+
+def test_factors_of_an_earlier_version_are_recomputed_where_the_films_shear(factors,
+                                                                          tmp_path):
+    """A patch's factors file written before the confined films' moments reads them as none
+    (zero), which is right where nothing reads them and wrong under ``thin_films =
+    "viscous"``: the micro stage keeps such a file only where the case does not shear
+    those films."""
+    from fem_twin.micro.flow_factors import ARRAYS
+    from fem_twin.stages.factors import _knows_thin
+    new = factors.save(tmp_path / "new.npz")
+    old = tmp_path / "old.npz"
+    np.savez(old, **{k: getattr(factors, k) for k in ARRAYS if not k.startswith("thin_")},
+             meta=np.array("{}"))
+    assert _knows_thin(new) and not _knows_thin(old)
+    assert np.all(type(factors).load(old).thin_area == 0)

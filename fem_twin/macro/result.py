@@ -217,15 +217,28 @@ def pin_friction(film, how: Shearing):
                                     ambient_pressure=settings.ambient_pressure,
                                     velocity=velocity)
     law = settings.boundary
-    if law.thin_films == "viscous":      # the confined films' viscous shear, along the sliding
-        tau_hd = tau_hd + confined_shear(mu, speed * local, shear, h_m, theta,
-                                         lubricant.eyring_stress) * along
     gauge = np.maximum(np.asarray(p_hd, float) - settings.ambient_pressure, 0.0)
+    if law.thin_films == "viscous":      # the confined films' viscous shear, along the sliding
+        tau_hd = tau_hd + thin_film_shear(gauge, mu, speed * local, shear, film, how) * along
     load = asperity_load(p_con, gauge, boundary_area(shear, law), law)
     tau_con = traction(load, shear.contact_fraction, speed * local, law,
                        settings.boundary_friction)
     return (tau_hd, tau_con * along * (speed > 0),   # along the reading; 0: no sliding
             load * along, shear.contact_fraction * along)
+
+
+def thin_film_shear(gauge, viscosity, speed, shear, film, how: Shearing) -> np.ndarray:
+    """The confined films' shear [Pa] (``thin_films = "viscous"``): viscous
+    (:func:`.friction.confined_shear`) up to a limiting shear, the boundary law's shear on
+    their film pressure ``gauge`` [Pa] over their area (``thin_area``; without tau_0): at
+    a ball's GPa the piezoviscous Eyring shear of nanometre films grows without bound
+    (docs/model.md, "Boundary friction")."""
+    law = how.settings.boundary
+    limit = traction(gauge * np.clip(shear.thin_area, 0.0, 1.0), 0.0, speed, law,
+                     how.settings.boundary_friction)
+    return np.minimum(confined_shear(viscosity, speed, shear, film.mean_gap,
+                                     film.cavity_fraction, how.lubricant.eyring_stress),
+                      np.maximum(limit, 0.0))
 
 
 def friction_with(result: MixedResult, factors, settings, lubricant) -> float:

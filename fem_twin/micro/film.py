@@ -59,6 +59,29 @@ def mean_inverse_film(gap, cut: float) -> float:
     return float(np.mean(total))
 
 
+def area_above(gap, cut: float) -> float:
+    """The share of the periodic cell [-] where the linear interpolant of the nodal ``gap``
+    [m] (two triangles a pixel, as :func:`mean_inverse_film`) lies above ``cut`` [m]:
+    per triangle of sorted nodal values lo <= mid <= hi, 1 below lo, ``1 - (c - lo)^2 /
+    ((mid - lo)(hi - lo))`` up to mid, ``(hi - c)^2 / ((hi - mid)(hi - lo))`` up to hi."""
+    h00 = np.asarray(gap, float)
+    h10 = np.roll(h00, -1, axis=1)
+    h01 = np.roll(h00, -1, axis=0)
+    h11 = np.roll(h10, -1, axis=0)
+    return float(np.mean(_triangle_areas(h00, h10, h11, cut)
+                         + _triangle_areas(h00, h11, h01, cut)) / 2)
+
+
+def _triangle_areas(a, b, c, cut):
+    """Each triangle's share above ``cut`` (:func:`area_above`)."""
+    lo, mid, hi = np.sort(np.stack([a, b, c]), axis=0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lower = 1 - (cut - lo) ** 2 / ((mid - lo) * (hi - lo))
+        upper = (hi - cut) ** 2 / ((hi - mid) * (hi - lo))
+    return np.where(cut <= lo, 1.0, np.where(cut >= hi, 0.0,
+                                             np.where(cut <= mid, lower, upper)))
+
+
 def shear_spread(h, density, film, shear_weight) -> dict:
     """The moments of the local shear's spread over the films thicker than each of
     ``film`` [m]: ``film_area`` [-], and ``log_shear``, the area mean of ``ln s`` there (zero

@@ -28,10 +28,10 @@ from .estimate import combine
 
 #: the arrays of a FlowFactors value, in the order of its fields
 ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "friction_factor", "pressure_friction",
-          "contact_fraction", "film_fraction", "log_friction", "thin_friction")
+          "contact_fraction", "film_fraction", "log_friction", "thin_friction", "thin_area")
 #: the arrays that files written without them take as none: the local shear's spread and
 #: the confined films' friction
-OPTIONAL = ("film_fraction", "log_friction", "thin_friction")
+OPTIONAL = ("film_fraction", "log_friction", "thin_friction", "thin_area")
 #: p_con is interpolated as ``log(p_con + P_CON_FLOOR max p_con)``: it falls by a factor of
 #: about 3 per 40 nm of h0, so its logarithm interpolates seven times closer than p_con
 #: itself (benchmarks/README.md); the floor keeps the log finite where the surfaces
@@ -39,7 +39,7 @@ OPTIONAL = ("film_fraction", "log_friction", "thin_friction")
 P_CON_FLOOR = 1e-6
 #: what the friction needs beyond the Reynolds equation (eqs 31-32, the force on the pin)
 SHEAR = ("C", "d", "friction_factor", "pressure_friction", "contact_fraction", "film_fraction",
-         "log_friction", "thin_friction")
+         "log_friction", "thin_friction", "thin_area")
 #: relative step of the central differences in h0 (:meth:`FlowFactors.slopes`)
 REL_STEP = 1e-6
 
@@ -68,6 +68,7 @@ class FlowFactors:
     thin_friction : (n,) ``h_m <1/h>`` over the confined films between the gap floor and the
     boundary film, whose Couette shear is ``mu u_r thin_friction / h_m`` under
     ``[boundary] thin_films = "viscous"`` [-]; default 0 (none known)
+    thin_area : (n,) the share of the cell those films cover [-]; default 0
     meta : JSON-able description (patch ids, grid, materials, method, version, ...)
     """
 
@@ -84,16 +85,19 @@ class FlowFactors:
     film_fraction: np.ndarray | None = None
     log_friction: np.ndarray | None = None
     thin_friction: np.ndarray | None = None
+    thin_area: np.ndarray | None = None
     meta: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        if self.thin_friction is None:                    # no confined films known
-            object.__setattr__(self, "thin_friction", np.zeros(np.shape(self.h0)))
+        for name in ("thin_friction", "thin_area"):       # no confined films known
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, np.zeros(np.shape(self.h0)))
         n = np.shape(self.h0)
         spread = self.film_fraction is not None and self.log_friction is not None
         expect = {"h0": n, "h_m": n, "p_con": n, "A": n + (2, 2), "b": n + (2,),
                   "C": n + (2, 2), "d": n + (2,), "friction_factor": n,
                   "pressure_friction": n + (2,), "contact_fraction": n, "thin_friction": n,
+                  "thin_area": n,
                   **({"film_fraction": n, "log_friction": n} if spread else {})}
         for name, shape in expect.items():
             try:
@@ -184,7 +188,8 @@ class FlowFactors:
                 "sC": self.friction_factor, "fP1": self.pressure_friction[:, 0],
                 "fP2": self.pressure_friction[:, 1],
                 "contact_fraction": self.contact_fraction, "film_fraction": self.film_fraction,
-                "log_sC": self.log_friction, "thin_sC": self.thin_friction}
+                "log_sC": self.log_friction, "thin_sC": self.thin_friction,
+                "thin_area": self.thin_area}
         return write_csv(path, cols)
 
     # -- interpolation -------------------------------------------------------------------
@@ -224,6 +229,7 @@ class FlowFactors:
         if friction:
             out["contact_fraction"][above] = 0.0
             out["thin_friction"][above] = 0.0
+            out["thin_area"][above] = 0.0
         out["h_m"] = self._extend_below(flat, out["h_m"], "h_m", 1e-9)
         out["p_con"] = self.contact_pressure(flat) if contact else None
         out = {k: None if v is None else v.reshape(x.shape + v.shape[1:])
@@ -330,6 +336,7 @@ class LocalFactors:
     film_fraction: np.ndarray | None = None
     log_friction: np.ndarray | None = None
     thin_friction: np.ndarray | None = None
+    thin_area: np.ndarray | None = None
 
 
 @arguments(factors=[FlowFactors])

@@ -198,7 +198,7 @@ def _film_variant(factors, moments, k) -> FlowFactors:
         return np.array([m[key][k] for m in moments])
 
     out = {"friction_factor": get("s_c") * factors.h_m,
-           "thin_friction": get("s_thin") * factors.h_m}
+           "thin_friction": get("s_thin") * factors.h_m, "thin_area": get("a_thin")}
     if all("film_area" in m for m in moments):
         out.update(film_spread(get("film_area"), get("log_shear"), factors.h_m))
     return replace(factors, meta={}, **out)

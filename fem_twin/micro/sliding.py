@@ -25,7 +25,7 @@ from ..contact import contact_rate
 from ..contact import solve as contact_solve
 from ..errors import InputError, SolverError
 from .cell_fv import CellSolverFV
-from .film import mean_inverse_film
+from .film import area_above, mean_inverse_film
 from .flow_factors import FlowFactors
 from .rolling import SLIDING
 
@@ -251,17 +251,19 @@ def film_moments(contact, cell: dict, settings: CellSettings) -> dict:
     ``settings.boundary_film``, then half and twice it (:data:`FILM_CUTS`): contact spots
     carry the boundary shear (eq 32) instead, and thinner films near them are boundary
     films.  ``h3_g1_pin``: eq 14's ``<h^3 grad chi_1>`` with the pin at rest (``k`` times
-    the frame's), for the Poiseuille friction ``2 e1 - b``.  ``s_thin``: ``<1/h>`` over the
-    films between the gap floor and each cut, the confined films' Couette shear
-    (:attr:`FlowFactors.thin_friction`)."""
+    the frame's), for the Poiseuille friction ``2 e1 - b``.  ``s_thin`` and ``a_thin``:
+    ``<1/h>`` over the films between the gap floor and each cut and their area, the
+    confined films' Couette shear and where it acts (:attr:`FlowFactors.thin_friction`,
+    :attr:`FlowFactors.thin_area`)."""
     k = 2 * frame_speed_ratio(settings)
-    h_inv = np.array([mean_inverse_film(contact.raw_gap, c * settings.boundary_film)
-                      for c in FILM_CUTS])
+    cuts = [c * settings.boundary_film for c in FILM_CUTS]
+    h_inv = np.array([mean_inverse_film(contact.raw_gap, c) for c in cuts])
     above_floor = mean_inverse_film(contact.raw_gap, settings.gap_floor)
+    area = [area_above(contact.raw_gap, c) for c in (settings.gap_floor, *cuts)]
     return {"p_con": float(contact.pressure.mean()),
             "contact_fraction": contact.contact_fraction,
             "h3_g1_pin": k * cell["h3_g1"], "s_c": h_inv + 3 * k * k * cell["h3_g1g1"],
-            "s_thin": above_floor - h_inv}
+            "s_thin": above_floor - h_inv, "a_thin": area[0] - np.array(area[1:])}
 
 
 def frame_speed_ratio(settings: CellSettings) -> float:
@@ -367,7 +369,8 @@ def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
                        friction_factor=get("s_c")[:, 0] * h_m,
                        pressure_friction=np.array([1.0, 0.0]) + get("h3_g1_pin") / h_m[:, None],
                        contact_fraction=get("contact_fraction"),
-                       thin_friction=get("s_thin")[:, 0] * h_m, meta=meta)
+                       thin_friction=get("s_thin")[:, 0] * h_m,
+                       thin_area=get("a_thin")[:, 0], meta=meta)
 
 
 def film_spread(film_area, log_shear, h_m) -> dict:

@@ -31,7 +31,7 @@ def save_point(folder, key, h0, moments):
 
 #: the moments a checkpoint must hold (eqs 11-16)
 MOMENTS = ("h", "h3_grad", "h3_g1", "h_grad", "h_g1", "h3_g1g1", "s_c", "h3_g1_pin",
-           "p_con", "contact_fraction", "s_thin")
+           "p_con", "contact_fraction", "s_thin", "a_thin")
 
 
 def read_point(path, key=None, h0=None):

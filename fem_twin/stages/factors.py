@@ -65,12 +65,20 @@ def homogenise_patches(case: Case, out: RunLayout, executor=None, progress: bool
             "files": [out.flow_factors_csv.name, out.flow_factors_png.name]}
 
 
+def _knows_thin(path) -> bool:
+    """Whether the factors file at ``path`` holds the confined films' moments (a file of
+    an earlier fem_twin does not, and reads them as none: its cells are recomputed where
+    the case shears those films, ``[boundary] thin_films = "viscous"``)."""
+    with np.load(path) as data:
+        return "thin_area" in data
+
+
 def _patch_factors(case: Case, out: RunLayout, i: int, h0, executor, bar) -> FlowFactors:
     """Flow factors of patch pair ``i`` (0-based): its file if present, else computed."""
     mc = case.micro
     path, checkpoints = out.patch_factors(i + 1), out.patch_checkpoints(i + 1)
     ff = load_or_none(path, FlowFactors.load)
-    if ff is not None:
+    if ff is not None and (case.boundary.thin_films != "viscous" or _knows_thin(path)):
         bar.update(len(h0))
         return ff
     low = read_topography(out.patch(i + 1, "low"))
