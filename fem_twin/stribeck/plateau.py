@@ -41,8 +41,8 @@ def fit_plateau(model: FitModel, measured, params, share: float = PLATEAU_SHARE)
     """Fit ``params`` (boundary law's) to the ``measured`` points whose twin asperity
     share is at least ``share`` [-], then predict every point (module docstring): the
     :func:`.fit.fit_curves` result with ``plateau``: the rows per curve and, for the
-    ``fitted`` and ``predicted`` points, their count, rms and largest |C_f,dev| [-] and
-    the predicted points inside their band."""
+    ``fitted`` and ``predicted`` points, their count, rms and largest absolute C_f,dev [-]
+    and the points inside their band."""
     check_plateau(params, share)
     on = [_shares(model, k, m) >= share for k, m in enumerate(measured)]
     keep = [k for k, mask in enumerate(on) if mask.any()]
@@ -81,8 +81,8 @@ def _cut(m: MeasuredCurve, mask) -> MeasuredCurve:
 
 
 def _summary(model: FitModel, rows, fitted: bool) -> dict:
-    """Count, rms and largest |C_f,dev| of the fitted or predicted points, and how many of
-    them lie inside their 95 % band."""
+    """Count, rms and largest absolute C_f,dev of the fitted or predicted points, and how
+    many of them lie inside their 95 % band."""
     pick = [np.array(r["fitted"]) == fitted for r in rows]
     get = lambda key: np.concatenate([np.array(r[key])[p] for r, p in zip(rows, pick)])  # noqa: E731
     dev = (get("cf") - get("measured_cf")) / model.boundary_friction
