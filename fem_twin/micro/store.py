@@ -15,7 +15,11 @@ from ..io.checkpoint import check_made_for, input_key, load_or_none, made_for
 
 
 def cell_key(z_low, z_up, spacing, settings) -> str:
-    return input_key(np.asarray(z_low), np.asarray(z_up), list(spacing), settings.__dict__)
+    """The key of a cell's checkpoints: its surfaces, spacing and settings, and the moments
+    a checkpoint holds (:data:`MOMENTS`; an earlier set is another key, recomputed and
+    pruned, not a damaged file)."""
+    return input_key(np.asarray(z_low), np.asarray(z_up), list(spacing), settings.__dict__,
+                     MOMENTS)
 
 
 def point_path(folder: Path, key: str, h0: float) -> Path:
