@@ -28,7 +28,7 @@ def atomic_path(path, suffix: str | None = None):
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",
                                    suffix=path.suffix if suffix is None else suffix)
     except OSError as err:           # /proc, a read-only mount: the path's, not the temporary's
-        raise _unwritable(path, err) from None
+        raise FileSystemError(err.errno, _unwritable(path, err)) from None
     os.close(fd)
     umask = os.umask(0)
     os.umask(umask)
@@ -38,16 +38,15 @@ def atomic_path(path, suffix: str | None = None):
         try:
             os.replace(tmp, path)
         except OSError as err:
-            raise _unwritable(path, err) from None
+            raise FileSystemError(err.errno, _unwritable(path, err)) from None
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
 
 
-def _unwritable(path: Path, err: OSError) -> FileSystemError:
-    """The error of a file that cannot be written at ``path`` (exit 4), naming it."""
-    return FileSystemError(err.errno, f"cannot write {path} ({err.strerror}); give another "
-                           "place")
+def _unwritable(path: Path, err: OSError) -> str:
+    """The message of a file that cannot be written at ``path`` (exit 4), naming it."""
+    return f"cannot write {path} ({err.strerror}); give another place"
 
 
 def remove_debris(folder) -> int:
