@@ -14,6 +14,7 @@ from .. import tables as T
 from ..case.sections import Geometry, LubricantSpec, MicroSpec, Tribometer
 from ..contact.levelling import level_pin
 from ..errors import NotConverged, RunLocked, SchedulerUnreachable
+from ..numerics.threads import quiet_resource_tracker
 from ..stribeck.fit import PARAMETERS
 from ..stribeck.plateau import PLATEAU_SHARE
 from ..topography.prepare import MacroOptions
@@ -63,6 +64,7 @@ def main(argv=None) -> int:
         handler.setLevel(level)
         if not args.debug:                          # tracebacks: run.log; the error: below
             handler.addFilter(lambda record: not record.exc_info)
+    quiet_resource_tracker()
     try:
         return args.func(args) or 0
     except KeyboardInterrupt:

@@ -140,6 +140,21 @@ class _SideThreads:
         return [f.result() for f in [self.submit(fn, item) for item in items]]
 
 
+def quiet_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker (one per program) with its standard error
+    on the null device: after Ctrl-C it warned of a LocalCluster's leaked semaphore, two
+    lines beside the run's one (it still cleans up).  The command line calls it first."""
+    from multiprocessing import resource_tracker
+    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 2)
+        resource_tracker.ensure_running()
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(null)
+
+
 def process_pool(workers: int) -> ProcessPoolExecutor:
     """A local pool of ``workers`` processes started by :func:`quiet_worker`."""
     return ProcessPoolExecutor(workers, initializer=quiet_worker)
