@@ -139,3 +139,30 @@ def test_factors_of_an_earlier_version_are_recomputed_where_the_films_shear(fact
              meta=np.array("{}"))
     assert _knows_thin(new) and not _knows_thin(old)
     assert np.all(type(factors).load(old).thin_area == 0)
+
+
+def test_each_shear_law_parameter_s_share_is_cf_s_sensitivity_to_it(factors):
+    """``share_shear_strength`` and ``share_pressure_coefficient`` (stribeck.csv) split the
+    boundary share between tau_0 and alpha: each is d ln C_f / d ln q, so raising tau_0 or
+    alpha by 10 % raises C_f by 10 % times its share, to 1e-9; they add up to the
+    boundary share; the constant law's one share is the boundary share."""
+    from fem_twin.stribeck import SweepRequest, stribeck_sweep
+    from fem_twin.stribeck.curve import parameter_shares
+    gap, dx, face = macro_case(32)
+
+    def sweep(law):
+        return stribeck_sweep(SweepRequest(gap, dx, factors, [0.05, 0.01], load=150.0,
+                                           face=face, lubricant=Lubricant(0.066),
+                                           settings=MacroSettings(boundary=law)))
+    base = sweep(SHEAR)
+    shares = parameter_shares(base, SHEAR)
+    assert np.allclose(shares["share_shear_strength"] + shares["share_pressure_coefficient"],
+                       base.boundary_share, rtol=1e-12)
+    assert np.all(shares["share_shear_strength"] > 0.05)
+    for name in ("shear_strength", "pressure_coefficient"):
+        up = sweep(BoundaryLaw(**{**SHEAR.__dict__, name: 1.1 * getattr(SHEAR, name)}))
+        rise = up.friction_coefficient / base.friction_coefficient - 1
+        assert np.allclose(rise, 0.1 * shares[f"share_{name}"], rtol=1e-9, atol=0)
+    constant = sweep(BoundaryLaw())
+    assert np.array_equal(parameter_shares(constant, BoundaryLaw())["share_boundary_friction"],
+                          constant.boundary_share)

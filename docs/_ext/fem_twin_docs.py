@@ -82,7 +82,11 @@ def outputs() -> str:
     lines += ["| `cf_err` | estimated discretisation error of C_f (both scales, "
               "{doc}`/accuracy`) |",
               "| `cf_min`, `cf_max` | the patch scatter band (`[run] patch_band`) |",
-              f"| `{BOUNDARY_SHARE[0]}` | {BOUNDARY_SHARE[2]} |"]
+              f"| `{BOUNDARY_SHARE[0]}` | {BOUNDARY_SHARE[2]} |",
+              "| `share_boundary_friction`, or `share_shear_strength` and "
+              "`share_pressure_coefficient` | C_f's relative sensitivity to each parameter "
+              "of the run's boundary law, d ln C_f / d ln q (they add up to "
+              "`boundary_share`) |"]
     thermal = lambda key: " (`[thermal]`)" if "temperature" in key or "spot" in key else ""  # noqa: E731
     lines += [f"| `{header}` | {meaning}{thermal(key)} |"
               for key, (header, _, meaning) in OPTIONAL.items()]

@@ -57,7 +57,7 @@ def stribeck_curves(case: Case, out: RunLayout, executor=None, progress: bool = 
     band = patch_band(patch_curves) if patch_curves else None
     patch_tasks = band_run + [task for added, _ in extra for task in added]
     _prune_points(out.points, tasks + patch_tasks)
-    write_stribeck_csv(out.stribeck_csv, curves, band)
+    write_stribeck_csv(out.stribeck_csv, curves, band, law=case.boundary)
     summary = _summary(case, out, curves, band)
     writers.write(write_run_results, case, out, curves, patch_curves)
     plot_curves(case, curves, band, out, writers)

@@ -158,16 +158,40 @@ def joined(curves) -> StribeckCurve:
                    coarse_friction_coefficient=coarse)
 
 
+def parameter_shares(curve: StribeckCurve, law) -> dict:
+    """C_f's relative sensitivity to each parameter of the boundary ``law`` (a
+    :class:`~fem_twin.macro.boundary.BoundaryLaw`) at each point of ``curve``, ``d ln C_f /
+    d ln q`` [-] by name ``share_q``: C_f,b's is :attr:`StribeckCurve.boundary_share`; the
+    shear law splits it between tau_0 (``tau_0 A_r``) and alpha (``alpha W``), from the
+    curve's real contact area and asperity load (none without them)."""
+    share = curve.boundary_share
+    if law.law == "constant":
+        return {"share_boundary_friction": share}
+    if curve.real_contact_area is None or curve.asperity_load is None:
+        return {}
+    tau = law.shear_strength * curve.real_contact_area
+    alpha = law.pressure_coefficient * curve.asperity_load
+    with np.errstate(invalid="ignore", divide="ignore"):
+        part = np.where(tau + alpha > 0, tau / (tau + alpha), 0.0)
+    return {"share_shear_strength": share * part,
+            "share_pressure_coefficient": share * (1 - part)}
+
+
 @arguments(path="path", curves=[StribeckCurve])
-def write_stribeck_csv(path, curves, band=None) -> Path:
+def write_stribeck_csv(path, curves, band=None, law=None) -> Path:
     """All curves into one CSV (:data:`HEADERS`, SI units), atomically; ``cf_err``, the
     estimated discretisation error of C_f, when a curve has it; ``band``: optional
-    ``(cf_min, cf_max)`` per curve (the patch scatter band), two more columns."""
+    ``(cf_min, cf_max)`` per curve (the patch scatter band), two more columns; ``law``:
+    the run's boundary law, whose parameters' shares of C_f follow
+    (:func:`parameter_shares`)."""
     curves = list(curves)
     columns = {HEADERS[k]: np.concatenate([np.broadcast_to(getattr(c, k), c.speed.shape)
                                            for c in curves]) for k in COLUMNS}
     columns["iterations"] = columns["iterations"].astype(int)
     columns[BOUNDARY_SHARE[0]] = np.concatenate([c.boundary_share for c in curves])
+    shares = [parameter_shares(c, law) for c in curves] if law is not None else []
+    for name in (shares[0] if shares and all(shares) else {}):
+        columns[name] = np.concatenate([s[name] for s in shares])
     if any(c.friction_error is not None for c in curves):
         columns["cf_err"] = np.concatenate([np.full(c.speed.shape, np.nan)
                                             if c.friction_error is None else c.friction_error
