@@ -14,7 +14,7 @@ from .. import tables as T
 from ..case.sections import Geometry, LubricantSpec, MicroSpec, Tribometer
 from ..contact.levelling import level_pin
 from ..errors import NotConverged, RunLocked, SchedulerUnreachable
-from ..numerics.threads import quiet_resource_tracker
+from ..numerics.threads import quiet_resource_tracker, side_threads_alive
 from ..stribeck.fit import PARAMETERS
 from ..stribeck.plateau import PLATEAU_SHARE
 from ..topography.prepare import MacroOptions
@@ -70,6 +70,11 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print(f"fem-twin {args.command}: interrupted; finished work is kept, run the same "
               "command again to resume", file=sys.stderr)
+        if side_threads_alive():          # the levelling beside the cells, maybe in C code
+            sys.stdout.flush()
+            sys.stderr.flush()
+            logging.shutdown()
+            os._exit(130)                 # the pool, cluster and run lock are closed by now
         return 130
     except Exception as err:                   # one line for the user, traceback on request
         if args.debug:

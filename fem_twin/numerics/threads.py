@@ -117,6 +117,17 @@ def side_threads():
         future.result()
 
 
+#: the name of :func:`side_threads`' threads
+SIDE_THREAD = "fem_twin-side"
+
+
+def side_threads_alive() -> bool:
+    """Whether a thread of :func:`side_threads` still runs (after Ctrl-C, one may be inside
+    native code, which aborts the process when the interpreter finalises around it: the
+    command line then leaves at once, its files already closed)."""
+    return any(t.name == SIDE_THREAD and t.is_alive() for t in threading.enumerate())
+
+
 class _SideThreads:
     """The executor of :func:`side_threads`: a daemon thread per task."""
 
@@ -132,7 +143,7 @@ class _SideThreads:
                     future.set_result(fn(*args))
                 except BaseException as err:       # handed to the waiting thread
                     future.set_exception(err)
-        threading.Thread(target=run, daemon=True, name="fem_twin-side").start()
+        threading.Thread(target=run, daemon=True, name=SIDE_THREAD).start()
         self.futures.append(future)
         return future
 
