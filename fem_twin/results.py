@@ -105,6 +105,9 @@ def stribeck_dataset(curves, patch_curves=None):
                 out[k][i, np.searchsorted(speed, c.speed)] = getattr(c, k)
     coords = {"viscosity": ("viscosity", mu, {"units": "Pa s"}),
               "speed": ("speed", speed, {"units": "m/s"})}
+    if patch_curves and any(len(per_mu) != len(curves) for per_mu in patch_curves):
+        raise InputError("stribeck_dataset: patch_curves holds, for each patch, one curve per "
+                         f"viscosity of curves ({len(curves)}), at the run's speeds")
     if patch_curves:
         cf = np.full((len(patch_curves), mu.size, speed.size), np.nan)
         for p, per_mu in enumerate(patch_curves):

@@ -471,3 +471,19 @@ def test_curves_read_back_from_a_csv_make_a_dataset():
     ds = stribeck_dataset([curve])
     assert ds["cf_err"].values.tolist() == [[1e-4, 2e-4]]
     assert stribeck_dataset([curve], patch_curves=[[curve]])["cf_max"].shape == (1, 2)
+    with pytest.raises(InputError, match="patch_curves"):         # a patch without curves
+        stribeck_dataset([curve], patch_curves=[[]])
+
+
+def test_a_kelvin_reference_temperature_is_refused_where_it_meets_a_temperature():
+    """Probe A108: BoundaryLaw(reference_temperature=297.15) alone cannot tell kelvin from
+    Celsius (it lies in -40 to 300 C); at a film temperature of 50 C its factor was 1.49,
+    the shear raised 49 %.  temperature_factor refuses a temperature more than 100 K from
+    T_ref, as the case parser does at every oil."""
+    from fem_twin.macro.boundary import BoundaryLaw, temperature_factor
+    law = BoundaryLaw(law="shear", shear_strength=1e7, pressure_coefficient=0.1,
+                      temperature_coefficient=0.002, reference_temperature=297.15)
+    with pytest.raises(InputError, match="not kelvin"):
+        temperature_factor(law, 50.0)
+    assert temperature_factor(BoundaryLaw(**{**law.__dict__, "reference_temperature": 24.0}),
+                              50.0) == pytest.approx(1 - 0.002 * 26)

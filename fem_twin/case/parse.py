@@ -12,7 +12,7 @@ from pathlib import Path
 from ..checks import arguments, memory_shortfall
 from ..errors import InputError
 from ..io.files import topography_shape
-from ..macro.boundary import FADED, BoundaryLaw, thin_films_choice
+from ..macro.boundary import FADED, REFERENCE_REACH, BoundaryLaw, thin_films_choice
 from ..macro.thermal import ThermalSettings
 from ..stribeck.curve import read_measured_csv
 from ..stribeck.validation import check_like_with_like
@@ -34,9 +34,6 @@ from .table import CaseError, int_pair, only, read_table
 #: local worker processes a case may ask for per core (``[run] workers``): more only add
 #: memory and switching
 WORKERS_PER_CORE = 4
-#: the largest distance [K] of [boundary] reference_temperature from every oil temperature:
-#: farther, it is a kelvin value typed as Celsius (24 C is 24.0, not 297.15)
-REFERENCE_REACH = 100.0
 #: the fewest pixels a side of the macro grid ([preprocessing] resolution): its error
 #: estimate solves the grid coarsened by two
 MACRO_SIDE = 16

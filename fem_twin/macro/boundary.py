@@ -39,6 +39,10 @@ THIN_FILMS = ("boundary", "viscous", "none")
 #: (the linear law is a local expansion about reference_temperature): the case parser's
 #: limit at the hottest oil, :func:`temperature_factor`'s at its temperature
 FADED = 0.5
+#: the largest distance [K] of a temperature from reference_temperature the linear law
+#: spans: farther, one of them is a kelvin value typed as Celsius (24 C is 24.0, not
+#: 297.15); the case parser's limit from every oil, :func:`temperature_factor`'s
+REFERENCE_REACH = 100.0
 
 
 def thin_films_choice(value):
@@ -182,7 +186,8 @@ def temperature_factor(law: BoundaryLaw, temperature: float, rise_per_shear: flo
     ``dT = G tau t`` (the flash is linear in the flux): so ``t = (1 - c_T (temperature -
     T_ref)) / (1 + c_T G tau)``; ``rise_per_shear`` is ``G tau`` [K], the rise of the
     untempered shear (0: no spot flash).  Refused, naming the argument: a ``temperature``
-    outside -40 to 300 C, a negative ``rise_per_shear``, and a temperature at which the
+    outside -40 to 300 C or more than :data:`REFERENCE_REACH` from T_ref (a kelvin
+    ``reference_temperature``), a negative ``rise_per_shear``, and a temperature at which the
     linear law alone takes :data:`FADED` (half) of the shear or more, as the case parser
     refuses at the case's hottest oil (297.15, kelvin typed as C, with c_T = 0.002 about
     24 C); the film's own heat may take it further (:func:`heated_factor`)."""
@@ -191,6 +196,13 @@ def temperature_factor(law: BoundaryLaw, temperature: float, rise_per_shear: flo
         raise InputError(f"temperature_factor: rise_per_shear = {rise_per_shear:g} K: the "
                          "spots' flash of the untempered shear, not negative (0: none)")
     fall = law.temperature_coefficient * (temperature - law.reference_temperature)
+    if law.law == "shear" and law.temperature_coefficient and abs(
+            temperature - law.reference_temperature) > REFERENCE_REACH:
+        raise InputError(f"temperature_factor: temperature = {temperature:g} C lies more than "
+                         f"{REFERENCE_REACH:g} K from reference_temperature = "
+                         f"{law.reference_temperature:g} C, beyond the linear law; "
+                         "temperatures are in degrees Celsius, not kelvin (24 C is 24.0, "
+                         "not 297.15)")
     if law.law == "shear" and fall >= FADED:
         raise InputError(f"temperature_factor: temperature = {temperature:g} C lies "
                          f"{temperature - law.reference_temperature:g} K above "
