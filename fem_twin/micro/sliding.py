@@ -359,18 +359,18 @@ def factors_from_moments(h0, moments, meta, prefix: str = "") -> FlowFactors:
         return values
 
     h_m = get("h")
-    spread = {}
+    optional = {}
     if all(prefix + "film_area" in m for m in moments):
-        spread = film_spread(get("film_area")[:, 0], get("log_shear")[:, 0], h_m)
-    return FlowFactors(h0=np.asarray(h0, float), h_m=h_m, p_con=get("p_con"), **spread,
+        optional = film_spread(get("film_area")[:, 0], get("log_shear")[:, 0], h_m)
+    if all(prefix + "s_thin" in m and prefix + "a_thin" in m for m in moments):
+        optional.update(thin_friction=get("s_thin")[:, 0] * h_m, thin_area=get("a_thin")[:, 0])
+    return FlowFactors(h0=np.asarray(h0, float), h_m=h_m, p_con=get("p_con"), **optional,
                        A=get("h3_grad") / h_m[:, None, None] ** 3,
                        b=np.array([1.0, 0.0]) - get("h3_g1") / h_m[:, None],
                        C=get("h_grad") / h_m[:, None, None], d=get("h_g1") * h_m[:, None],
                        friction_factor=get("s_c")[:, 0] * h_m,
                        pressure_friction=np.array([1.0, 0.0]) + get("h3_g1_pin") / h_m[:, None],
-                       contact_fraction=get("contact_fraction"),
-                       thin_friction=get("s_thin")[:, 0] * h_m,
-                       thin_area=get("a_thin")[:, 0], meta=meta)
+                       contact_fraction=get("contact_fraction"), meta=meta)
 
 
 def film_spread(film_area, log_shear, h_m) -> dict:

@@ -38,16 +38,17 @@ MOMENTS = ("h", "h3_grad", "h3_g1", "h_grad", "h_g1", "h3_g1g1", "s_c", "h3_g1_p
            "p_con", "contact_fraction", "s_thin", "a_thin")
 
 
-def read_point(path, key=None, h0=None):
+def read_point(path, key=None, h0=None, required=MOMENTS):
     """The moments of an h0 checkpoint; with ``key`` and ``h0``, refused
-    (:class:`~fem_twin.errors.ForeignCheckpoint`) unless it was made for them."""
+    (:class:`~fem_twin.errors.ForeignCheckpoint`) unless it was made for them; refused
+    (InputError) without the ``required`` moments or with non-finite ones."""
     data = json.loads(path.read_text())
     if key is not None:
         check_made_for(data, key, h0, path)
     moments = {k: (np.array(v) if isinstance(v, list) else v)
                for k, v in data["moments"].items()}
-    missing = [k for k in MOMENTS if k not in moments]
-    if missing or not np.all([np.all(np.isfinite(moments[k])) for k in MOMENTS]):
+    missing = [k for k in required if k not in moments]
+    if missing or not np.all([np.all(np.isfinite(moments[k])) for k in required]):
         raise InputError(f"checkpoint lacks or has non-finite moments {missing or ''}")
     return moments
 

@@ -20,12 +20,12 @@ from collections import defaultdict
 import numpy as np
 
 from ..case import Case
-from ..errors import MissingFile
+from ..errors import FemTwinError, MissingFile
 from ..io.layout import RunLayout
 from ..micro import FlowFactors
 from ..micro.sampling import adaptive_separations
 from ..micro.sliding import factors_from_moments
-from ..micro.store import load_point
+from ..micro.store import point_path, read_point
 from ..stribeck.sweep import GUIDED_BY, LEVEL_OF, point_files, point_key, readable_meta
 from .schedule import Task, critical_path, makespan
 
@@ -80,10 +80,13 @@ def _rounds(h0, folder, key, h0_tol) -> list[list[int]]:
 
 
 def _moments(folder, key, h0) -> dict:
-    moments = load_point(folder, key, h0)
-    if moments is None:
-        raise MissingFile(f"{folder}: the run's h0 checkpoint at {h0:.4e} m is missing")
-    return moments
+    """A checkpoint's moments as they are (an earlier fem_twin's set too: the task graph
+    reads its times and the factors of its adaptive rounds), never set aside."""
+    try:
+        return read_point(point_path(folder, key, h0), key, h0, required=("h",))
+    except (OSError, ValueError, KeyError, FemTwinError):
+        raise MissingFile(f"{folder}: the run's h0 checkpoint at {h0:.4e} m is missing or "
+                          "unreadable") from None
 
 
 def _seconds(moments) -> float:
