@@ -163,7 +163,8 @@ def test_measured_curves_at_two_loads_and_a_prediction_at_a_third(tmp_path, caps
     twin swept at that load and oil (checkpointed in OUT/fit/): the run's own curve at
     150 N and the twin's at 300 N, both at C_f,b = 0.15, return C_f,b = 0.15 with the
     loads in fit.json; ``--predict-load 225`` writes the fitted twin at 225 N with its
-    band; tau_0 with alpha from one load is refused before any work."""
+    band, which holds the twin's cf_err there; tau_0 with alpha from one load is refused
+    before any work."""
     case = small_case(tmp_path)
     out, heavy = tmp_path / "o", tmp_path / "heavy"
     assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
@@ -188,6 +189,9 @@ def test_measured_curves_at_two_loads_and_a_prediction_at_a_third(tmp_path, caps
     assert {"speed_m_s", "friction_coefficient", "cf_low", "cf_high"} <= set(rows[0])
     assert all(float(r["cf_low"]) <= float(r["friction_coefficient"]) <= float(r["cf_high"])
                for r in rows)
+    # the band holds the twin's own error at that load, as the run's curves do (it was
+    # missing: the fit's sweeps at other loads ran without the estimate)
+    assert all(float(r["cf_err"]) >= 0 for r in rows)
     assert main(["fit", str(case), light, "-o", str(out), "--no-progress", "--params",
                  "shear_strength,pressure_coefficient"]) == 2
     assert "two or more loads" in capsys.readouterr().err

@@ -183,7 +183,7 @@ def _simulated(case: Case, out: RunLayout, tests, progress: bool) -> list:
     run = read_stribeck_csv(out.stribeck_csv)
     own = [run[mus.index(mu)] if load == tr.load and mu in mus else None
            for load, mu in tests]
-    first = _fit_sweep(case, out)
+    first = _fit_sweep(case, out, error_estimate=True)   # cf_err, as the run's: the band
     tasks = [replace(first, load=load, lubricant=replace(first.lubricant, viscosity=mu))
              for (load, mu), c in zip(tests, own) if c is None]
     with executor_for(case.run.workers, case.run.scheduler) as executor:
