@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import InputError
 from .curve import MeasuredCurve
 from .fit import SHEAR, FitModel, fit_curves
-from .prediction import predict
+from .prediction import finish_fit_figure, predict
 
 #: the asperities' share of the load from which a measured point is on the plateau
 PLATEAU_SHARE = 0.9
@@ -97,8 +97,6 @@ def plot_plateau(result: dict, path, labels=None):
     """Each curve's measured points (filled: the plateau fitted, open: predicted) and the
     predicted C_f with its 95 % band."""
     import matplotlib.pyplot as plt
-
-    from ..io.figure import save_figure
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     for i, row in enumerate(result["plateau"]["rows"]):
         label = labels[i] if labels else f"curve {row['curve']}"
@@ -113,12 +111,6 @@ def plot_plateau(result: dict, path, labels=None):
         ax.loglog(u[~fitted], cf[~fitted], "s", mfc="none", color=line.get_color(), ms=5,
                   label=f"predicted, {label}")
     p = result["plateau"]
-    ax.set_title(f"boundary level from {p['fitted']['points']} plateau points; "
-                 f"{p['predicted']['inside_band']} of {p['predicted']['points']} predicted "
-                 "inside their band", fontsize="small")
-    ax.set_xlabel("sliding speed $U$ [m/s]")
-    ax.set_ylabel("$C_f$ [-]")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize="x-small")
-    fig.tight_layout()
-    return save_figure(fig, path, dpi=110)
+    return finish_fit_figure(fig, ax, path, f"boundary level from {p['fitted']['points']} "
+                             f"plateau points; {p['predicted']['inside_band']} of "
+                             f"{p['predicted']['points']} predicted inside their band")

@@ -80,7 +80,6 @@ def plot_fit(result: dict, path, labels=None):
     """Measured and fitted C_f against speed, one colour per curve."""
     import matplotlib.pyplot as plt
 
-    from ..io.figure import save_figure
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     for i, row in enumerate(result["residuals"]):
         label = labels[i] if labels else f"curve {row['curve']}"
@@ -89,7 +88,14 @@ def plot_fit(result: dict, path, labels=None):
                   label=f"measured, {label}")
     fitted = ", ".join(f"{k} = {v['value']:.4g} [{v['low']:.4g}, {v['high']:.4g}]"
                        for k, v in result.items() if k in result["fit"]["parameters"])
-    ax.set_title(fitted, fontsize="small")
+    return finish_fit_figure(fig, ax, path, fitted)
+
+
+def finish_fit_figure(fig, ax, path, title: str):
+    """A fit's C_f-against-speed figure with its ``title``, labels, grid and legend,
+    saved to ``path``."""
+    from ..io.figure import save_figure
+    ax.set_title(title, fontsize="small")
     ax.set_xlabel("sliding speed $U$ [m/s]")
     ax.set_ylabel("$C_f$ [-]")
     ax.grid(True, which="both", alpha=0.3)
