@@ -104,6 +104,7 @@ def test_the_deterministic_pad_takes_the_twins_boundary_law(thin_films):
         assert shear.film_friction > plain.film_friction
 
 
+@pytest.mark.integration
 def test_the_boundary_share_is_cf_s_sensitivity_to_the_boundary_level(factors, tmp_path):
     """``boundary_share`` = F_b / F_T (stribeck.csv, results.nc) is the relative change of
     C_f per relative change of C_f,b (the boundary force does not feed back into an
@@ -141,6 +142,7 @@ def test_factors_of_an_earlier_version_are_recomputed_where_the_films_shear(fact
     assert np.all(type(factors).load(old).thin_area == 0)
 
 
+@pytest.mark.integration
 def test_each_shear_law_parameter_s_share_is_cf_s_sensitivity_to_it(factors):
     """``share_shear_strength`` and ``share_pressure_coefficient`` (stribeck.csv) split the
     boundary share between tau_0 and alpha: each is d ln C_f / d ln q, so raising tau_0 or
