@@ -460,16 +460,18 @@ def test_the_terminal_never_shows_a_traceback(tmp_path):
 
     case = small_case(tmp_path, workers=2)
     text = case.read_text()
-    (tmp_path / "broken.npz").write_bytes(b"PK\x03\x04 not a topography")
+    flat = dict(np.load(ROOT / "meshes" / "sample" / "pin_1.npz"))   # reads, then fails
+    flat["heights"] = np.zeros_like(flat["heights"])                  # in the geometry stage
+    np.savez(tmp_path / "flat.npz", **flat)
     broken = tmp_path / "broken.toml"
     broken.write_text(text.replace(str(ROOT / "meshes" / "sample" / "pin_1.npz"),
-                                   str(tmp_path / "broken.npz")))
+                                   str(tmp_path / "flat.npz")))
     command = [sys.executable, "-m", "fem_twin.cli", "run", "-o"]
     done = subprocess.run(command + [str(tmp_path / "a"), str(broken), "--no-progress"],
                           capture_output=True, text=True)
     lines = done.stderr.strip().splitlines()
     assert done.returncode == 2 and "Traceback" not in done.stderr
-    assert "broken.npz" in lines[-1] and "estimated" in lines[0] and len(lines) == 2
+    assert "no pin face" in lines[-1] and "estimated" in lines[0] and len(lines) == 2
     assert "Traceback" in (tmp_path / "a" / "run.log").read_text()
     slow = tmp_path / "slow.toml"                     # a micro stage of several seconds
     slow.write_text(text.replace("resolution = [16, 16]", "resolution = [64, 64]")

@@ -156,7 +156,14 @@ def pad_friction(pressure, gap, cavity_fraction, viscosity, spacing, speed: floa
         raise InputError("pad_friction: viscosity [Pa s] is positive (66 mPa s is 0.066)")
     plausible("pad_friction: spacing [m]", spacing, "pitch")
     plausible("pad_friction: boundary_film [m]", boundary_film, "boundary_film")
-    dp1 = np.gradient(p, spacing[0], axis=1)
+    return film_force(p, h, cavity_fraction, viscosity, spacing, speed, boundary_film)
+
+
+def film_force(pressure, gap, cavity_fraction, viscosity, spacing, speed: float,
+               boundary_film: float) -> float:
+    """:func:`pad_friction` without its checks, for the solvers' own fields [N]."""
+    h = np.asarray(gap, float)
+    dp1 = np.gradient(np.asarray(pressure, float), spacing[0], axis=1)
     shear = np.where(h > boundary_film, viscosity * speed / h, 0.0) * (1 - cavity_fraction)
     return float(np.sum(trapezoid_weights(h.shape, spacing) * (shear + h / 2 * dp1)))
 
@@ -309,8 +316,8 @@ def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant:
     s, dx, load, speed = _checked(shape, spacing, load, speed, lubricant, settings)
     pad = _Pad(s, dx, speed, lubricant, settings)
     h_d, st, history, _ = balance(pad, load, initial.separation if initial else None)
-    film = pad_friction(st["p"], st["gap"], st["theta"], st["mu"], dx, speed,
-                        viscous_cut(settings))
+    film = film_force(st["p"], st["gap"], st["theta"], st["mu"], dx, speed,
+                      viscous_cut(settings))
     return DeterministicResult(speed, load, float(h_d), st["film_load"], st["contact_load"],
                                film, boundary_force(pad.area, st, settings, speed),
                                dx, st["p"], st["p_con"], st["theta"], st["gap"],

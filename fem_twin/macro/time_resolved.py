@@ -44,7 +44,7 @@ from .deterministic import (
     _Pad,
     balance,
     boundary_force,
-    pad_friction,
+    film_force,
     viscous_cut,
 )
 from .lubricant import Lubricant
@@ -227,8 +227,8 @@ class _March:
         self.last = st
         s, dx = pad.settings, pad.spacing
         flank = float(np.sum(pad.area * st["p"] * disk_at(self.slopes, shift, self.nodes)))
-        film = pad_friction(st["p"], st["gap"], st["theta"], st["mu"], dx, pad.speed,
-                            viscous_cut(s)) + flank
+        film = film_force(st["p"], st["gap"], st["theta"], st["mu"], dx, pad.speed,
+                          viscous_cut(s)) + flank
         return {"contact_load": st["contact_load"], "film_load": st["film_load"],
                 "film_friction": film,
                 "boundary_force": boundary_force(pad.area, st, s, pad.speed)}
