@@ -491,7 +491,7 @@ def test_a_report_that_cannot_be_written_is_a_file_system_error(tmp_path, capsys
     with pytest.raises(OSError, match=f"cannot write {target}") as err, atomic_path(target):
         pass
     assert not isinstance(err.value, FileNotFoundError | NotADirectoryError)
-    from fem_twin.cli.main import _report
+    from fem_twin.cli.exits import report as _report
     assert _report("report", err.value) == 4
 
 

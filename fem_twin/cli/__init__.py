@@ -3,6 +3,7 @@
 compare, calibrate, fit, validate, report) and the commands that run one step of the chain
 on its own (:mod:`~fem_twin.cli.steps`: topography, contact, homogenise, macro, mesh)."""
 
-from .main import EXIT_CODES, build_parser, main
+from .exits import EXIT_CODES
+from .main import build_parser, main
 
 __all__ = ["EXIT_CODES", "build_parser", "main"]

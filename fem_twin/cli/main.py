@@ -7,18 +7,17 @@ import inspect
 import logging
 import os
 import re
-import sys
 from pathlib import Path
 
 from .. import tables as T
 from ..case.sections import Geometry, LubricantSpec, MicroSpec, Tribometer
 from ..contact.levelling import level_pin
-from ..errors import NotConverged, RunLocked, SchedulerUnreachable
-from ..numerics.threads import quiet_resource_tracker, side_threads_alive
+from ..numerics.threads import quiet_resource_tracker
 from ..stribeck.fit import PARAMETERS
 from ..stribeck.plateau import PLATEAU_SHARE
 from ..topography.prepare import MacroOptions
 from . import runs, steps
+from .exits import interrupted, report
 
 DEFAULT_CASE = Path("examples/pin_on_disk.toml")
 
@@ -42,18 +41,6 @@ _STEPS = {
 }
 
 
-#: exit codes (docs/troubleshooting.md): exception types -> (code, label, advice)
-EXIT_CODES = (
-    ((ValueError, FileNotFoundError, IsADirectoryError, NotADirectoryError), 2, "error",
-     "check the input named above"),
-    ((NotConverged,), 3, "not converged",
-     "the residual history is in run.log; see docs/troubleshooting.md"),
-    ((OSError,), 4, "file system", "check free space and write permission of the folder"),
-    ((SchedulerUnreachable,), 5, "cluster", "start the scheduler or remove [run] scheduler"),
-    ((RunLocked,), 6, "busy", ""),
-)
-
-
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -68,35 +55,11 @@ def main(argv=None) -> int:
     try:
         return args.func(args) or 0
     except KeyboardInterrupt:
-        print(f"fem-twin {args.command}: interrupted; finished work is kept, run the same "
-              "command again to resume", file=sys.stderr)
-        if side_threads_alive():          # the levelling beside the cells, maybe in C code
-            sys.stdout.flush()
-            sys.stderr.flush()
-            logging.shutdown()
-            os._exit(130)                 # the pool, cluster and run lock are closed by now
-        return 130
+        return interrupted(args.command)
     except Exception as err:                   # one line for the user, traceback on request
         if args.debug:
             raise
-        return _report(args.command, err)
-
-
-def _report(command: str, err: Exception) -> int:
-    """Print one line (what, and what to do) and return the documented exit code."""
-    for types, code, label, advice in EXIT_CODES:
-        if isinstance(err, types):
-            hint = f" ({advice})" if advice and code != 2 else ""
-            print(f"fem-twin {command}: {label}: {_one_line(err)}{hint}", file=sys.stderr)
-            return code
-    print(f"fem-twin {command}: internal error: {type(err).__name__}: {_one_line(err)} "
-          "(run again with --debug for the traceback, and please report it)", file=sys.stderr)
-    return 1
-
-
-def _one_line(err: Exception) -> str:
-    text = " ".join(str(err).split())
-    return text if len(text) < 400 else text[:400] + " ..."
+        return report(args.command, err)
 
 
 class _Formatter(argparse.HelpFormatter):

@@ -24,8 +24,8 @@ from ..errors import InputError, NotConverged
 from ..macro.boundary import BoundaryLaw
 from ..macro.viscosity import WaltherLaw
 from .curve import SPEED_MATCH, MeasuredCurve, StribeckCurve
-from .fit_statistics import correlation, covariance, interval
-from .identify import PAIR, check_separable, separability
+from .fit_statistics import correlation, covariance, interval, temperature_warnings
+from .identify import check_pair
 
 #: the shear law's parameters a fit can identify (``[boundary]`` keys), with their bounds
 SHEAR = {"shear_strength": (0.0, 5e8), "pressure_coefficient": (0.0, 1.0),
@@ -36,8 +36,6 @@ PARAMETERS = ("boundary_friction", "temperature", "load_share", "bulk_resistance
 LOAD_SHARES = (0.5, 0.625, 0.75, 0.875, 1.0)
 #: the rig's thermal resistances [K/W] swept for a ``bulk_resistance`` fit (its bounds)
 RESISTANCES = (0.0, 1.0, 2.0, 4.0)
-#: a fitted contact temperature this far [K] from its curve's oil temperature is flagged
-TEMPERATURE_OFFSET = 15.0
 #: expected range of three normal samples in standard deviations (d2 of n = 3)
 RANGE_OF_THREE = 1.693
 
@@ -201,10 +199,7 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     measured, dropped = _inside(model, measured, *unpack(x0))
     sigma = [_sigma(m) for m in measured]
     weighted = all(s is not None for s in sigma)
-    identified = None
-    if set(PAIR) <= set(params):                 # tau_0 and alpha: refused unless separable
-        identified = separability(model, measured, unpack(x0)[1], sigma)
-        check_separable(identified)
+    identified = check_pair(model, measured, params, unpack(x0)[1], sigma)
 
     def residuals(x):
         cfb, mus, share, resistance, shear = unpack(x)
@@ -228,9 +223,7 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
         raise NotConverged(f"fit did not converge: {sol.message}", [float(sol.cost)])
     sol.x, sol.jac = low + sol.x * span, sol.jac / span
     out = _summary(model, measured, names, sol, weighted, unpack, (lower, upper))
-    out["fit"]["points_not_counted"] = dropped
-    if identified is not None:
-        out["fit"]["identifiability"] = identified
+    out["fit"].update(points_not_counted=dropped, **identified)
     out["fit"]["warnings"] += [f"curve {k + 1}: {n} measured point(s) outside the simulated "
                                "speeds not counted" for k, n in enumerate(dropped) if n]
     check_misfit(out, names, sol.x, lower, upper)
@@ -390,19 +383,5 @@ def _summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
                   "correlation": correlation(cov).tolist(), "covariance": cov.tolist(),
                   "t_factor": float(stats.t.ppf(0.975, dof))}
     out["residuals"] = rows
-    out["fit"]["warnings"] = _temperature_warnings(model, out, len(measured))
+    out["fit"]["warnings"] = temperature_warnings(model, out, len(measured))
     return out
-
-
-def _temperature_warnings(model: FitModel, out: dict, n: int) -> list[str]:
-    """Fitted contact temperatures more than :data:`TEMPERATURE_OFFSET` from their curve's."""
-    warnings = []
-    for k in range(n):
-        fitted = out.get(f"temperature_{k + 1}", {}).get("value")
-        oil = None if fitted is None else float(model.law.temperature(model.curves[k].viscosity))
-        if fitted is not None and abs(fitted - oil) > TEMPERATURE_OFFSET:
-            warnings.append(f"curve {k + 1}: the fitted contact temperature is {fitted:.1f} C "
-                            f"({oil:.1f} C in the case): frictional heating of a few K is "
-                            "usual; a larger offset may stand for another load or lubricant "
-                            "(the Hersey collapse trades the two)")
-    return warnings

@@ -1,9 +1,13 @@
 """The statistics of a least-squares fit (:mod:`.fit`): 95 % intervals clipped to the
-parameters' bounds, the parameters' covariance and correlation."""
+parameters' bounds, the parameters' covariance and correlation, and the warnings on
+fitted contact temperatures."""
 
 from __future__ import annotations
 
 import numpy as np
+
+#: a fitted contact temperature this far [K] from its curve's oil temperature is flagged
+TEMPERATURE_OFFSET = 15.0
 
 
 def interval(value: float, half: float, lower: float, upper: float) -> dict:
@@ -37,3 +41,18 @@ def correlation(cov):
     d = np.sqrt(np.diag(cov))
     outer = np.outer(d, d)
     return np.divide(cov, outer, out=np.zeros_like(cov), where=outer > 0)
+
+
+def temperature_warnings(model, out: dict, n: int) -> list[str]:
+    """Fitted contact temperatures more than :data:`TEMPERATURE_OFFSET` from their curve's
+    oil temperature (``model``: the :class:`.fit.FitModel`)."""
+    warnings = []
+    for k in range(n):
+        fitted = out.get(f"temperature_{k + 1}", {}).get("value")
+        oil = None if fitted is None else float(model.law.temperature(model.curves[k].viscosity))
+        if fitted is not None and abs(fitted - oil) > TEMPERATURE_OFFSET:
+            warnings.append(f"curve {k + 1}: the fitted contact temperature is {fitted:.1f} C "
+                            f"({oil:.1f} C in the case): frictional heating of a few K is "
+                            "usual; a larger offset may stand for another load or lubricant "
+                            "(the Hersey collapse trades the two)")
+    return warnings

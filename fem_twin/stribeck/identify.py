@@ -74,3 +74,14 @@ def check_separable(found: dict) -> None:
             + "; ".join(reach) + f"). The data identify alpha + tau_0 / p_r = "
             f"{found['alpha_eff']:.4g} at p_r = {mean:.3g} GPa: fit pressure_coefficient "
             "alone with [boundary] shear_strength = 0, which then carries it")
+
+
+def check_pair(model, measured, params, viscosities, sigma) -> dict:
+    """Where ``params`` fit tau_0 and alpha together: their :func:`separability`, refused
+    unless separable (:func:`check_separable`), as ``{"identifiability": ...}`` for the
+    fit's record; else nothing."""
+    if not set(PAIR) <= set(params):
+        return {}
+    found = separability(model, measured, viscosities, sigma)
+    check_separable(found)
+    return {"identifiability": found}
