@@ -1,6 +1,6 @@
-"""What the benchmark groups share: the bundled sample's maps, the best of repeated
-timings, a fresh ``fem-twin run`` of a case file, and the macro groups' inputs (sample pin 1
-on disk 1, patch 1's flow factors)."""
+"""What the benchmark groups share: a group's checked line (:class:`Check`), the bundled
+sample's maps, the best of repeated timings, a fresh ``fem-twin run`` of a case file, and
+the macro groups' inputs (sample pin 1 on disk 1, patch 1's flow factors)."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import os
 import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,20 @@ from fem_twin.topography import pin_face
 from fem_twin.topography.prepare import prepare_pin
 
 SAMPLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "meshes", "sample")
+
+
+@dataclass(frozen=True)
+class Check:
+    """A group's last line: ``text`` names the criterion and what the run measured for it;
+    ``holds`` True or False, or None where there was nothing to check."""
+
+    holds: bool | None
+    text: str
+
+    def line(self) -> str:
+        if self.holds is None:
+            return f"check: {self.text}: skipped"
+        return f"check: {self.text}: holds" if self.holds else f"FAILED: {self.text}"
 
 
 def best_of(fn, repeat=3):
@@ -60,3 +75,12 @@ def macro_gap(n):
     pin = prepare_pin(read_topography(os.path.join(SAMPLE, "pin_1.npz")), opts)
     disk = prepare_disk(read_topography(os.path.join(SAMPLE, "disk_1.npz")), opts)
     return disk.heights - pin.heights, pin.spacing, pin_face(pin, opts.holder_height)
+
+
+def sample_patch_pair(n=256):
+    """Sample patch pair 3 prepared at n^2 (pin, disk): the micro and contact groups' cell."""
+    from fem_twin.topography.prepare import prepare_patch
+    pin = prepare_patch(read_topography(os.path.join(SAMPLE, "patch_3_pin.npz")), (n, n))
+    disk = prepare_patch(read_topography(os.path.join(SAMPLE, "patch_3_disk.npz")), (n, n),
+                         upper=True)
+    return pin, disk

@@ -9,7 +9,9 @@ pad of 8 cells: the film pressure's deformation of the asperities switched off i
 deterministic solver; the film cut-off at 5 and 20 nm, an isoviscous oil and a shear law
 with tau_0 = 50 MPa (the homogenised tau_0 a_c against tau_0 on the resolved spots), on
 both sides; on the pad of 4 cells, cells of 64 px on both sides.  The times are
-per point; the baseline is the twin's on the finest pad; the last line is the summary.
+per point; the baseline is the twin's on the finest pad.  The summary line gives the worst
+gaps on the finest pad; checked: the worst C_f gap falls with eps (scale separation).
+The knee at eps = 1/32 is the group ``deterministic-fine``.
 """
 
 from __future__ import annotations
@@ -19,10 +21,12 @@ import time
 from dataclasses import replace
 
 import numpy as np
+from common import Check
 
 from fem_twin.macro import BoundaryLaw, Lubricant
 from fem_twin.studies import verification as V
 
+DEFAULT = False
 HERE = os.path.dirname(os.path.abspath(__file__))
 SAMPLE = os.path.join(HERE, "..", "meshes", "sample")
 #: the speeds at two cells a side [m/s] (the finer pads' scale as 2 / tiles)
@@ -80,8 +84,8 @@ def _diagnostics(pad, tiles, cfb, base):
     return rows
 
 
-def bench_deterministic(tiles=V.TILES):
-    """The comparison table (module docstring) and its summary line."""
+def run(tiles=V.TILES):
+    """The comparison table (module docstring), its summary line and the check."""
     pad = V.sample_pad(SAMPLE, PIXELS)
     cfb = pad.settings.boundary_friction
     factors = V.pad_factors(pad, H0)
@@ -102,33 +106,9 @@ def bench_deterministic(tiles=V.TILES):
                 f"{100 * cf:+.2f} % C_f,b")
         rows.append((f"eps -> 0 (speed {speed:.3g} m/s at eps 1/2)", 0.0, note))
     rows += _diagnostics(pad, 8, cfb, dets.get(8) or V.deterministic_sweep(pad, 8, SPEEDS))
-    return t_twin / len(SPEEDS), rows, V.summary(table[-1], cfb)
-
-
-#: the knee at two cells a side: 70 % to 22 % of the load on asperities at eps = 1/16
-KNEE = SPEEDS[2:5]
-
-
-def bench_deterministic_fine(tiles=(8, 16, 32)):
-    """The knee speeds at eps = 1/8, 1/16 and 1/32 (1025^2 nodes, about 20 min a point on
-    2 cores): the gaps and the order each speed observes (``to_zero``), so that the
-    eps -> 0 value is measured, not assumed.  Times per point, the baseline the first; the
-    last line is the summary at 1/32."""
-    pad = V.sample_pad(SAMPLE, PIXELS)
-    cfb = pad.settings.boundary_friction
-    factors = V.pad_factors(pad, H0)
-    rows, table = [], []
-    for n in tiles:
-        t0 = time.perf_counter()
-        det = V.deterministic_sweep(pad, n, KNEE)
-        t1 = time.perf_counter()
-        table.append(V.compared(det, V.twin_sweep(pad, n, KNEE, factors), n))
-        rows += [_row(p, cfb, (t1 - t0) / len(KNEE)) for p in table[-1]]
-    eps = [1 / n for n in tiles]
-    for k, speed in enumerate(KNEE):
-        cf, order = V.to_zero(eps, [t[k].cf_gap(cfb) for t in table])
-        share, share_order = V.to_zero(eps, [t[k].share - t[k].share_det for t in table])
-        rows.append((f"eps -> 0 (speed {speed:.3g} m/s at eps 1/2)", 0.0,
-                     f"C_f - C_f,det {100 * cf:+.2f} % C_f,b ({V.order_text(order)}), share "
-                     f"- share,det {share:+.4f} ({V.order_text(share_order)})"))
-    return rows[0][1], rows, V.summary(table[-1], cfb, "mixed regime at eps 1/32")
+    worst = [max(abs(p.cf_gap(cfb)) for p in pairs) for pairs in table]
+    falls = all(b < a for a, b in zip(worst, worst[1:]))
+    gaps = ", ".join(f"{100 * w:.2f}" for w in worst)
+    return t_twin / len(SPEEDS), rows, V.summary(table[-1], cfb), Check(
+        falls, f"the worst |C_f - C_f,det| falls with eps: {gaps} % C_f,b at eps "
+               + ", ".join(f"1/{n}" for n in tiles))

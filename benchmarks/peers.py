@@ -15,7 +15,8 @@ twin, both against the deterministic reference (docs/peers.md).
    and each run's wall time.  ``$FEM_TWIN_BENCH_DIR`` keeps the runs (a finished one is read).
 
 Times are per point (1, 2) or per run (3); the baseline is the peer's bundled run.  The
-last line is the checked summary.
+summary line gives both models' worst gaps to the deterministic pads and the curves' times;
+checked: the twin's worst C_f gap below the average-flow model's.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from dataclasses import replace
 import deterministic as D  # the benchmarks' sibling modules
 import numpy as np
 import unsteady as U
+from common import Check
 
 from fem_twin.case import load_case
 from fem_twin.stages import pipeline
@@ -35,6 +37,7 @@ from fem_twin.stribeck.analysis import knee_speed
 from fem_twin.stribeck.curve import read_stribeck_csv
 from fem_twin.studies import verification as V
 
+DEFAULT = False
 HERE = os.path.dirname(os.path.abspath(__file__))
 #: the steady pad's tile counts
 STEADY_TILES = (2, 4, 8)
@@ -117,8 +120,8 @@ def _curves(rows, keep):
     return times
 
 
-def bench_peers():
-    """The rows of the module docstring and the summary line."""
+def run():
+    """The rows of the module docstring, the summary line and the check."""
     rows = []
     twin, peer, cfb = _steady(rows)
     twin_moving, peer_moving = _moving(rows)
@@ -135,7 +138,10 @@ def bench_peers():
                f"{100 * worst['peer']:.2f} % C_f,b; twin: {100 * worst['twin']:.2f} % C_f,b; "
                f"curve time average flow {_seconds(bundled['average-flow'])}, twin "
                f"{_seconds(bundled['cells'])}")
-    return bundled["average-flow"] or 1.0, rows, summary
+    return bundled["average-flow"] or 1.0, rows, summary, Check(
+        worst["twin"] < worst["peer"], f"the twin's worst |C_f - C_f,det| "
+                                       f"{100 * worst['twin']:.2f} % C_f,b below the average-flow "
+                                       f"model's {100 * worst['peer']:.2f} %")
 
 
 def _seconds(value) -> str:
