@@ -14,7 +14,7 @@ region keeps its own squeeze only (docs/model.md, "Friction on the pin").
 The bundled sample patch pair 3 (the roughest, Sq 186 nm composite), resampled to three
 cell grids, at h0 from 0.2 to 0.6 um: s_C leaking and sealed, and at the finest grid with
 the gap floor at 0.5 and 2 nm. Prints how far s_C moves across the grids and with the
-floor; ends in ``OUT/sealed_pockets.png``. Measured (2026-11-29): leaking, s_C moves by up
+floor; ends in ``OUT/sealed_pockets.png``. What it prints: leaking, s_C moves by up
 to 218 % across 64, 128, 256 px and by 66 % with the floor; sealed, by 87 % and 2.9 %. What
 still moves the sealed s_C is the topography's resolution (a coarser cell smooths the
 asperities, so its s_C is lower at every h0) and the squeeze of films just above the
