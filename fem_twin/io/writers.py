@@ -2,7 +2,8 @@
 the figures, ``results.nc`` and ``fields.nc``.
 
 Written in the main process, the figures kept the workers waiting (matplotlib's layout and
-text are pure Python, so they gain from processes, not threads; benchmarks/README.md).
+text are pure Python, so they gain from processes, not threads; ``python
+benchmarks/run.py stribeck`` times the bundled run end to end).
 """
 
 from __future__ import annotations

@@ -10,7 +10,8 @@ the Intel Simplified Software License).  MKL runs sequentially: parallel speed c
 processes; ``FEM_TWIN_THREADS=N`` before MKL loads gives N PARDISO threads on matrices of
 ``THREADED_UNKNOWNS`` or more, idle threads sleeping at once (``KMP_BLOCKTIME=0``).
 ``backend=None`` reads ``FEM_TWIN_SPARSE`` (``auto``: PARDISO when ``libmkl_rt`` loads,
-else SuperLU); the two agree to about 1e-11 (tested).  Measurements: benchmarks/README.md.
+else SuperLU); the two agree to about 1e-11 (tested).  Measurements: ``python
+benchmarks/run.py micro`` (the cell step on both) and ``scale`` (the macro points).
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from .threads import thread_limit
 BACKENDS = ("superlu", "pardiso")
 #: PARDISO uses the threads ``FEM_TWIN_THREADS`` allows only on matrices of at least this
 #: many unknowns: below, waking the sleeping threads for each small solve costs more than
-#: they bring (benchmarks/README.md, "linalg")
+#: they bring (``python benchmarks/run.py scale`` with ``FEM_TWIN_THREADS`` 1 and 2)
 THREADED_UNKNOWNS = 1 << 17
 
 
@@ -162,7 +163,8 @@ class SPDSolver:
         if self._a is None:
             raise SolverError("factor() a matrix before solve()")
         # all columns in one call: 1.4-2.3x faster than one call a column for 2-5 columns of
-        # a 48^2-256^2 cell (benchmarks/README.md)
+        # a 48^2-256^2 cell (``python benchmarks/run.py micro`` times the cell step that
+        # calls it)
         b = np.asfortranarray(rhs.reshape(self.n, -1), dtype=self.dtype)
         return self._pardiso(33, b).reshape(rhs.shape).astype(float, copy=False)
 

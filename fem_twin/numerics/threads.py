@@ -57,7 +57,8 @@ def worker_heap() -> None:
     (33.7 s against 17.0 s without that setting, contact 2.8x).  32 MB, glibc's own largest
     threshold, keeps the 1997^2 grids (31.9 MB a field) on the heap and maps the 2048^2 ones
     (33.5 MB), which a heap would hold beyond their use (a 2048^2 point's peak with 64 MB,
-    32 MB and none: benchmarks/README.md).  Called by the worker tasks (also when they
+    32 MB and none: ``FEM_TWIN_SCALE_MAX=2048 python benchmarks/run.py scale``).  Called by
+    the worker tasks (also when they
     run in the calling process), once per process; a no-op without glibc."""
     global _HEAP_SET
     if _HEAP_SET or not sys.platform.startswith("linux"):

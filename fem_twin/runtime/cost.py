@@ -2,9 +2,10 @@
 
 ``fem-twin run`` prints it scaled to this machine by :func:`fem_twin.runtime.machine.slowdown` and
 asks for ``--yes`` above seven times the bundled case's.  The constants were fitted to the
-bundled, paper and ball cases on the calibration machine (their measurements:
-``benchmarks/README.md``, "The run-time cost model"); ``tests/test_cli.py`` holds the
-estimate within 0.7-1.3x of those runs.
+bundled, paper and ball cases on the calibration machine (``python benchmarks/run.py
+estimates`` sets each example's estimate beside its run and checks 0.8-1.25x);
+``tests/test_cli.py::test_run_time_estimates_hold`` holds the estimate within 0.8-1.25x of
+those runs.
 """
 
 from __future__ import annotations
@@ -52,7 +53,8 @@ MICRO_SECONDS = 3.5e-6
 ADAPTIVE_H0 = (5.5, 2.7)
 
 #: how a sweep point's time grows with the grid's nodes N, as N^COST_GROWTH (the resolution
-#: study's points grow as N^1.39 from 500^2 to 1997^2, benchmarks/README.md), so that the
+#: study's points grow as N^1.39 from 500^2 to 1997^2, ``fem-twin calibrate --study
+#: resolution``; ``python benchmarks/run.py scale`` times single points), so that the
 #: largest-first schedule starts the finest grids' points first
 COST_GROWTH = 1.35
 

@@ -175,8 +175,10 @@ def chains(tasks, workers: int) -> list:
     costing at most half such a share (one point at least), so that a largest-first
     schedule keeps every worker busy to the end.  A chain's first point starts cold (from
     the coarsest nested level), about as fast as a warm one on fine grids and with the same
-    C_f to 2e-6 (benchmarks/README.md).  A sweep that writes fields stays whole (one VTU per speed,
-    numbered along the sweep, and one PVD)."""
+    C_f to 2e-6 (the resolution study's 999^2 sweep, ``fem-twin calibrate --study
+    resolution``; the cutting: ``tests/test_scaleout.py::
+    test_a_sweep_longer_than_a_workers_share_runs_as_chains``).  A sweep that writes fields
+    stays whole (one VTU per speed, numbered along the sweep, and one PVD)."""
     share = sum(map(sweep_cost, tasks)) / max(workers, 1)
     out = []
     for i, task in enumerate(tasks):
