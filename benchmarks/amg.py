@@ -66,7 +66,7 @@ def _capture(n: int, path: str) -> dict:
     """Solve ``scale``'s cold point until the finest level's first Newton step; keep it."""
     from common import macro_factors, macro_gap
 
-    import fem_twin.macro.switch as switch
+    import fem_twin.macro.film.switch as switch
     from fem_twin.macro import Lubricant, OperatingPoint
     from fem_twin.macro.nested import solve_nested
     real = switch.newton_solver
@@ -108,11 +108,11 @@ def _solve(solver: str, path: str) -> dict:
     out = {}
     t0 = time.perf_counter()
     if solver == "pardiso":
-        from fem_twin.macro.stencil_solver import newton_solver
+        from fem_twin.macro.film.stencil_solver import newton_solver
         step = newton_solver(d["shape"], d["dirichlet"], interior, K, B)
         x = step(pos, dtheta, rhs)
     elif solver == "superlu":
-        from fem_twin.macro.switch import _interior_order
+        from fem_twin.macro.film.switch import _interior_order
         order = _interior_order(d["shape"], d["dirichlet"], interior)
         lu = spla.splu(J[order][:, order].tocsc(), permc_spec="NATURAL",
                        diag_pivot_thresh=0.1, options={"SymmetricMode": True})
@@ -121,7 +121,7 @@ def _solve(solver: str, path: str) -> dict:
     else:
         import pyamg
 
-        from fem_twin.macro.stencil_solver import STEP_RTOL
+        from fem_twin.macro.film.stencil_solver import STEP_RTOL
         ml = pyamg.ruge_stuben_solver(J, max_coarse=500)
         its = []
         x, _ = spla.gmres(J, rhs, M=ml.aspreconditioner(), rtol=STEP_RTOL, restart=60,

@@ -8,7 +8,7 @@ twin, both against the deterministic reference (docs/peers.md).
 2. Both bodies rough, the disk's roughness moving (the ``unsteady`` group's pads: pair 1,
    and the x3p-2 crops when ../shared is there, isoviscous oil on both sides), at
    eps = 1/4 over the knee's three speeds (the crops: its middle one), against
-   :func:`fem_twin.macro.time_resolved.solve_time_resolved`.
+   :func:`fem_twin.macro.reference.time_resolved.solve_time_resolved`.
 3. The bundled pin and the paper case run twice (``fem-twin run``'s pipeline), with
    ``[micro] model = "cells"`` and ``"average-flow"``: per viscosity the largest C_f
    difference, the knee speeds (half the load on asperities) and the slowest point's C_f,

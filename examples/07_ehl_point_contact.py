@@ -22,7 +22,7 @@ import numpy as np
 
 from fem_twin.io.table import write_csv
 from fem_twin.macro import Lubricant, MacroSettings, MixedNotConverged, solve_mixed
-from fem_twin.macro.point_contact import PointContact, film_thickness
+from fem_twin.macro.reference.point_contact import PointContact, film_thickness
 from fem_twin.micro import FlowFactors
 
 args = [a for a in sys.argv[1:] if a != "--quick"]

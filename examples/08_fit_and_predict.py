@@ -38,7 +38,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from fem_twin.case import load_case
-from fem_twin.macro.viscosity import WaltherLaw
+from fem_twin.macro.laws.viscosity import WaltherLaw
 from fem_twin.stages.pipeline import run
 from fem_twin.stribeck.curve import read_stribeck_csv
 from fem_twin.studies.fitting import fit_case

@@ -26,8 +26,8 @@ import numpy as np
 
 from fem_twin import read_topography
 from fem_twin.macro import Lubricant, MacroSettings
-from fem_twin.macro.thermal import ContactThermal, ThermalSettings, surface_temperature
-from fem_twin.macro.viscosity import WaltherLaw
+from fem_twin.macro.laws.thermal import ContactThermal, ThermalSettings, surface_temperature
+from fem_twin.macro.laws.viscosity import WaltherLaw
 from fem_twin.micro import homogenise
 from fem_twin.stribeck import SweepRequest, stribeck_sweep
 from fem_twin.topography import pin_face, resample_cell

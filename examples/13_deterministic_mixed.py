@@ -5,7 +5,7 @@ The mixed regime against a deterministic solution
 The twin against a solution that does not homogenise: a crowned square pad carrying a
 roughness cell tiled ``n`` times per side (the bundled patch pair 1, the disk smooth), solved
 with the roughness resolved on the film's grid, the asperity contact and the film together
-(:func:`fem_twin.macro.deterministic.solve_deterministic`), and by the twin with the flow
+(:func:`fem_twin.macro.reference.deterministic.solve_deterministic`), and by the twin with the flow
 factors of that cell (:mod:`fem_twin.studies.verification`).
 
     python examples/13_deterministic_mixed.py [OUT] [--quick]

@@ -5,7 +5,7 @@ Both bodies rough, the disk's roughness moving
 The configuration every run uses, against a solution resolved in time: the crowned pad of
 :mod:`fem_twin.studies.verification` carries the pin's cell of the bundled patch pair 1
 tiled ``n`` times a side, and the disk's cell slides over it one pixel a step
-(:func:`fem_twin.macro.time_resolved.solve_time_resolved`: the transient, mass-conserving
+(:func:`fem_twin.macro.reference.time_resolved.solve_time_resolved`: the transient, mass-conserving
 Reynolds equation with JFO, the asperity contact with the hardness cap, the separation
 balanced on the load of each roughness period).  The twin takes the pair's unsteady cells
 (eq 8 with its time term).  Both sides take the isoviscous oil and asperities that feel

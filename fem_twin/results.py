@@ -24,15 +24,15 @@ from .checks import arguments
 from .errors import FileSystemError, InputError, MissingFile
 from .io.atomic import atomic_path
 from .io.layout import RunLayout
+from .macro.coupling.result import FIELDS
 from .macro.estimate import PARTS
-from .macro.result import FIELDS
 from .micro.flow_factors import FlowFactors
 from .stribeck.curve import BOUNDARY_SHARE, LEGACY, OPTIONAL, UNITS, StribeckCurve
 
 ENGINE = "h5netcdf"
 #: ``fields.nc``'s variables and units: an operating point's fields
-#: (:data:`fem_twin.macro.result.FIELDS`), its piezoviscous viscosity as ``local_viscosity``
-#: (``viscosity`` is the coordinate mu_0 of the sweep)
+#: (:data:`fem_twin.macro.coupling.result.FIELDS`), its piezoviscous viscosity as
+#: ``local_viscosity`` (``viscosity`` is the coordinate mu_0 of the sweep)
 FIELD_UNITS = {("local_viscosity" if k == "viscosity" else k): u for k, u in FIELDS.items()}
 
 @dataclass(frozen=True)

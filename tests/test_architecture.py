@@ -122,15 +122,92 @@ def test_imports_run_down_the_pipeline():
     assert not up, "imports against the pipeline's order:\n" + "\n".join(sorted(up))
 
 
+def _rooms() -> dict:
+    """The layer of each room of ``macro/`` and of each module of its porch, from the table
+    in fem_twin.macro's docstring."""
+    import re
+
+    import fem_twin.macro
+    rows = re.findall(r"^ {4}(\d+) +([\w, ]+)$", fem_twin.macro.__doc__, re.M)
+    return {name.strip(): int(layer) for layer, names in rows for name in names.split(",")}
+
+
+ROOMS = _rooms()
+MACRO = PACKAGE / "macro"
+
+
+def _room(module: str) -> str:
+    """The room of a module of fem_twin.macro (its first part below macro/), or, for the
+    porch, the module itself; the package ``fem_twin.macro`` is the porch's front."""
+    parts = module.split(".")[2:]
+    return parts[0] if parts else "__init__"
+
+
+def test_the_macro_table_names_every_room_and_the_porch():
+    """The table in fem_twin.macro's docstring names each room (a folder of macro/) and
+    each module of the porch (macro/'s own modules) once, and the porch is on top."""
+    rooms = {p.parent.name for p in MACRO.glob("*/__init__.py")}
+    porch = {p.stem for p in MACRO.glob("*.py")} - {"__init__"}
+    assert set(ROOMS) == rooms | porch, set(ROOMS) ^ (rooms | porch)
+    assert min(ROOMS[m] for m in porch) > max(ROOMS[r] for r in rooms), ROOMS
+
+
+def test_macro_rooms_import_down():
+    """Inside macro/, no room imports a later room (laws -> film -> coupling -> reference,
+    the table in fem_twin.macro's docstring) and none imports the porch, which sits on top
+    (point, mixed, nested, estimate, figures and the package's own ``__init__``)."""
+    top = max(ROOMS.values()) + 1
+    rank = {**ROOMS, "__init__": top}
+    up = []
+    for path in MACRO.rglob("*.py"):
+        m = _module(path)
+        if m == "fem_twin.macro":
+            continue
+        up += [f"{m} -> {d}" for d in _imports(path) if d.startswith("fem_twin.macro")
+               and rank[_room(d)] > rank[_room(m)]]
+    assert not up, "imports against macro's rooms:\n" + "\n".join(sorted(up))
+
+
+def test_architecture_md_names_every_package_and_no_missing_path():
+    """ARCHITECTURE.md names every subpackage of fem_twin and every room of macro/ (as
+    ``name/``, checked against the folders), and every path it gives into the package or
+    the repository (``macro/film/reynolds.py``, ``stages/geometry.measured_ball``,
+    ``benchmarks/run.py``) exists: a moved module leaves no stale line there."""
+    import re
+    root = PACKAGE.parent
+    text = (root / "ARCHITECTURE.md").read_text()
+    packages = sorted(str(p.parent.relative_to(PACKAGE)) for p in PACKAGE.rglob("__init__.py")
+                      if p.parent != PACKAGE and "__pycache__" not in p.parts)
+    unnamed = [p for p in packages if not re.search(rf"(?<![\w.-]){re.escape(p)}/", text)]
+    assert not unnamed, f"packages ARCHITECTURE.md does not name: {unnamed}"
+    tops = sorted({p.split("/")[0] for p in packages} | {"tests", "benchmarks", "docs",
+                                                         "examples"})
+    pattern = rf"(?<![\w/.-])((?:{'|'.join(tops)})(?:/\w+)*)(\.\w+)?"
+    missing = sorted({path + ext for path, ext in re.findall(pattern, text) if not any(
+        (base / path).is_dir() or (base / f"{path}.py").is_file()
+        or (base / f"{path}{ext}").is_file() for base in (PACKAGE, root))})
+    assert not missing, f"paths in ARCHITECTURE.md that do not exist: {missing}"
+    import importlib
+    names = re.findall(r"(?<![\w/.-])((?:[a-z_]+/)+[a-z_]+)\.([A-Za-z_][\w.]*[A-Za-z_])", text)
+    gone = []
+    for path, attr in sorted(set(names)):
+        if (PACKAGE / f"{path}.py").is_file() and attr != "py":
+            obj = importlib.import_module("fem_twin." + path.replace("/", "."))
+            for name in attr.split("."):
+                obj = getattr(obj, name, None)
+            gone += [f"{path}.{attr}"] if obj is None else []
+    assert not gone, f"names in ARCHITECTURE.md that their module does not hold: {gone}"
+
+
 def test_result_variables_are_declared_once():
     """An output variable is declared in one place, so adding one touches
     at most two files: an operating point's grid fields are MixedResult's arrays, each with
-    its unit in macro/result.FIELDS (checkpoints, VTU, fields.nc and the docs read it); a
+    its unit in macro/coupling/result.FIELDS (checkpoints, VTU, fields.nc and the docs read it); a
     Stribeck curve's are StribeckCurve's arrays, each a column of stribeck/curve.COLUMNS with
     its CSV header and its results.nc unit (UNITS)."""
     from dataclasses import fields
 
-    from fem_twin.macro.result import FIELDS, MixedResult
+    from fem_twin.macro.coupling.result import FIELDS, MixedResult
     from fem_twin.results import FIELD_UNITS
     from fem_twin.stribeck.curve import COLUMNS, HEADERS, UNITS, StribeckCurve
     arrays = {f.name for f in fields(MixedResult) if f.type == "np.ndarray"} - {"history"}
@@ -152,7 +229,7 @@ def test_every_setting_another_section_sets_is_filled_from_it():
 
     from fem_twin.case.sections import FILLED, SECTIONS, Case, Geometry
     from fem_twin.macro import MacroSettings
-    from fem_twin.macro.thermal import ThermalSettings
+    from fem_twin.macro.laws.thermal import ThermalSettings
     from fem_twin.micro.sliding import CellSettings
     from fem_twin.stages.factors import cell_settings
     from fem_twin.stages.requests import macro_settings
@@ -173,7 +250,8 @@ def test_every_setting_another_section_sets_is_filled_from_it():
 
 
 #: literals equal to a table value that are not that value: (file, the table's name, why)
-NOT_THE_TABLES = {("macro/point_contact.py", "ROELANDS_ALPHA"): "Moes' alpha of a test case",
+NOT_THE_TABLES = {("macro/reference/point_contact.py", "ROELANDS_ALPHA"):
+                  "Moes' alpha of a test case",
                   ("io/samples.py", "PIN_DIAMETER"): "the sample map's 8 mm field of view"}
 
 

@@ -1,4 +1,4 @@
-"""The boundary shear law (fem_twin.macro.boundary, docs/model.md "Boundary friction"):
+"""The boundary shear law (fem_twin.macro.laws.boundary, docs/model.md "Boundary friction"):
 its constant limit bit for bit, a single Hertzian asperity, one decade of speed, and the
 case file's [boundary] section."""
 
@@ -10,7 +10,7 @@ from fem_twin import Topography
 from fem_twin.case import CaseError
 from fem_twin.errors import InputError
 from fem_twin.macro import BOUNDARY_FRICTION, BoundaryLaw, Lubricant, MacroSettings, solve_mixed
-from fem_twin.macro.boundary import boundary_area, boundary_traction
+from fem_twin.macro.laws.boundary import boundary_area, boundary_traction
 from fem_twin.micro import homogenise
 
 SHEAR = BoundaryLaw(law="shear", shear_strength=50e6, pressure_coefficient=0.1,
@@ -111,8 +111,8 @@ def test_the_temperature_term_reads_the_flash_of_the_tempered_shear(factors):
     t = 1 - c_T (T_c - T_ref) to rounding (the flash is linear in the flux, so the closed
     form t = (1 - c_T (T - T_ref)) / (1 + c_T G tau) is exact, no iteration), and the
     point's boundary friction is t times the untempered one's at the same film."""
-    from fem_twin.macro.thermal import ContactThermal, ThermalSettings, thermal_point
-    from fem_twin.macro.viscosity import WaltherLaw
+    from fem_twin.macro.laws.thermal import ContactThermal, ThermalSettings, thermal_point
+    from fem_twin.macro.laws.viscosity import WaltherLaw
     gap, dx, face = macro_case(32)
     law = BoundaryLaw(law="shear", shear_strength=20e6, pressure_coefficient=0.1,
                       temperature_coefficient=0.01)
@@ -298,8 +298,8 @@ def test_the_two_oils_boundary_forces_differ_by_their_temperatures(factors, mode
     thermal model T_c is the point's asperity temperature (oil, bulk rise, face and spot
     flash), isothermal the oil's.  With tau_0 = 0 the force is alpha t times the
     asperities' load exactly.  The spot's flash alone (0.2-3 K) gave a ratio near 1."""
-    from fem_twin.macro.thermal import ContactThermal, ThermalSettings
-    from fem_twin.macro.viscosity import WaltherLaw
+    from fem_twin.macro.laws.thermal import ContactThermal, ThermalSettings
+    from fem_twin.macro.laws.viscosity import WaltherLaw
     from fem_twin.stribeck.request import SweepRequest
     from fem_twin.stribeck.sweep import _solve_point
     gap, dx, face = macro_case(32)

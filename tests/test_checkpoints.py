@@ -87,8 +87,8 @@ def test_the_sweep_key_changes_with_every_field_that_sets_the_points():
     stale checkpoints."""
     from dataclasses import fields, replace
 
-    from fem_twin.macro.thermal import ContactThermal, ThermalSettings
-    from fem_twin.macro.viscosity import WaltherLaw
+    from fem_twin.macro.laws.thermal import ContactThermal, ThermalSettings
+    from fem_twin.macro.laws.viscosity import WaltherLaw
     from fem_twin.stribeck import request as rq
     gap, dx, face = macro_case(16)
     law = WaltherLaw.through([24.0, 50.0], [0.066, 0.024], 850.0)

@@ -156,8 +156,8 @@ def test_non_convergence_errors_survive_pickling():
     """Errors raised in worker processes cross back by pickle with message and history."""
     import pickle
 
+    from fem_twin.macro.film.reynolds import ReynoldsNotConverged
     from fem_twin.macro.mixed import MixedNotConverged
-    from fem_twin.macro.reynolds import ReynoldsNotConverged
     for cls in (contact.ContactNotConverged, ReynoldsNotConverged, MixedNotConverged):
         err = pickle.loads(pickle.dumps(cls("did not converge", [3.0, 2.0, 1.5])))
         assert type(err) is cls and err.history == [3.0, 2.0, 1.5]

@@ -1,4 +1,4 @@
-"""The Couette flux of eq 17 (fem_twin.macro.couette): the second-order central scheme
+"""The Couette flux of eq 17 (fem_twin.macro.film.couette): the second-order central scheme
 against an exact mass-conserving solution with inlet suction, rupture and reformation, the
 paper's upwind scheme beside it, and the operator's derivatives for the Newton coupling.
 """
@@ -9,7 +9,7 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from fem_twin.macro import solve_reynolds
-from fem_twin.macro.couette import couette, couette_matrix
+from fem_twin.macro.film.couette import couette, couette_matrix
 
 MU, U = 0.05, 1.0
 #: the pocketed pad: length, land and pocket gaps, pocket from A to B, wall width [m]

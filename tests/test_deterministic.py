@@ -1,4 +1,4 @@
-"""The deterministic mixed-lubrication solver (fem_twin.macro.deterministic) against the
+"""The deterministic mixed-lubrication solver (fem_twin.macro.reference.deterministic) against the
 references the twin passes: the plane slider (smooth limit), Hertz and rigid-plastic
 contact (dry limit), the resolved ridged slider (full film); and the twin beside it on a
 rough pad (fem_twin.studies.verification)."""
@@ -14,7 +14,7 @@ from fem_twin.contact import solve as contact_solve
 from fem_twin.contact.elastic import elastic_operator
 from fem_twin.errors import InputError
 from fem_twin.macro import Lubricant, MacroSettings, solve_mixed, solve_reynolds
-from fem_twin.macro.deterministic import (
+from fem_twin.macro.reference.deterministic import (
     DeterministicNotConverged,
     DeterministicSettings,
     pad_friction,

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from fem_twin.macro import Lubricant, MacroSettings, solve_mixed
-from fem_twin.macro.point_contact import PointContact, film_thickness
+from fem_twin.macro.reference.point_contact import PointContact, film_thickness
 from fem_twin.micro import FlowFactors
 
 EHL = Path(__file__).resolve().parents[2] / "shared" / "references" / "ehl"
@@ -78,9 +78,9 @@ def test_newton_preconditioner_inverts_its_matrix(mourier97, monkeypatch, block,
 
     import scipy.sparse as sp
 
-    from fem_twin.macro import jacobian as jm
-    from fem_twin.macro import newton
-    from fem_twin.macro.problem import macro_problem
+    from fem_twin.macro.coupling import jacobian as jm
+    from fem_twin.macro.coupling import newton
+    from fem_twin.macro.coupling.problem import macro_problem
 
     monkeypatch.setattr(jm, "SOLVE_BLOCK", block)
     res, _, _ = mourier97

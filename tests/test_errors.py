@@ -145,7 +145,8 @@ PUBLIC = ["fem_twin", "fem_twin.topography", "fem_twin.contact", "fem_twin.micro
 #: modules without an ``__all__`` whose own public functions are walked too (issue 87
 #: item 7: the new round's functions)
 MODULES = ["fem_twin.results", "fem_twin.studies.verification", "fem_twin.stribeck.analysis",
-           "fem_twin.macro.boundary", "fem_twin.macro.thermal", "fem_twin.macro.deterministic",
+           "fem_twin.macro.laws.boundary", "fem_twin.macro.laws.thermal",
+           "fem_twin.macro.reference.deterministic",
            "fem_twin.macro.point", "fem_twin.runtime.machine", "fem_twin.topography.statistics",
            "fem_twin.peers.patir_cheng", "fem_twin.peers.greenwood_tripp",
            "fem_twin.peers.average_flow"]
@@ -158,8 +159,8 @@ def _extra_callables() -> dict:
     """Public callables outside the packages' ``__all__``: the thermal, kinematics,
     viscosity-law, case-reading and fit-application functions (issue 72 item 5)."""
     from fem_twin.case import load_case
-    from fem_twin.macro import kinematics, thermal
-    from fem_twin.macro.viscosity import WaltherLaw
+    from fem_twin.macro.laws import kinematics, thermal
+    from fem_twin.macro.laws.viscosity import WaltherLaw
     from fem_twin.studies import fitting
     return {"ThermalSettings": thermal.ThermalSettings,
             "surface_temperature": thermal.surface_temperature,
@@ -222,7 +223,7 @@ def _declared_settings():
 
     from fem_twin.case.sections import SECTIONS
     from fem_twin.macro import MacroSettings
-    from fem_twin.macro.thermal import ThermalSettings
+    from fem_twin.macro.laws.thermal import ThermalSettings
     from fem_twin.micro.sliding import CellSettings
     for cls in {CellSettings, MacroSettings, ThermalSettings, *SECTIONS.values()}:
         for f in fields(cls):
@@ -265,8 +266,8 @@ def test_settings_refuse_text_none_and_truthy_flags_where_a_number_or_flag_goes(
     """``check_ranges`` refused numbers out of range but let text and None through, which
     failed later with a bare error, and took ``"no"`` for a flag (truthy)."""
     from fem_twin.macro import BoundaryLaw, MacroSettings
-    from fem_twin.macro.deterministic import DeterministicSettings
-    from fem_twin.macro.thermal import ThermalSettings
+    from fem_twin.macro.laws.thermal import ThermalSettings
+    from fem_twin.macro.reference.deterministic import DeterministicSettings
     from fem_twin.micro.sliding import CellSettings
     for make, words in ((lambda: DeterministicSettings(film_deforms="no"), "true or false"),
                         (lambda: BoundaryLaw(film_on_contacts="yes"), "true or false"),
@@ -287,9 +288,9 @@ def test_settings_refuse_text_none_and_truthy_flags_where_a_number_or_flag_goes(
 def test_the_new_public_functions_check_their_arguments():
     """Issue 87 item 7: each raised a bare error or returned NaN."""
     from fem_twin.macro import BoundaryLaw, Lubricant, boundary_traction
+    from fem_twin.macro.laws.thermal import ThermalSettings, face_flash
+    from fem_twin.macro.laws.viscosity import WaltherLaw
     from fem_twin.macro.point import OperatingPoint
-    from fem_twin.macro.thermal import ThermalSettings, face_flash
-    from fem_twin.macro.viscosity import WaltherLaw
     from fem_twin.micro import FlowFactors
     from fem_twin.runtime.machine import probe_seconds
     gap = np.full((9, 9), 1e-6)
@@ -353,18 +354,18 @@ def test_unit_slips_and_impossible_values_of_the_round_six_functions():
 def _round_five_api_probes():
     """``(probe id, call, words)`` of issue 87's API probes that returned a result, raised a
     bare error or named neither the argument nor its unit."""
-    from fem_twin.macro.boundary import (
+    from fem_twin.macro.laws.boundary import (
         BoundaryLaw,
         asperity_load,
         boundary_area,
         boundary_traction,
         temperature_factor,
     )
-    from fem_twin.macro.deterministic import DeterministicSettings, pad_friction
-    from fem_twin.macro.lubricant import Lubricant
-    from fem_twin.macro.thermal import ThermalSettings, face_flash, spot_flash
-    from fem_twin.macro.time_resolved import disk_at, solve_time_resolved
-    from fem_twin.macro.viscosity import WaltherLaw
+    from fem_twin.macro.laws.lubricant import Lubricant
+    from fem_twin.macro.laws.thermal import ThermalSettings, face_flash, spot_flash
+    from fem_twin.macro.laws.viscosity import WaltherLaw
+    from fem_twin.macro.reference.deterministic import DeterministicSettings, pad_friction
+    from fem_twin.macro.reference.time_resolved import disk_at, solve_time_resolved
     from fem_twin.peers import Summits, average_flow_factors, contact_pressure, mean_gap
     from fem_twin.peers import patir_cheng as pc
     from fem_twin.runtime import machine
@@ -480,7 +481,7 @@ def test_a_kelvin_reference_temperature_is_refused_where_it_meets_a_temperature(
     Celsius (it lies in -40 to 300 C); at a film temperature of 50 C its factor was 1.49,
     the shear raised 49 %.  temperature_factor refuses a temperature more than 100 K from
     T_ref, as the case parser does at every oil."""
-    from fem_twin.macro.boundary import BoundaryLaw, temperature_factor
+    from fem_twin.macro.laws.boundary import BoundaryLaw, temperature_factor
     law = BoundaryLaw(law="shear", shear_strength=1e7, pressure_coefficient=0.1,
                       temperature_coefficient=0.002, reference_temperature=297.15)
     with pytest.raises(InputError, match="not kelvin"):

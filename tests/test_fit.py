@@ -12,8 +12,8 @@ import pytest
 
 from fem_twin.errors import InputError
 from fem_twin.macro import Lubricant, MacroSettings
-from fem_twin.macro.thermal import ContactThermal, ThermalSettings
-from fem_twin.macro.viscosity import WaltherLaw
+from fem_twin.macro.laws.thermal import ContactThermal, ThermalSettings
+from fem_twin.macro.laws.viscosity import WaltherLaw
 from fem_twin.stribeck import SweepRequest, stribeck_sweep
 from fem_twin.stribeck.curve import MeasuredCurve
 from fem_twin.stribeck.fit import LOAD_SHARES, RESISTANCES, FitModel, fit_curves
@@ -228,7 +228,7 @@ def test_a_parameter_the_points_do_not_see_is_refused(twin):
 
 @pytest.fixture(scope="module")
 def resistances(factors):
-    """The thermal twin (fem_twin.macro.thermal) at 24 and 50 C swept at each of
+    """The thermal twin (fem_twin.macro.laws.thermal) at 24 and 50 C swept at each of
     RESISTANCES [K/W], and the 'measured' curves run directly at R_b = 1.5 (between two
     swept ones) with C_f,b = 0.15, all at the measured speeds (no interpolation in speed)."""
     gap, dx, face = macro_case(32)

@@ -17,7 +17,7 @@ from fem_twin.macro import (
     solve_mixed,
     solve_reynolds,
 )
-from fem_twin.macro.reynolds import trapezoid_weights
+from fem_twin.macro.film.reynolds import trapezoid_weights
 from fem_twin.micro import CellSettings, FlowFactors, homogenise
 from fem_twin.micro.film import mean_inverse_film
 from fem_twin.micro.sliding import cell_solver, sliding_contacts, sliding_pass, sliding_squeeze
@@ -413,7 +413,7 @@ def test_an_eyring_film_averages_its_local_shear_over_the_cell():
     from Newtonian to deep Eyring.  Within 1 % everywhere (measured 0.8 % where tau ~
     tau_0, where the spread's shape is the log-normal's guess) and 0.01 % deep in Eyring
     (the log mean is exact); the homogenised tau_0 asinh(mean tau / tau_0) is 15 % high."""
-    from fem_twin.macro.friction import eyring_shear
+    from fem_twin.macro.laws.friction import eyring_shear
     n, height, length, tau0 = 64, 0.5e-6, 80e-6, 5e6
     dx = length / n
     z = 0.8 * height * np.cos(2 * np.pi * np.arange(n) / n)

@@ -1,4 +1,4 @@
-"""The rotating disk under the face (fem_twin.macro.kinematics), against references that do
+"""The rotating disk under the face (fem_twin.macro.laws.kinematics), against references that do
 not share the twin's Cartesian grid: a sector thrust pad solved in polar coordinates, a
 face with the disk's rotational symmetry, mass balance through a cavity, and the limit of
 an infinite track radius.
@@ -17,10 +17,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from fem_twin.macro import BOUNDARY_FRICTION, Lubricant, MacroSettings, solve_mixed, solve_reynolds
-from fem_twin.macro.couette import couette_matrix
-from fem_twin.macro.friction import face_slope
-from fem_twin.macro.kinematics import disk_velocity, in_grid_frame, rotations
-from fem_twin.macro.reynolds import fe_poiseuille, trapezoid_weights
+from fem_twin.macro.film.couette import couette_matrix
+from fem_twin.macro.film.reynolds import fe_poiseuille, trapezoid_weights
+from fem_twin.macro.laws.friction import face_slope
+from fem_twin.macro.laws.kinematics import disk_velocity, in_grid_frame, rotations
 from fem_twin.micro.flow_factors import LocalFactors
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -188,7 +188,7 @@ def test_a_far_axis_is_uniform_sliding(factors):
 
 def test_the_boundary_shear_acts_along_the_local_sliding(factors):
     """On the turning disk the contacts' shear C_f,b (p_con + p a_r) (eq 32 on the
-    asperities' load, :mod:`fem_twin.macro.boundary`) acts along the local sliding, and
+    asperities' load, :mod:`fem_twin.macro.laws.boundary`) acts along the local sliding, and
     the load cell reads its x1 part: that times cos(phi) over the face, less than C_f,b
     times the asperity load by at most 1 - cos 7.6 degrees (0.9 %)."""
     gap, dx, face = macro_case(32)

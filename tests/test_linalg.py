@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from fem_twin.errors import InputError
 from fem_twin.fvm import CellSolverFV
-from fem_twin.macro.stencil_solver import _stencil_pattern
+from fem_twin.macro.film.stencil_solver import _stencil_pattern
 from fem_twin.micro import CellSolver
 from fem_twin.numerics.linalg import SPDSolver, _mkl_rt, default_backend
 from fem_twin.numerics.ordering import nested_dissection, subgrid_order

@@ -23,7 +23,7 @@ from fem_twin.macro import (
     solve_mixed,
     solve_reynolds,
 )
-from fem_twin.macro.reynolds import fe_poiseuille
+from fem_twin.macro.film.reynolds import fe_poiseuille
 from fem_twin.micro import FlowFactors
 
 ISOVISCOUS = dict(roelands_alpha=0.0)
@@ -95,7 +95,7 @@ def test_converged_state_balances_load_and_is_consistent(case32, factors):
     assert np.all(res.pressure[[0, -1], :] == 1e5)
     # eq 19 and p_con(h0) at the converged state
     assert np.allclose(res.h0, np.maximum(res.h_d + gap + res.elastic_deformation, 1e-9))
-    from fem_twin.macro.contact_load import nodal_contact_pressure
+    from fem_twin.macro.film.contact_load import nodal_contact_pressure
     assert np.allclose(res.contact_pressure, nodal_contact_pressure(factors, res.h0, "gauss"))
     assert 0 < res.contact_load < 150
     # friction parts add up (eqs 32-34)
@@ -119,11 +119,12 @@ def test_paper_pid_coupling_reaches_the_same_state(case32, factors):
 
 def test_every_coupling_takes_its_cavitation_model_from_the_registry(case32, factors,
                                                                      monkeypatch):
-    """A cavitation model registered in macro/cavitation.MODELS is used by
+    """A cavitation model registered in macro/film/cavitation.MODELS is used by
     solve_reynolds, the fixed point and the Newton coupling (its inner solve, split and
     derivatives), so adding one touches that module and a test only.  A counting copy of
     the switch gives the switch's state."""
-    from fem_twin.macro import cavitation, solve_reynolds
+    from fem_twin.macro import solve_reynolds
+    from fem_twin.macro.film import cavitation
     calls = {"solve": 0, "split": 0, "unknown": 0, "derivatives": 0}
 
     class Counting(cavitation.PThetaSwitch):
@@ -176,7 +177,7 @@ def test_a_singular_newton_matrix_is_a_non_convergence(case32, factors, monkeypa
     import pickle
 
     from fem_twin.errors import MixedNotConverged
-    from fem_twin.macro import jacobian
+    from fem_twin.macro.coupling import jacobian
 
     def singular(*args, **kwargs):
         raise RuntimeError("Factor is exactly singular")
@@ -285,8 +286,8 @@ def test_newton_jacobian_is_exact(case32, factors):
     mixed state (p_con carries part of the load), in directions away from the p-theta kink;
     each node's mass residual relative to its flux size (a 1e-13 m change of a 1 mm gap
     beside the pin is round-off): within 1e-6 of the change (measured 1e-11 and below)."""
-    from fem_twin.macro import jacobian, newton
-    from fem_twin.macro.problem import macro_problem
+    from fem_twin.macro.coupling import jacobian, newton
+    from fem_twin.macro.coupling.problem import macro_problem
     gap, spacing, face = case32
     s = MacroSettings(coupling="newton")
     res = solve_mixed(gap, spacing, factors, load=150.0, speed=0.03,
@@ -316,14 +317,14 @@ def test_newton_jacobian_is_exact(case32, factors):
 
 
 def test_start_separations_find_analytic_roots():
-    """The cold start's root finders (macro/start.py) on loads with known roots: a lifting
+    """The cold start's root finders (macro/coupling/start.py) on loads with known roots: a lifting
     film ``F = W (h*/h)^2`` (bracket by doubling upward), a film plus asperities below first
     contact (bracket by halving towards the dry state) within their ``rtol`` 1e-3, the
     dry contact ``p_con = k (h_c - h0)^1.5`` to 1e-12, and a clear error when no
     separation below 1 mm carries the load."""
     from types import SimpleNamespace
 
-    from fem_twin.macro.start import dry_separation, rigid_separation
+    from fem_twin.macro.coupling.start import dry_separation, rigid_separation
     W, calls = 100.0, []
 
     def film(h_star):
@@ -578,18 +579,18 @@ def exponential_factors(scale=40e-9, p0=1e10):
 
 @pytest.mark.parametrize("block", [1 << 16, 32])
 def test_contact_load_integrates_the_bilinear_film(block, monkeypatch):
-    """The "gauss" contact quadrature (macro/contact_load.py) on a film tilted by 60 nm a
+    """The "gauss" contact quadrature (macro/film/contact_load.py) on a film tilted by 60 nm a
     pixel (as a crowned pin face at 128^2) under p_con = p0 exp(-h0 / 40 nm): the load
     sum a_i p_i is the exact integral to 1e-5 (3 x 3 Gauss points of an exponential that
     changes 4.5x over a pixel: 1e-6 measured), where reading p_con at the nodes (the
     paper's rule) is 19 % high (the trapezoid rule's (k dx)^2 / 12); its derivative is
     the exact one of the nodal pressures (central differences, 1e-6); the same with the
     pixels taken in one block and one row at a time."""
-    from fem_twin.macro import contact_load as module
-    from fem_twin.macro.contact_load import nodal_contact_pressure
+    from fem_twin.macro.film import contact_load as module
+    from fem_twin.macro.film.contact_load import nodal_contact_pressure
     monkeypatch.setattr(module, "BLOCK", block)
     contact_load = module.ContactLoad
-    from fem_twin.macro.reynolds import trapezoid_weights
+    from fem_twin.macro.film.reynolds import trapezoid_weights
     ff, scale, dx = exponential_factors(), 40e-9, 62.5e-6
     ny, nx, slope = 17, 33, 60e-9 / dx
     x = np.arange(nx) * dx
@@ -666,7 +667,7 @@ def test_the_newton_merit_of_an_overflowing_trial_step_is_inf():
     it) instead of raising OverflowError from Python float arithmetic."""
     from types import SimpleNamespace
 
-    from fem_twin.macro.newton import merit
+    from fem_twin.macro.coupling.newton import merit
     ev = SimpleNamespace(R=np.ones(3), G=np.ones(3), L=1e300)
     assert merit(ev, (1.0, 1.0, 1e-200)) == np.inf
     ev = SimpleNamespace(R=np.ones(3), G=np.ones(3), L=3.0)

@@ -69,7 +69,7 @@ def test_swift_stieber_reference_quadrature():
 
 def face_flux(h, theta):
     """The liquid flux per unit U/2 through each x1-face of a row: the face gap times the
-    upstream liquid fraction, ``h_f (1 - theta_up)`` (:mod:`fem_twin.macro.couette`)."""
+    upstream liquid fraction, ``h_f (1 - theta_up)`` (:mod:`fem_twin.macro.film.couette`)."""
     return (h[:-1] + h[1:]) / 2 * (1 - theta[:-1])
 
 
@@ -210,11 +210,15 @@ def test_poiseuille_reassembly_equals_the_scikit_fem_form(block, monkeypatch):
     blocks of two rows or one."""
     import skfem
 
-    from fem_twin.macro import reynolds
+    from fem_twin.macro.film import reynolds
     monkeypatch.setattr(reynolds, "BLOCK", block)
 
     from fem_twin.io.mesh import grid_mesh
-    from fem_twin.macro.reynolds import fe_poiseuille, homogenised_poiseuille_form, poiseuille_form
+    from fem_twin.macro.film.reynolds import (
+        fe_poiseuille,
+        homogenised_poiseuille_form,
+        poiseuille_form,
+    )
     rng = np.random.default_rng(0)
     shape, dx = (9, 12), (1.3e-5, 1.1e-5)
     g, A = rng.random(shape), rng.random(shape + (2, 2))
@@ -236,7 +240,7 @@ def test_poiseuille_reassembly_equals_the_scikit_fem_form(block, monkeypatch):
 
 @pytest.mark.parametrize("scale", [1e5, 1e8])
 def test_a_newton_step_reuses_the_factors_of_its_inner_solve(monkeypatch, scale):
-    """fem_twin.macro.stencil_solver: within one inner solve (K and B fixed) a Newton step
+    """fem_twin.macro.film.stencil_solver: within one inner solve (K and B fixed) a Newton step
     whose switch differs from the factorised one in a few nodes is solved with the kept
     factors updated for the switched columns (Woodbury) to STEP_RTOL, without a new
     factorisation, each switched column solved once however many steps it stays switched;
@@ -245,9 +249,9 @@ def test_a_newton_step_reuses_the_factors_of_its_inner_solve(monkeypatch, scale)
     node's, as on the 2048^2 pin where GMRES with the kept factors failed such steps."""
     import scipy.sparse as sp
 
-    from fem_twin.macro import stencil_solver as ss
-    from fem_twin.macro.couette import couette_matrix
-    from fem_twin.macro.reynolds import fe_poiseuille
+    from fem_twin.macro.film import stencil_solver as ss
+    from fem_twin.macro.film.couette import couette_matrix
+    from fem_twin.macro.film.reynolds import fe_poiseuille
     from fem_twin.numerics.linalg import SPDSolver, default_backend
     if default_backend() != "pardiso":
         pytest.skip("the stencil solver needs MKL PARDISO")
@@ -291,13 +295,13 @@ def test_a_newton_step_reuses_the_factors_of_its_inner_solve(monkeypatch, scale)
 
 
 def test_a_settled_solve_stops_once_its_active_set_has_settled():
-    """fem_twin.macro.switch: ``settle`` truncates the semismooth Newton path (the same
+    """fem_twin.macro.film.switch: ``settle`` truncates the semismooth Newton path (the same
     steps, fewer of them) at the first step that switches at most that fraction of the
     nodes the first step switched, not earlier; ``settle=0`` solves to convergence (the
     2D cavitating bump from an ambient start: 4501, 2190, 1463, 767, 114, 42 nodes switch)."""
-    from fem_twin.macro.couette import couette_matrix
-    from fem_twin.macro.reynolds import fe_poiseuille
-    from fem_twin.macro.switch import solve_complementarity
+    from fem_twin.macro.film.couette import couette_matrix
+    from fem_twin.macro.film.reynolds import fe_poiseuille
+    from fem_twin.macro.film.switch import solve_complementarity
     n, settle = 97, 0.1
     g = np.linspace(-1, 1, n)
     X, Y = np.meshgrid(g, g)

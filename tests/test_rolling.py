@@ -6,7 +6,7 @@ import pytest
 
 from fem_twin.errors import InputError
 from fem_twin.macro import MacroSettings, solve_mixed
-from fem_twin.macro.lubricant import Lubricant
+from fem_twin.macro.laws.lubricant import Lubricant
 from fem_twin.micro import FlowFactors, at_slide_to_roll, average, homogenise
 from fem_twin.topography.synthetic import self_affine
 

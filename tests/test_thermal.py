@@ -1,4 +1,4 @@
-"""The contact's temperature (fem_twin.macro.thermal) against the moving heat source's
+"""The contact's temperature (fem_twin.macro.laws.thermal) against the moving heat source's
 closed forms, the heat balance, and the isothermal limit.
 
 Closed forms (a uniform flux q over a source of half-width l on a half-space of
@@ -22,7 +22,7 @@ from scipy.special import k0e
 
 from fem_twin.errors import NotConverged
 from fem_twin.macro import Lubricant, MacroSettings, solve_mixed
-from fem_twin.macro.thermal import (
+from fem_twin.macro.laws.thermal import (
     ContactThermal,
     ThermalNotConverged,
     ThermalSettings,
@@ -30,7 +30,7 @@ from fem_twin.macro.thermal import (
     surface_temperature,
     thermal_point,
 )
-from fem_twin.macro.viscosity import WaltherLaw
+from fem_twin.macro.laws.viscosity import WaltherLaw
 
 sys.path.insert(0, str(Path(__file__).parent))
 from sample_cases import macro_case  # noqa: E402

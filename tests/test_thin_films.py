@@ -10,8 +10,8 @@ from test_deterministic import OIL, rough_pad
 
 from fem_twin import Topography
 from fem_twin.macro import BoundaryLaw, Lubricant, MacroSettings, solve_mixed
-from fem_twin.macro.deterministic import DeterministicSettings, solve_deterministic
-from fem_twin.macro.reynolds import trapezoid_weights
+from fem_twin.macro.film.reynolds import trapezoid_weights
+from fem_twin.macro.reference.deterministic import DeterministicSettings, solve_deterministic
 from fem_twin.micro import homogenise
 
 SHEAR = BoundaryLaw(law="shear", shear_strength=50e6, pressure_coefficient=0.1)

@@ -1,4 +1,4 @@
-"""The time-resolved deterministic solver (fem_twin.macro.time_resolved): the steady
+"""The time-resolved deterministic solver (fem_twin.macro.reference.time_resolved): the steady
 solver where the disk is smooth, exact unsteady films (a wavy disk over a plane pin; a
 moving rupture front and the film content it leaves in the cavity), the closed channels
 that did not converge, and bad inputs."""
@@ -11,12 +11,12 @@ from conftest import ROOT
 
 from fem_twin.errors import InputError
 from fem_twin.macro import Lubricant
-from fem_twin.macro.deterministic import (
+from fem_twin.macro.reference.deterministic import (
     DeterministicNotConverged,
     DeterministicSettings,
     solve_deterministic,
 )
-from fem_twin.macro.time_resolved import TimeSettings, disk_at, solve_time_resolved
+from fem_twin.macro.reference.time_resolved import TimeSettings, disk_at, solve_time_resolved
 
 MU, U = 0.01, 1.0
 OIL = Lubricant(MU, roelands_alpha=0.0, dh_c2=1.0)

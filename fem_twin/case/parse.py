@@ -12,8 +12,8 @@ from pathlib import Path
 from ..checks import arguments, memory_shortfall
 from ..errors import InputError
 from ..io.files import topography_shape
-from ..macro.boundary import FADED, REFERENCE_REACH, BoundaryLaw, thin_films_choice
-from ..macro.thermal import ThermalSettings
+from ..macro.laws.boundary import FADED, REFERENCE_REACH, BoundaryLaw, thin_films_choice
+from ..macro.laws.thermal import ThermalSettings
 from ..stribeck.curve import read_measured_csv
 from ..stribeck.validation import check_like_with_like
 from ..topography.prepare import MacroOptions

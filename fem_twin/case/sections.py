@@ -11,10 +11,10 @@ from pathlib import Path
 
 from .. import tables as T
 from ..checks import check_ranges, setting
-from ..macro.boundary import BoundaryLaw
-from ..macro.friction import READINGS
-from ..macro.settings import MacroSettings
-from ..macro.thermal import ThermalSettings
+from ..macro.coupling.settings import MacroSettings
+from ..macro.laws.boundary import BoundaryLaw
+from ..macro.laws.friction import READINGS
+from ..macro.laws.thermal import ThermalSettings
 from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN, h0_candidates
 from ..micro.sliding import CellSettings
 from ..topography.prepare import MacroOptions
@@ -119,7 +119,7 @@ class LubricantSpec:
 
     def lubricants(self) -> list:
         """One :class:`fem_twin.macro.Lubricant` per viscosity."""
-        from ..macro.lubricant import Lubricant
+        from ..macro.laws.lubricant import Lubricant
         return [Lubricant(mu, density=self.density, roelands_alpha=self.roelands_alpha,
                           roelands_p0=self.roelands_p0, dh_c1=self.dh_c1, dh_c2=self.dh_c2,
                           eyring_stress=self.eyring_stress or None)
@@ -178,7 +178,7 @@ class MicroSpec(CellSettings):
 @dataclass(frozen=True)
 class MacroSpec(MacroSettings):
     """``[macro]``: the homogenised Reynolds scale (eqs 17-34): every setting of the macro
-    solver (:class:`fem_twin.macro.settings.MacroSettings`, declared there once), the macro
+    solver (:class:`fem_twin.macro.coupling.settings.MacroSettings`, declared there once), the macro
     pin and a ball's grid."""
 
     pin: str | int = setting("average", "the macro pin: the levelled set's average, or a "

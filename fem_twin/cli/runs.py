@@ -236,7 +236,7 @@ def validate(args):
 
     from ..case import load_case
     from ..io.table import write_csv
-    from ..macro.boundary import BOUNDARY_FRICTION
+    from ..macro.laws.boundary import BOUNDARY_FRICTION
     from ..stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
     from ..stribeck.curve import read_stribeck_csv
     from ..stribeck.validation import check_like_with_like

@@ -23,9 +23,9 @@ import numpy as np
 
 from ..errors import MixedNotConverged
 from ..micro.estimate import FILM_VARIANTS
+from .coupling.result import friction_with
 from .mixed import solve_point
 from .point import OperatingPoint
-from .result import friction_with
 
 #: the order assumed in ``|C_f(h) - C_f(2h)| / (2^p - 1)``.  The scheme's is 2 (bundled
 #: pin at 0.03 m/s: 1.97, 1.95 on 128 -> 255 -> 509 -> 1017 px refined in place), but

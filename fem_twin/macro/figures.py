@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io.figure import save_figure
-from .result import MixedResult
+from .coupling.result import MixedResult
 
 #: (field, colour-bar label, scale to the plotted unit)
 PANELS = (("pressure_gauge", "hydrodynamic pressure $p - p_{amb}$ [MPa]", 1e-6),

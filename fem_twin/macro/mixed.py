@@ -24,14 +24,14 @@ from ..errors import MixedNotConverged
 from ..micro.flow_factors import FlowFactors
 from ..micro.rolling import at_slide_to_roll
 from ..numerics.threads import one_thread
-from . import newton
-from .fixed_point import Concentrated, solve_fixed_point
-from .kinematics import disk_velocity
-from .lubricant import Lubricant
+from .coupling import newton
+from .coupling.fixed_point import Concentrated, solve_fixed_point
+from .coupling.problem import macro_problem
+from .coupling.result import MixedResult, mixed_result, on_grid
+from .coupling.settings import MacroSettings
+from .laws.kinematics import disk_velocity
+from .laws.lubricant import Lubricant
 from .point import OperatingPoint
-from .problem import macro_problem
-from .result import MixedResult, mixed_result, on_grid
-from .settings import MacroSettings
 
 __all__ = ["MacroSettings", "MixedNotConverged", "MixedResult", "OperatingPoint", "solve_mixed",
            "solve_point"]
@@ -93,7 +93,7 @@ def seeded_point(point: OperatingPoint, *, initial: MixedResult | None = None, s
                  progress=None):
     """:func:`solve_point` whose Anderson coupling starts from ``secants``, the last
     differences of the same point's coupling on a coarser grid
-    (:class:`~fem_twin.macro.fixed_point.Secants`, interpolated).  Returns ``(result,
+    (:class:`~fem_twin.macro.coupling.fixed_point.Secants`, interpolated).  Returns ``(result,
     secants)``, the second this solve's own (None where the coupling is not Anderson):
     :func:`~fem_twin.macro.nested.solve_nested` hands them from level to level.
     """

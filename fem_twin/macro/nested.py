@@ -21,9 +21,9 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import MixedNotConverged
+from .coupling.result import MixedResult, resampled
 from .mixed import COARSE_START, seeded_point
 from .point import OperatingPoint
-from .result import MixedResult, resampled
 
 #: the fields a coarse-grid correction moves (``h_d`` besides)
 CORRECTED = ("pressure", "elastic_deformation", "cavity_fraction", "contact_pressure")

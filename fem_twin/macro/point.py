@@ -12,9 +12,9 @@ import numpy as np
 from ..checks import arguments, as_field, as_pair, number, plausible
 from ..errors import InputError
 from ..micro.flow_factors import FlowFactors
-from .lubricant import Lubricant
-from .reynolds import check_closed
-from .settings import MacroSettings
+from .coupling.settings import MacroSettings
+from .film.reynolds import check_closed
+from .laws.lubricant import Lubricant
 
 #: the largest rigid gap [m] either way: a pin's holder lies 1 mm below its face
 MAX_GAP = 0.05

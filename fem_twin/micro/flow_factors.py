@@ -64,7 +64,7 @@ class FlowFactors:
     log_friction : (n,) ``<ln(h_m s)>`` over that film, zero elsewhere, with ``s`` the local
     dissipation per ``mu u_r^2`` [1/m], whose cell mean is ``s_C / h_m`` [-]; default
     ``ln s_C``.  With ``film_fraction``, the spread of the local shear that an Eyring film
-    averages (:func:`fem_twin.macro.friction.eyring_shear`)
+    averages (:func:`fem_twin.macro.laws.friction.eyring_shear`)
     thin_friction : (n,) ``h_m <1/h>`` over the confined films between the gap floor and the
     boundary film, whose Couette shear is ``mu u_r thin_friction / h_m`` under
     ``[boundary] thin_films = "viscous"`` [-]; default 0 (none known)
@@ -207,7 +207,7 @@ class FlowFactors:
         ``friction_factor``, ``pressure_friction``) and the contact fraction, which the
         Reynolds iterations do not need (80 B a node less);
         ``contact=False`` leaves out the nodal ``p_con`` (for a caller that integrates it
-        over the elements instead, :mod:`fem_twin.macro.contact_load`).
+        over the elements instead, :mod:`fem_twin.macro.film.contact_load`).
         """
         x = np.asarray(h0, dtype=float)
         if np.any(~np.isfinite(x)) or np.any(x <= 0):

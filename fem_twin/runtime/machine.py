@@ -28,7 +28,7 @@ import numpy as np
 from .. import tables as T
 from ..errors import InputError, SolverError
 from ..macro import Lubricant, MacroSettings, solve_mixed
-from ..macro.point_contact import PointContact
+from ..macro.reference.point_contact import PointContact
 from ..micro import FlowFactors, homogenise
 from ..numerics.threads import one_thread, quiet_worker, worker_heap, workers_ignore_ctrl_c
 from ..topography.synthetic import self_affine

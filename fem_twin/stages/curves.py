@@ -16,7 +16,7 @@ from ..io.layout import RunLayout
 from ..io.writers import Writers
 from ..macro import MixedResult
 from ..macro.figures import plot_point_files
-from ..macro.point_contact import film_against_hamrock_dowson
+from ..macro.reference.point_contact import film_against_hamrock_dowson
 from ..micro import FlowFactors
 from ..stribeck import plot_stribeck, read_measured_csv, write_stribeck_csv
 from ..stribeck.accuracy import error_summary, range_summary

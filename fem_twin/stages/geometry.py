@@ -18,7 +18,7 @@ from ..io.checkpoint import load_or_none
 from ..io.files import read_topography, write_topography
 from ..io.layout import RunLayout
 from ..io.mesh import grid_mesh, write_vtu
-from ..macro.point_contact import PointContact
+from ..macro.reference.point_contact import PointContact
 from ..numerics.threads import run_jobs
 from ..topography.filling import fill_defects
 from ..topography.geometry import pin_face

@@ -9,8 +9,8 @@ from dataclasses import fields, replace
 from ..case import Case
 from ..io.layout import RunLayout
 from ..macro import MacroSettings
-from ..macro.thermal import ContactThermal
-from ..macro.viscosity import WaltherLaw
+from ..macro.laws.thermal import ContactThermal
+from ..macro.laws.viscosity import WaltherLaw
 from ..micro import FlowFactors
 from ..stribeck.request import RollingSliding, Sliding, SweepRequest
 from .geometry import hersey_length, macro_geometry

@@ -21,8 +21,8 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from ..errors import InputError, NotConverged
-from ..macro.boundary import BoundaryLaw
-from ..macro.viscosity import WaltherLaw
+from ..macro.laws.boundary import BoundaryLaw
+from ..macro.laws.viscosity import WaltherLaw
 from .curve import SPEED_MATCH, MeasuredCurve, StribeckCurve
 from .fit_statistics import correlation, covariance, interval, temperature_warnings
 from .identify import check_pair
@@ -110,9 +110,9 @@ class FitModel:
         return (hd + self._law_force(c, at, speed, shear, viscosity)) / load, inside
 
     def _law_force(self, c: StribeckCurve, at, speed, shear: dict, viscosity: float):
-        """The shear law's boundary force [N] (:mod:`fem_twin.macro.boundary`) from the
+        """The shear law's boundary force [N] (:mod:`fem_twin.macro.laws.boundary`) from the
         curve's real contact area and asperity load, the film temperature and the spots'
-        flash for the temperature factor (:func:`~fem_twin.macro.boundary.temperature_factor`,
+        flash for the temperature factor (:func:`~fem_twin.macro.laws.boundary.temperature_factor`,
         dT the untempered shear's flash); the iterate's tau_0 [Pa] enters the force
         directly (the optimiser passes through tau_0 below the law's plausible floor,
         10 kPa, on its way from 0)."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ..macro.boundary import BoundaryLaw
+from ..macro.laws.boundary import BoundaryLaw
 
 #: the shear law's pair that one Stribeck curve set may not separate
 PAIR = ("shear_strength", "pressure_coefficient")

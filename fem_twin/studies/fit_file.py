@@ -11,7 +11,7 @@ import numpy as np
 
 from ..checks import QUANTITIES, plausible
 from ..errors import InputError
-from ..macro.viscosity import WaltherLaw
+from ..macro.laws.viscosity import WaltherLaw
 from ..stribeck.fit import PARAMETERS, SHEAR
 
 

@@ -17,8 +17,8 @@ from ..errors import InputError
 from ..io.atomic import atomic_path
 from ..io.layout import RunLayout
 from ..io.table import write_csv
-from ..macro.boundary import BoundaryLaw
-from ..macro.viscosity import WaltherLaw
+from ..macro.laws.boundary import BoundaryLaw
+from ..macro.laws.viscosity import WaltherLaw
 from ..numerics.threads import executor_for
 from ..runtime.taskgraph import fit_scaling
 from ..stages.requests import per_viscosity, sweep_request

@@ -3,12 +3,14 @@
 
 A crowned square pad carries a roughness cell (the composite ``disk - pin`` of a patch pair,
 on the pin at rest; the disk smooth and sliding along +x1) tiled ``n`` times per side, so the
-wavelength ratio is ``eps = 1/n``.  :func:`fem_twin.macro.deterministic.solve_deterministic`
-solves it resolved; the twin solves the same pad with the flow factors of that cell
+wavelength ratio is ``eps = 1/n``.
+:func:`fem_twin.macro.reference.deterministic.solve_deterministic` solves it resolved; the
+twin solves the same pad with the flow factors of that cell
 (:func:`fem_twin.micro.homogenise`) on a macro grid.  With both bodies rough (``RoughPad.disk``,
 the configuration of every run) the pin carries its cell tiled and the disk's cell slides
-over it, :func:`fem_twin.macro.time_resolved.solve_time_resolved` resolves it in time and the
-twin takes the unsteady cells of the pair (eq 8 with its time term, one pixel a step).
+over it, :func:`fem_twin.macro.reference.time_resolved.solve_time_resolved` resolves it in
+time and the twin takes the unsteady cells of the pair (eq 8 with its time term, one pixel a
+step).
 The pad grows with ``n`` at a fixed mean pressure and crown, and the speed falls as
 ``1/n``: ``mu U L / (p h^2)`` and the load share are then the same problem at every
 ``eps`` (the macro deformation, ``p L / E'``, is below a picometre), and the film's
@@ -25,14 +27,14 @@ from ..checks import arguments, check, plausible, whole
 from ..errors import InputError
 from ..io.files import read_topography
 from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
-from ..macro.boundary import temperature_factor
-from ..macro.deterministic import (
+from ..macro.laws.boundary import temperature_factor
+from ..macro.laws.thermal import tempered
+from ..macro.reference.deterministic import (
     DeterministicResult,
     DeterministicSettings,
     solve_deterministic,
 )
-from ..macro.thermal import tempered
-from ..macro.time_resolved import solve_time_resolved
+from ..macro.reference.time_resolved import solve_time_resolved
 from ..micro import FlowFactors, homogenise
 from ..peers import average_flow_factors
 from ..topography import Topography, resample_cell
@@ -125,7 +127,8 @@ class RoughPad:
     def moving(self, tiles: int):
         """``(shape, strip, spacing)`` of the time-resolved pad (both bodies rough): the
         crown less the pin's tiled cell on ``tiles m + 1`` nodes a side, and the disk's cell
-        tiled across x2 as one period along x1 (:func:`~fem_twin.macro.time_resolved.disk_at`)."""
+        tiled across x2 as one period along x1
+        (:func:`~fem_twin.macro.reference.time_resolved.disk_at`)."""
         if self.disk is None:
             raise InputError("the pad's disk is smooth: RoughPad.resolved is its pad")
         tiles = whole("tiles", tiles, "samples")
@@ -218,10 +221,10 @@ def deterministic_sweep(pad: RoughPad, tiles: int, speeds, settings=None) -> lis
 
 @arguments(pad=RoughPad, settings=DeterministicSettings)
 def time_resolved_sweep(pad: RoughPad, tiles: int, speeds, settings=None, time=None) -> list:
-    """:func:`~fem_twin.macro.time_resolved.solve_time_resolved` on the pad of ``tiles``
+    """:func:`~fem_twin.macro.reference.time_resolved.solve_time_resolved` on the pad of ``tiles``
     (both bodies rough) at each of ``speeds`` (given at two tiles), each started from the
     one before; ``settings`` replace the pad's, ``time``: its
-    :class:`~fem_twin.macro.time_resolved.TimeSettings`."""
+    :class:`~fem_twin.macro.reference.time_resolved.TimeSettings`."""
     shape, strip, dx = pad.moving(tiles)
     out, last = [], None
     for u in pad_speeds(speeds, tiles):
@@ -335,7 +338,7 @@ def to_zero(eps, values) -> tuple[float, float | None]:
 @arguments(pad=RoughPad)
 def with_settings(pad: RoughPad, **changes) -> RoughPad:
     """The pad with its deterministic settings changed (``film_deforms``, ``boundary_film``,
-    any field of :class:`~fem_twin.macro.deterministic.DeterministicSettings`)."""
+    any field of :class:`~fem_twin.macro.reference.deterministic.DeterministicSettings`)."""
     unknown = sorted(set(changes) - {f.name for f in fields(DeterministicSettings)})
     if unknown:
         raise InputError(f"with_settings: {', '.join(unknown)}: not a setting of "

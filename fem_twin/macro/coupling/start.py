@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
-from ..errors import MixedNotConverged
+from ...errors import MixedNotConverged
 
 
 def dry_separation(factors, h_g, area, load, s):

@@ -8,12 +8,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.atomic import atomic_path
-from ..micro.rolling import at_slide_to_roll
-from .boundary import asperity_load, boundary_area, traction
-from .friction import confined_shear, disk_shear, hydrodynamic_shear
-from .kinematics import disk_velocity, rotations
-from .reynolds import trapezoid_weights
+from ...io.atomic import atomic_path
+from ...micro.rolling import at_slide_to_roll
+from ..film.reynolds import trapezoid_weights
+from ..laws.boundary import asperity_load, boundary_area, traction
+from ..laws.friction import confined_shear, disk_shear, hydrodynamic_shear
+from ..laws.kinematics import disk_velocity, rotations
 
 #: the grid fields of an operating point and their SI units: declared once, for the
 #: checkpoints, VTU files and ``fields.nc`` (:func:`fem_twin.results.fields_dataset`)
@@ -109,7 +109,7 @@ class MixedResult:
         """Fields on the structured grid for ParaView (:func:`fem_twin.io.mesh.write_vtu`),
         SI units; ``pressure`` is absolute (its minimum is p_cav), ``pressure_gauge`` is
         ``pressure - p_amb``; ``face`` is 1 on the pin face (threshold on it in ParaView)."""
-        from ..io.mesh import grid_mesh, write_vtu
+        from ...io.mesh import grid_mesh, write_vtu
         gm = grid_mesh(self.pressure.shape, self.spacing, origin)
         p_amb = self.meta.get("settings", {}).get("ambient_pressure", 0.0)
         return write_vtu(path, gm, {**self.fields(), "pressure_gauge": self.pressure - p_amb})

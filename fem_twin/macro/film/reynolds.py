@@ -8,10 +8,10 @@ wherever the gap opens beyond ``OPEN_GAP`` (the oil bath).  The Poiseuille term 
 finite-element stiffness of ``G`` (scikit-fem form, 2 x 2 Gauss; ``method="fe"``) or the
 paper's 5-point finite volumes (``"fvm"``).  The Couette term is in both a flux through
 the faces of each node's dual cell with the liquid fraction from the upstream node
-(:mod:`fem_twin.macro.couette`): a Galerkin Couette term is unstable here, as a cavitated
+(:mod:`fem_twin.macro.film.couette`): a Galerkin Couette term is unstable here, as a cavitated
 zone is pure transport of ``(1 - theta) h`` (infinite Peclet number), and the face fluxes
 conserve mass exactly.  One unknown per node, ``phi``, carries ``p`` and ``theta`` as the
-cavitation model says (:mod:`fem_twin.macro.cavitation`)."""
+cavitation model says (:mod:`fem_twin.macro.film.cavitation`)."""
 
 from __future__ import annotations
 
@@ -23,12 +23,12 @@ import scipy.sparse as sp
 import skfem
 from skfem.helpers import dot, grad
 
-from ..checks import arguments, as_field, as_pair
-from ..errors import InputError, ReynoldsNotConverged
-from ..numerics.assembly import at_points, grid_stencil, unit_element
+from ...checks import arguments, as_field, as_pair
+from ...errors import InputError, ReynoldsNotConverged
+from ...numerics.assembly import at_points, grid_stencil, unit_element
+from ..laws.lubricant import Lubricant
 from .cavitation import cavitation_model
 from .couette import SCHEMES, couette_matrix
-from .lubricant import Lubricant
 from .reynolds_fv import fvm_poiseuille
 
 #: Nodes whose gap exceeds this [m] are at ambient pressure (Dirichlet): the oil bath around
@@ -120,9 +120,9 @@ def solve_reynolds(gap, spacing, speed, viscosity, *, ambient_pressure: float = 
     complementarity : ``"switch"`` (p-theta semismooth Newton) or ``"fb"`` (the paper's
         Fischer-Burmeister-Newton-Schur, :mod:`fem_twin.fvm.fbns`; slower, same solution)
     couette : ``"central"`` (second order) or ``"upwind"`` (the paper's first order), the
-        Couette flux of :mod:`fem_twin.macro.couette`
+        Couette flux of :mod:`fem_twin.macro.film.couette`
     velocity : (ny, nx, 2) the sliding surface's velocity over ``speed`` [-] (a rotating
-        disk's, :func:`~fem_twin.macro.kinematics.disk_velocity`); None: +x1
+        disk's, :func:`~fem_twin.macro.laws.kinematics.disk_velocity`); None: +x1
     """
     h, dx, lubricant, mu0 = _inputs(gap, spacing, viscosity, method, couette)
     velocity = _velocity(velocity, h.shape)

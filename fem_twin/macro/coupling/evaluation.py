@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..micro.flow_factors import LocalFactors
+from ...micro.flow_factors import LocalFactors
 
 
 @dataclass(frozen=True, eq=False)

@@ -14,8 +14,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..errors import ReynoldsNotConverged
-from ..numerics.ordering import subgrid_order
+from ...errors import ReynoldsNotConverged
+from ...numerics.ordering import subgrid_order
 from .stencil_solver import newton_solver
 
 #: relative mass residual at which Newton steps can no longer improve the solution
@@ -26,7 +26,7 @@ def solve_complementarity(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=
                           max_iter=200, inexact=False, settle=0.0, source=None):
     """Semismooth Newton on ``K p + B (1 - theta) = f`` with the p-theta switch ``phi``
     (``source`` f, each node's inflow [m^3/s]; default 0: a time step's earlier film
-    content, :mod:`fem_twin.macro.time_resolved`).
+    content, :mod:`fem_twin.macro.reference.time_resolved`).
 
     Dirichlet nodes keep ``p = p_boundary``, ``theta = 0``.  ``phi0`` warm-starts the
     interior; ``inexact`` returns the iterate after ``max_iter`` steps instead of raising (a

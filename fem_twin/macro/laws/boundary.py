@@ -26,9 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import arguments, check_choices, check_ranges, plausible, setting
-from ..errors import InputError
-from ..tables import BOUNDARY_FRICTION
+from ...checks import arguments, check_choices, check_ranges, plausible, setting
+from ...errors import InputError
+from ...tables import BOUNDARY_FRICTION
 
 #: the boundary laws: eq 32's constant C_f,b, or the shear strength of a boundary film
 LAWS = ("constant", "shear")

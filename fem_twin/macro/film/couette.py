@@ -21,8 +21,8 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import InputError
-from ..numerics.assembly import grid_stencil
+from ...errors import InputError
+from ...numerics.assembly import grid_stencil
 
 #: the Couette schemes (``MacroSettings.couette``, ``solve_reynolds(couette=...)``)
 SCHEMES = ("central", "upwind")

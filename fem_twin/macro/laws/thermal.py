@@ -21,9 +21,9 @@ from functools import lru_cache
 import numpy as np
 import scipy.fft as fft
 
-from ..checks import arguments, as_pair, check_ranges, plausible, setting
-from ..contact.elastic import love_rectangle
-from ..errors import InputError, NotConverged
+from ...checks import arguments, as_pair, check_ranges, plausible, setting
+from ...contact.elastic import love_rectangle
+from ...errors import InputError, NotConverged
 from .boundary import BoundaryLaw, heated_factor
 
 #: sub-samples a side of a cell for the moving part of the kernel (it varies over 2 kappa / U)

@@ -19,8 +19,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..checks import arguments, as_pair, plausible
-from ..errors import InputError
+from ...checks import arguments, as_pair, plausible
+from ...errors import InputError
 
 
 @arguments(face="field", spacing="pair", track_radius="number")

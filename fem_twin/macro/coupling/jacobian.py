@@ -19,12 +19,12 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..errors import SolverError
-from ..numerics.ordering import subgrid_order
-from .cavitation import cavitation_model
-from .contact_load import contact_load
+from ...errors import SolverError
+from ...numerics.ordering import subgrid_order
+from ..film.cavitation import cavitation_model
+from ..film.contact_load import contact_load
+from ..laws.kinematics import rotate_tensor, rotate_vector
 from .evaluation import NewtonEvaluation
-from .kinematics import rotate_tensor, rotate_vector
 from .problem import MAX_COEFFICIENT_PRESSURE, Problem
 
 #: a node joins the dense elastic block when its elastic coupling exceeds this fraction of

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import arguments
+from ...checks import arguments
 from .kinematics import rotate_tensor, rotations
 
 #: the friction laws: the force on the pin, or the paper's eq 31

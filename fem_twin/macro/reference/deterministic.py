@@ -25,8 +25,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import brentq
 
-from .. import tables as T
-from ..checks import (
+from ... import tables as T
+from ...checks import (
     arguments,
     as_field,
     as_pair,
@@ -36,17 +36,17 @@ from ..checks import (
     plausible,
     setting,
 )
-from ..contact import solve as contact_solve
-from ..contact.elastic import elastic_operator
-from ..errors import InputError, NotConverged, ReynoldsNotConverged
-from ..micro.sliding import CellSettings
-from ..numerics.anderson import Anderson
-from .boundary import BoundaryLaw, asperity_load, temperature_factor, traction
-from .cavitation import cavitation_model
-from .couette import couette_matrix
-from .lubricant import Lubricant
-from .problem import MAX_COEFFICIENT_PRESSURE
-from .reynolds import fe_poiseuille, trapezoid_weights
+from ...contact import solve as contact_solve
+from ...contact.elastic import elastic_operator
+from ...errors import InputError, NotConverged, ReynoldsNotConverged
+from ...micro.sliding import CellSettings
+from ...numerics.anderson import Anderson
+from ..coupling.problem import MAX_COEFFICIENT_PRESSURE
+from ..film.cavitation import cavitation_model
+from ..film.couette import couette_matrix
+from ..film.reynolds import fe_poiseuille, trapezoid_weights
+from ..laws.boundary import BoundaryLaw, asperity_load, temperature_factor, traction
+from ..laws.lubricant import Lubricant
 
 __all__ = ["DeterministicNotConverged", "DeterministicResult", "DeterministicSettings",
            "boundary_force", "pad_friction", "solve_deterministic"]
@@ -75,7 +75,7 @@ class DeterministicSettings:
     gap_floor: float = setting(CellSettings.gap_floor, "the film in a contact spot (the "
                                "cells' default)", "gap_floor")
     boundary: BoundaryLaw = setting(BoundaryLaw(), "the boundary shear's law, the twin's "
-                                    "(fem_twin.macro.boundary), node by node on the "
+                                    "(fem_twin.macro.laws.boundary), node by node on the "
                                     "resolved spots", unit="a section")
     temperature: float = setting(24.0, "the oil's temperature [C], where the shear law's "
                                  "temperature factor is read (isothermal)", "temperature_C")

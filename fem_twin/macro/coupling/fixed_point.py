@@ -19,13 +19,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import MixedNotConverged
-from ..numerics.anderson import Anderson
-from .cavitation import cavitation_model
-from .couette import couette_matrix
+from ...errors import MixedNotConverged
+from ...numerics.anderson import Anderson
+from ..film.cavitation import cavitation_model
+from ..film.couette import couette_matrix
+from ..film.reynolds import ReynoldsNotConverged
 from .evaluation import FixedPointEvaluation
 from .result import resampled
-from .reynolds import ReynoldsNotConverged
 from .start import dry_separation, rigid_separation
 
 #: ``coupling="auto"`` takes the Newton coupling when the first iterate's elastic

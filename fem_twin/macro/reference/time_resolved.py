@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..checks import (
+from ...checks import (
     arguments,
     as_field,
     check_choices,
@@ -35,7 +35,8 @@ from ..checks import (
     setting,
     whole,
 )
-from ..errors import InputError
+from ...errors import InputError
+from ..laws.lubricant import Lubricant
 from .deterministic import (
     DeterministicNotConverged,
     DeterministicResult,
@@ -47,7 +48,6 @@ from .deterministic import (
     film_force,
     viscous_cut,
 )
-from .lubricant import Lubricant
 
 __all__ = ["TimeResolvedResult", "TimeSettings", "disk_at", "solve_time_resolved"]
 
@@ -86,7 +86,7 @@ class TimeSettings:
 @dataclass(frozen=True, eq=False)
 class TimeResolvedResult(DeterministicResult):
     """A periodic state of the time-resolved pad: the loads, friction and separation of
-    :class:`~fem_twin.macro.deterministic.DeterministicResult` as means over the last
+    :class:`~fem_twin.macro.reference.deterministic.DeterministicResult` as means over the last
     roughness period, its fields at the period's last instant, and ``instants``: each
     step's ``contact_load``, ``film_load``, ``film_friction``, ``boundary_force`` [N] over
     that period; ``periods`` run; ``history``: per period ``(log load residual, change of
@@ -131,7 +131,7 @@ def solve_time_resolved(shape, disk, spacing, *, load: float, speed: float,
     whose separation starts the steady start's bracket (a time-resolved one's also moves
     the first period from the steady start as far as its own periodic state lay from its
     start).  Raises
-    :class:`~fem_twin.macro.deterministic.DeterministicNotConverged` with the history
+    :class:`~fem_twin.macro.reference.deterministic.DeterministicNotConverged` with the history
     when the period means do not repeat within ``time.max_periods``."""
     s, dx, load, speed = _checked(shape, spacing, load, speed, lubricant, settings)
     z = as_field("disk [m]", disk, 2)

@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import tables as T
-from ..checks import check, plausible
-from ..errors import InputError
+from ... import tables as T
+from ...checks import check, plausible
+from ...errors import InputError
 
 
 @dataclass(frozen=True)

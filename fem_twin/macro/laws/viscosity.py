@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check, plausible
-from ..errors import InputError
+from ...checks import check, plausible
+from ...errors import InputError
 
 #: 0 C in K
 KELVIN = 273.15

@@ -17,9 +17,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import MixedNotConverged, SolverError
-from .cavitation import cavitation_model
-from .couette import couette, couette_matrix
+from ...errors import MixedNotConverged, SolverError
+from ..film.cavitation import cavitation_model
+from ..film.couette import couette, couette_matrix
 from .evaluation import NewtonEvaluation
 from .jacobian import newton_step, scales
 from .problem import Problem

@@ -6,7 +6,7 @@ fluxes.  The flux through the face between two neighbours is
 nodal values; the normal derivative is the two-point difference, the tangential one (for
 the off-diagonal entries of ``A``) the mean of the central differences at the two nodes.
 The Couette term and the cavitation loop are shared with the FE path
-(:mod:`fem_twin.macro.reynolds`).
+(:mod:`fem_twin.macro.film.reynolds`).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..checks import arguments
+from ...checks import arguments
 
 
 @arguments(g="field", spacing="pair")

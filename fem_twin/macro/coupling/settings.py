@@ -7,14 +7,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .. import tables as T
-from ..checks import check_choices, check_ranges, setting
-from ..errors import InputError
-from .boundary import BoundaryLaw
-from .cavitation import MODELS, cavitation_model
-from .contact_load import RULES
-from .couette import SCHEMES
-from .friction import LAWS, READINGS
+from ... import tables as T
+from ...checks import check_choices, check_ranges, setting
+from ...errors import InputError
+from ..film.cavitation import MODELS, cavitation_model
+from ..film.contact_load import RULES
+from ..film.couette import SCHEMES
+from ..laws.boundary import BoundaryLaw
+from ..laws.friction import LAWS, READINGS
 
 
 @dataclass(frozen=True)
@@ -30,14 +30,14 @@ class MacroSettings:
     boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", "friction",
                                        section="tribometer")
     boundary: BoundaryLaw = setting(BoundaryLaw(), "the boundary shear's law (eq 32 or the "
-                                    "shear law, fem_twin.macro.boundary)", unit="a section",
+                                    "shear law, fem_twin.macro.laws.boundary)", unit="a section",
                                     section="boundary")
     reading: str = setting("force", "what the rig reads: the tangential force on the pin "
                            "holder, or the disk's reaction torque over the track radius",
                            choices=READINGS, section="tribometer")
     track_radius: float | None = setting(
         None, "the disk's axis at this distance from the face's centre: the disk's velocity "
-        "field over the face (fem_twin.macro.kinematics); none: uniform sliding along x1",
+        "field over the face (fem_twin.macro.laws.kinematics); none: uniform sliding along x1",
         "axis_distance", section="tribometer")
     friction: str = setting("pin", "friction law: the force on the pin (wall shear and "
                             "the film pressure on the asperity flanks and the face's slope), "
@@ -47,7 +47,7 @@ class MacroSettings:
     coupling: str = setting("auto", "pressure-deformation-load coupling (auto: Anderson, "
                             "Newton for concentrated contacts or when it fails; pid: the "
                             "paper's)", choices=("auto", "anderson", "newton", "pid"))
-    complementarity: str = setting("switch", "cavitation model (fem_twin.macro.cavitation): "
+    complementarity: str = setting("switch", "cavitation model (fem_twin.macro.film.cavitation): "
                                    + ", ".join(f'"{m}"' for m in MODELS) + " (fb: the paper's "
                                    "FBNS, slower)", unit="a registered model")
     couette: str = setting("central", "Couette flux of eq 17: second order, or the paper's "
@@ -65,7 +65,7 @@ class MacroSettings:
     anderson_depth: int = setting(8, "iterates the Anderson acceleration keeps",
                                  "history")
     # 0.5: fewer coupling iterations than undamped, C_f the same to 3.3e-5 C_f,b
-    # (benchmarks/README.md, "macro/settings")
+    # (benchmarks/README.md, "macro/coupling/settings")
     anderson_damping: float = setting(0.5, "damping beta of the Anderson step (1: undamped)",
                                       "relaxation")
     inner_steps: int = setting(1, "Newton steps per Reynolds solve while far from the fixed "

@@ -20,9 +20,9 @@ from collections import OrderedDict
 import numpy as np
 import scipy.sparse as sp
 
-from ..numerics.assembly import grid_stencil
-from ..numerics.linalg import SPDSolver, default_backend
-from ..numerics.ordering import subgrid_order
+from ...numerics.assembly import grid_stencil
+from ...numerics.linalg import SPDSolver, default_backend
+from ...numerics.ordering import subgrid_order
 
 #: relative residual ``|J x - rhs| / |rhs|`` a step must reach
 STEP_RTOL = 1e-8

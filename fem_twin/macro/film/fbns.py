@@ -20,15 +20,15 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..checks import arguments
-from ..errors import ReynoldsNotConverged
+from ...checks import arguments
+from ...errors import ReynoldsNotConverged
 
 
 @arguments(K=sp.spmatrix, B=sp.spmatrix, scale="number")
 def solve_complementarity_fb(K, B, dirichlet, p_boundary, scale, *, phi0=None, tol=1e-10,
                              max_iter=200, inexact=False):
     """FBNS on the interior nodes; same arguments and results as
-    :func:`fem_twin.macro.switch.solve_complementarity`."""
+    :func:`fem_twin.macro.film.switch.solve_complementarity`."""
     n = K.shape[0]
     interior = np.flatnonzero(~np.asarray(dirichlet).ravel())
     KI = K[interior][:, interior].tocsc()
@@ -84,7 +84,7 @@ def solve_complementarity_fb(K, B, dirichlet, p_boundary, scale, *, phi0=None, t
 
 
 def _phi(p, theta, s, scale, n, interior, p_boundary):
-    """The switch variable of :func:`fem_twin.macro.switch.solve_complementarity`."""
+    """The switch variable of :func:`fem_twin.macro.film.switch.solve_complementarity`."""
     phi = np.full(n, float(p_boundary))
     phi[interior] = np.where(p >= s * theta, p, -theta * scale)
     return phi

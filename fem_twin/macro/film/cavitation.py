@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from ...errors import InputError
 from .fbns import solve_complementarity_fb
 from .switch import solve_complementarity
 
@@ -23,7 +23,7 @@ from .switch import solve_complementarity
 class PThetaSwitch:
     """``p = max(phi, 0)``, ``theta = max(-phi, 0) / scale``: ``p theta = 0`` exact, the
     residual piecewise linear in ``phi``, solved by semismooth Newton (primal-dual active
-    set, :func:`fem_twin.macro.switch.solve_complementarity`)."""
+    set, :func:`fem_twin.macro.film.switch.solve_complementarity`)."""
 
     name = "switch"
     settles = True

@@ -20,8 +20,8 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
-from ..micro.flow_factors import REL_STEP
-from ..numerics.assembly import CORNERS, at_points, grid_stencil
+from ...micro.flow_factors import REL_STEP
+from ...numerics.assembly import CORNERS, at_points, grid_stencil
 
 #: the rules of ``MacroSettings.contact_quadrature``
 RULES = ("gauss", "nodal")

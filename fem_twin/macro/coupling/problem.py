@@ -17,13 +17,13 @@ import numpy as np
 import scipy.fft as fft
 import scipy.sparse as sp
 
-from ..contact.elastic import ElasticOperator, elastic_operator
-from ..micro.flow_factors import FlowFactors
-from .contact_load import nodal_contact_pressure
-from .kinematics import in_grid_frame, rotations
-from .lubricant import Lubricant
-from .reynolds import OPEN_GAP, fe_poiseuille, trapezoid_weights
-from .reynolds_fv import fvm_poiseuille
+from ...contact.elastic import ElasticOperator, elastic_operator
+from ...micro.flow_factors import FlowFactors
+from ..film.contact_load import nodal_contact_pressure
+from ..film.reynolds import OPEN_GAP, fe_poiseuille, trapezoid_weights
+from ..film.reynolds_fv import fvm_poiseuille
+from ..laws.kinematics import in_grid_frame, rotations
+from ..laws.lubricant import Lubricant
 from .settings import MacroSettings
 
 #: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
