@@ -158,6 +158,15 @@ def as_pair(name: str, value) -> tuple[float, float]:
     return float(v1), float(v2)
 
 
+def as_spacing(name: str, value):
+    """A grid's spacing: ``(dx1, dx2)`` (:func:`as_pair`), or a graded mesh as it is (an
+    object with a ``pitch`` and node ``lines``, :class:`fem_twin.numerics.graded_mesh.Mesh`, which
+    checks itself)."""
+    if hasattr(value, "pitch") and hasattr(value, "lines"):
+        return value
+    return as_pair(name, value)
+
+
 def as_field(name: str, value, min_side: int = 2) -> np.ndarray:
     """``value`` as a finite 2D float array of at least ``min_side`` a side, or
     :class:`InputError` naming ``name`` (a gap, a map: SI units are the caller's)."""
@@ -182,7 +191,8 @@ def arguments(**kinds):
     and the argument.  A kind is a class (or a tuple of classes: ``isinstance``), a
     sequence of one (``[cls]``: a non-empty collection of such), or one of ``"path"``
     (a str or path), ``"number"`` (one finite real), ``"numbers"`` (a non-empty numeric
-    array, finite), ``"field"`` (:func:`as_field`), ``"pair"`` (:func:`as_pair`),
+    array, finite), ``"field"`` (:func:`as_field`), ``"pair"`` (:func:`as_pair`), ``"spacing"``
+    (:func:`as_spacing`),
     ``"shape"`` (two positive whole numbers).  None is accepted where it is the default."""
     def wrap(func):
         signature = inspect.signature(func)
@@ -227,6 +237,8 @@ def check(name: str, value, kind) -> None:
         as_field(name, value)
     elif kind == "pair":
         as_pair(name, value)
+    elif kind == "spacing":
+        as_spacing(name, value)
     elif kind == "shape":
         if not (isinstance(value, (tuple, list)) and len(value) == 2
                 and all(isinstance(v, (int, np.integer)) and v > 0 for v in value)):

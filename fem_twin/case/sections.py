@@ -185,6 +185,10 @@ class MacroSpec(MacroSettings):
                              "pin number from 1", "pin_number")
     grid: int = setting(97, "nodes per side of a ball's grid over [-4a, 2a] x [-3a, 3a]",
                         "nodes")
+    mesh: str = setting("uniform", "a ball's film mesh: \"uniform\" (the grid itself) or "
+                        "\"graded\" (the grid's pitch over the Hertz zone, coarser outward, on "
+                        "the grid's lines; the elastic FFT stays on the grid)",
+                        choices=("uniform", "graded"))
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ import skfem
 
 from ..checks import arguments
 from ..errors import InputError, MissingFile
+from ..numerics.graded_mesh import Mesh
 from .atomic import atomic_path
 
 
@@ -42,6 +43,8 @@ class GridMesh:
     origin : (x1, x2) of pixel [0, 0] [m]
     periodic : bool
         Periodic in both directions (period ``nx dx1`` by ``ny dx2``).
+    lines : the node lines (x1, x2) on the grid of a graded mesh
+        (:class:`fem_twin.numerics.graded_mesh.Mesh`), None: every line
     """
 
     mesh: skfem.Mesh
@@ -49,6 +52,7 @@ class GridMesh:
     spacing: tuple[float, float]
     origin: tuple[float, float]
     periodic: bool
+    lines: tuple | None = None
 
     @property
     def node_shape(self) -> tuple[int, int]:
@@ -87,10 +91,11 @@ class GridMesh:
         return nodal.reshape(*self.node_shape, *nodal.shape[1:])[:ny, :nx]
 
 
-@arguments(shape="shape", spacing="pair")
+@arguments(shape="shape", spacing="spacing")
 def grid_mesh(shape, spacing, origin=(0.0, 0.0), *, periodic: bool = False,
               kind: str = "quad") -> GridMesh:
-    """Structured mesh with one node per pixel of a ``(ny, nx)`` grid of pitch ``spacing`` [m].
+    """Structured mesh with one node per pixel of a ``(ny, nx)`` grid of pitch ``spacing`` [m],
+    or on the nodes of a graded :class:`~fem_twin.numerics.graded_mesh.Mesh` ``spacing``.
 
     ``kind`` is ``"quad"`` (bilinear quadrilaterals, one per pixel square) or ``"tri"`` (each
     square split along its diagonal).  ``periodic=True`` meshes the full period.
@@ -98,14 +103,19 @@ def grid_mesh(shape, spacing, origin=(0.0, 0.0), *, periodic: bool = False,
     ny, nx = (int(v) for v in shape)
     if ny < 2 or nx < 2:
         raise InputError(f"a grid mesh needs at least 2 x 2 pixels, got {shape}")
-    dx1, dx2 = (float(v) for v in np.broadcast_to(np.asarray(spacing, float), (2,)))
+    graded = isinstance(spacing, Mesh)
+    if graded and (periodic or tuple(shape) != spacing.shape):
+        raise InputError(f"a graded mesh of {spacing.shape} nodes is not periodic and has "
+                         f"no other shape, got {tuple(shape)}")
+    dx1, dx2 = spacing.pitch if graded else (
+        float(v) for v in np.broadcast_to(np.asarray(spacing, float), (2,)))
     if not (dx1 > 0 and dx2 > 0):
         raise InputError(f"spacing must be positive [m], got {spacing}")
     if kind not in ("quad", "tri"):
         raise InputError(f"kind must be 'quad' or 'tri', got {kind!r}")
     my, mx = (ny + 1, nx + 1) if periodic else (ny, nx)
-    x1 = origin[0] + dx1 * np.arange(mx)
-    x2 = origin[1] + dx2 * np.arange(my)
+    x1, x2 = spacing.coordinates if graded else (dx1 * np.arange(mx), dx2 * np.arange(my))
+    x1, x2 = origin[0] + x1, origin[1] + x2
     X1, X2 = np.meshgrid(x1, x2)
     p = np.vstack([X1.ravel(), X2.ravel()])
     n00 = (np.arange(my - 1)[:, None] * mx + np.arange(mx - 1)[None, :]).ravel()
@@ -116,7 +126,7 @@ def grid_mesh(shape, spacing, origin=(0.0, 0.0), *, periodic: bool = False,
         t = np.hstack([np.vstack([n00, n10, n11]), np.vstack([n00, n11, n01])])
         mesh = skfem.MeshTri1(p, t)
     return GridMesh(mesh, (ny, nx), (dx1, dx2), (float(origin[0]), float(origin[1])),
-                    bool(periodic))
+                    bool(periodic), spacing.lines if graded else None)
 
 
 # -- meshio ------------------------------------------------------------------------------
@@ -136,6 +146,8 @@ def to_meshio(gm: GridMesh, point_data: dict | None = None, *,
     cell_type = "quad" if isinstance(gm.mesh, skfem.MeshQuad1) else "triangle"
     grid = {"shape": list(gm.shape), "spacing": list(gm.spacing), "origin": list(gm.origin),
             "periodic": gm.periodic, "kind": "quad" if cell_type == "quad" else "tri"}
+    if gm.lines is not None:
+        grid["lines"] = [v.tolist() for v in gm.lines]
     field_data = {"fem_twin_grid": np.frombuffer(json.dumps(grid).encode(), dtype=np.uint8)}
     return meshio.Mesh(points, [(cell_type, gm.mesh.t.T.copy())], point_data=nodal,
                        field_data=field_data)
@@ -152,11 +164,14 @@ def from_meshio(mesh: meshio.Mesh, *, periodic: bool | None = None) -> tuple[Gri
     info = _grid_info(mesh)
     x, y = mesh.points[:, 0], mesh.points[:, 1]
     if info is not None:
-        gm = grid_mesh(info["shape"], info["spacing"], info["origin"],
+        spacing = (Mesh(info["spacing"], info["lines"]) if "lines" in info
+                   else info["spacing"])
+        gm = grid_mesh(info["shape"], spacing, info["origin"],
                        periodic=info["periodic"], kind=info.get("kind", "quad"))
         my, mx = gm.node_shape
-        j = np.rint((y - gm.origin[1]) / gm.spacing[1]).astype(int)
-        i = np.rint((x - gm.origin[0]) / gm.spacing[0]).astype(int)
+        lines = gm.lines or (np.arange(mx), np.arange(my))
+        i = np.searchsorted(lines[0], np.rint((x - gm.origin[0]) / gm.spacing[0]))
+        j = np.searchsorted(lines[1], np.rint((y - gm.origin[1]) / gm.spacing[1]))
     else:
         ux, uy = _unique_coords(x), _unique_coords(y)
         mx, my = ux.size, uy.size

@@ -9,9 +9,10 @@ from dataclasses import KW_ONLY, dataclass, replace
 
 import numpy as np
 
-from ..checks import arguments, as_field, as_pair, number, plausible
+from ..checks import arguments, as_field, as_spacing, number, plausible
 from ..errors import InputError
 from ..micro.flow_factors import FlowFactors
+from ..numerics.graded_mesh import Mesh
 from .coupling.settings import MacroSettings
 from .film.reynolds import check_closed
 from .laws.lubricant import Lubricant
@@ -51,8 +52,10 @@ class OperatingPoint:
                              f"for a pin or a ball (at most {MAX_GAP:g} m either way); give it "
                              "in metres")
         check_closed(gap)
-        spacing = as_pair("spacing [m]", self.spacing)
-        plausible("spacing [m]", spacing, "pitch")
+        spacing = as_spacing("spacing [m]", self.spacing)
+        plausible("spacing [m]", getattr(spacing, "pitch", spacing), "pitch")
+        if isinstance(spacing, Mesh) and spacing.shape != gap.shape:
+            raise InputError(f"the gap {gap.shape} is not on the mesh's nodes {spacing.shape}")
         face = np.ones(gap.shape, bool) if self.face is None else np.asarray(self.face, bool)
         if face.shape != gap.shape:
             raise InputError(f"face mask {face.shape} does not match the gap {gap.shape}")
@@ -88,8 +91,12 @@ class OperatingPoint:
         return replace(self, gap=gap, spacing=spacing, face=face)
 
 
-@arguments(gap="field", spacing="pair")
+@arguments(gap="field", spacing="spacing")
 def coarsened(gap, spacing, face):
-    """``(gap, spacing, face)`` on every other node of the grid [m] (``face`` None: None)."""
+    """``(gap, spacing, face)`` on every other node of the grid [m], or every other line
+    of a graded :class:`~fem_twin.numerics.graded_mesh.Mesh` (``face`` None: None)."""
+    if isinstance(spacing, Mesh):
+        return (spacing.every_other(gap), spacing.coarsened(),
+                None if face is None else spacing.every_other(np.asarray(face, bool)))
     return (np.asarray(gap)[::2, ::2], (2 * spacing[0], 2 * spacing[1]),
             None if face is None else np.asarray(face, bool)[::2, ::2])

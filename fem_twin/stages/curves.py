@@ -25,7 +25,7 @@ from ..stribeck.curve import plot_temperatures
 from ..stribeck.parts import plot_parts
 from ..stribeck.sweep import LOAD_BELOW, point_files, point_key
 from ..stribeck.validation import validate_curves
-from .geometry import ball_contact, hersey_length
+from .geometry import ball_contact, ball_grid, hersey_length
 from .provenance import provenance
 from .requests import per_viscosity, sweep_request
 from .sweeps import guide_of, run_sweeps
@@ -237,7 +237,7 @@ def ehl_film(case: Case, points) -> dict:
     fastest = next(p for p in points if p.sweep == 0)
     u_m, point = fastest.speed, MixedResult.load(fastest.path)
     film_mu = point.meta.get("thermal", {}).get("viscosity_Pa_s", mu)
-    _, _, x1, x2 = ball_contact(case).grid(case.macro.grid)
+    _, _, x1, x2 = ball_grid(case)
     film = film_against_hamrock_dowson(replace(ball_contact(case), viscosity=film_mu,
                                                entrainment=u_m), point, x1, x2)
     log.info("EHL film at u_m = %g m/s: h_c %.4g m, h_min %.4g m; Hamrock-Dowson %.4g m, "

@@ -219,7 +219,7 @@ def macro_geometry(case: Case, out: RunLayout):
     """Gap ``h_g = x3_up - x3_low``, spacing, pin-face mask and origin of the macro pin, or
     of the ball's sphere over [-4a, 2a] x [-3a, 3a] (a the Hertz radius; face: all)."""
     if case.tribometer.ball:
-        gap, spacing, x1, x2 = ball_contact(case).grid(case.macro.grid)
+        gap, spacing, x1, x2 = ball_grid(case)
         if case.geometry.ball is not None:
             gap = cap_gap(*measured_ball(case.geometry.ball), x1, x2)
         return gap, spacing, np.ones(gap.shape, bool), (float(x1[0]), float(x2[0]))
@@ -228,6 +228,14 @@ def macro_geometry(case: Case, out: RunLayout):
     disk = read_topography(out.disk(1 if k == "average" else k))
     face = pin_face(pin, case.preprocessing.holder_height)
     return disk.heights - pin.heights, pin.spacing, face, pin.origin
+
+
+def ball_grid(case: Case) -> tuple:
+    """A ball's ``(gap, spacing, x1, x2)`` on its ``[macro] grid``, or on the mesh graded
+    over it (``[macro] mesh``, :meth:`.PointContact.mesh`)."""
+    contact = ball_contact(case)
+    build = contact.mesh if case.macro.mesh == "graded" else contact.grid
+    return build(case.macro.grid)
 
 
 def ball_contact(case: Case) -> PointContact:

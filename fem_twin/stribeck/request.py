@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import tables as T
-from ..checks import as_field, as_pair, check, number
+from ..checks import as_field, as_spacing, check, number
 from ..errors import InputError
 from ..io.checkpoint import input_key
 from ..macro import Lubricant, MacroSettings
@@ -113,7 +113,7 @@ class SweepRequest:
                              ("motion", (Sliding, RollingSliding))):
             check(f"{name}: {field_}", getattr(self, field_), kind)
         object.__setattr__(self, "gap", as_field(f"{name}: gap", self.gap))
-        object.__setattr__(self, "spacing", as_pair(f"{name}: spacing", self.spacing))
+        object.__setattr__(self, "spacing", as_spacing(f"{name}: spacing", self.spacing))
         object.__setattr__(self, "speeds", speeds)
         object.__setattr__(self, "load", number(f"{name}: load", self.load, "load"))
         number(f"{name}: load_share", self.load_share, "load_share")

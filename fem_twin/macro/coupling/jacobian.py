@@ -98,7 +98,7 @@ def jacobian(P: Problem, ev: NewtonEvaluation) -> dict:
     out = dict(J_pp=J_p[:, I].tocsc(), J_ph=J_h.tocsr(), pos=pos,
                dpc=(d["p_con"] * free).ravel(), Dpc=None)
     if P.settings.contact_quadrature != "nodal":        # p_con_i depends on its neighbours
-        out["Dpc"] = contact_load(P.shape).derivative(P.factors, ev.h0, free)
+        out["Dpc"] = contact_load(P.shape, P.mesh).derivative(P.factors, ev.h0, free)
         out["dpc"] = np.asarray(out["Dpc"].sum(axis=1)).ravel()    # lumped: preconditioner
     return out
 
@@ -247,7 +247,8 @@ def dense_set(P: Problem, jac: dict) -> np.ndarray:
     diag = np.abs(jac["J_pp"].diagonal())
     row = np.asarray(abs(jac["J_ph"]).sum(axis=1)).ravel()
     score = np.zeros(P.gap.size)
-    score[I] = e0 * row / np.maximum(diag, 1e-300 + 1e-12 * diag.max())
+    e0 = e0 * np.sqrt(P.cells)           # a node's own compliance grows with its side
+    score[I] = e0[I] * row / np.maximum(diag, 1e-300 + 1e-12 * diag.max())
     score = np.maximum(score, e0 * np.abs(jac["dpc"]))
     score = maximum_filter(score.reshape(P.shape), size=5, mode="constant").ravel()[I]
     chosen = np.flatnonzero(score > DENSE_THRESHOLD)

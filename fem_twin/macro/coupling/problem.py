@@ -19,6 +19,7 @@ import scipy.sparse as sp
 
 from ...contact.elastic import ElasticOperator, elastic_operator
 from ...micro.flow_factors import FlowFactors
+from ...numerics.graded_mesh import Mesh, MeshElastic
 from ..film.contact_load import nodal_contact_pressure
 from ..film.reynolds import OPEN_GAP, fe_poiseuille, trapezoid_weights
 from ..film.reynolds_fv import fvm_poiseuille
@@ -40,12 +41,12 @@ class Problem:
     """The grid, the physics and the speeds of one operating point (SI units)."""
 
     gap: np.ndarray            # rigid gap h_g (ny, nx) [m]
-    spacing: tuple[float, float]  # (dx1, dx2) [m]
+    spacing: tuple[float, float] | Mesh  # (dx1, dx2) [m], or a graded mesh
     factors: FlowFactors       # at the point's slide-to-roll ratio
     lubricant: Lubricant
     settings: MacroSettings
     poiseuille: Callable[[np.ndarray, np.ndarray | None], sp.csr_matrix]  # (g, A) -> K
-    elastic: ElasticOperator   # eqs 20-22 on the padded grid
+    elastic: ElasticOperator | MeshElastic  # eqs 20-22 on the padded grid
     area: np.ndarray           # trapezoid weights [m^2]
     interior: np.ndarray       # flat indices of the interior nodes
     speed: float               # sliding speed u_r [m/s]
@@ -61,6 +62,11 @@ class Problem:
     @property
     def shape(self):
         return self.gap.shape
+
+    @property
+    def mesh(self) -> Mesh | None:
+        """The graded mesh, None on a grid."""
+        return self.spacing if isinstance(self.spacing, Mesh) else None
 
     @property
     def boundary(self) -> np.ndarray:
@@ -81,7 +87,8 @@ class Problem:
         loc = in_grid_frame(self.factors.at(h0, friction=False, contact=rule == "nodal"),
                             self.turn)
         if rule != "nodal":
-            loc = replace(loc, p_con=nodal_contact_pressure(self.factors, h0, rule))
+            loc = replace(loc, p_con=nodal_contact_pressure(self.factors, h0, rule,
+                                                            self.mesh))
         p_coef = np.minimum(p, MAX_COEFFICIENT_PRESSURE)
         mu = self.lubricant.viscosity_at(p_coef)
         rho = self.lubricant.density_ratio(p_coef)
@@ -93,18 +100,43 @@ class Problem:
 
     def kernel(self):
         """The influence kernel on the padded grid (real space, [m/Pa])."""
-        ny, nx = self.shape
+        ny, nx = self.shape if self.mesh is None else self.mesh.grid_shape
         cache = self.__dict__.setdefault("_kernel", [])
         if not cache:
             cache.append(fft.irfft2(self.elastic.kernel_hat, s=(2 * ny, 2 * nx)))
         return cache[0]
 
     def dense_elastic(self, nodes) -> np.ndarray:
-        """``E[nodes, nodes]``: deformation at node i per pressure at node j [m/Pa]."""
-        ny, nx = self.shape
-        r, c = np.divmod(nodes, nx)
-        return self.kernel()[(r[:, None] - r[None, :]) % (2 * ny),
-                             (c[:, None] - c[None, :]) % (2 * nx)]
+        """``E[nodes, nodes]``: deformation at node i per pressure at node j [m/Pa]; on a
+        graded mesh node j's pressure is its hat function on the grid
+        (:meth:`~fem_twin.numerics.graded_mesh.Mesh.to_grid`), summed over its grid nodes."""
+        if self.mesh is None:
+            ny, nx = self.shape
+            r, c = np.divmod(nodes, nx)
+            return self.kernel()[(r[:, None] - r[None, :]) % (2 * ny),
+                                 (c[:, None] - c[None, :]) % (2 * nx)]
+        ny, nx = self.mesh.grid_shape
+        kernel = self.kernel()
+        r, c = np.divmod(self.mesh.grid_nodes[nodes], nx)
+        E = kernel[(r[:, None] - r[None, :]) % (2 * ny), (c[:, None] - c[None, :]) % (2 * nx)]
+        hats = self.mesh.prolongation[:, nodes]
+        spread = np.flatnonzero(np.diff(hats.indptr) > 1)    # nodes beside a coarse element
+        if spread.size:
+            hats = hats[:, spread].tocoo()                       # (grid node, column, weight)
+            rf, cf = np.divmod(hats.row, nx)
+            parts = kernel[(r[:, None] - rf[None, :]) % (2 * ny),
+                           (c[:, None] - cf[None, :]) % (2 * nx)] * hats.data
+            E[:, spread] = parts @ sp.csr_matrix(
+                (np.ones(hats.nnz), (np.arange(hats.nnz), hats.col)),
+                shape=(hats.nnz, spread.size)).toarray()
+        return E
+
+    @cached_property
+    def cells(self) -> np.ndarray:
+        """Each node's area in cells of the FFT grid, (n,) (1 on a grid)."""
+        if self.mesh is None:
+            return np.ones(self.gap.size)
+        return self.mesh.area.ravel() / (self.mesh.pitch[0] * self.mesh.pitch[1])
 
 
 def macro_problem(gap, spacing, factors, lubricant, settings, speed: float,
@@ -115,15 +147,22 @@ def macro_problem(gap, spacing, factors, lubricant, settings, speed: float,
     non-periodic FFT half-space of eqs 20-22 and the Poiseuille operator of
     ``settings.method``; ``velocity``: the disk's (:func:`.kinematics.disk_velocity`)."""
     gap = np.asarray(gap, float)
-    dx = tuple(float(v) for v in spacing)
+    dx = spacing if isinstance(spacing, Mesh) else tuple(float(v) for v in spacing)
     boundary = gap > OPEN_GAP
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
     return Problem(gap, dx, factors, lubricant, settings,
                    partial(_poiseuille, POISEUILLE[settings.method], dx),
-                   elastic_operator(gap.shape, dx, settings.e_reduced),
+                   _elastic(gap.shape, dx, settings.e_reduced),
                    trapezoid_weights(gap.shape, dx), np.flatnonzero(~boundary.ravel()),
                    float(speed), float(entrainment), velocity)
 
 
 def _poiseuille(assemble, dx, g, A):
     return assemble(g, dx, A)
+
+
+def _elastic(shape, dx, e_reduced):
+    """The half-space on the grid, or through its grid on a graded mesh."""
+    if isinstance(dx, Mesh):
+        return MeshElastic(dx, elastic_operator(dx.grid_shape, dx.pitch, e_reduced))
+    return elastic_operator(shape, dx, e_reduced)

@@ -7,9 +7,11 @@ from dataclasses import dataclass, field, fields, is_dataclass, replace
 from pathlib import Path
 
 import numpy as np
+import scipy.sparse as sp
 
 from ...io.atomic import atomic_path
 from ...micro.rolling import at_slide_to_roll
+from ...numerics.graded_mesh import Mesh
 from ..film.reynolds import trapezoid_weights
 from ..laws.boundary import asperity_load, boundary_area, traction
 from ..laws.friction import confined_shear, disk_shear, hydrodynamic_shear
@@ -77,12 +79,17 @@ class MixedResult:
                 if f.name not in FIELDS and f.name not in ("history", "meta")}
 
     def save(self, path) -> Path:
-        """Write ``.npz`` (fields, history, scalars and meta as JSON) atomically."""
+        """Write ``.npz`` (fields, history, scalars and meta as JSON; a graded mesh's
+        lines) atomically."""
         path = Path(path)
+        scalars, lines = self.scalars(), {}
+        if isinstance(self.spacing, Mesh):
+            scalars["spacing"] = self.spacing.pitch
+            lines = {"mesh_lines1": self.spacing.lines[0], "mesh_lines2": self.spacing.lines[1]}
         with atomic_path(path) as tmp:
             with open(tmp, "wb") as f:
-                np.savez(f, **self.fields(), history=self.history,
-                         scalars=np.array(json.dumps(self.scalars())),
+                np.savez(f, **self.fields(), history=self.history, **lines,
+                         scalars=np.array(json.dumps(scalars)),
                          meta=np.array(json.dumps(self.meta, sort_keys=True)))
         return path
 
@@ -91,6 +98,9 @@ class MixedResult:
         with np.load(path) as data:
             scalars = json.loads(str(data["scalars"]))
             scalars["spacing"] = tuple(scalars["spacing"])
+            if "mesh_lines1" in data:
+                scalars["spacing"] = Mesh(scalars["spacing"], (data["mesh_lines1"],
+                                                               data["mesh_lines2"]))
             arrays = {k: data[k] for k in FIELDS}
             arrays["face"] = arrays["face"].astype(bool)
             return cls(**scalars, **arrays, history=data["history"],
@@ -102,6 +112,9 @@ class MixedResult:
         there :meth:`~fem_twin.micro.FlowFactors.at` extrapolates p_con instead of reading
         it from a cell problem (lumped nodal areas, the face alone) [-]."""
         below = self.face & (self.h0 < h0_min)
+        if isinstance(self.spacing, Mesh):
+            return float((self.spacing.area * self.contact_pressure)[below].sum()
+                         / self.normal_load)
         cell = self.spacing[0] * self.spacing[1]
         return float(self.contact_pressure[below].sum() * cell / self.normal_load)
 
@@ -257,12 +270,13 @@ def friction_with(result: MixedResult, factors, settings, lubricant) -> float:
 
 
 def on_grid(result: MixedResult, shape, dx) -> MixedResult:
-    """``result`` interpolated (linearly, by coordinates from the first node) onto a grid."""
-    if result.pressure.shape == tuple(shape) and np.allclose(result.spacing, dx):
+    """``result`` interpolated (linearly, by coordinates from the first node) onto a grid
+    or a graded ``Mesh`` ``dx``."""
+    if _same_grid(result.spacing, result.pressure.shape, dx, shape):
         return result
     fields = {k: resampled(getattr(result, k), result.spacing, shape, dx)
               for k in FIELDS if k != "face"}
-    return replace(result, spacing=tuple(dx), **fields,
+    return replace(result, spacing=dx if isinstance(dx, Mesh) else tuple(dx), **fields,
                    face=resampled(result.face, result.spacing, shape, dx) > 0.5)
 
 
@@ -270,7 +284,10 @@ def resampled(field, spacing, shape, dx) -> np.ndarray:
     """A nodal ``field`` on a grid of ``spacing`` interpolated (linearly, by coordinates from
     the first node, held at the last node beyond it) onto the grid ``shape``, ``dx`` [m]:
     bilinear, one axis after the other (half the time of ``scipy.ndimage.map_coordinates``
-    at 2048^2, equal to 1e-14)."""
+    at 2048^2, equal to 1e-14); from or onto a graded ``Mesh`` by its coordinates."""
+    if isinstance(spacing, Mesh) or isinstance(dx, Mesh):
+        return _by_coordinates(field, _coordinates(spacing, np.shape(field)),
+                               _coordinates(dx, shape))
     out = np.asarray(field, float)
     for axis, (n_new, d_new, d_old) in enumerate(((shape[0], dx[1], spacing[1]),
                                                  (shape[1], dx[0], spacing[0]))):
@@ -284,3 +301,32 @@ def resampled(field, spacing, shape, dx) -> np.ndarray:
         else:
             out = out[:, below] * (1 - t) + out[:, above] * t
     return out
+
+
+def _same_grid(spacing, shape, dx, new_shape) -> bool:
+    if isinstance(spacing, Mesh) or isinstance(dx, Mesh):
+        return spacing is dx
+    return tuple(shape) == tuple(new_shape) and np.allclose(spacing, dx)
+
+
+def _coordinates(spacing, shape) -> tuple:
+    """``(x1, x2)`` of a grid's node lines from its first node [m]."""
+    if isinstance(spacing, Mesh):
+        return spacing.coordinates
+    return np.arange(shape[1]) * spacing[0], np.arange(shape[0]) * spacing[1]
+
+
+def _by_coordinates(field, old, new) -> np.ndarray:
+    """Bilinear interpolation of ``field`` on the lines ``old`` (x1, x2) at the lines
+    ``new``, held at the last line beyond it."""
+    M1, M2 = (_interpolation(n, o) for n, o in zip(new, old))
+    return np.asarray(M1 @ np.asarray(M2 @ np.asarray(field, float)).T).T
+
+
+def _interpolation(new, old) -> sp.csr_matrix:
+    """(new, old): linear interpolation between the lines ``old`` at ``new``."""
+    k = np.clip(np.searchsorted(old, new, side="right") - 1, 0, old.size - 2)
+    t = np.clip((new - old[k]) / (old[k + 1] - old[k]), 0.0, 1.0)
+    rows = np.arange(new.size)
+    return sp.csr_matrix((np.r_[1 - t, t], (np.r_[rows, rows], np.r_[k, k + 1])),
+                         shape=(new.size, old.size))

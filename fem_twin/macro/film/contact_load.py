@@ -22,6 +22,7 @@ import scipy.sparse as sp
 
 from ...micro.flow_factors import REL_STEP
 from ...numerics.assembly import CORNERS, at_points, grid_stencil
+from ...numerics.graded_mesh import Mesh
 
 #: the rules of ``MacroSettings.contact_quadrature``
 RULES = ("gauss", "nodal")
@@ -41,9 +42,10 @@ class ContactLoad:
     block of rows at a time, their corners by slicing (:data:`fem_twin.numerics.assembly.CORNERS`),
     so nothing is kept per pixel."""
 
-    def __init__(self, shape, points: int = POINTS):
+    def __init__(self, shape, points: int = POINTS, area=None):
         ny, nx = shape
         self.shape, self.n = (ny, nx), ny * nx
+        self.area = area            # a graded mesh's element areas (ny - 1, nx - 1) [m^2]
         x, w = np.polynomial.legendre.leggauss(points)
         x, w = (x + 1) / 2, w / 2                                         # on [0, 1]
         s, t = (v.ravel() for v in np.meshgrid(x, x))                     # s: x1, t: x2
@@ -64,8 +66,15 @@ class ContactLoad:
     def _to_nodes(self, out, per_pixel, r0) -> None:
         """Add ``(4, rows, nx - 1)`` contributions of the pixels' corners onto the nodes."""
         rows, nx = per_pixel.shape[1], self.shape[1]
+        per_pixel = self._weighted(per_pixel, r0)
         for (a, b), values in zip(CORNERS, per_pixel):
             out[r0 + a:r0 + a + rows, b:nx - 1 + b] += values
+
+    def _weighted(self, per_pixel, r0) -> np.ndarray:
+        """``(..., rows, nx - 1)`` pixel values times their area (a graded mesh's)."""
+        if self.area is None:
+            return per_pixel
+        return per_pixel * self.area[r0:r0 + per_pixel.shape[-2]]
 
     def at_points(self, h0, r0, r1) -> np.ndarray:
         """The bilinear interpolant of the nodal ``h0`` at the Gauss points of the pixel rows
@@ -91,20 +100,24 @@ class ContactLoad:
             eps = REL_STEP * hq
             slope = (factors.contact_pressure(hq + eps)
                      - factors.contact_pressure(hq - eps)) / (2 * eps)        # (nq, rows, nx-1)
-            stencil.add_elements(S, np.einsum("aq,bq,qrc->abrc", self.wphi, self.phi, slope),
-                                 r0)
+            stencil.add_elements(S, self._weighted(
+                np.einsum("aq,bq,qrc->abrc", self.wphi, self.phi, slope), r0), r0)
         D = sp.diags(1 / self.mass.ravel()) @ stencil.csr(S)
         return D if free is None else D @ sp.diags(np.ravel(free).astype(float))
 
 
 @lru_cache(maxsize=4)
-def contact_load(shape) -> ContactLoad:
-    """The (cached) :class:`ContactLoad` of a grid."""
-    return ContactLoad(tuple(shape))
+def contact_load(shape, mesh: Mesh | None = None) -> ContactLoad:
+    """The (cached) :class:`ContactLoad` of a grid, or of a graded ``Mesh``."""
+    if mesh is None:
+        return ContactLoad(tuple(shape))
+    h1, h2 = mesh.sizes
+    return ContactLoad(mesh.shape, area=h2[:, None] * h1[None, :])
 
 
-def nodal_contact_pressure(factors, h0, rule: str) -> np.ndarray:
-    """The nodal contact pressure [Pa] of the film ``h0`` [m] by ``rule`` (:data:`RULES`)."""
+def nodal_contact_pressure(factors, h0, rule: str, mesh: Mesh | None = None) -> np.ndarray:
+    """The nodal contact pressure [Pa] of the film ``h0`` [m] by ``rule`` (:data:`RULES`)
+    on the grid or a graded ``Mesh``."""
     if rule == "nodal":
         return factors.contact_pressure(h0)
-    return contact_load(np.shape(h0)).pressure(factors, h0)
+    return contact_load(np.shape(h0), mesh).pressure(factors, h0)

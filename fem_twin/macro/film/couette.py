@@ -23,6 +23,7 @@ import scipy.sparse as sp
 
 from ...errors import InputError
 from ...numerics.assembly import grid_stencil
+from ...numerics.graded_mesh import Mesh
 
 #: the Couette schemes (``MacroSettings.couette``, ``solve_reynolds(couette=...)``)
 SCHEMES = ("central", "upwind")
@@ -55,11 +56,12 @@ class Couette:
 
 def couette(q1, q2, spacing, scheme: str = "central") -> Couette:
     """The :class:`Couette` term of the nodal coefficient ``(q1, q2)`` (ny, nx) [m^2/s] on a
-    non-periodic grid of spacing ``(dx1, dx2)`` [m]."""
+    non-periodic grid of spacing ``(dx1, dx2)`` [m] or a graded ``Mesh``."""
     q1, q2 = _checked(q1, q2, scheme)
     parts = []
     for k, q in enumerate((q1, q2)):
-        D, mean, a, b = _faces(q1.shape, tuple(float(v) for v in spacing), k)
+        D, mean, a, b = _faces(q1.shape, spacing if isinstance(spacing, Mesh)
+                               else tuple(float(v) for v in spacing), k)
         q = q.ravel()
         forward = mean @ q >= 0
         U = _pick(np.where(forward, a, b), q.size)
@@ -79,7 +81,7 @@ def couette_matrix(q1, q2, spacing, scheme: str = "central") -> sp.csr_matrix:
     stencil = grid_stencil(q1.shape)
     S = np.zeros((*q1.shape, 3, 3))
     for k, q in enumerate((q1, q2)):
-        width = float(spacing[1] if k == 0 else spacing[0])
+        width = face_width(spacing, k)
         q_a, q_b = (q[:, :-1], q[:, 1:]) if k == 0 else (q[:-1, :], q[1:, :])
         forward = q_a + q_b >= 0
         flux = width * ((q_a + q_b) / 2 if scheme == "central" else np.where(forward, q_a, q_b))
@@ -109,7 +111,19 @@ def _face_nodes(shape, spacing, k):
     ny, nx = shape
     idx = np.arange(ny * nx).reshape(ny, nx)
     a, b = (idx[:, :-1], idx[:, 1:]) if k == 0 else (idx[:-1, :], idx[1:, :])
-    return a.ravel(), b.ravel(), float(spacing[1] if k == 0 else spacing[0])
+    width = face_width(spacing, k)
+    return a.ravel(), b.ravel(), (width if np.ndim(width) == 0
+                                  else np.broadcast_to(width, a.shape).ravel())
+
+
+def face_width(spacing, k):
+    """The width [m] of the faces along direction ``k`` (0: x1, 1: x2) between two nodes:
+    the grid's other pitch, or on a graded ``Mesh`` the dual cell's width of
+    each face's row (``(ny, 1)``, k = 0) or column (``(1, nx)``, k = 1)."""
+    if isinstance(spacing, Mesh):
+        w1, w2 = spacing.widths
+        return w2[:, None] if k == 0 else w1[None, :]
+    return float(spacing[1] if k == 0 else spacing[0])
 
 
 @lru_cache(maxsize=16)
@@ -119,7 +133,7 @@ def _faces(shape, spacing, k):
     each face."""
     a, b, width = _face_nodes(shape, spacing, k)
     nf, n, f = a.size, shape[0] * shape[1], np.arange(a.size)
-    D = sp.csr_matrix((np.r_[np.full(nf, width), np.full(nf, -width)],
+    D = sp.csr_matrix((np.r_[np.broadcast_to(width, nf), -np.broadcast_to(width, nf)],
                        (np.r_[a, b], np.r_[f, f])), shape=(n, nf))
     mean = sp.csr_matrix((np.full(2 * nf, 0.5), (np.r_[f, f], np.r_[a, b])), shape=(nf, n))
     return D, mean, a, b

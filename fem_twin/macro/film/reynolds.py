@@ -26,6 +26,7 @@ from skfem.helpers import dot, grad
 from ...checks import arguments, as_field, as_pair
 from ...errors import InputError, ReynoldsNotConverged
 from ...numerics.assembly import at_points, grid_stencil, unit_element
+from ...numerics.graded_mesh import Mesh
 from ..laws.lubricant import Lubricant
 from .cavitation import cavitation_model
 from .couette import SCHEMES, couette_matrix
@@ -173,7 +174,10 @@ def _velocity(velocity, shape):
 
 
 def trapezoid_weights(shape, dx) -> np.ndarray:
-    """Nodal weights [m^2] of the trapezoidal rule on the node grid (half at the edges)."""
+    """Nodal weights [m^2] of the trapezoidal rule on the node grid (half at the edges), or
+    on a graded ``Mesh`` ``dx``."""
+    if isinstance(dx, Mesh):
+        return dx.area
     w1 = np.full(shape[1], dx[0])
     w1[[0, -1]] /= 2
     w2 = np.full(shape[0], dx[1])
@@ -185,11 +189,14 @@ def fe_poiseuille(g, spacing, A=None) -> sp.csr_matrix:
     """Q1 stiffness of ``-div(g A grad p)`` on the node grid (nodes = pixels), non-periodic.
 
     ``g`` is ``(ny, nx)``; ``A`` is ``(ny, nx, 2, 2)`` (identity if None).  Nodal fields
-    are interpolated to the 2 x 2 Gauss points.  The matrix is
+    are interpolated to the 2 x 2 Gauss points.  ``spacing`` (dx1, dx2) [m], or a graded
+    :class:`~fem_twin.numerics.graded_mesh.Mesh`.  The matrix is
     ``homogenised_poiseuille_form`` assembled by scikit-fem, re-assembled from element
     tensors computed once per grid (see :class:`PoiseuilleAssembly`).
     """
     g = np.asarray(g, dtype=float)
+    if isinstance(spacing, Mesh):
+        return graded_assembly(spacing).matrix(g, A)
     return _assembly(g.shape, tuple(float(v) for v in spacing)).matrix(g, A)
 
 
@@ -210,9 +217,11 @@ class PoiseuilleAssembly:
     (``benchmarks/run.py macro``), with nothing kept per element.
     """
 
-    def __init__(self, shape, spacing):
+    def __init__(self, shape, spacing, sizes=None):
         self.shape = tuple(shape)
-        b = unit_element(spacing)
+        b = unit_element((1.0, 1.0) if sizes is not None else spacing)
+        # a graded mesh: the unit square's tensors scaled per element (h2/h1, 1, 1, h1/h2)
+        self._scale = None if sizes is None else _element_scales(*sizes)
         nq = b.X.shape[1]
         T = np.zeros((nq, 2, 2, 16))
         names = (("a11", "a12"), ("a21", "a22"))
@@ -247,7 +256,11 @@ class PoiseuilleAssembly:
         for r0 in range(0, ny - 1, rows):
             r1 = min(r0 + rows, ny - 1)
             gq = self.at_quadrature(g, r0, r1)                       # (nq, rows, nx - 1)
-            if A4 is None:
+            if self._scale is not None:
+                Aq = (np.eye(2).reshape(1, 2, 2, 1, 1) if A4 is None else
+                      self.at_quadrature(A4, r0, r1).reshape(-1, 2, 2, r1 - r0, nx - 1))
+                coef, T = gq[:, None, None] * Aq * self._scale[:, :, r0:r1], self._T
+            elif A4 is None:
                 coef, T = gq, self._T[:, 0, 0] + self._T[:, 1, 1]
             else:
                 coef, T = gq[:, None] * self.at_quadrature(A4, r0, r1), self._T
@@ -260,5 +273,18 @@ class PoiseuilleAssembly:
 @lru_cache(maxsize=8)
 def _assembly(shape, spacing) -> PoiseuilleAssembly:
     return PoiseuilleAssembly(shape, spacing)
+
+
+@lru_cache(maxsize=8)
+def graded_assembly(mesh: Mesh) -> PoiseuilleAssembly:
+    """The (cached) :class:`PoiseuilleAssembly` of a graded ``Mesh``."""
+    return PoiseuilleAssembly(mesh.shape, mesh.pitch, sizes=mesh.sizes)
+
+
+def _element_scales(h1, h2) -> np.ndarray:
+    """``(2, 2, ny - 1, nx - 1)``: the factors of a ``h1 x h2`` element's ``d_k phi d_m phi``
+    integrals over the unit square's (Q1: ``h2/h1``, ``1``, ``1``, ``h1/h2``)."""
+    r = h2[:, None] / h1[None, :]
+    return np.array([[r, np.ones_like(r)], [np.ones_like(r), 1 / r]])
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...checks import arguments
+from ...numerics.graded_mesh import Mesh
 from .kinematics import rotate_tensor, rotations
 
 #: the friction laws: the force on the pin, or the paper's eq 31
@@ -29,7 +30,7 @@ _WEIGHTS = _WEIGHTS / _WEIGHTS.sum()
 READINGS = ("force", "torque")
 
 
-@arguments(pressure="field", mean_gap="field", spacing="pair", speed="number")
+@arguments(pressure="field", mean_gap="field", spacing="spacing", speed="number")
 def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing,
                        speed, *, entrainment=None, eyring_stress=None, law: str = "pin",
                        ambient_pressure: float = 0.0, face=None,
@@ -50,7 +51,7 @@ def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, sp
     isotropically commutes with the turn) and the traction is its x1 component.
     """
     p = np.asarray(pressure, float)
-    dp2, dp1 = np.gradient(p, spacing[1], spacing[0])
+    dp2, dp1 = gradient(p, spacing)
     c, s, v = (1.0, 0.0, 1.0) if velocity is None else rotations(velocity)
     across = 0.0
     if law == "paper":
@@ -70,10 +71,10 @@ def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, sp
     couette = couette * c - across * (1 - cavity_fraction)
     if law == "paper":
         return poiseuille + couette
-    return poiseuille + couette - (p - ambient_pressure) * face_slope(mean_gap, face, spacing[0])
+    return poiseuille + couette - (p - ambient_pressure) * face_slope(mean_gap, face, spacing)
 
 
-@arguments(pressure="field", mean_gap="field", spacing="pair", speed="number")
+@arguments(pressure="field", mean_gap="field", spacing="spacing", speed="number")
 def disk_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing, speed, *,
                eyring_stress=None, velocity=None) -> np.ndarray:
     """The film's drag on the disk along its local sliding [Pa].
@@ -85,7 +86,7 @@ def disk_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing, s
     on the pin (docs/model.md, "Friction on the pin"); times ``s`` it is the disk's torque
     over the track radius."""
     p = np.asarray(pressure, float)
-    dp2, dp1 = np.gradient(p, spacing[1], spacing[0])
+    dp2, dp1 = gradient(p, spacing)
     c, s, v = (1.0, 0.0, 1.0) if velocity is None else rotations(velocity)
     f = shear.pressure_friction                                 # 2 e1 - b
     couette = viscosity / mean_gap * speed * v * shear.friction_factor * (1 - cavity_fraction)
@@ -126,15 +127,31 @@ def confined_shear(viscosity, speed, shear, mean_gap, cavity_fraction,
     return tau if eyring_stress is None else eyring_shear(tau, eyring_stress)
 
 
-def face_slope(gap, face, dx1: float) -> np.ndarray:
+def face_slope(gap, face, spacing) -> np.ndarray:
     """``d gap / dx1`` [-] on the pin ``face`` (bool grid; None: all), by central
-    differences inside it and one-sided ones at its edge, zero off it."""
+    differences inside it (the mean of the two one-sided slopes on a graded
+    ``Mesh``) and one-sided ones at its edge, zero off it; ``spacing``
+    (dx1, dx2) [m], dx1 alone, or a mesh."""
     h = np.asarray(gap, float)
     face = np.ones(h.shape, bool) if face is None else np.asarray(face, bool)
     left, right = np.zeros_like(face), np.zeros_like(face)
     left[:, 1:], right[:, :-1] = face[:, :-1], face[:, 1:]
+    step, dx1 = np.diff(h, axis=1), 1.0
+    if isinstance(spacing, Mesh):
+        step = step / spacing.sizes[0]
+    else:
+        dx1 = float(np.ravel(spacing)[0])
     back, ahead = np.zeros_like(h), np.zeros_like(h)
-    back[:, 1:], ahead[:, :-1] = h[:, 1:] - h[:, :-1], h[:, 1:] - h[:, :-1]
+    back[:, 1:], ahead[:, :-1] = step, step
     both = left & right
     slope = np.where(both, (back + ahead) / 2, np.where(left, back, np.where(right, ahead, 0.0)))
     return np.where(face, slope / dx1, 0.0)
+
+
+def gradient(field, spacing) -> tuple[np.ndarray, np.ndarray]:
+    """``(d/dx2, d/dx1)`` of a nodal field on a grid of ``spacing`` (dx1, dx2) [m] or a
+    graded :class:`~fem_twin.numerics.graded_mesh.Mesh` (second order, one-sided at the edges)."""
+    if isinstance(spacing, Mesh):
+        x1, x2 = spacing.coordinates
+        return tuple(np.gradient(field, x2, x1))
+    return tuple(np.gradient(field, spacing[1], spacing[0]))

@@ -19,11 +19,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...checks import arguments, as_pair, plausible
+from ...checks import arguments, as_spacing, plausible
 from ...errors import InputError
+from ...numerics.graded_mesh import Mesh
 
 
-@arguments(face="field", spacing="pair", track_radius="number")
+@arguments(face="field", spacing="spacing", track_radius="number")
 def disk_velocity(face, spacing, track_radius=None) -> np.ndarray | None:
     """``v`` (ny, nx, 2): the disk's velocity over the grid of the pin ``face`` (bool,
     x1 along the columns, pitch ``spacing`` [m]) relative to ``u_r`` [-], the disk's axis
@@ -33,12 +34,13 @@ def disk_velocity(face, spacing, track_radius=None) -> np.ndarray | None:
         return None
     if not np.isfinite(track_radius) or track_radius <= 0:
         raise InputError(f"track radius must be positive [m], got {track_radius}")
-    spacing = plausible("disk_velocity: spacing [m]", as_pair("spacing", spacing), "pitch")
+    spacing = as_spacing("spacing", spacing)
+    plausible("disk_velocity: spacing [m]", getattr(spacing, "pitch", spacing), "pitch")
     face = np.asarray(face, bool)
     ny, nx = face.shape
     centre = face_centre(face if face.any() else np.ones_like(face), spacing)
-    x1 = np.arange(nx) * float(spacing[0]) - float(centre[0])
-    x2 = np.arange(ny) * float(spacing[1]) - float(centre[1])
+    x1, x2 = node_lines(spacing, face.shape)
+    x1, x2 = x1 - float(centre[0]), x2 - float(centre[1])
     if track_radius <= np.abs(x2).max():
         raise InputError(f"track radius {track_radius:g} m: the disk's axis lies inside the "
                          "macro grid")
@@ -49,9 +51,22 @@ def disk_velocity(face, spacing, track_radius=None) -> np.ndarray | None:
 
 
 def face_centre(face, spacing) -> tuple:
-    """The centroid (x1, x2) [m] of the ``face`` nodes (bool grid), from the first node."""
+    """The centroid (x1, x2) [m] of the ``face`` nodes (bool grid), from the first node;
+    on a graded ``Mesh`` weighted by the nodes' areas."""
+    if isinstance(spacing, Mesh):
+        x1, x2 = spacing.coordinates
+        w = spacing.area * np.asarray(face, bool)
+        return float((w * x1[None, :]).sum() / w.sum()), float((w * x2[:, None]).sum() / w.sum())
     rows, cols = np.nonzero(np.asarray(face, bool))
     return float(cols.mean() * spacing[0]), float(rows.mean() * spacing[1])
+
+
+def node_lines(spacing, shape) -> tuple[np.ndarray, np.ndarray]:
+    """``(x1, x2)`` [m] of the node lines of a ``shape`` grid of ``spacing`` (dx1, dx2), or
+    of a graded ``Mesh``, from the first node."""
+    if isinstance(spacing, Mesh):
+        return spacing.coordinates
+    return np.arange(shape[1]) * float(spacing[0]), np.arange(shape[0]) * float(spacing[1])
 
 
 def rotations(v) -> tuple:

@@ -24,6 +24,7 @@ import scipy.fft as fft
 from ...checks import arguments, as_pair, check_ranges, plausible, setting
 from ...contact.elastic import love_rectangle
 from ...errors import InputError, NotConverged
+from ...numerics.graded_mesh import Mesh
 from .boundary import BoundaryLaw, heated_factor
 
 #: sub-samples a side of a cell for the moving part of the kernel (it varies over 2 kappa / U)
@@ -186,9 +187,14 @@ class ContactThermal:
         power = max(float(result.friction_force * result.speed), 0.0)
         face = np.asarray(result.face, bool)
         flux = np.where(face, np.maximum(result.shear_stress, 0.0), 0.0)
-        total = flux.sum() * result.spacing[0] * result.spacing[1]
+        mesh, spacing = result.spacing, result.spacing
+        if isinstance(mesh, Mesh):                   # on the mesh's grid
+            total = float(np.sum(mesh.area * flux))
+            flux, face, spacing = mesh.to_grid(flux), mesh.to_grid(face) > 0.5, mesh.pitch
+        else:
+            total = flux.sum() * result.spacing[0] * result.spacing[1]
         flux = flux * (power / total) if total > 0 else flux
-        flash, share = face_flash(flux, face, result.spacing, speeds, self.settings)
+        flash, share = face_flash(flux, face, spacing, speeds, self.settings)
         return {"power": power, "flash": flash, "pin_share": share}
 
     def spot(self, result, factors, speeds) -> float:
@@ -196,9 +202,10 @@ class ContactThermal:
         boundary shear over the real contact area (``factors``: the point's flow factors,
         for the contact fraction) at the sliding speed."""
         face = np.asarray(result.face, bool)
-        fraction = factors.at(result.h0).contact_fraction[face].sum()
-        flux = (max(result.boundary_shear[face].sum(), 0.0) / fraction * abs(result.speed)
-                if fraction > 0 else 0.0)
+        w = result.spacing.area[face] if isinstance(result.spacing, Mesh) else 1.0
+        fraction = (w * factors.at(result.h0).contact_fraction[face]).sum()
+        flux = (max((w * result.boundary_shear[face]).sum(), 0.0) / fraction
+                * abs(result.speed) if fraction > 0 else 0.0)
         return spot_flash(flux, speeds, self.settings)
 
     def tempered(self, result, factors, speeds, temperature: float):

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
+from ...numerics.graded_mesh import point_contact_mesh
 
 
 @dataclass(frozen=True)
@@ -114,6 +115,19 @@ class PointContact:
         gap = x1[None, :] ** 2 / (2 * self.radius) + x2[:, None] ** 2 / (
             2 * (self.radius_y or self.radius))
         return gap, (x1[1] - x1[0], x2[1] - x2[0]), x1, x2
+
+
+    def mesh(self, n: int, extent=((-4.0, 2.0), (-3.0, 3.0))):
+        """:meth:`grid`'s ``(gap, spacing, x1, x2)`` on the mesh graded over that grid
+        (:func:`~fem_twin.numerics.graded_mesh.point_contact_mesh`): ``spacing`` is the
+        :class:`~fem_twin.numerics.graded_mesh.Mesh`, whose grid is ``n x n``."""
+        a = self.hertz_radius
+        mesh = point_contact_mesh(n, extent, (a, a * self.ellipticity))
+        x1, x2 = (c + e[0] * w for c, e, w in zip(mesh.coordinates, extent,
+                                                   (a, a * self.ellipticity)))
+        gap = x1[None, :] ** 2 / (2 * self.radius) + x2[:, None] ** 2 / (
+            2 * (self.radius_y or self.radius))
+        return gap, mesh, x1, x2
 
 
 def film_thickness(result, x1, x2) -> tuple:
