@@ -26,6 +26,7 @@ from .io.atomic import atomic_path
 from .io.layout import RunLayout
 from .macro.coupling.result import FIELDS
 from .macro.estimate import PARTS
+from .macro.laws.kinematics import node_lines
 from .micro.flow_factors import FlowFactors
 from .stribeck.curve import BOUNDARY_SHARE, LEGACY, OPTIONAL, UNITS, StribeckCurve
 
@@ -168,7 +169,7 @@ def fields_dataset(sweeps, origin=(0.0, 0.0)):
     speeds = np.unique([k[1] for k in points])
     first = next(iter(points.values()))
     ny, nx = first.pressure.shape
-    dx1, dx2 = first.spacing
+    x1, x2 = node_lines(first.spacing, (ny, nx))         # a grid's or a graded mesh's
     fields = {k: np.full((mus.size, speeds.size, ny, nx), np.nan) for k in FIELD_UNITS}
     for (mu, u), res in points.items():
         i, j = np.searchsorted(mus, mu), np.searchsorted(speeds, u)
@@ -176,8 +177,8 @@ def fields_dataset(sweeps, origin=(0.0, 0.0)):
             fields["local_viscosity" if k == "viscosity" else k][i, j] = v
     coords = {"viscosity": ("viscosity", mus, {"units": "Pa s"}),
               "speed": ("speed", speeds, {"units": "m/s"}),
-              "x2": ("x2", origin[1] + dx2 * np.arange(ny), {"units": "m"}),
-              "x1": ("x1", origin[0] + dx1 * np.arange(nx), {"units": "m"})}
+              "x2": ("x2", origin[1] + x2, {"units": "m"}),
+              "x1": ("x1", origin[0] + x1, {"units": "m"})}
     return xr.Dataset({k: (("viscosity", "speed", "x2", "x1"), v, {"units": FIELD_UNITS[k]})
                        for k, v in fields.items()}, coords=coords)
 
