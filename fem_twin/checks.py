@@ -14,7 +14,7 @@ import functools
 import inspect
 import math
 import os
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from dataclasses import field
 
 import numpy as np
@@ -266,12 +266,14 @@ def setting(default, doc: str, quantity: str | None = None, *, unit: str = "",
     """The one declaration of a setting (a dataclass field of its settings object): its
     default, a one-line ``doc``, the ``quantity`` of :data:`QUANTITIES` whose plausible
     range and unit the parser enforces (or a ``unit`` of its own), the ``choices`` of a
-    text setting, and the case-file ``section`` that sets it when that is another one (a
-    value the stage takes from elsewhere in the case).  The case parser, the API's checks
-    (:func:`check_choices`) and the documentation's case-file reference read it
+    text setting (a registry, a mapping by name, is kept as it is: a name registered
+    later is a choice too), and the case-file ``section`` that sets it when that is another
+    one (a value the stage takes from elsewhere in the case).  The case parser, the API's
+    checks (:func:`check_choices`) and the documentation's case-file reference read it
     (:func:`describe`)."""
+    choices = choices if isinstance(choices, Mapping) else tuple(choices)
     return field(default=default, metadata={"doc": doc, "quantity": quantity, "unit": unit,
-                                            "choices": tuple(choices), "section": section})
+                                            "choices": choices, "section": section})
 
 
 def check_choices(settings) -> None:

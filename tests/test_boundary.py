@@ -32,6 +32,41 @@ def test_the_shear_law_with_the_constant_coefficient_is_the_constant_law(factors
     assert np.array_equal(shear.shear_stress, constant.shear_stress)
 
 
+def test_a_new_law_is_one_class_and_one_registry_line(factors, monkeypatch):
+    """A toy law registered here (half of eq 32's shear, its own fitted factor) is a choice
+    of the [boundary] section, the macro scale's boundary force follows it (half the
+    constant law's on the same fields, which the boundary shear does not move) and the
+    fit lists its parameter, with its start and bounds."""
+    from fem_twin.macro.laws.boundary import LAWS, ConstantLaw, Fitted, fitted_law
+    from fem_twin.stribeck.fit import FitModel, _unknowns, parameters
+
+    class Half(ConstantLaw):
+        name = "half"
+        fitted = {"half_factor": Fitted(0.0, 1.0, "friction")}
+        limits = ()
+
+        def traction(self, law, load, dry_fraction, speed, boundary_friction):
+            return 0.5 * boundary_friction * np.asarray(load, float)
+
+        def unknowns(self, law, boundary_friction):
+            return [("half_factor", 0.5, 0.0, 1.0)]
+
+    with pytest.raises(InputError, match="law: one of"):
+        BoundaryLaw(law="half")
+    monkeypatch.setitem(LAWS, "half", Half())
+    gap, dx, face = macro_case(32)
+    run = lambda law: solve_mixed(gap, dx, factors, load=150.0, speed=0.02,  # noqa: E731
+                                  face=face, lubricant=Lubricant(0.066),
+                                  settings=MacroSettings(boundary=law))
+    constant, half = run(BoundaryLaw()), run(BoundaryLaw(law="half"))
+    assert half.boundary_force == pytest.approx(0.5 * constant.boundary_force, rel=1e-12)
+    assert half.hydrodynamic_friction == constant.hydrodynamic_friction
+    assert "half_factor" in parameters() and fitted_law(["half_factor"]) is LAWS["half"]
+    names, x0, lower, upper = _unknowns(FitModel((), BOUNDARY_FRICTION, 150.0, None),
+                                        ["half_factor"], 1, None)
+    assert (names, list(x0), lower, upper) == (["half_factor"], [0.5], [0.0], [1.0])
+
+
 def test_one_decade_of_speed_multiplies_the_shear_by_one_plus_the_coefficient():
     """s(10 u) / s(u) = 1 + c_u at u = u_ref, and the constant law has no speed term."""
     p, a = np.array([1e8, 2e8]), np.array([0.1, 0.3])

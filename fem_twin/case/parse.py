@@ -5,14 +5,14 @@ from __future__ import annotations
 import os
 import re
 import tomllib
-from dataclasses import replace
 from itertools import pairwise
 from pathlib import Path
 
 from ..checks import arguments, memory_shortfall
 from ..errors import InputError
 from ..io.files import topography_shape
-from ..macro.laws.boundary import FADED, REFERENCE_REACH, BoundaryLaw, thin_films_choice
+from ..macro.laws.boundary import COMMON_KEYS, LAWS, BoundaryLaw, thin_films_choice
+from ..macro.laws.friction import LAWS as FRICTION_LAWS
 from ..macro.laws.thermal import ThermalSettings
 from ..stribeck.curve import read_measured_csv
 from ..stribeck.validation import check_like_with_like
@@ -292,7 +292,7 @@ def _macro(data, where, tribometer, geometry) -> MacroSpec:
     if not 9 <= macro.grid <= 1025:
         raise CaseError(f"{where} [macro] grid: nodes per side of the ball's grid, 9 to 1025 "
                         f"(e.g. 97), got {macro.grid}")
-    if tribometer.reading == "torque" and macro.friction != "pin":
+    if tribometer.reading == "torque" and not FRICTION_LAWS[macro.friction].drag:
         raise CaseError(f"{where} [tribometer] reading = \"torque\": the disk's drag is the "
                         "force law's; it needs [macro] friction = \"pin\"")
     if macro.pin != "average" and not tribometer.ball and not (isinstance(macro.pin, int)
@@ -324,42 +324,28 @@ def _thermal(data, where, lubricant) -> ThermalSettings:
 
 
 def _boundary(data, where, lubricant, sweep, tribometer) -> BoundaryLaw:
-    """[boundary]: the shear law's keys only with ``law = "shear"``, its alpha by default
-    the case's ``[tribometer] boundary_friction``, some shear (tau_0 or alpha), a
-    temperature term that leaves more than :data:`FADED` of the shear at the hottest oil,
-    a speed factor positive over the sweep's speeds."""
+    """[boundary]: the keys of its law alone (:attr:`~BoundaryLaw.model`'s ``keys``), the
+    values the law takes from elsewhere in the case (the shear law's alpha: ``[tribometer]
+    boundary_friction``), the law's own rules at the case's oils (the shear law: some
+    shear, a temperature term that leaves more than half of it at the hottest oil), a
+    speed factor positive over the sweep's speeds."""
     table = data.get("boundary", {})
     if "thin_films" in table:                          # true/false of older case files
         table = {**table, "thin_films": thin_films_choice(table["thin_films"])}
     boundary = read_table({"boundary": table}, "boundary", BoundaryLaw, where)
-    given = set(data.get("boundary", {})) - {"law", "film_on_contacts", "thin_films"}
-    if boundary.law == "constant" and given:
-        raise CaseError(f"{where} [boundary] {', '.join(sorted(given))}: the shear law's, unused "
-                        "by law = \"constant\" (eq 32 with [tribometer] boundary_friction); set "
-                        "law = \"shear\" or remove them")
-    if boundary.law == "shear" and "pressure_coefficient" not in given:
-        boundary = replace(boundary, pressure_coefficient=tribometer.boundary_friction)
-    if boundary.law == "shear" and not (boundary.shear_strength or
-                                        boundary.pressure_coefficient):
-        raise CaseError(f"{where} [boundary]: shear_strength = pressure_coefficient = 0 leaves "
-                        "the asperities no shear at all; give tau_0 [Pa] (10 MPa is 1e7) or "
-                        "alpha (0.1), or law = \"constant\"")
-    reference = boundary.reference_temperature
-    if "reference_temperature" in given and min(
-            abs(t - reference) for t in lubricant.temperatures) > REFERENCE_REACH:
-        raise CaseError(f"{where} [boundary] reference_temperature = {reference:g}: more than "
-                        f"{REFERENCE_REACH:g} K from every oil temperature "
-                        f"{list(lubricant.temperatures)} C; it is in degrees Celsius, not "
-                        "kelvin (24 C is 24.0, not 297.15)")
-    hottest = max(lubricant.temperatures) - reference
-    if boundary.temperature_coefficient * hottest >= FADED:
-        raise CaseError(f"{where} [boundary] temperature_coefficient = "
-                        f"{boundary.temperature_coefficient:g}: at the oil's "
-                        f"{max(lubricant.temperatures):g} C, {hottest:g} K above "
-                        f"reference_temperature, the shear would fall by "
-                        f"{boundary.temperature_coefficient * hottest:.0%} before any heat; "
-                        "a relative fall per kelvin (0.2 % is 0.002)")
+    law = boundary.model
+    given = set(data.get("boundary", {})) - set(COMMON_KEYS)
+    unused = sorted(given - set(law.keys))
+    if unused:
+        owners = [other.name for other in LAWS.values() if set(unused) & set(other.keys)]
+        whose = f"the {' or '.join(owners)} law's, " if owners else ""
+        raise CaseError(f"{where} [boundary] {', '.join(unused)}: {whose}unused by law = "
+                        f"\"{law.name}\" ({law.reads or 'its keys: ' + ', '.join(law.keys)}); "
+                        + (f"set law = \"{owners[0]}\" or " if owners else "")
+                        + "remove them")
     try:
+        boundary = law.from_case(boundary, given, tribometer.boundary_friction)
+        law.check_case(boundary, given, lubricant.temperatures)
         boundary.check_speeds(sweep.speed_min, sweep.speed_max)
     except InputError as err:
         raise CaseError(f"{where} {err}") from None

@@ -161,20 +161,12 @@ def joined(curves) -> StribeckCurve:
 def parameter_shares(curve: StribeckCurve, law) -> dict:
     """C_f's relative sensitivity to each parameter of the boundary ``law`` (a
     :class:`~fem_twin.macro.laws.boundary.BoundaryLaw`) at each point of ``curve``, ``d ln C_f /
-    d ln q`` [-] by name ``share_q``: C_f,b's is :attr:`StribeckCurve.boundary_share`; the
-    shear law splits it between tau_0 (``tau_0 A_r``) and alpha (``alpha W``), from the
-    curve's real contact area and asperity load (none without them)."""
-    share = curve.boundary_share
-    if law.law == "constant":
-        return {"share_boundary_friction": share}
-    if curve.real_contact_area is None or curve.asperity_load is None:
-        return {}
-    tau = law.shear_strength * curve.real_contact_area
-    alpha = law.pressure_coefficient * curve.asperity_load
-    with np.errstate(invalid="ignore", divide="ignore"):
-        part = np.where(tau + alpha > 0, tau / (tau + alpha), 0.0)
-    return {"share_shear_strength": share * part,
-            "share_pressure_coefficient": share * (1 - part)}
+    d ln q`` [-] by name ``share_q``, the law's split of :attr:`StribeckCurve.boundary_share`
+    (:meth:`~fem_twin.macro.laws.boundary.Law.shares`): C_f,b's is all of it; the shear law
+    splits it between tau_0 (``tau_0 A_r``) and alpha (``alpha W``), from the curve's real
+    contact area and asperity load (none without them)."""
+    return law.model.shares(law, curve.boundary_share, curve.real_contact_area,
+                            curve.asperity_load)
 
 
 @arguments(path="path", curves=[StribeckCurve])

@@ -1,7 +1,10 @@
 """Fitting the twin's unknowns to measured Stribeck curves, with 95 % intervals.
 
-Parameters, by their case-file keys (none re-runs the micro stage): ``boundary_friction``,
-C_f,b of eq 32, from a simulated curve's force parts; ``temperature``, one oil temperature
+Parameters, by their case-file keys (none re-runs the micro stage): a boundary law's
+(:func:`fem_twin.macro.laws.boundary.fitted_parameters`: ``boundary_friction``, C_f,b of eq
+32, from a simulated curve's force parts, or the shear law's, from its real contact area and
+asperity load; the law owns them, :meth:`~fem_twin.macro.laws.boundary.Law.fit_force`);
+``temperature``, one oil temperature
 per curve through the case's Walther law, the simulated curve at ``mu_S`` giving the one at
 ``mu`` at the speeds ``U mu / mu_S`` (the Hersey collapse, eq 46); ``load_share``, the pin
 face's share of the load, the first viscosity swept at :data:`LOAD_SHARES`;
@@ -15,29 +18,55 @@ weights with the HC3 covariance (:func:`.fit_statistics.covariance`); intervals
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from ..errors import InputError, NotConverged
-from ..macro.laws.boundary import BoundaryLaw
+from ..macro.laws.boundary import LAWS, BoundaryLaw, fitted_law, fitted_parameters
 from ..macro.laws.viscosity import WaltherLaw
 from .curve import SPEED_MATCH, MeasuredCurve, StribeckCurve
 from .fit_statistics import correlation, covariance, interval, temperature_warnings
 from .identify import check_pair
 
-#: the shear law's parameters a fit can identify (``[boundary]`` keys), with their bounds
-SHEAR = {"shear_strength": (0.0, 5e8), "pressure_coefficient": (0.0, 1.0),
-         "speed_coefficient": (-0.3, 0.3), "temperature_coefficient": (0.0, 0.05)}
-#: the parameters :func:`fit_curves` can fit (case-file keys)
-PARAMETERS = ("boundary_friction", "temperature", "load_share", "bulk_resistance", *SHEAR)
+#: the parameters :func:`fit_curves` fits besides the boundary laws' (case-file keys)
+OWN = ("temperature", "load_share", "bulk_resistance")
+
+
+def parameters() -> tuple:
+    """The parameters :func:`fit_curves` can fit (case-file keys), in the order of a fit's
+    unknowns: the default boundary law's (eq 32's C_f,b), the fit's own (:data:`OWN`),
+    then the other registered laws' (:data:`~fem_twin.macro.laws.boundary.LAWS`)."""
+    first = LAWS[BoundaryLaw().law]
+    return (*first.fitted, *OWN, *(name for name in fitted_parameters()
+                                   if name not in first.fitted))
+
+
+#: :func:`parameters` at import: what the command line offers
+PARAMETERS = parameters()
 #: the face's shares of the imposed load swept for a ``load_share`` fit (its bounds)
 LOAD_SHARES = (0.5, 0.625, 0.75, 0.875, 1.0)
 #: the rig's thermal resistances [K/W] swept for a ``bulk_resistance`` fit (its bounds)
 RESISTANCES = (0.0, 1.0, 2.0, 4.0)
 #: expected range of three normal samples in standard deviations (d2 of n = 3)
 RANGE_OF_THREE = 1.693
+
+
+@dataclass(frozen=True)
+class Readings:
+    """What a boundary law's fit reads of one simulated curve at the measured speeds
+    (:meth:`~fem_twin.macro.laws.boundary.Law.fit_force`): the ``speed`` [m/s], ``read(name)``
+    the curve's column ``name`` there (None where the curve has none), the simulated
+    curves' C_f,b ``boundary_friction``, the law's section ``base`` whose unfitted values
+    the fit keeps, and ``film_temperature()`` [C] of the points at the fitted oil."""
+
+    speed: np.ndarray
+    read: Callable
+    boundary_friction: float
+    base: BoundaryLaw | None
+    film_temperature: Callable
 
 
 @dataclass(frozen=True)
@@ -49,9 +78,11 @@ class FitModel:
     viscosity, ascending, that bracket ``load_share`` (empty: the share is not a parameter);
     ``resistance_curves``: per curve, ``((R_b, StribeckCurve), ...)`` ascending around the
     curves' own ``bulk_resistance`` [K/W] (empty: not a parameter); ``loads``: each
-    curve's imposed load [N] (empty: ``load`` for all); ``boundary``: the
-    shear law whose unfitted values a fit of its parameters keeps (None: eq 32's constant
-    C_f,b as a shear law, tau_0 = 0 and alpha = ``boundary_friction``).
+    curve's imposed load [N] (empty: ``load`` for all); ``boundary``: the case's boundary
+    law (its ``[boundary]`` section; None: eq 32's constant law at ``boundary_friction``),
+    from which a fit of a law's parameters starts and whose unfitted values it keeps
+    (:meth:`~fem_twin.macro.laws.boundary.Law.start`: the shear law from a constant case is
+    tau_0 = 0 and alpha = ``boundary_friction``).
     """
 
     curves: tuple
@@ -65,17 +96,15 @@ class FitModel:
     boundary: BoundaryLaw | None = None
     loads: tuple = ()
 
-    def friction(self, k: int, speed, boundary_friction: float, viscosity: float,
-                 share: float | None = None, resistance: float | None = None,
-                 shear: dict | None = None):
-        """C_f of curve ``k`` at ``speed`` [m/s] for C_f,b, mu_0 [Pa s], the face's
-        ``share`` of the load and the rig's thermal ``resistance`` [K/W] (None: the curves'
-        own), the boundary shear by the shear law with the values ``shear`` (None: C_f,b);
-        and the mask of speeds whose Hersey number lies inside the simulated range (ends
-        held outside)."""
+    def friction(self, k: int, speed, viscosity: float, values: dict | None = None,
+                 share: float | None = None, resistance: float | None = None):
+        """C_f of curve ``k`` at ``speed`` [m/s] for mu_0 [Pa s], a boundary law's fitted
+        ``values`` (case-file keys of one law's :attr:`~fem_twin.macro.laws.boundary.Law.fitted`;
+        None or empty: the curves' own boundary force), the face's ``share`` of the load and
+        the rig's thermal ``resistance`` [K/W] (None: the curves' own); and the mask of
+        speeds whose Hersey number lies inside the simulated range (ends held outside)."""
         load = self.loads[k] if self.loads else self.load
-        at = lambda c: self._at(c, speed, boundary_friction, viscosity, shear,  # noqa: E731
-                                load)
+        at = lambda c: self._at(c, speed, viscosity, values, load)  # noqa: E731
         cf, inside = at(self.curves[k])
         for value, own, swept in ((share, self.load_share, self.share_curves),
                                   (resistance, self.bulk_resistance,
@@ -83,11 +112,11 @@ class FitModel:
                                    else ())):
             if value is None or value == own or not swept:
                 continue
-            values = [at(c) for _, c in swept]
-            grid = PchipInterpolator([s for s, _ in swept], np.stack([v[0] for v in values]),
+            values_ = [at(c) for _, c in swept]
+            grid = PchipInterpolator([s for s, _ in swept], np.stack([v[0] for v in values_]),
                                      axis=0)
             cf = cf + grid(value) - grid(own)
-            inside = inside & np.all([v[1] for v in values], axis=0)
+            inside = inside & np.all([v[1] for v in values_], axis=0)
         return cf, inside
 
     def reader(self, c: StribeckCurve, speed, viscosity: float):
@@ -100,36 +129,19 @@ class FitModel:
         inside = (u >= x[0] - SPEED_MATCH) & (u <= x[-1] + SPEED_MATCH)
         return (lambda a: PchipInterpolator(x, a[order])(np.clip(u, x[0], x[-1])), inside)
 
-    def _at(self, c: StribeckCurve, speed, boundary_friction: float, viscosity: float,
-            shear: dict | None, load: float):
+    def _at(self, c: StribeckCurve, speed, viscosity: float, values: dict | None,
+            load: float):
         at, inside = self.reader(c, speed, viscosity)
         hd = at(c.hydrodynamic_friction)
-        if shear is None:
-            return (hd + boundary_friction * at(c.boundary_force)
+        if not values:                     # the curves' own boundary force, as simulated
+            return (hd + self.boundary_friction * at(c.boundary_force)
                     / self.boundary_friction) / load, inside
-        return (hd + self._law_force(c, at, speed, shear, viscosity)) / load, inside
-
-    def _law_force(self, c: StribeckCurve, at, speed, shear: dict, viscosity: float):
-        """The shear law's boundary force [N] (:mod:`fem_twin.macro.laws.boundary`) from the
-        curve's real contact area and asperity load, the film temperature and the spots'
-        flash for the temperature factor (:func:`~fem_twin.macro.laws.boundary.temperature_factor`,
-        dT the untempered shear's flash); the iterate's tau_0 [Pa] enters the force
-        directly (the optimiser passes through tau_0 below the law's plausible floor,
-        10 kPa, on its way from 0)."""
-        base = self.boundary or BoundaryLaw(law="shear", shear_strength=0.0,
-                                            pressure_coefficient=self.boundary_friction)
-        tau0 = shear.get("shear_strength", base.shear_strength)
-        law = replace(base, law="shear", **{k: v for k, v in shear.items()
-                                            if k != "shear_strength"})
-        area, load = at(c.real_contact_area), at(c.asperity_load)
-        force = (tau0 * area + law.pressure_coefficient * load) * law.speed_factor(speed)
-        if law.temperature_coefficient:
-            rise = (0.0 if c.spot_rise is None else at(c.spot_rise) * np.divide(
-                force, area, out=np.zeros_like(force), where=area > 0))
-            c_t, hot = law.temperature_coefficient, self._film_temperature(c, at, viscosity)
-            force = (force * np.maximum(1 - c_t * (hot - law.reference_temperature), 0.0)
-                     / (1 + c_t * np.maximum(rise, 0.0)))
-        return force
+        law = fitted_law(values)
+        readings = Readings(
+            speed, lambda name: None if getattr(c, name) is None else at(getattr(c, name)),
+            self.boundary_friction, law.start(self.boundary, self.boundary_friction),
+            lambda: self._film_temperature(c, at, viscosity))
+        return (hd + law.fit_force(readings, values)) / load, inside
 
     def _film_temperature(self, c: StribeckCurve, at, viscosity: float):
         """The film temperature [C] of curve ``c``'s points read at the oil of ``viscosity``:
@@ -145,18 +157,19 @@ class FitModel:
 
 
 def check_parameters(params) -> None:
-    """Refuse an empty list, a name outside :data:`PARAMETERS`, and a set the data cannot
-    identify: C_f,b beside the shear law's parameters (two boundary laws), or tau_0 with
-    alpha from curves at one load (the real area and the asperity load grow together
-    along a curve, so one load does not separate them)."""
-    unknown = set(params) - set(PARAMETERS)
+    """Refuse an empty list, a name outside :func:`parameters`, and a set the data cannot
+    identify: the parameters of two boundary laws (each replaces the other)."""
+    unknown = set(params) - set(parameters())
     if unknown or not params:
         raise InputError(f"unknown fit parameter(s) {sorted(unknown)}; choose from "
-                         f"{list(PARAMETERS)}")
-    if "boundary_friction" in params and set(params) & set(SHEAR):
-        raise InputError("boundary_friction is eq 32's constant law; the shear law's "
-                         f"{', '.join(sorted(set(params) & set(SHEAR)))} replace it: fit one "
-                         "law")
+                         f"{list(parameters())}")
+    fitted_law(params)
+
+
+def boundary_values(values: dict) -> dict:
+    """The boundary law's fitted parameters among ``values`` (by name)."""
+    law = fitted_law(values)
+    return {} if law is None else {k: v for k, v in values.items() if k in law.fitted}
 
 
 def check_loads(params, loads) -> None:
@@ -184,17 +197,16 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     names, x0, lower, upper = _unknowns(model, params, len(measured), start_temperatures)
 
     def unpack(x):
-        """C_f,b, the viscosity [Pa s] of each curve, the face's load share and R_b."""
+        """The boundary law's values, the viscosity [Pa s] of each curve, the face's load
+        share and R_b."""
         v = dict(zip(names, x))
-        cfb = v.get("boundary_friction", model.boundary_friction)
         temps = [v.get(f"temperature_{k + 1}") for k in range(len(measured))]
         if temps[0] is None:                          # known temperatures, or the curves'
             mus = ([c.viscosity for c in model.curves] if start_temperatures is None
                    else [float(model.law.viscosity(t)) for t in start_temperatures])
         else:
             mus = [float(model.law.viscosity(t)) for t in temps]
-        shear = {k: v[k] for k in SHEAR if k in v} or None
-        return cfb, mus, v.get("load_share"), v.get("bulk_resistance"), shear
+        return boundary_values(v), mus, v.get("load_share"), v.get("bulk_resistance")
 
     measured, dropped = _inside(model, measured, *unpack(x0))
     sigma = [_sigma(m) for m in measured]
@@ -202,10 +214,10 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
     identified = check_pair(model, measured, params, unpack(x0)[1], sigma)
 
     def residuals(x):
-        cfb, mus, share, resistance, shear = unpack(x)
+        values, mus, share, resistance = unpack(x)
         out = []
         for k, m in enumerate(measured):
-            cf, _ = model.friction(k, m.speed, cfb, mus[k], share, resistance, shear)
+            cf, _ = model.friction(k, m.speed, mus[k], values, share, resistance)
             r = (cf - m.friction_coefficient) / model.boundary_friction
             out.append(r / (sigma[k] / model.boundary_friction) if weighted else r)
         return np.concatenate(out)
@@ -231,24 +243,28 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
 
 
 def _unknowns(model, params, n_curves, start_temperatures):
-    """Names, start values and bounds of the unknowns: C_f,b in [1e-4, 1], a temperature
-    per curve in [-30, 250] C, the load share over :attr:`FitModel.share_curves`."""
+    """Names, start values and bounds of the unknowns, in the order of :func:`parameters`:
+    the boundary law's (:meth:`~fem_twin.macro.laws.boundary.Law.unknowns`: C_f,b in [1e-4,
+    1]), a temperature per curve in [-30, 250] C, the load share over
+    :attr:`FitModel.share_curves`, R_b over :attr:`FitModel.resistance_curves`."""
+    law = fitted_law(params)
+    boundary = {} if law is None else {
+        row[0]: row for row in law.unknowns(model.boundary, model.boundary_friction)}
     rows = []
-    if "boundary_friction" in params:
-        rows.append(("boundary_friction", model.boundary_friction, 1e-4, 1.0))
-    if "temperature" in params:
-        rows += [(f"temperature_{k + 1}", float(t), -30.0, 250.0)
-                 for k, t in zip(range(n_curves), start_temperatures)]
-    if "load_share" in params:
-        lo, hi = model.share_curves[0][0], model.share_curves[-1][0]
-        rows.append(("load_share", min(max(model.load_share, lo), hi), lo, hi))
-    if "bulk_resistance" in params:
-        lo, hi = model.resistance_curves[0][0][0], model.resistance_curves[0][-1][0]
-        rows.append(("bulk_resistance", min(max(model.bulk_resistance, lo), hi), lo, hi))
-    base = model.boundary or BoundaryLaw(law="shear", pressure_coefficient=min(
-        model.boundary_friction, SHEAR["pressure_coefficient"][1]))
-    rows += [(name, min(max(getattr(base, name), lo), hi), lo, hi)
-             for name, (lo, hi) in SHEAR.items() if name in params]
+    for name in parameters():
+        if name not in params:
+            continue
+        if name == "temperature":
+            rows += [(f"temperature_{k + 1}", float(t), -30.0, 250.0)
+                     for k, t in zip(range(n_curves), start_temperatures)]
+        elif name == "load_share":
+            lo, hi = model.share_curves[0][0], model.share_curves[-1][0]
+            rows.append(("load_share", min(max(model.load_share, lo), hi), lo, hi))
+        elif name == "bulk_resistance":
+            lo, hi = model.resistance_curves[0][0][0], model.resistance_curves[0][-1][0]
+            rows.append(("bulk_resistance", min(max(model.bulk_resistance, lo), hi), lo, hi))
+        else:
+            rows.append(boundary[name])
     names, x0, lower, upper = zip(*rows)
     return list(names), np.array(x0, float), list(lower), list(upper)
 
@@ -269,9 +285,10 @@ def check_misfit(result: dict, names, x, lower, upper) -> None:
                  for u, d in zip(r["speed_m_s"], r["cf_dev"])))
     where = (f"rms C_f,dev {f['rms_cf_dev']:.1%} of C_f,b, largest {worst[3]:+.1%} at "
              f"{worst[2]:.3g} m/s on curve {worst[1]}")
+    free = {"load_share", "bulk_resistance"} | {
+        name for law in LAWS.values() for name in law.fitted if name not in law.limits}
     pinned = [n for n, v, lo, hi in zip(names, x, lower, upper)
-              if n not in ("load_share", "bulk_resistance", *SHEAR)
-              and min(v - lo, hi - v) <= 1e-6 * (hi - lo)]
+              if n not in free and min(v - lo, hi - v) <= 1e-6 * (hi - lo)]
     if f["weights"] == "equal":
         bad = f["rms_cf_dev"] > MISFIT_RMS
     else:
@@ -284,13 +301,13 @@ def check_misfit(result: dict, names, x, lower, upper) -> None:
                          "the case's lubricant?")
 
 
-def _inside(model: FitModel, measured, cfb, mus, share, resistance, shear) -> tuple:
+def _inside(model: FitModel, measured, values, mus, share, resistance) -> tuple:
     """The ``measured`` curves cut to the points inside the simulated curves' Hersey range
     at the start values (C_f there would be held at the ends), and how many each lost;
     a curve with none inside is refused."""
     kept, dropped = [], []
     for k, m in enumerate(measured):
-        inside = model.friction(k, m.speed, cfb, mus[k], share, resistance, shear)[1]
+        inside = model.friction(k, m.speed, mus[k], values, share, resistance)[1]
         if not inside.any():
             raise InputError(f"measured curve {k + 1}: all {m.speed.size} points lie outside "
                              "the simulated speeds; sweep its speeds, or leave it out")
@@ -320,15 +337,18 @@ def _check_model(model: FitModel, measured, params, start_temperatures) -> None:
 
 
 def _check_columns(model: FitModel, params) -> None:
-    """Refuse a shear-law fit on curves without the law's integrals (a run of an older
-    fem_twin) or, for its temperature term, without a temperature that varies: the spots'
-    flash of the thermal model, or, isothermal, oils at two temperatures (a Walther law)."""
-    needs = (("real_contact_area", "asperity_load") if set(params) & set(SHEAR) else ()) + (
-        ("spot_rise",) if "temperature_coefficient" in params and model.law is None else ())
-    for name in needs:
+    """Refuse a boundary law's fit on curves without the columns the law reads
+    (:attr:`~fem_twin.macro.laws.boundary.Law.columns`: the shear law's integrals, absent
+    from a run of an older fem_twin) or, for a temperature term, without a temperature that
+    varies: the spots' flash of the thermal model, or, isothermal, oils at two temperatures
+    (a Walther law)."""
+    law = fitted_law(params)
+    if law is None:
+        return
+    for name in law.columns(params, model.law is not None):
         if any(getattr(c, name) is None for c in model.curves):
-            raise InputError(f"fitting {', '.join(p for p in params if p in SHEAR)} needs each "
-                             f"simulated curve's {name} (" + (
+            raise InputError(f"fitting {', '.join(p for p in params if p in law.fitted)} "
+                             f"needs each simulated curve's {name} (" + (
                                  "a run with [thermal] model = \"flash\"), or curves at "
                                  "two oil temperatures" if name == "spot_rise" else
                                  "run the case again with this fem_twin)"))
@@ -358,7 +378,7 @@ def _summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
     half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
     out = {name: interval(v, h, lo, hi)
            for name, v, h, lo, hi in zip(names, sol.x, half, *bounds)}
-    cfb, mus, share, resistance, shear = unpack(sol.x)
+    values, mus, share, resistance = unpack(sol.x)
     for k in range(len(measured)):
         t = out.get(f"temperature_{k + 1}")
         if t is not None:                       # viscosity falls as temperature rises
@@ -367,7 +387,7 @@ def _summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
                                          "high": float(mu[2])}
     rows, outside = [], 0
     for k, m in enumerate(measured):
-        cf, inside = model.friction(k, m.speed, cfb, mus[k], share, resistance, shear)
+        cf, inside = model.friction(k, m.speed, mus[k], values, share, resistance)
         outside += int((~inside).sum())
         rows.append({"curve": k + 1, "speed_m_s": m.speed.tolist(),
                      "measured_cf": m.friction_coefficient.tolist(), "fitted_cf": cf.tolist(),

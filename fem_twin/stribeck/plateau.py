@@ -15,21 +15,22 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import InputError
+from ..macro.laws.boundary import fitted_parameters
 from .curve import MeasuredCurve
-from .fit import SHEAR, FitModel, fit_curves
+from .fit import FitModel, fit_curves
 from .prediction import finish_fit_figure, predict
 
 #: the asperities' share of the load from which a measured point is on the plateau
 PLATEAU_SHARE = 0.9
-#: what a plateau fit may vary: the boundary law's parameters alone
-BOUNDARY = ("boundary_friction", *SHEAR)
-
 
 def check_plateau(params, share: float) -> None:
-    """Refuse a plateau fit of anything but the boundary law, or a share outside (0, 1)."""
-    other = [p for p in params if p not in BOUNDARY]
+    """Refuse a plateau fit of anything but a boundary law's parameters
+    (:func:`~fem_twin.macro.laws.boundary.fitted_parameters`: what it may vary), or a share
+    outside (0, 1)."""
+    boundary = fitted_parameters()
+    other = [p for p in params if p not in boundary]
     if other:
-        raise InputError(f"--plateau fits the boundary law alone ({', '.join(BOUNDARY)}) and "
+        raise InputError(f"--plateau fits the boundary law alone ({', '.join(boundary)}) and "
                          f"predicts the rest; {', '.join(other)} would be fitted to the "
                          "mixed regime it predicts: leave them out")
     if not 0 < share < 1:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .fit import SHEAR, FitModel
+from .fit import FitModel, boundary_values
 
 
 def predict(model: FitModel, result: dict, speeds, temperature: float | None,
@@ -37,9 +37,8 @@ def predict(model: FitModel, result: dict, speeds, temperature: float | None,
               else float(model.law.viscosity(temperature + offset)))
         if k is None:
             k = int(np.argmin([abs(np.log(c.viscosity / mu)) for c in model.curves]))
-        return model.friction(k, speeds, v.get("boundary_friction", model.boundary_friction),
-                              mu, v.get("load_share"), v.get("bulk_resistance"),
-                              {n: v[n] for n in SHEAR if n in v} or None)
+        return model.friction(k, speeds, mu, boundary_values(v), v.get("load_share"),
+                              v.get("bulk_resistance"))
 
     value, inside = cf(x)
     discretisation = _error_at(model, speeds) + (_collapse_error(model, cf, x)

@@ -9,10 +9,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..checks import QUANTITIES, plausible
+from ..checks import OFF_AT_ZERO, QUANTITIES, plausible
 from ..errors import InputError
+from ..macro.laws.boundary import LAWS
 from ..macro.laws.viscosity import WaltherLaw
-from ..stribeck.fit import PARAMETERS, SHEAR
+from ..stribeck.fit import parameters
+
+#: the plausible quantity (:data:`fem_twin.checks.QUANTITIES`) of each fitted value but the
+#: temperatures: the fit's own and the boundary laws' (their ``fitted``)
+QUANTITY = {"load_share": "load_share", "bulk_resistance": "thermal_resistance"}
 
 
 def temperature_offset(result: dict) -> float | None:
@@ -48,11 +53,12 @@ def check_fit(result, where: str = "fit") -> dict:
                          "rewrite it")
     try:
         result["case"]["temperatures"]
-        unknown = [k for k in params if k not in PARAMETERS
+        known = {**QUANTITY, **{name: fitted.quantity for law in LAWS.values()
+                                for name, fitted in law.fitted.items()}}
+        quantity = {name: known[name] for name in parameters() if name in known}
+        unknown = [k for k in params if k not in parameters()
                    and not re.fullmatch(r"temperature_[1-9][0-9]*", k)]
-        values = {k: float(result[k]["value"]) for k in ("boundary_friction", "load_share",
-                                                         "bulk_resistance", *SHEAR)
-                  if k in result}
+        values = {k: float(result[k]["value"]) for k in quantity if k in result}
         offset = temperature_offset(result)
         law = None if offset is None else WaltherLaw(**result["case"]["law"])
         law is None or float(law.viscosity(20.0))
@@ -61,12 +67,11 @@ def check_fit(result, where: str = "fit") -> dict:
                          "fit again to rewrite it") from err
     if unknown:
         raise InputError(f"{where}: unknown fitted parameter(s) {unknown}; fem-twin fit writes "
-                         f"{', '.join(PARAMETERS)} and temperature_K")
-    quantity = {"boundary_friction": "friction", "load_share": "load_share",
-                "bulk_resistance": "thermal_resistance", **{k: k for k in SHEAR}}
+                         f"{', '.join(parameters())} and temperature_K")
     for name, value in values.items():          # the case parser's ranges
-        if name == "shear_strength" and 0 <= value < QUANTITIES[name][0]:
-            value = 0.0                         # below 10 kPa: no tau_0 the data can tell
+        off = quantity[name] in OFF_AT_ZERO     # below its floor (tau_0: 10 kPa), none
+        if off and 0 <= value < QUANTITIES[quantity[name]][0]:
+            value = 0.0                         # the data can tell
         plausible(f"{where} {name}", value, quantity[name])
         result[name]["value"] = value           # a number, whatever the file spelled
     if offset is not None and not -100.0 <= offset <= 100.0:

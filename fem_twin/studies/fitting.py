@@ -17,7 +17,7 @@ from ..errors import InputError
 from ..io.atomic import atomic_path
 from ..io.layout import RunLayout
 from ..io.table import write_csv
-from ..macro.laws.boundary import BoundaryLaw
+from ..macro.laws.boundary import fitted_law
 from ..macro.laws.viscosity import WaltherLaw
 from ..numerics.threads import executor_for
 from ..runtime.taskgraph import fit_scaling
@@ -28,7 +28,6 @@ from ..stribeck.curve import read_stribeck_csv
 from ..stribeck.fit import (
     LOAD_SHARES,
     RESISTANCES,
-    SHEAR,
     FitModel,
     check_loads,
     check_parameters,
@@ -70,7 +69,7 @@ def fit_case(case: Case, measured, outdir, params, *, predict_at=(), predict_loa
         RESISTANCES if "bulk_resistance" in params else (), progress)
     model = FitModel(tuple(simulated), case.tribometer.boundary_friction, case.tribometer.load,
                      law, case.tribometer.load_share, shares, case.thermal.bulk_resistance,
-                     resistances, _shear_base(case), loads=tuple(load for load, _ in tests))
+                     resistances, case.boundary, loads=tuple(load for load, _ in tests))
     nominal = [lb.temperatures[k] if c.viscosity is None else
                None if law is None else float(law.temperature(c.viscosity))
                for k, c in enumerate(curves_measured)]
@@ -170,10 +169,9 @@ def _check_models(case: Case, params) -> None:
         raise InputError("temperature_coefficient needs a temperature that varies: the "
                          "thermal twin ([thermal] model = \"flash\") or oils at two "
                          "temperatures")
-    if "boundary_friction" in params and case.boundary.law != "constant":
-        raise InputError("boundary_friction is eq 32's constant C_f,b; the case's [boundary] "
-                         "law = \"shear\" does not read it: fit the other parameters, or "
-                         "set law = \"constant\"")
+    law = fitted_law(params)
+    if law is not None:
+        law.check_fit(case.boundary)
 
 
 def _simulated(case: Case, out: RunLayout, tests, progress: bool) -> list:
@@ -198,7 +196,7 @@ def _predict_load(case: Case, out: RunLayout, result: dict, load: float, progres
     tests = [(load, mu) for mu in case.lubricant.viscosities]
     curves = _simulated(case, out, tests, progress)
     model = FitModel(tuple(curves), case.tribometer.boundary_friction, load, None,
-                     boundary=_shear_base(case))
+                     boundary=case.boundary)
     rows = [predict(model, result, c.speed, None, curve=k) for k, c in enumerate(curves)]
     _write_prediction(out.prediction_at_load(load), rows, [c.viscosity for c in curves])
 
@@ -282,24 +280,16 @@ def apply_fit(case: Case, result: dict) -> Case:
                  load_share=get("load_share", tr.load_share))
     thermal = replace(case.thermal, bulk_resistance=get("bulk_resistance",
                                                         case.thermal.bulk_resistance))
-    shear = {k: result[k]["value"] for k in SHEAR if k in result}
-    boundary = (replace(_shear_base(case), law="shear", **shear) if shear
-                else case.boundary)
+    law = fitted_law(params)
+    section = {} if law is None else {k: result[k]["value"] for k in law.keys if k in result}
+    boundary = (replace(law.start(case.boundary, case.tribometer.boundary_friction), **section)
+                if section else case.boundary)
     offset = temperature_offset(result)
     if offset is not None:
         law = WaltherLaw(**result["case"]["law"])
         lb = replace(lb, viscosities=tuple(float(law.viscosity(t + offset))
                                            for t in lb.temperatures))
     return replace(case, tribometer=tr, lubricant=lb, thermal=thermal, boundary=boundary)
-
-
-def _shear_base(case: Case) -> BoundaryLaw:
-    """The shear law whose unfitted values a fit of the law's parameters keeps: the case's
-    own, or eq 32's constant C_f,b as a shear law (tau_0 = 0, alpha = C_f,b)."""
-    if case.boundary.law == "shear":
-        return case.boundary
-    return BoundaryLaw(law="shear", shear_strength=0.0,
-                       pressure_coefficient=case.tribometer.boundary_friction)
 
 
 def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=None,
@@ -330,7 +320,7 @@ def run_from_fit(case: Case, fit_path, outdir, *, progress: bool = True, run=Non
     shares = shares if len(shares) > 1 else ()                # a zero-width interval
     resistances = resistances if resistances and len(resistances[0]) > 1 else ()
     model = FitModel(tuple(curves), tr.boundary_friction, tr.load, law, tr.load_share, shares,
-                     fitted.thermal.bulk_resistance, resistances, _shear_base(fitted))
+                     fitted.thermal.bulk_resistance, resistances, fitted.boundary)
     offset = temperature_offset(result)
     rows = [predict(model, result, c.speed, None if offset is None else t,
                     result["case"]["temperatures"], curve=k)

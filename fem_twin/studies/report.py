@@ -23,6 +23,7 @@ from ..io.figure import save_figure
 from ..io.files import read_topography
 from ..io.layout import RunLayout
 from ..io.render import render_views
+from ..macro.laws.friction import LAWS
 from .fit_file import read_fit
 
 
@@ -104,16 +105,10 @@ def plot_centre_lines(files, path) -> Path:
     return save_figure(fig, path, dpi=110)
 
 
-#: how the report names each friction law (``[macro] friction``)
-FRICTION_LAWS = {"pin": "the force on the pin: wall shear and the film pressure on the "
-                        "asperity flanks and the face's slope",
-                 "paper": "eq 31, the pin's wall shear (the paper's)"}
-
-
 def stribeck_section(out: RunLayout, friction: str | None = None) -> str:
     pngs = [out.stribeck_png("speed"), out.stribeck_png("hersey"), out.parts_png,
             out.temperature_png]
-    law = FRICTION_LAWS.get(friction, "eq 31") if friction else "eq 31"
+    law = LAWS[friction].description if friction in LAWS else "eq 31"
     text = ("Friction coefficient (eq 34) of the patch-average flow factors, the friction "
             f"being {law}, with the estimated "
             "discretisation error of each point as error bars; the shaded band spans the "

@@ -87,7 +87,7 @@ class MacroSettings:
         if self.ambient_pressure < self.cavitation_pressure:
             raise InputError("ambient pressure must not be below the cavitation pressure [Pa]")
         cavitation_model(self.complementarity)              # a registered model
-        if self.reading == "torque" and self.friction != "pin":
+        if self.reading == "torque" and not LAWS[self.friction].drag:
             raise InputError("reading = \"torque\" reads the disk's drag, the force law's; "
                              "it needs friction = \"pin\" (eq 31 is the pin's wall shear)")
         if len(self.gains) != 3:

@@ -6,7 +6,9 @@ shear plus the film pressure on the pin's asperity flanks (the micro scale's fri
 factors ``friction_factor`` s_C and ``pressure_friction`` ``2 e1 - b``) plus the film
 pressure on the face's own slope.  Its integral equals the force on the disk and the
 film's dissipation over the sliding speed (docs/model.md, "Friction on the pin").
-``"paper"`` is eq 31, the pin's wall shear with ``<1/h>`` read as ``1/h_m``.
+``"paper"`` is eq 31, the pin's wall shear with ``<1/h>`` read as ``1/h_m``.  The laws are
+classes in the registry :data:`LAWS` (``[macro] friction``), each its film traction's parts
+and what it reads: :func:`hydrodynamic_shear` asks the law.
 """
 
 from __future__ import annotations
@@ -14,11 +16,10 @@ from __future__ import annotations
 import numpy as np
 
 from ...checks import arguments
+from ...errors import InputError
 from ...numerics.graded_mesh import Mesh
 from .kinematics import rotate_tensor, rotations
 
-#: the friction laws: the force on the pin, or the paper's eq 31
-LAWS = ("pin", "paper")
 #: the nodes of the probabilists' Gauss-Hermite rule over the log-normal spread of the
 #: local shear (:func:`eyring_shear`); with 8 a deep cosine film (a = 0.8 h) reads its exact
 #: cell mean within 0.8 % at every shear (tests/test_friction.py)
@@ -30,48 +31,111 @@ _WEIGHTS = _WEIGHTS / _WEIGHTS.sum()
 READINGS = ("force", "torque")
 
 
+class PinForce:
+    """The force on the pin (the default): ``(mu u_r / h_m) s_C (1 - theta) - (h_m/2)
+    (2 e1 - b) . grad p - (p - p_amb) dh_m/dx1``, the last term the film pressure on the
+    slope of the pin's face; its Eyring shear spread over the cell's local shear
+    (:func:`eyring_shear`); the disk's drag (``reading = "torque"``) is its force too."""
+
+    name = "pin"
+    description = ("the force on the pin: wall shear and the film pressure on the asperity "
+                   "flanks and the face's slope")
+    #: whether the disk's drag, a torque reading's, is this law's force (:func:`disk_shear`)
+    drag = True
+
+    def parts(self, grad, mean_gap, viscosity, shear, speeds, turn):
+        """``(poiseuille, couette, across)`` [Pa]: the pressure-driven traction along x1,
+        the Couette traction along the sliding before the cavity and Eyring, and the
+        Couette traction across it (0 here), at ``grad`` ``(dp/dx2, dp/dx1)``, ``speeds``
+        ``(u_r, u_m)`` and the sliding's ``turn`` ``(cos, sin, |v|)``."""
+        dp2, dp1 = grad
+        f = shear.pressure_friction
+        poiseuille = -mean_gap / 2 * (f[..., 0] * dp1 + f[..., 1] * dp2)
+        return poiseuille, viscosity / mean_gap * (speeds[0] * shear.friction_factor) * turn[2], 0.0
+
+    def spread(self, shear):
+        """The factors whose local shear spreads the Eyring shear (:func:`eyring_shear`)."""
+        return shear
+
+    def face_term(self, pressure, ambient_pressure, mean_gap, face, spacing):
+        """The film pressure on the face's slope [Pa] (None: not read)."""
+        return (pressure - ambient_pressure) * face_slope(mean_gap, face, spacing)
+
+
+class PaperShear(PinForce):
+    """Eq 31, the pin's wall shear: ``-(h_m/2) (C grad p)_1 + (mu / h_m) (-6 u_m d_1 + u_r)
+    (1 - theta)`` with ``d`` at the slide-to-roll ratio; its Eyring shear on the cell mean;
+    no force on the face's slope, and not the disk's drag."""
+
+    name = "paper"
+    description = "eq 31, the pin's wall shear (the paper's)"
+    drag = False
+
+    def parts(self, grad, mean_gap, viscosity, shear, speeds, turn):
+        dp2, dp1 = grad
+        (speed, u_m), (c, s, v) = speeds, turn
+        C = shear.C if turn is UNIFORM else rotate_tensor(shear.C, c, s)
+        poiseuille = -mean_gap / 2 * (C[..., 0, 0] * dp1 + C[..., 0, 1] * dp2)
+        couette = viscosity / mean_gap * (-6 * u_m * shear.d[..., 0] + speed) * v
+        across = 0.0
+        if turn is not UNIFORM:
+            across = viscosity / mean_gap * (-6 * u_m * shear.d[..., 1]) * v * s
+        return poiseuille, couette, across
+
+    def spread(self, shear):
+        return None
+
+    def face_term(self, pressure, ambient_pressure, mean_gap, face, spacing):
+        return None
+
+
+#: the friction laws by name (``[macro] friction``): the force on the pin, or the paper's
+#: eq 31
+LAWS = {law.name: law() for law in (PinForce, PaperShear)}
+#: the turn ``(cos, sin, |v|)`` of uniform sliding along x1
+UNIFORM = (1.0, 0.0, 1.0)
+
+
+@arguments(name=str)
+def friction_law(name: str):
+    """The registered friction law called ``name`` (:data:`LAWS`)."""
+    try:
+        return LAWS[name]
+    except KeyError:
+        raise InputError(f"friction: one of {', '.join(map(repr, LAWS))}, got "
+                         f"{name!r}") from None
+
+
 @arguments(pressure="field", mean_gap="field", spacing="spacing", speed="number")
 def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing,
                        speed, *, entrainment=None, eyring_stress=None, law: str = "pin",
                        ambient_pressure: float = 0.0, face=None,
                        velocity=None) -> np.ndarray:
-    """The film's tangential traction on the pin along +x1 [Pa], the disk sliding at
-    ``speed`` u_r along +x1 (``entrainment`` u_m, default u_r / 2: the pin at rest), or
-    at ``speed`` times ``velocity`` (ny, nx, 2), a rotating disk's (:mod:`.kinematics`).
-
-    ``"pin"``: ``(mu u_r / h_m) s_C (1 - theta) - (h_m/2) (2 e1 - b) . grad p
-    - (p - p_amb) dh_m/dx1``, the last term the film pressure on the slope of the pin's
-    ``face`` (bool grid, default all; one-sided at its edge: not the rim's drop).
-    ``"paper"``: eq 31, ``-(h_m/2) (C grad p)_1 + (mu / h_m) (-6 u_m d_1 + u_r) (1 - theta)``
-    with ``d`` at the slide-to-roll ratio.  ``shear``: the
-    :class:`~fem_twin.micro.LocalFactors` at the point's h0; gradients by central
-    differences; ``eyring_stress`` tau_0 [Pa]: the Couette part becomes
-    ``tau_0 asinh(tau / tau_0)`` (Eyring) along the sliding.  On a rotating disk the
-    cell-frame factors turn with the sliding (``C``, ``d``; ``2 e1 - b`` completed
-    isotropically commutes with the turn) and the traction is its x1 component.
+    """The film's tangential traction on the pin along +x1 [Pa] by the friction ``law`` of
+    :data:`LAWS` (:class:`PinForce`, :class:`PaperShear`), the disk sliding at ``speed``
+    u_r along +x1 (``entrainment`` u_m, default u_r / 2: the pin at rest), or at ``speed``
+    times ``velocity`` (ny, nx, 2), a rotating disk's (:mod:`.kinematics`); the pin's
+    ``face`` (bool grid, default all; one-sided at its edge: not the rim's drop) for the
+    film pressure on its slope.  ``shear``: the :class:`~fem_twin.micro.LocalFactors` at
+    the point's h0; gradients by central differences; ``eyring_stress`` tau_0 [Pa]: the
+    Couette part becomes ``tau_0 asinh(tau / tau_0)`` (Eyring) along the sliding.  On a
+    rotating disk the cell-frame factors turn with the sliding (``C``, ``d``; ``2 e1 - b``
+    completed isotropically commutes with the turn) and the traction is its x1 component.
     """
+    model = friction_law(law)
     p = np.asarray(pressure, float)
-    dp2, dp1 = gradient(p, spacing)
-    c, s, v = (1.0, 0.0, 1.0) if velocity is None else rotations(velocity)
-    across = 0.0
-    if law == "paper":
-        u_m = speed / 2 if entrainment is None else entrainment
-        C = shear.C if velocity is None else rotate_tensor(shear.C, c, s)
-        poiseuille = -mean_gap / 2 * (C[..., 0, 0] * dp1 + C[..., 0, 1] * dp2)
-        couette = viscosity / mean_gap * (-6 * u_m * shear.d[..., 0] + speed) * v
-        if velocity is not None:
-            across = viscosity / mean_gap * (-6 * u_m * shear.d[..., 1]) * v * s
-    else:
-        f = shear.pressure_friction
-        poiseuille = -mean_gap / 2 * (f[..., 0] * dp1 + f[..., 1] * dp2)
-        couette = viscosity / mean_gap * (speed * shear.friction_factor) * v
+    turn = UNIFORM if velocity is None else rotations(velocity)
+    u_m = speed / 2 if entrainment is None else entrainment
+    poiseuille, couette, across = model.parts(gradient(p, spacing), mean_gap, viscosity,
+                                              shear, (speed, u_m), turn)
     couette = couette * (1 - cavity_fraction)
     if eyring_stress is not None:
-        couette = eyring_shear(couette, eyring_stress, shear if law == "pin" else None)
-    couette = couette * c - across * (1 - cavity_fraction)
-    if law == "paper":
+        couette = eyring_shear(couette, eyring_stress, model.spread(shear))
+    couette = couette * turn[0] - across * (1 - cavity_fraction)
+    on_face = model.face_term(p, ambient_pressure, mean_gap, face, spacing)
+    if on_face is None:
         return poiseuille + couette
-    return poiseuille + couette - (p - ambient_pressure) * face_slope(mean_gap, face, spacing)
+    return poiseuille + couette - on_face
 
 
 @arguments(pressure="field", mean_gap="field", spacing="spacing", speed="number")
