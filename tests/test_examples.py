@@ -49,6 +49,9 @@ PINNED = {
     "17_average_flow": (r"eps 1/2, average flow: worst \|C_f - C_f,det\| ([\d.]+) %", 15.0,
                         30.0, "the statistical model's gap on the pad, 5-8x the twin's (22.6 %; "
                         "the twin 3.6 %)"),
+    "18_graded_ball_mesh": (r"graded mesh over the 97\^2 grid: \d+ nodes, h_c ([\d.]+) nm",
+                            200.0, 215.0, "the central film on the graded mesh, as on the "
+                            "grid (206.8 nm against 207.7 nm)"),
     "14_boundary_law": (r"shear_strength: ([\d.e+]+) ", 2.4e7, 3.6e7,
                         "the fitted tau_0 within 20 % of the truth, 30 MPa (33.3 MPa)"),
 }
