@@ -282,3 +282,46 @@ def test_the_papers_table_values_are_declared_once():
                       and (where, name) not in NOT_THE_TABLES]
     assert not twice, "the tables' values written again (use fem_twin.tables):\n" + "\n".join(
         twice)
+
+
+#: the most required parameters, and parameters in all, of a public function of macro/
+MOST_REQUIRED, MOST_PARAMETERS = 5, 12
+
+
+def _public_functions(package: str):
+    """``(qualified name, function)`` of every public function and public method of a
+    public class defined in each module under ``package``."""
+    import importlib
+    import inspect
+    import pkgutil
+    root = importlib.import_module(package)
+    for info in pkgutil.walk_packages(root.__path__, f"{package}."):
+        module = importlib.import_module(info.name)
+        for name, obj in vars(module).items():
+            if name.startswith("_") or getattr(obj, "__module__", None) != module.__name__:
+                continue
+            if inspect.isfunction(obj):
+                yield f"{module.__name__}.{name}", obj
+            elif inspect.isclass(obj):
+                for attr, member in vars(obj).items():
+                    method = inspect.isfunction(member) or isinstance(
+                        member, (staticmethod, classmethod))
+                    if method and not attr.startswith("_"):
+                        yield f"{module.__name__}.{name}.{attr}", getattr(obj, attr)
+
+
+def test_no_public_function_of_macro_takes_too_many_parameters():
+    """No public function (nor public method) of a module under fem_twin/macro takes more
+    than 5 required parameters or 12 in all (``self``, ``cls``, ``*args`` and ``**kwargs``
+    aside): a longer list is a value waiting to be named (issue 86 item 2: the operating
+    point carried down instead of its fields spread out)."""
+    import inspect
+    long = []
+    for name, func in _public_functions("fem_twin.macro"):
+        params = [p for p in inspect.signature(func).parameters.values()
+                  if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)
+                  and p.name not in ("self", "cls")]
+        required = [p for p in params if p.default is p.empty]
+        if len(required) > MOST_REQUIRED or len(params) > MOST_PARAMETERS:
+            long.append(f"{name}: {len(required)} required, {len(params)} in all")
+    assert not long, "functions with too many parameters:\n" + "\n".join(long)

@@ -9,7 +9,14 @@ from sample_cases import macro_case
 from fem_twin import Topography
 from fem_twin.case import CaseError
 from fem_twin.errors import InputError
-from fem_twin.macro import BOUNDARY_FRICTION, BoundaryLaw, Lubricant, MacroSettings, solve_mixed
+from fem_twin.macro import (
+    BOUNDARY_FRICTION,
+    BoundaryLaw,
+    Lubricant,
+    MacroSettings,
+    OperatingPoint,
+    solve_mixed,
+)
 from fem_twin.macro.laws.boundary import boundary_area, boundary_traction
 from fem_twin.micro import homogenise
 
@@ -157,8 +164,9 @@ def test_the_temperature_term_reads_the_flash_of_the_tempered_shear(factors):
                             lubricant=lubricant, settings=MacroSettings(boundary=law)),)
     thermal = ContactThermal(ThermalSettings(), WaltherLaw.through((24.0, 50.0),
                                                                    (0.066, 0.024), 875.0))
-    (res,), film, record = thermal_point(solve, Lubricant(0.066), thermal, factors,
-                                         (0.0, 0.05))
+    point = OperatingPoint(gap, dx, factors, load=150.0, speed=0.05, face=face,
+                           lubricant=Lubricant(0.066), settings=MacroSettings(boundary=law))
+    (res,), film, record = thermal_point(solve, point, thermal)
     t = res.meta["boundary_temperature_factor"]
     assert 0.5 < t < 0.999
     assert t == pytest.approx(1 - 0.01 * (record["asperity_C"] - law.reference_temperature),

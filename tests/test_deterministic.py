@@ -13,7 +13,7 @@ import pytest
 from fem_twin.contact import solve as contact_solve
 from fem_twin.contact.elastic import elastic_operator
 from fem_twin.errors import InputError
-from fem_twin.macro import Lubricant, MacroSettings, solve_mixed, solve_reynolds
+from fem_twin.macro import FilmFields, Lubricant, MacroSettings, solve_mixed, solve_reynolds
 from fem_twin.macro.reference.deterministic import (
     DeterministicNotConverged,
     DeterministicSettings,
@@ -137,8 +137,9 @@ def test_pad_friction_cuts_the_boundary_films():
     pressure has none with a 10 nm cut-off and ``mu U / h`` per area with a 1 nm one."""
     h = np.full((5, 5), 5e-9)
     zero = np.zeros_like(h)
-    assert pad_friction(zero, h, zero, MU, (1e-6, 1e-6), U, 10e-9) == 0
-    assert pad_friction(zero, h, zero, MU, (1e-6, 1e-6), U, 1e-9) == pytest.approx(
+    film = FilmFields(zero, h, zero, MU)
+    assert pad_friction(film, (1e-6, 1e-6), U, 10e-9) == 0
+    assert pad_friction(film, (1e-6, 1e-6), U, 1e-9) == pytest.approx(
         MU * U / 5e-9 * 16e-12)
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fem_twin.macro import Lubricant, MacroSettings, solve_mixed
+from fem_twin.macro import Lubricant, MacroSettings, OperatingPoint, solve_mixed
 from fem_twin.macro.reference.point_contact import PointContact, film_thickness
 from fem_twin.micro import FlowFactors
 
@@ -85,9 +85,10 @@ def test_newton_preconditioner_inverts_its_matrix(mourier97, monkeypatch, block,
     monkeypatch.setattr(jm, "SOLVE_BLOCK", block)
     res, _, _ = mourier97
     gap, spacing, _, _ = MOURIER.grid(1 + 96 // every)
-    P = macro_problem(gap, spacing, FlowFactors.smooth(),
-                      Lubricant(MOURIER.viscosity, roelands_alpha=MOURIER.alpha), POINT,
-                      2 * MOURIER.entrainment, MOURIER.entrainment)
+    P = macro_problem(OperatingPoint(
+        gap, spacing, FlowFactors.smooth(), load=MOURIER.load, speed=2 * MOURIER.entrainment,
+        entrainment=MOURIER.entrainment, settings=POINT,
+        lubricant=Lubricant(MOURIER.viscosity, roelands_alpha=MOURIER.alpha)))
     state = types.SimpleNamespace(**{k: getattr(res, k)[::every, ::every] for k in (
         "pressure", "cavity_fraction", "elastic_deformation")}, h_d=res.h_d)
     jac = jm.jacobian(P, newton.evaluate(P, newton.state_from(state, P), MOURIER.load))
@@ -216,15 +217,15 @@ def test_eyring_shear_limits():
     """Eyring shear thinning of the Couette shear (both friction laws): Newtonian while
     tau << tau_0, and tau_0 ln(2 tau / tau_0) (logarithmic, bounded traction) when
     tau >> tau_0."""
-    from fem_twin.macro import hydrodynamic_shear
+    from fem_twin.macro import FilmFields, hydrodynamic_shear
     shape = (5, 5)
     ones, zeros = np.ones(shape), np.zeros(shape)
     smooth = FlowFactors.smooth().at(1e-6 * ones)
     for law in ("pin", "paper"):
         for mu, limit in ((1e-3, lambda t: t), (1e6, lambda t: 5e6 * np.log(2 * t / 5e6))):
-            args = (zeros, 1e-6 * ones, zeros, mu * ones, smooth, (1e-5, 1e-5), 1.0)
-            newton = hydrodynamic_shear(*args, law=law)
-            eyring = hydrodynamic_shear(*args, law=law, eyring_stress=5e6)
+            args = (FilmFields(zeros, 1e-6 * ones, zeros, mu * ones), smooth, (1e-5, 1e-5), 1.0)
+            newton = hydrodynamic_shear(*args, law=law, entrainment=0.5)
+            eyring = hydrodynamic_shear(*args, law=law, entrainment=0.5, eyring_stress=5e6)
             assert np.allclose(eyring, limit(newton), rtol=1e-6)
     with pytest.raises(ValueError, match="eyring"):
         Lubricant(0.066, eyring_stress=-1.0)

@@ -361,6 +361,7 @@ def _round_five_api_probes():
         boundary_traction,
         temperature_factor,
     )
+    from fem_twin.macro.laws.friction import FilmFields
     from fem_twin.macro.laws.lubricant import Lubricant
     from fem_twin.macro.laws.thermal import ThermalSettings, face_flash, spot_flash
     from fem_twin.macro.laws.viscosity import WaltherLaw
@@ -420,21 +421,21 @@ def _round_five_api_probes():
         ("A162", lambda: WaltherLaw.through([24.0, 50.0], [0.066, 0.024], 850.0).viscosity(1e6),
          r"temperature \[C\]"),
         ("A166", lambda: WaltherLaw(float("nan"), 1.0, 850.0), "WaltherLaw.a"),
-        ("A195", lambda: pad_friction(zeros, np.ones((6, 6)), zeros, 0.066, (1e-5, 1e-5), 0.1,
-                                      1e-8), "one grid"),
-        ("A196", lambda: pad_friction(zeros, micron, zeros, 0.066, (1e-5, 1e-5), 0.1, -1e-8),
-         r"boundary_film \[m\]"),
-        ("A197", lambda: pad_friction(zeros, micron, zeros, -0.066, (1e-5, 1e-5), 0.1, 1e-8),
-         r"viscosity \[Pa s\]"),
-        ("A198", lambda: pad_friction(zeros, micron, zeros + 3, 0.066, (1e-5, 1e-5), 0.1,
-                                      1e-8), "cavity_fraction"),
-        ("A199", lambda: pad_friction(zeros, micron, zeros, 0.066, (0.0, 1e-5), 0.1, 1e-8),
-         r"spacing \[m\]"),
+        ("A195", lambda: pad_friction(FilmFields(zeros, np.ones((6, 6)), zeros, 0.066),
+                                      (1e-5, 1e-5), 0.1, 1e-8), "one grid"),
+        ("A196", lambda: pad_friction(FilmFields(zeros, micron, zeros, 0.066), (1e-5, 1e-5),
+                                      0.1, -1e-8), r"boundary_film \[m\]"),
+        ("A197", lambda: pad_friction(FilmFields(zeros, micron, zeros, -0.066), (1e-5, 1e-5),
+                                      0.1, 1e-8), r"viscosity \[Pa s\]"),
+        ("A198", lambda: pad_friction(FilmFields(zeros, micron, zeros + 3, 0.066),
+                                      (1e-5, 1e-5), 0.1, 1e-8), "cavity_fraction"),
+        ("A199", lambda: pad_friction(FilmFields(zeros, micron, zeros, 0.066), (0.0, 1e-5),
+                                      0.1, 1e-8), r"spacing \[m\]"),
         ("A215", lambda: disk_at(np.zeros((9, 9)), float("nan"), 9), "shift"),
         ("A216", lambda: disk_at(np.zeros((9, 9)), 0.5, 0), "nodes"),
         ("A217", lambda: disk_at(None, 0.5, 9), "disk"),
         ("A221", lambda: solve_time_resolved(
-            gap, np.full((17, 17), 1.0), (1e-5, 1e-5), load=1.0, speed=0.1,
+            (gap, np.full((17, 17), 1.0)), (1e-5, 1e-5), load=1.0, speed=0.1,
             lubricant=Lubricant(0.066), settings=DeterministicSettings()), "disk"),
         ("A250", lambda: V.summary([pair], 0.0), "boundary_friction"),
         ("A252", lambda: V.compared([1, 2], [3, 4], 2), "compared: det"),

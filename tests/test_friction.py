@@ -11,6 +11,7 @@ import pytest
 from fem_twin import Topography
 from fem_twin.macro import (
     BoundaryLaw,
+    FilmFields,
     Lubricant,
     MacroSettings,
     hydrodynamic_shear,
@@ -168,8 +169,9 @@ def test_a_smooth_slider_has_the_runners_friction(method):
     runner = scale * (4 * np.log(RATIO) - 6 * (RATIO - 1) / (RATIO + 1))
     pad = scale * (6 * (RATIO - 1) / (RATIO + 1) - 2 * np.log(RATIO))
     c = ROWS // 2
-    per_width = {law: np.trapezoid(hydrodynamic_shear(r.pressure, h, r.cavity_fraction, MU,
-                                                      shear, dx, U, law=law)[c], x)
+    film = FilmFields(r.pressure, h, r.cavity_fraction, MU)
+    per_width = {law: np.trapezoid(hydrodynamic_shear(film, shear, dx, U, entrainment=U / 2,
+                                                      law=law)[c], x)
                  for law in ("pin", "paper")}
     assert per_width["pin"] == pytest.approx(runner, rel=2e-3)
     assert per_width["paper"] == pytest.approx(pad, rel=2e-3)

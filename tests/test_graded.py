@@ -12,7 +12,7 @@ import pytest
 import skfem
 
 from fem_twin.errors import InputError
-from fem_twin.macro import Lubricant, MacroSettings, solve_mixed
+from fem_twin.macro import Lubricant, MacroSettings, OperatingPoint, solve_mixed
 from fem_twin.macro.coupling.result import MixedResult
 from fem_twin.macro.film.contact_load import POINTS, contact_load
 from fem_twin.macro.film.couette import couette, couette_matrix
@@ -229,8 +229,9 @@ def test_the_dense_elastic_block_on_the_graded_mesh_is_the_operator_itself():
     the finest nodes and beside the coarse elements."""
     from fem_twin.macro.coupling.problem import macro_problem
     gap, mesh, _, _ = MOURIER.mesh(49)
-    P = macro_problem(gap, mesh, FlowFactors.smooth(), Lubricant(0.25),
-                      MacroSettings(e_reduced=110e9), 0.18, 0.09)
+    P = macro_problem(OperatingPoint(gap, mesh, FlowFactors.smooth(), load=MOURIER.load,
+                                     speed=0.18, entrainment=0.09, lubricant=Lubricant(0.25),
+                                     settings=MacroSettings(e_reduced=110e9)))
     S = np.flatnonzero(np.random.default_rng(4).random(gap.size) < 0.3)
     p = np.zeros(gap.size)
     p[S] = np.random.default_rng(5).random(S.size) * 1e8

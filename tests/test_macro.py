@@ -20,6 +20,7 @@ from fem_twin.macro import (
     MacroSettings,
     MixedNotConverged,
     MixedResult,
+    OperatingPoint,
     solve_mixed,
     solve_reynolds,
 )
@@ -293,7 +294,8 @@ def test_newton_jacobian_is_exact(case32, factors):
     res = solve_mixed(gap, spacing, factors, load=150.0, speed=0.03,
                       lubricant=Lubricant(0.066), face=face, settings=s)
     assert res.contact_load > 10
-    P = macro_problem(gap, spacing, factors, Lubricant(0.066), s, 0.03, 0.015)
+    P = macro_problem(OperatingPoint(gap, spacing, factors, load=150.0, speed=0.03,
+                                     lubricant=Lubricant(0.066), settings=s))
     interior = P.interior
     x = newton.state_from(res, P)
     ev = newton.evaluate(P, x, 150.0)

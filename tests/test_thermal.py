@@ -21,7 +21,7 @@ from scipy.integrate import quad
 from scipy.special import k0e
 
 from fem_twin.errors import NotConverged
-from fem_twin.macro import Lubricant, MacroSettings, solve_mixed
+from fem_twin.macro import Lubricant, MacroSettings, OperatingPoint, solve_mixed
 from fem_twin.macro.laws.thermal import (
     ContactThermal,
     ThermalNotConverged,
@@ -102,15 +102,23 @@ def point(factors):
     return solve
 
 
+@pytest.fixture(scope="module")
+def operating(factors):
+    """The operating point :func:`point` solves, with the oil at 24 C."""
+    gap, dx, face = macro_case(32)
+    return OperatingPoint(gap, dx, factors, load=150.0, speed=1.0, face=face,
+                          settings=MacroSettings(tol=1e-8), lubricant=Lubricant(0.066))
+
+
 LAW = WaltherLaw.through((24.0, 50.0), (0.066, 0.024), 875.0)
 
 
-def test_the_film_temperature_settles_and_its_heat_is_the_frictional_power(point, factors):
+def test_the_film_temperature_settles_and_its_heat_is_the_frictional_power(point, operating):
     """At 1 m/s on the sample pin: the converged film temperature is the oil's plus R_b Q
     plus the face's flash (to the tolerance), Q = F_T U, and the film's viscosity is the
     Walther law's at that temperature."""
     thermal = ContactThermal(ThermalSettings(bulk_resistance=2.0), LAW)
-    (res,), film, record = thermal_point(point, Lubricant(0.066), thermal, factors, (0.0, 1.0))
+    (res,), film, record = thermal_point(point, operating, thermal)
     assert record["power_W"] == pytest.approx(res.friction_force * 1.0, rel=1e-12)
     assert abs(record["oil_C"] + 2.0 * record["power_W"] + record["face_flash_K"]
                - record["film_C"]) < 0.01
@@ -119,26 +127,25 @@ def test_the_film_temperature_settles_and_its_heat_is_the_frictional_power(point
     assert res.friction_coefficient < point(Lubricant(0.066), None)[0].friction_coefficient
 
 
-def test_ideal_heat_sinks_recover_the_isothermal_twin(point, factors):
+def test_ideal_heat_sinks_recover_the_isothermal_twin(point, operating):
     """No bulk resistance, a conductivity 1e9 times steel's, no spots: one iteration, and
     C_f equals the isothermal point's to 1e-9.  (The ideal heat sink lies outside the
     plausible conductivities ThermalSettings accepts, so it is set past the check.)"""
     s = ThermalSettings(bulk_resistance=0.0, spot_radius=0.0)
     object.__setattr__(s, "conductivity", 46e9)
-    (res,), film, record = thermal_point(point, Lubricant(0.066), ContactThermal(s, LAW),
-                                         factors, (0.0, 1.0))
+    (res,), film, record = thermal_point(point, operating, ContactThermal(s, LAW))
     iso = point(Lubricant(0.066), None)[0]
     assert record["iterations"] == 1
     assert res.friction_coefficient == pytest.approx(iso.friction_coefficient, rel=1e-9)
 
 
-def test_a_temperature_that_does_not_settle_raises_with_its_history(point, factors):
+def test_a_temperature_that_does_not_settle_raises_with_its_history(point, operating):
     """max_iter 1 with a large resistance: ThermalNotConverged carries |dT| per iteration,
     survives pickling to and from a worker process, and is a NotConverged (the CLI's
     documented exit 3, not an internal error)."""
     s = ThermalSettings(bulk_resistance=20.0, max_iter=1)
     with pytest.raises(ThermalNotConverged) as err:
-        thermal_point(point, Lubricant(0.066), ContactThermal(s, LAW), factors, (0.0, 1.0))
+        thermal_point(point, operating, ContactThermal(s, LAW))
     assert len(err.value.history) == 1 and err.value.history[0] > 10
     again = pickle.loads(pickle.dumps(err.value))
     assert again.history == err.value.history and str(again) == str(err.value)
@@ -164,23 +171,23 @@ def test_a_first_step_along_the_neighbours_slope_lands_within_the_tolerance():
         law = SimpleNamespace(viscosity=lambda T: 0.066 * np.exp(-0.03 * (T - 24.0)),
                               temperature=lambda mu: 24.0 - np.log(mu / 0.066) / 0.03)
 
-        def tempered(self, result, factors, speeds, temperature):
+        def tempered(self, result, point, temperature):
             return result
 
-        def heat(self, result, speeds):
+        def heat(self, result, point):
             return {"power": result.power, "flash": 0.0, "pin_share": 0.5}
 
-        def spot(self, result, factors, speeds):
+        def spot(self, result, point):
             return 0.0
 
     def solve(lubricant, previous):
         return (SimpleNamespace(speed=1.0, power=100 * lubricant.viscosity),)
 
-    _, film, record = thermal_point(solve, Lubricant(0.066), Model(), None, (0.0, 1.0))
+    oil = SimpleNamespace(lubricant=Lubricant(0.066), surface_speeds=(0.0, 1.0))
+    _, film, record = thermal_point(solve, oil, Model())
     assert record["residual_slope"] == pytest.approx(-1.0 - 3.0 * film.viscosity, rel=1e-2)
     off = {**record, "film_C": record["film_C"] + 0.5}
-    plain = thermal_point(solve, Lubricant(0.066), Model(), None, (0.0, 1.0),
-                          {**off, "residual_slope": None})[2]
-    along = thermal_point(solve, Lubricant(0.066), Model(), None, (0.0, 1.0), off)[2]
+    plain = thermal_point(solve, oil, Model(), {**off, "residual_slope": None})[2]
+    along = thermal_point(solve, oil, Model(), off)[2]
     assert plain["iterations"] == 3 and along["iterations"] == 2
     assert abs(along["film_C"] - record["film_C"]) < Model.settings.tol

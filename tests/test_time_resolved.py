@@ -72,7 +72,7 @@ def test_a_smooth_disk_is_the_steady_solution():
     shape, dx = pad.resolved(2)
     steady = solve_deterministic(shape, dx, load=pad.load(2), speed=0.5,
                                  lubricant=pad.lubricant, settings=settings)
-    moving = solve_time_resolved(shape, np.zeros((shape.shape[0], 4)), dx, load=pad.load(2),
+    moving = solve_time_resolved((shape, np.zeros((shape.shape[0], 4))), dx, load=pad.load(2),
                                  speed=0.5, lubricant=pad.lubricant, settings=settings,
                                  time=TimeSettings(step_tol=1e-8))
     assert 0.3 < steady.load_share < 0.9
@@ -97,7 +97,7 @@ def test_a_wavy_disk_over_a_plane_pin_meets_the_exact_unsteady_film():
             x = np.linspace(0, L, 50001)
             exact = np.array([wavy_film(n * dx[0] / U, form(x), x)[0] for n in range(m)])
             width = (ROWS - 1) * dx[1]
-            r = solve_time_resolved(shape, strip, dx, load=exact.mean() * width, speed=U,
+            r = solve_time_resolved((shape, strip), dx, load=exact.mean() * width, speed=U,
                                     lubricant=OIL, settings=STRIP,
                                     time=TimeSettings(scheme=scheme, period_tol=1e-9,
                                                       step_tol=1e-9))
@@ -134,7 +134,7 @@ def test_a_moving_rupture_front_leaves_the_exact_film_content_in_the_cavity():
         shape, strip, dx = strip_pad(m, form)
         exact = np.array([wavy_film(n * dx[0] / U, form(x), x)[0] for n in range(m)])
         width = (ROWS - 1) * dx[1]
-        r = solve_time_resolved(shape, strip, dx, load=exact.mean() * width, speed=U,
+        r = solve_time_resolved((shape, strip), dx, load=exact.mean() * width, speed=U,
                                 lubricant=OIL, settings=STRIP, time=TIGHT)
         assert np.abs(r.instants["film_load"] / width - exact).max() < tol_load * exact.mean()
         last = (m - 1) * dx[0] / U
@@ -189,7 +189,7 @@ def test_closed_channels_converge_at_every_load(periods):
         shares.append(r.load_share)
     assert shares[0] < 0.01 and shares[-1] > 0.95 and np.all(np.diff(shares[1:]) > 0)
     tilt, ridges = shape - shape[:, :1] + shape[0, 0], shape[:, :1] - shape[0, 0]
-    moving = solve_time_resolved(tilt, np.tile(ridges, (1, 4)), dx, load=400.0, speed=0.05,
+    moving = solve_time_resolved((tilt, np.tile(ridges, (1, 4))), dx, load=400.0, speed=0.05,
                                  lubricant=oil, settings=settings)
     steady = solve_deterministic(shape, dx, load=400.0, speed=0.05, lubricant=oil,
                                  settings=settings)
@@ -210,14 +210,14 @@ def test_the_disk_strip_moves_by_whole_and_fractional_pixels():
 def test_bad_inputs_are_refused_and_failures_keep_their_history():
     shape, strip, dx = strip_pad(16, lambda x: 1e-6 + 1e-6 * (1 - x / L))
     with pytest.raises(InputError, match="ny rows"):
-        solve_time_resolved(shape, strip[:2], dx, load=1e-3, speed=U, lubricant=OIL,
+        solve_time_resolved((shape, strip[:2]), dx, load=1e-3, speed=U, lubricant=OIL,
                             settings=STRIP)
     with pytest.raises(InputError):
         TimeSettings(scheme="crank-nicolson")
     with pytest.raises(InputError):
         TimeSettings(min_periods=5, max_periods=3)
     with pytest.raises(DeterministicNotConverged) as err:
-        solve_time_resolved(shape, strip, dx, load=1e-3, speed=U, lubricant=OIL,
+        solve_time_resolved((shape, strip), dx, load=1e-3, speed=U, lubricant=OIL,
                             settings=STRIP, time=TimeSettings(max_periods=1,
                                                               min_periods=1,
                                                               period_tol=1e-15))

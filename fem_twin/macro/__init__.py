@@ -33,14 +33,15 @@ The porch, what a caller uses:
 
 from .film.reynolds import ReynoldsNotConverged, ReynoldsResult, solve_reynolds
 from .laws.boundary import BOUNDARY_FRICTION, BoundaryLaw, boundary_traction
-from .laws.friction import hydrodynamic_shear
+from .laws.friction import FilmFields, hydrodynamic_shear
 from .laws.kinematics import disk_velocity
 from .laws.lubricant import Lubricant
 from .mixed import MacroSettings, MixedNotConverged, MixedResult, solve_mixed, solve_point
 from .point import OperatingPoint
 from .reference.deterministic import DeterministicResult, DeterministicSettings, solve_deterministic
 
-__all__ = ["BOUNDARY_FRICTION", "BoundaryLaw", "boundary_traction", "hydrodynamic_shear",
+__all__ = ["BOUNDARY_FRICTION", "BoundaryLaw", "boundary_traction", "FilmFields",
+           "hydrodynamic_shear",
            "disk_velocity",
            "DeterministicResult", "DeterministicSettings", "solve_deterministic",
            "Lubricant",

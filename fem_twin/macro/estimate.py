@@ -74,7 +74,7 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
     ``lubricant`` the film's); ``levels``: the same point already solved on the grid's
     coarsenings by two, finest first (:func:`.nested.solve_nested`'s levels after the
     first), which are then not solved again."""
-    factors, settings, lubricant = point.factors, point.settings, point.lubricant
+    factors = point.factors
     if factors.screening:                         # a statistical model: no error bar
         return {**{part: np.nan for part in PARTS}, "total": np.nan,
                 "failed": [SCREENING]}
@@ -90,8 +90,8 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
     signed.update(micro)
     films = [v for k, v in factors.variants().items() if k in FILM_VARIANTS]
     if films:                                 # the friction factor alone: no solve
-        own = friction_with(result, factors, settings, lubricant)
-        moved = [friction_with(result, v, settings, lubricant) - own for v in films]
+        own = friction_with(result, factors, point)
+        moved = [friction_with(result, v, point) - own for v in films]
         signed["film"] = FILM_COUPLING * max(moved, key=abs)
     smooth = factors.meta.get("smooth", False)              # no roughness: no micro error
     for kind in set(PARTS) - set(signed):

@@ -19,6 +19,7 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 
+from .. import tables as T
 from ..checks import check
 from ..errors import MixedNotConverged
 from ..micro.flow_factors import FlowFactors
@@ -27,9 +28,8 @@ from ..numerics.threads import one_thread
 from .coupling import newton
 from .coupling.fixed_point import Concentrated, solve_fixed_point
 from .coupling.problem import macro_problem
-from .coupling.result import MixedResult, mixed_result, on_grid
+from .coupling.result import Convergence, MixedResult, mixed_result, on_grid
 from .coupling.settings import MacroSettings
-from .laws.kinematics import disk_velocity
 from .laws.lubricant import Lubricant
 from .point import OperatingPoint
 
@@ -47,7 +47,7 @@ COARSE_START = 36
 
 
 @one_thread
-def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float,
+def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float = T.LOAD, speed: float,
                 entrainment: float | None = None,
                 lubricant: Lubricant, face=None, settings: MacroSettings = MacroSettings(),
                 initial: MixedResult | None = None, progress=None) -> MixedResult:
@@ -59,7 +59,7 @@ def solve_mixed(gap, spacing, factors: FlowFactors, *, load: float, speed: float
         sliding direction of the disk) along the columns
     spacing : (dx1, dx2) [m]
     factors : flow factors of the micro scale (patch average)
-    load : imposed normal load F_N,imp [N]
+    load : imposed normal load F_N,imp [N] (default: Table 6's, 150 N)
     speed : sliding speed U of the disk [m/s] (``u_r = U``; ``u_m = U/2`` on a pin)
     entrainment : mean speed ``u_m`` of the surfaces [m/s] when it is not ``U/2``: a ball on
         a disk at slide-to-roll ratio ``SRR = u_r / u_m`` has ``speed = SRR u_m`` (0: pure
@@ -98,29 +98,26 @@ def seeded_point(point: OperatingPoint, *, initial: MixedResult | None = None, s
     :func:`~fem_twin.macro.nested.solve_nested` hands them from level to level.
     """
     check("point", point, OperatingPoint)
-    h_g, dx, face, settings = point.gap, point.spacing, point.face, point.settings
-    factors = at_slide_to_roll(point.factors, point.speed / point.u_m)
+    settings = point.settings
+    factors = at_slide_to_roll(point.factors, point.slide_to_roll)
     t0 = time.perf_counter()
-    if initial is None and min(h_g.shape) >= 2 * COARSE_START:
+    if initial is None and min(point.gap.shape) >= 2 * COARSE_START:
         initial, secants = _coarse_start(replace(point, factors=factors))
     if initial is not None:
-        initial = on_grid(initial, h_g.shape, dx)
-    velocity = disk_velocity(face, dx, settings.track_radius)
-    P = macro_problem(h_g, dx, factors, point.lubricant, settings, point.speed, point.u_m,
-                      velocity)
-    load = point.load
+        initial = on_grid(initial, point.gap.shape, point.spacing)
+    P = macro_problem(point, factors)
     if settings.coupling == "newton" or (settings.coupling == "auto" and initial is not None
                                          and initial.meta.get("coupling") == "newton"):
-        return _solve_newton(P, load, face, initial, progress, t0), None
+        return _solve_newton(P, initial, progress, t0), None
     try:
-        ev, h_el, h_d, it, history, secants = solve_fixed_point(P, load, face, initial,
-                                                                progress, secants)
+        ev, h_el, h_d, it, history, secants = solve_fixed_point(P, point.load, point.face,
+                                                                initial, progress, secants)
     except (MixedNotConverged, Concentrated):
         if settings.coupling != "auto":
             raise
-        return _solve_newton(P, load, face, initial, progress, t0), None
-    return mixed_result(ev, h_el, h_d, P, load, face, it, history,
-                        time.perf_counter() - t0), secants
+        return _solve_newton(P, initial, progress, t0), None
+    run = Convergence(it, history, time.perf_counter() - t0)
+    return mixed_result(P, ev, h_el, h_d, run), secants
 
 
 def _coarse_start(point: OperatingPoint):
@@ -135,10 +132,10 @@ def _coarse_start(point: OperatingPoint):
         return None, None
 
 
-def _solve_newton(P, load, face, initial, progress, t0):
+def _solve_newton(P, initial, progress, t0):
     """The ``"newton"`` coupling (:mod:`.newton`): warm from ``initial``, else by load
     continuation from the rigid film."""
-    s = P.settings
+    s, load = P.point.settings, P.point.load
     max_iter = min(s.max_iter, NEWTON_MAX_ITER)
     if initial is None:
         x, ev, it, history = newton.continuation(P, load, tol=s.tol, max_iter=max_iter,
@@ -146,5 +143,5 @@ def _solve_newton(P, load, face, initial, progress, t0):
     else:
         x, ev, it, history = newton.solve(P, newton.state_from(initial, P), load, tol=s.tol,
                                           max_iter=max_iter, progress=progress)
-    return mixed_result(ev, x.w, x.h_d, P, load, face, it, history,
-                        time.perf_counter() - t0, coupling="newton")
+    run = Convergence(it, history, time.perf_counter() - t0, coupling="newton")
+    return mixed_result(P, ev, x.w, x.h_d, run)

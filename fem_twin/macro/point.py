@@ -77,8 +77,14 @@ class OperatingPoint:
 
     @property
     def u_m(self) -> float:
-        """The entrainment speed u_m [m/s]: ``entrainment``, else u_r / 2 (a pin at rest)."""
+        """The entrainment speed u_m [m/s]: ``entrainment``, else u_r / 2 (a pin at rest);
+        the one place this convention is written (the macro scale reads it here)."""
         return self.speed / 2 if self.entrainment is None else self.entrainment
+
+    @property
+    def slide_to_roll(self) -> float:
+        """SRR = u_r / u_m [-], 2 for a pin at rest (the flow factors' own)."""
+        return self.speed / self.u_m
 
     @property
     def surface_speeds(self) -> tuple[float, float]:

@@ -254,9 +254,8 @@ def _solve_point(request: SweepRequest, speed: float, previous):
             return levels
         t = temperature_factor(r.settings.boundary, r.oil_temperature)
         return (tempered(levels[0], t), *levels[1:])
-    surfaces = point.surface_speeds
     start = time.perf_counter()
-    levels, film, record = thermal_point(solve, r.lubricant, r.thermal, r.factors, surfaces,
+    levels, film, record = thermal_point(solve, point, r.thermal,
                                          previous[0].meta.get("thermal") if previous
                                          else None)
     record["viscosity_Pa_s"] = film.viscosity

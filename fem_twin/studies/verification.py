@@ -228,7 +228,7 @@ def time_resolved_sweep(pad: RoughPad, tiles: int, speeds, settings=None, time=N
     shape, strip, dx = pad.moving(tiles)
     out, last = [], None
     for u in pad_speeds(speeds, tiles):
-        last = solve_time_resolved(shape, strip, dx, load=pad.load(tiles), speed=u,
+        last = solve_time_resolved((shape, strip), dx, load=pad.load(tiles), speed=u,
                                    lubricant=pad.lubricant, settings=settings or pad.settings,
                                    time=time, initial=last)
         out.append(last)

@@ -80,12 +80,12 @@ class Concentrated(Exception):
 
 
 def solve_fixed_point(P, load: float, face, initial=None, progress=None, secants=None):
-    """Iterate the ``P.settings.coupling`` fixed point (``"auto"`` means ``"anderson"``, and
+    """Iterate the ``P.point.settings.coupling`` fixed point (``"auto"`` means ``"anderson"``, and
     raises :class:`Concentrated` at the first iterate of an elastically dominated contact);
     ``secants`` (:class:`Secants`, of a coarser grid's solve) seed the Anderson history.
     Returns ``(ev, h_el, h_d, iterations, history, secants)``, the last this solve's own
     (None for ``"pid"``); raises :class:`MixedNotConverged`."""
-    s = P.settings
+    s = P.point.settings
     inner = _Reynolds(P, initial)
     h_el, h_d, p_con = _start(P, inner, load, face, initial)
     outer = _Pid(s) if s.coupling == "pid" else _Mixing(P, load, face, secants)
@@ -141,7 +141,7 @@ class _Reynolds:
     the previous switch ``phi``: the inner problem of the fixed point."""
 
     def __init__(self, P, initial):
-        s = P.settings
+        s = P.point.settings
         self.P, self.model = P, cavitation_model(s.complementarity)
         self.p_amb_rel = s.ambient_pressure - s.cavitation_pressure
         self.phi, self.p, self.newton = None, np.full(P.shape, self.p_amb_rel), 0
@@ -158,12 +158,12 @@ class _Reynolds:
         the deformation when given (``"pid"``), else ``p_con(h0)``; ``steps`` cuts the solve
         to that many Newton steps, ``settle`` stops it once its active set has settled
         (inexact inner solves).  Returns every field the updates and the result need."""
-        P, s = self.P, self.P.settings
-        h0 = np.maximum(h_d + P.gap + h_el, s.gap_floor)
+        P, s = self.P, self.P.point.settings
+        h0 = np.maximum(h_d + P.point.gap + h_el, s.gap_floor)
         p_prev = self.p
         loc, mu, rho, g, q = P.coefficients(p_prev, h0)
         K = P.poiseuille(g, loc.A)
-        B = couette_matrix(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing, s.couette)
+        B = couette_matrix(q * loc.b[..., 0], q * loc.b[..., 1], P.point.spacing, s.couette)
         # of the factors the result needs h_m and p_con: A, b, g and q are not kept through
         # the solve (64 B a node)
         loc = replace(loc, A=None, b=None)
@@ -193,7 +193,7 @@ def _start(P, inner, load, face, initial):
     if initial is not None:
         return (initial.elastic_deformation.copy(), float(initial.h_d),
                 initial.contact_pressure.copy())
-    s, factors, h_g = P.settings, P.factors, P.gap
+    s, factors, h_g = P.point.settings, P.factors, P.point.gap
     h_el = np.zeros(P.shape)
 
     def excess(h_d):
@@ -239,18 +239,18 @@ class _Mixing:
         self.best, self.stall = np.inf, 0
         self.restart()
         if secants is not None:
-            self.mixer.seed(*secants.on(P.shape, P.spacing))
+            self.mixer.seed(*secants.on(P.shape, P.point.spacing))
 
     def restart(self):
-        s = self.P.settings
+        s = self.P.point.settings
         self.mixer = Anderson(s.anderson_depth, s.anderson_damping)
 
     def secants(self) -> Secants:
         """This solve's last :data:`SEED_PAIRS` Anderson differences."""
-        return Secants(self.P.shape, self.P.spacing, *self.mixer.pairs(SEED_PAIRS))
+        return Secants(self.P.shape, self.P.point.spacing, *self.mixer.pairs(SEED_PAIRS))
 
     def update(self, ev, h_el, h_d, p_con, row, res):
-        P, s = self.P, self.P.settings
+        P, s = self.P, self.P.point.settings
         self.stall += 1
         if res < 0.5 * self.best:
             self.best, self.stall = res, 0

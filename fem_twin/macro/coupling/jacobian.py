@@ -68,9 +68,9 @@ def jacobian(P: Problem, ev: NewtonEvaluation) -> dict:
     ``J_ph = dR/dh0`` (interior x all, through h_m, A and b), ``pos`` (dp/dphi) and
     ``dpc = dp_con/dh0`` (per node; with the ``"gauss"`` contact quadrature the row sums of
     ``Dpc``, the sparse ``dp_con,i/dh0_j`` that the exact action uses)."""
-    lub, I = P.lubricant, P.interior
-    pos, dtheta = cavitation_model(P.settings.complementarity).derivatives(
-        ev.phi.ravel(), P.settings.p_ref)
+    lub, I = P.point.lubricant, P.interior
+    pos, dtheta = cavitation_model(P.point.settings.complementarity).derivatives(
+        ev.phi.ravel(), P.point.settings.p_ref)
     p_coef = np.minimum(ev.p, MAX_COEFFICIENT_PRESSURE)
     unclipped = ev.p < MAX_COEFFICIENT_PRESSURE
     dlnrho = lub.density_log_slope(p_coef) * unclipped
@@ -97,7 +97,7 @@ def jacobian(P: Problem, ev: NewtonEvaluation) -> dict:
     J_p, J_h = J_p.tocsr()[I], J_h.tocsr()[I]
     out = dict(J_pp=J_p[:, I].tocsc(), J_ph=J_h.tocsr(), pos=pos,
                dpc=(d["p_con"] * free).ravel(), Dpc=None)
-    if P.settings.contact_quadrature != "nodal":        # p_con_i depends on its neighbours
+    if P.point.settings.contact_quadrature != "nodal":        # p_con_i depends on its neighbours
         out["Dpc"] = contact_load(P.shape, P.mesh).derivative(P.factors, ev.h0, free)
         out["dpc"] = np.asarray(out["Dpc"].sum(axis=1)).ravel()    # lumped: preconditioner
     return out
@@ -114,7 +114,7 @@ class Preconditioner:
     """
 
     def __init__(self, P: Problem, jac: dict):
-        I, n = P.interior, P.gap.size
+        I, n = P.interior, P.point.gap.size
         J_pp, J_ph, pos, dpc = jac["J_pp"], jac["J_ph"], jac["pos"], jac["dpc"]
         sI = dense_set(P, jac)
         S = I[sI]
@@ -246,7 +246,7 @@ def dense_set(P: Problem, jac: dict) -> np.ndarray:
     I = P.interior
     diag = np.abs(jac["J_pp"].diagonal())
     row = np.asarray(abs(jac["J_ph"]).sum(axis=1)).ravel()
-    score = np.zeros(P.gap.size)
+    score = np.zeros(P.point.gap.size)
     e0 = e0 * np.sqrt(P.cells)           # a node's own compliance grows with its side
     score[I] = e0[I] * row / np.maximum(diag, 1e-300 + 1e-12 * diag.max())
     score = np.maximum(score, e0 * np.abs(jac["dpc"]))
@@ -259,7 +259,7 @@ def dense_set(P: Problem, jac: dict) -> np.ndarray:
 
 def apply_jacobian(P: Problem, jac: dict, dphi, dw, dhd):
     """The exact Jacobian action (``E`` by FFT) on an update ``(dphi, dw, dhd)``."""
-    dp = np.zeros(P.gap.size)
+    dp = np.zeros(P.point.gap.size)
     dp[P.interior] = jac["pos"][P.interior] * dphi
     dh = dw + dhd
     dpt = dp + (jac["dpc"] * dh if jac["Dpc"] is None else jac["Dpc"] @ dh)
@@ -271,10 +271,10 @@ def newton_step(P: Problem, ev: NewtonEvaluation, load: float, rtol: float, pre=
     """The Newton update ``(dphi, dw, dhd)``, the GMRES iteration count and the
     preconditioner (built from this step's Jacobian unless ``pre`` is given).  GMRES runs on
     the system scaled by the residuals' natural sizes (:func:`scales`) to ``rtol``."""
-    s = P.settings
+    s = P.point.settings
     jac = jacobian(P, ev)
     pre = Preconditioner(P, jac) if pre is None else pre
-    nI, n = P.interior.size, P.gap.size
+    nI, n = P.interior.size, P.point.gap.size
     size, h_s, _ = scales(ev, s, load)
     row = np.r_[1 / size, np.full(n, 1 / h_s), 1 / load]                 # residual scales
 

@@ -45,16 +45,16 @@ class State:
 
 def evaluate(P: Problem, x: State, load: float) -> NewtonEvaluation:
     """Residuals ``R, G, L`` and every field the Jacobian and the result need."""
-    s = P.settings
+    s = P.point.settings
     shape = P.shape
     p, theta = (v.reshape(shape) for v in
                 cavitation_model(s.complementarity).split(x.phi, s.p_ref))
-    h_raw = x.h_d + P.gap + x.w
+    h_raw = x.h_d + P.point.gap + x.w
     h0 = np.maximum(h_raw, s.gap_floor)
     loc, mu, rho, g, q = P.coefficients(p, h0)
     K = P.poiseuille(g, loc.A)
     q1, q2 = (q * loc.b[..., 0]).ravel(), (q * loc.b[..., 1]).ravel()
-    C = couette(q1.reshape(shape), q2.reshape(shape), P.spacing, s.couette)
+    C = couette(q1.reshape(shape), q2.reshape(shape), P.point.spacing, s.couette)
     B = C.matrix()
     flux = K @ p.ravel() + B @ (1 - theta.ravel())
     size = abs(K) @ p.ravel() + C.size()
@@ -66,6 +66,18 @@ def evaluate(P: Problem, x: State, load: float) -> NewtonEvaluation:
         phi=x.phi, touching=h_raw <= s.gap_floor, g=g, q=q, K=K, B=B, couette=C,
         R=flux[P.interior], size=size[P.interior] + 1e-300, G=x.w - P.elastic(p_tot),
         L=F - load)
+
+
+@dataclass(frozen=True)
+class Merit:
+    """The merit function of one Newton step at ``load`` [N]: the scaled residual norm
+    (:func:`merit`) with the residuals' ``sizes`` held fixed over its line search."""
+
+    load: float
+    sizes: tuple
+
+    def __call__(self, ev: NewtonEvaluation) -> float:
+        return merit(ev, self.sizes)
 
 
 def merit(ev: NewtonEvaluation, sizes: tuple) -> float:
@@ -87,22 +99,22 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
     :class:`MixedNotConverged` otherwise, or after ``WATCHDOG`` steps in a row that did not
     decrease the merit function.
     """
-    s = P.settings
+    s = P.point.settings
     ev = evaluate(P, x, load)
     history, pre, uphill, short = [], None, 0, 0
     for it in range(1, max_iter + 1):
-        sizes = scales(ev, s, load)
-        f = merit(ev, sizes)
+        measure = Merit(load, scales(ev, s, load))
+        f = measure(ev)
         try:
             step, gm, pre = newton_step(P, ev, load, pre=pre,
                                         rtol=min(1e-3, max(1e-8, 0.1 * f)))
             if gm > REBUILD_AFTER:
                 pre = None
-            trial, ev_t, f_t, alpha, downhill = line_search(P, x, ev, step, load, sizes, f)
+            trial, ev_t, f_t, alpha, downhill = line_search(P, x, ev, step, measure)
             short = short + 1 if alpha < SHORT_STEP else 0
             if not downhill or short >= STALL:
                 # no decrease, or steps so short that the iteration stalls at a kink
-                trial, ev_t, f_t, alpha = clamped_step(P, x, step[0], load, sizes)
+                trial, ev_t, f_t, alpha = clamped_step(P, x, step[0], measure)
                 downhill, short = f_t < f, 0
         except (SolverError, ValueError) as err:      # a singular matrix, NaN in a step
             raise MixedNotConverged(f"Newton coupling, iteration {it}: {err}", history) from err
@@ -123,12 +135,12 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
                             f"(merit {f_t:.2e})", history)
 
 
-def clamped_step(P: Problem, x: State, dphi, load: float, sizes):
+def clamped_step(P: Problem, x: State, dphi, measure: Merit):
     """The Newton step with the nodes that the step ``dphi`` moves across the p-theta kink
     held on it (``p = theta = 0``, their own mass balance dropped for this step): where a
     degenerate node of the solution sits on the kink, the plain step overshoots it back
     and forth between the two branches.  Returns ``(state, ev, merit, 1.0)``."""
-    I = P.interior
+    I, load = P.interior, measure.load
     crossing = (x.phi[I] + dphi) * x.phi[I] < 0
     clamped = replace(P, interior=I[~crossing])
     phi = x.phi.copy()
@@ -140,11 +152,12 @@ def clamped_step(P: Problem, x: State, dphi, load: float, sizes):
     phi[clamped.interior] += dphi_c
     trial = State(phi, held.w + dw.reshape(P.shape), held.h_d + dhd)
     ev_t = evaluate(P, trial, load)
-    return trial, ev_t, merit(ev_t, sizes), 1.0
+    return trial, ev_t, measure(ev_t), 1.0
 
 
-def line_search(P: Problem, x: State, ev: NewtonEvaluation, step, load: float, sizes, f: float):
-    """The accepted trial ``(state, ev, merit, alpha, decreased)`` along a Newton step.
+def line_search(P: Problem, x: State, ev: NewtonEvaluation, step, measure: Merit):
+    """The accepted trial ``(state, ev, merit, alpha, decreased)`` along a Newton ``step``
+    from ``x`` (evaluated as ``ev``), by the ``measure`` of the step's merit function.
 
     The step is first shortened so that no film thins by more than half.  If the merit
     function does not decrease, the nodes that would cross the p-theta kink stop on it
@@ -155,7 +168,7 @@ def line_search(P: Problem, x: State, ev: NewtonEvaluation, step, load: float, s
     merit function).
     """
     dphi, dw, dhd = step
-    I = P.interior
+    I, load, f = P.interior, measure.load, measure(ev)
     dh = (dw + dhd).reshape(P.shape)
     thinning = (dh < 0) & ~ev.touching
     alpha = min(1.0, float(np.min(0.5 * ev.h0[thinning] / -dh[thinning], initial=np.inf)))
@@ -165,7 +178,7 @@ def line_search(P: Problem, x: State, ev: NewtonEvaluation, step, load: float, s
         phi[I] += alpha * dphi
         trial = State(phi, x.w + alpha * dw.reshape(P.shape), x.h_d + alpha * dhd)
         ev_t = evaluate(P, trial, load)
-        f_t = merit(ev_t, sizes)
+        f_t = measure(ev_t)
         if np.isfinite(f_t) and f_t <= (1 - 1e-4 * alpha) * f:
             return trial, ev_t, f_t, alpha, True
         if trial_no == 0:
@@ -181,7 +194,7 @@ def line_search(P: Problem, x: State, ev: NewtonEvaluation, step, load: float, s
 def state_from(result, P: Problem) -> State:
     """The Newton state of a converged :class:`MixedResult` (a warm start), its Dirichlet
     nodes at ambient pressure."""
-    s = P.settings
+    s = P.point.settings
     phi = cavitation_model(s.complementarity).unknown(
         (result.pressure - s.cavitation_pressure).ravel(), result.cavity_fraction.ravel(),
         s.p_ref)
@@ -194,15 +207,15 @@ def rigid_start(P: Problem, load: float, ratio: float):
     (halving ``h_d - h_touch`` from the first-contact separation) whose load reaches
     ``load`` or whose elastic deformation reaches ``ratio`` of its thinnest loaded film.
     Returns the state and the load it carries (at most ``load``)."""
-    s = P.settings
+    s = P.point.settings
     model = cavitation_model(s.complementarity)
-    touch = s.gap_floor - float(P.gap.min())
-    t = float(P.factors.h0[-1]) - float(P.gap.min()) - touch
+    touch = s.gap_floor - float(P.point.gap.min())
+    t = float(P.factors.h0[-1]) - float(P.point.gap.min()) - touch
     for _ in range(80):
         h_d = touch + t
-        loc, _, _, g, q = P.coefficients(np.zeros(P.shape), np.maximum(h_d + P.gap,
+        loc, _, _, g, q = P.coefficients(np.zeros(P.shape), np.maximum(h_d + P.point.gap,
                                                                          s.gap_floor))
-        B = couette_matrix(q * loc.b[..., 0], q * loc.b[..., 1], P.spacing, s.couette)
+        B = couette_matrix(q * loc.b[..., 0], q * loc.b[..., 1], P.point.spacing, s.couette)
         phi, _, _ = model.solve(P.poiseuille(g, loc.A), B, P.boundary,
                                 s.ambient_pressure - s.cavitation_pressure, s.p_ref)
         x = State(phi, np.zeros(P.shape), h_d)

@@ -1,8 +1,9 @@
-"""An operating point's assembled problem: the grid, the physics and the speeds.
+"""An operating point's assembled problem: the point, its grid's operators and the disk's
+motion.
 
-:func:`macro_problem` builds, from an :class:`~fem_twin.macro.point.OperatingPoint`'s
-values, the :class:`Problem` that both couplings (:mod:`.fixed_point`
-and :mod:`.newton`) solve; :meth:`Problem.coefficients` evaluates eq 17's homogenised
+:func:`macro_problem` builds, from an :class:`~fem_twin.macro.point.OperatingPoint`, the
+:class:`Problem` that both couplings (:mod:`.fixed_point` and :mod:`.newton`) solve, which
+holds the point itself; :meth:`Problem.coefficients` evaluates eq 17's homogenised
 Poiseuille and Couette coefficients with Roelands (eq 23) and Dowson-Higginson (eq 24) at a
 pressure and a separation field.
 """
@@ -19,13 +20,12 @@ import scipy.sparse as sp
 
 from ...contact.elastic import ElasticOperator, elastic_operator
 from ...micro.flow_factors import FlowFactors
+from ...micro.rolling import at_slide_to_roll
 from ...numerics.graded_mesh import Mesh, MeshElastic
 from ..film.contact_load import nodal_contact_pressure
 from ..film.reynolds import OPEN_GAP, fe_poiseuille, trapezoid_weights
 from ..film.reynolds_fv import fvm_poiseuille
-from ..laws.kinematics import in_grid_frame, rotations
-from ..laws.lubricant import Lubricant
-from .settings import MacroSettings
+from ..laws.kinematics import disk_velocity, in_grid_frame, rotations
 
 #: Pressures above this [Pa] (transients of the iteration, far beyond the hardness) are
 #: clipped before eqs 23-24 are evaluated (both couplings), so that the Roelands
@@ -38,19 +38,17 @@ POISEUILLE = {"fe": fe_poiseuille, "fvm": fvm_poiseuille}
 
 @dataclass(frozen=True, eq=False)
 class Problem:
-    """The grid, the physics and the speeds of one operating point (SI units)."""
+    """One operating point's problem (SI units): the ``point``
+    (:class:`~fem_twin.macro.point.OperatingPoint`: gap, grid, load, speeds, lubricant,
+    settings, face), its flow ``factors`` at its slide-to-roll ratio, and what its grid
+    assembles once."""
 
-    gap: np.ndarray            # rigid gap h_g (ny, nx) [m]
-    spacing: tuple[float, float] | Mesh  # (dx1, dx2) [m], or a graded mesh
-    factors: FlowFactors       # at the point's slide-to-roll ratio
-    lubricant: Lubricant
-    settings: MacroSettings
+    point: object              # the OperatingPoint (fem_twin.macro.point), checked
+    factors: FlowFactors       # the point's, at its slide-to-roll ratio
     poiseuille: Callable[[np.ndarray, np.ndarray | None], sp.csr_matrix]  # (g, A) -> K
     elastic: ElasticOperator | MeshElastic  # eqs 20-22 on the padded grid
     area: np.ndarray           # trapezoid weights [m^2]
     interior: np.ndarray       # flat indices of the interior nodes
-    speed: float               # sliding speed u_r [m/s]
-    entrainment: float         # mean (entrainment) speed u_m [m/s]
     velocity: np.ndarray | None = None  # the disk's velocity / u_r (ny, nx, 2); None: e1
 
     @cached_property
@@ -61,12 +59,13 @@ class Problem:
 
     @property
     def shape(self):
-        return self.gap.shape
+        return self.point.gap.shape
 
     @property
     def mesh(self) -> Mesh | None:
         """The graded mesh, None on a grid."""
-        return self.spacing if isinstance(self.spacing, Mesh) else None
+        spacing = self.point.spacing
+        return spacing if isinstance(spacing, Mesh) else None
 
     @property
     def boundary(self) -> np.ndarray:
@@ -83,17 +82,17 @@ class Problem:
         ``g = rho h_m^3 / (12 mu)`` [m^3/(Pa s)] and ``q = rho h_m u_m`` [m^2/s], with
         ``loc``'s tensors in the grid frame and ``u_m`` the local speed on a rotating
         disk (:mod:`.kinematics`)."""
-        rule = self.settings.contact_quadrature
+        rule = self.point.settings.contact_quadrature
         loc = in_grid_frame(self.factors.at(h0, friction=False, contact=rule == "nodal"),
                             self.turn)
         if rule != "nodal":
             loc = replace(loc, p_con=nodal_contact_pressure(self.factors, h0, rule,
                                                             self.mesh))
         p_coef = np.minimum(p, MAX_COEFFICIENT_PRESSURE)
-        mu = self.lubricant.viscosity_at(p_coef)
-        rho = self.lubricant.density_ratio(p_coef)
+        mu = self.point.lubricant.viscosity_at(p_coef)
+        rho = self.point.lubricant.density_ratio(p_coef)
         g = rho * loc.h_m ** 3 / (12 * mu)
-        q = rho * loc.h_m * self.entrainment
+        q = rho * loc.h_m * self.point.u_m
         if self.turn is not None:
             q = q * self.turn[2]
         return loc, mu, rho, g, q
@@ -135,26 +134,30 @@ class Problem:
     def cells(self) -> np.ndarray:
         """Each node's area in cells of the FFT grid, (n,) (1 on a grid)."""
         if self.mesh is None:
-            return np.ones(self.gap.size)
+            return np.ones(self.point.gap.size)
         return self.mesh.area.ravel() / (self.mesh.pitch[0] * self.mesh.pitch[1])
 
 
-def macro_problem(gap, spacing, factors, lubricant, settings, speed: float,
-                  entrainment: float, velocity=None) -> Problem:
-    """The :class:`Problem` of a validated gap (ny, nx) [m] and spacing (dx1, dx2) [m]:
-    Dirichlet nodes (ambient pressure) on the grid's edge and wherever the rigid gap opens
-    beyond ``OPEN_GAP`` (around the pin face: the oil bath over the holder), the
-    non-periodic FFT half-space of eqs 20-22 and the Poiseuille operator of
-    ``settings.method``; ``velocity``: the disk's (:func:`.kinematics.disk_velocity`)."""
-    gap = np.asarray(gap, float)
-    dx = spacing if isinstance(spacing, Mesh) else tuple(float(v) for v in spacing)
+def macro_problem(point, factors=None, velocity=None) -> Problem:
+    """The :class:`Problem` of the operating ``point`` (an
+    :class:`~fem_twin.macro.point.OperatingPoint`, checked): Dirichlet nodes (ambient
+    pressure) on the grid's edge and wherever the rigid gap opens beyond ``OPEN_GAP``
+    (around the pin face: the oil bath over the holder), the non-periodic FFT half-space of
+    eqs 20-22 and the Poiseuille operator of ``settings.method``; ``factors``: the point's
+    at its slide-to-roll ratio (None: carried there, :func:`fem_twin.micro.at_slide_to_roll`),
+    ``velocity``: the disk's (None: :func:`.kinematics.disk_velocity` of the point's face
+    and track radius)."""
+    gap, dx, settings = point.gap, point.spacing, point.settings
+    if factors is None:
+        factors = at_slide_to_roll(point.factors, point.slide_to_roll)
+    if velocity is None:
+        velocity = disk_velocity(point.face, dx, settings.track_radius)
     boundary = gap > OPEN_GAP
     boundary[[0, -1], :] = boundary[:, [0, -1]] = True
-    return Problem(gap, dx, factors, lubricant, settings,
-                   partial(_poiseuille, POISEUILLE[settings.method], dx),
+    return Problem(point, factors, partial(_poiseuille, POISEUILLE[settings.method], dx),
                    _elastic(gap.shape, dx, settings.e_reduced),
                    trapezoid_weights(gap.shape, dx), np.flatnonzero(~boundary.ravel()),
-                   float(speed), float(entrainment), velocity)
+                   velocity)
 
 
 def _poiseuille(assemble, dx, g, A):

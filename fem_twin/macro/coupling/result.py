@@ -14,7 +14,7 @@ from ...micro.rolling import at_slide_to_roll
 from ...numerics.graded_mesh import Mesh
 from ..film.reynolds import trapezoid_weights
 from ..laws.boundary import asperity_load, boundary_area, traction
-from ..laws.friction import confined_shear, disk_shear, hydrodynamic_shear
+from ..laws.friction import FilmFields, confined_shear, disk_shear, hydrodynamic_shear
 from ..laws.kinematics import disk_velocity, rotations
 
 #: the grid fields of an operating point and their SI units: declared once, for the
@@ -129,24 +129,37 @@ class MixedResult:
 
 
 
-def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
-                 coupling=None) -> MixedResult:
+@dataclass(frozen=True)
+class Convergence:
+    """How a coupling reached its converged state: its ``iterations``, the ``history`` rows
+    of :attr:`MixedResult.history`, the wall time ``seconds`` [s] and the ``coupling``'s
+    name (None: the settings')."""
+
+    iterations: int
+    history: list
+    seconds: float
+    coupling: str | None = None
+
+
+def mixed_result(P, ev, h_el, h_d, run: Convergence) -> MixedResult:
     """The :class:`MixedResult` of a converged state of ``P`` (a :class:`.problem.Problem`):
-    ``ev`` its :class:`.evaluation.Evaluation`, with the friction of eqs 31-34 over the pin
-    ``face``."""
-    s, dx, area, speed, lubricant = P.settings, P.spacing, P.area, P.speed, P.lubricant
+    ``ev`` its :class:`.evaluation.Evaluation`, the elastic deformation ``h_el`` [m] and
+    the separation ``h_d`` [m], reached as ``run`` says; the friction of eqs 31-34 over the
+    point's face."""
+    point = P.point
+    s, dx, area, face = point.settings, point.spacing, P.area, point.face
     loc = ev.loc
     p_hd = ev.p + s.cavitation_pressure
-    film = Film(pressure=p_hd, cavity_fraction=ev.theta, viscosity=ev.mu, h0=ev.h0,
-                mean_gap=loc.h_m, contact_pressure=ev.p_con, face=face)
-    tau_hd, tau_con, asperity, a_r = pin_friction(film, Shearing(
-        dx, P.factors, s, lubricant, speed, P.entrainment, P.velocity))
+    fields = PointFields(pressure=p_hd, cavity_fraction=ev.theta, viscosity=ev.mu, h0=ev.h0,
+                         mean_gap=loc.h_m, contact_pressure=ev.p_con, face=face)
+    tau_hd, tau_con, asperity, a_r = pin_friction(fields, point, P.factors, P.velocity)
     weights = area * face                         # the load's trapezoidal rule on the face
     F_hd = float(np.sum(weights * tau_hd))
     F_con = float(np.sum(weights * tau_con))
     F_N = ev.F
     return MixedResult(
-        speed=float(speed), imposed_load=float(load), normal_load=F_N, h_d=float(h_d),
+        speed=float(point.speed), imposed_load=float(point.load), normal_load=F_N,
+        h_d=float(h_d),
         friction_force=F_hd + F_con, hydrodynamic_friction=F_hd, boundary_force=F_con,
         friction_coefficient=(F_hd + F_con) / F_N,
         contact_load=float(np.sum(area * ev.p_con)),
@@ -155,11 +168,13 @@ def mixed_result(ev, h_el, h_d, P, load, face, it, history, seconds,
         pressure=p_hd, contact_pressure=ev.p_con, cavity_fraction=ev.theta,
         h0=ev.h0, mean_gap=loc.h_m, elastic_deformation=h_el,
         viscosity=ev.mu, density_ratio=ev.rho, shear_stress=tau_hd + tau_con,
-        boundary_shear=tau_con * face, face=face, iterations=it, history=np.array(history),
+        boundary_shear=tau_con * face, face=face, iterations=run.iterations,
+        history=np.array(run.history),
         meta={"settings": _plain(s),
-              "lubricant": lubricant.__dict__.copy(), "seconds": seconds,
-              "coupling": coupling or ("anderson" if s.coupling == "auto" else s.coupling),
-              "entrainment": P.entrainment})
+              "lubricant": point.lubricant.__dict__.copy(), "seconds": run.seconds,
+              "coupling": run.coupling or ("anderson" if s.coupling == "auto"
+                                           else s.coupling),
+              "entrainment": float(point.u_m)})
 
 
 def _plain(settings) -> dict:
@@ -169,70 +184,50 @@ def _plain(settings) -> dict:
 
 
 @dataclass(frozen=True, eq=False)
-class Film:
-    """The fields of a converged state that its friction reads (a :class:`MixedResult`
-    has the same names): the film ``pressure`` (absolute) [Pa], the ``cavity_fraction``
-    [-], the local ``viscosity`` [Pa s], the separation ``h0`` and the ``mean_gap`` h_m
-    [m], the ``contact_pressure`` [Pa] and the pin ``face`` (bool), all (ny, nx)."""
+class PointFields(FilmFields):
+    """The fields of a converged operating point that its friction reads (a
+    :class:`MixedResult` has the same names): the film's (:class:`~.friction.FilmFields`:
+    ``pressure`` (absolute) [Pa], ``mean_gap`` h_m [m], ``cavity_fraction`` [-], local
+    ``viscosity`` [Pa s]), the separation ``h0`` [m], the ``contact_pressure`` [Pa] and the
+    pin ``face`` (bool), all (ny, nx)."""
 
-    pressure: np.ndarray
-    cavity_fraction: np.ndarray
-    viscosity: np.ndarray
     h0: np.ndarray
-    mean_gap: np.ndarray
     contact_pressure: np.ndarray
     face: np.ndarray
 
 
-@dataclass(frozen=True, eq=False)
-class Shearing:
-    """What turns a state's fields into tractions: the grid ``spacing`` (dx1, dx2) [m],
-    the ``factors`` at the state's slide-to-roll ratio, the macro ``settings``, the
-    ``lubricant``, the sliding ``speed`` u_r and the ``entrainment`` u_m [m/s] (None: u_r
-    / 2), and the disk's ``velocity`` (:func:`.kinematics.disk_velocity`; None: along
-    x1)."""
-
-    spacing: tuple[float, float]
-    factors: object
-    settings: object
-    lubricant: object
-    speed: float
-    entrainment: float | None
-    velocity: np.ndarray | None
-
-
-def pin_friction(film, how: Shearing):
+def pin_friction(fields, point, factors, velocity=None):
     """The film's and the contacts' tangential tractions [Pa] of a converged state's
-    ``film`` (a :class:`Film` or a :class:`MixedResult`) as the rig reads them
-    (``settings.reading``): on the pin along x1 (eqs 31-32, or the force on the pin:
-    ``settings.friction``, :func:`.friction.hydrodynamic_shear`), or the disk's drag times
-    ``|v|`` (its torque over the track radius, :func:`.friction.disk_shear`), sheared
-    ``how``; and the asperities' load field (:func:`.boundary.asperity_load`) [Pa] and the
-    dry contact fraction a_c [-] the law reads, each weighted alike (the x1 share of the
-    sliding, or ``|v|``).  The confined films' viscous shear (``thin_films =
-    "viscous"``) joins the film's traction."""
-    p_hd, theta, mu, h_m, p_con = (film.pressure, film.cavity_fraction, film.viscosity,
-                                   film.mean_gap, film.contact_pressure)
-    h0, face, velocity, settings = film.h0, film.face, how.velocity, how.settings
-    dx, factors, speed, lubricant = how.spacing, how.factors, how.speed, how.lubricant
+    ``fields`` (:class:`PointFields` or a :class:`MixedResult`) at the operating ``point``
+    (an :class:`~fem_twin.macro.point.OperatingPoint`: its grid, settings, lubricant and
+    speeds) as the rig reads them (``settings.reading``): on the pin along x1 (eqs 31-32,
+    or the force on the pin: ``settings.friction``, :func:`.friction.hydrodynamic_shear`),
+    or the disk's drag times ``|v|`` (its torque over the track radius,
+    :func:`.friction.disk_shear`), with the flow ``factors`` at the point's slide-to-roll
+    ratio and the disk's ``velocity`` (:func:`.kinematics.disk_velocity`; None: along x1);
+    and the asperities' load field (:func:`.boundary.asperity_load`) [Pa] and the dry
+    contact fraction a_c [-] the law reads, each weighted alike (the x1 share of the
+    sliding, or ``|v|``).  The confined films' viscous shear (``thin_films = "viscous"``)
+    joins the film's traction."""
+    settings, lubricant, speed = point.settings, point.lubricant, point.speed
+    dx, h0, face, p_con = point.spacing, fields.h0, fields.face, fields.contact_pressure
     shear = factors.at(h0)              # the shear factors (the iterations read none)
     cos, _, local = (1.0, 0.0, 1.0) if velocity is None else rotations(velocity)
     if settings.reading == "torque":    # the disk's drag times |v| = r / R (its lever)
         along = local
-        tau_hd = disk_shear(p_hd, h_m, theta, mu, shear, dx, speed,
-                            eyring_stress=lubricant.eyring_stress, velocity=velocity) * local
+        tau_hd = disk_shear(fields, shear, dx, speed, eyring_stress=lubricant.eyring_stress,
+                            velocity=velocity) * local
     else:                               # the load cell on the pin: the x1 component
         along = cos
-        tau_hd = hydrodynamic_shear(p_hd, h_m, theta, mu, shear, dx, speed,
-                                    entrainment=how.entrainment,
+        tau_hd = hydrodynamic_shear(fields, shear, dx, speed, entrainment=point.u_m,
                                     eyring_stress=lubricant.eyring_stress,
                                     law=settings.friction, face=face,
                                     ambient_pressure=settings.ambient_pressure,
                                     velocity=velocity)
     law = settings.boundary
-    gauge = np.maximum(np.asarray(p_hd, float) - settings.ambient_pressure, 0.0)
+    gauge = np.maximum(np.asarray(fields.pressure, float) - settings.ambient_pressure, 0.0)
     if law.thin_films == "viscous":      # the confined films' viscous shear, along the sliding
-        tau_hd = tau_hd + thin_film_shear(gauge, mu, speed * local, shear, film, how) * along
+        tau_hd = tau_hd + thin_film_shear(fields, shear, gauge, speed * local, point) * along
     load = asperity_load(p_con, gauge, boundary_area(shear, law), law)
     tau_con = traction(load, shear.contact_fraction, speed * local, law,
                        settings.boundary_friction)
@@ -240,32 +235,31 @@ def pin_friction(film, how: Shearing):
             load * along, shear.contact_fraction * along)
 
 
-def thin_film_shear(gauge, viscosity, speed, shear, film, how: Shearing) -> np.ndarray:
-    """The confined films' shear [Pa] (``thin_films = "viscous"``): viscous
-    (:func:`.friction.confined_shear`) up to a limiting shear, the boundary law's shear on
-    their film pressure ``gauge`` [Pa] over their area (``thin_area``; without tau_0): at
-    a ball's GPa the piezoviscous Eyring shear of nanometre films grows without bound
-    (docs/model.md, "Boundary friction")."""
-    law = how.settings.boundary
+def thin_film_shear(fields, shear, gauge, speed, point) -> np.ndarray:
+    """The confined films' shear [Pa] (``thin_films = "viscous"``) of a converged state's
+    ``fields`` with its shear factors ``shear``: viscous (:func:`.friction.confined_shear`
+    at the local sliding ``speed`` [m/s]) up to a limiting shear, the ``point``'s boundary
+    law's shear on their film pressure ``gauge`` [Pa] over their area (``thin_area``;
+    without tau_0): at a ball's GPa the piezoviscous Eyring shear of nanometre films grows
+    without bound (docs/model.md, "Boundary friction")."""
+    law = point.settings.boundary
     limit = traction(gauge * np.clip(shear.thin_area, 0.0, 1.0), 0.0, speed, law,
-                     how.settings.boundary_friction)
-    return np.minimum(confined_shear(viscosity, speed, shear, film.mean_gap,
-                                     film.cavity_fraction, how.lubricant.eyring_stress),
+                     point.settings.boundary_friction)
+    return np.minimum(confined_shear(fields.viscosity, speed, shear, fields.mean_gap,
+                                     fields.cavity_fraction, point.lubricant.eyring_stress),
                       np.maximum(limit, 0.0))
 
 
-def friction_with(result: MixedResult, factors, settings, lubricant) -> float:
-    """The friction coefficient of ``result`` with the shear factors of ``factors`` (a
-    :class:`~fem_twin.micro.FlowFactors` at the pin's SRR 2, carried to the point's), the
-    point's fields unchanged: for factors that differ only in what the Reynolds equation
-    does not read (the friction factors)."""
-    u_m = result.meta.get("entrainment") or result.speed / 2
-    moved = at_slide_to_roll(factors, result.speed / u_m)
-    tau_hd, tau_con, *_ = pin_friction(result, Shearing(
-        result.spacing, moved, settings, lubricant, result.speed,
-        result.meta.get("entrainment"), disk_velocity(result.face, result.spacing,
-                                                      settings.track_radius)))
-    weights = trapezoid_weights(result.face.shape, result.spacing) * result.face
+def friction_with(result: MixedResult, factors, point) -> float:
+    """The friction coefficient of ``result``, the operating ``point``'s
+    (:class:`~fem_twin.macro.point.OperatingPoint`, with the film's lubricant), with the
+    shear factors of ``factors`` (a :class:`~fem_twin.micro.FlowFactors` at the pin's SRR
+    2, carried to the point's), the point's fields unchanged: for factors that differ only
+    in what the Reynolds equation does not read (the friction factors)."""
+    moved = at_slide_to_roll(factors, point.slide_to_roll)
+    velocity = disk_velocity(point.face, point.spacing, point.settings.track_radius)
+    tau_hd, tau_con, *_ = pin_friction(result, point, moved, velocity)
+    weights = trapezoid_weights(result.face.shape, point.spacing) * result.face
     return float(np.sum(weights * (tau_hd + tau_con)) / result.normal_load)
 
 

@@ -13,14 +13,14 @@ them; they import nothing else of ``macro/``.
 """
 
 from .boundary import BoundaryLaw, boundary_traction
-from .friction import confined_shear, disk_shear, eyring_shear, hydrodynamic_shear
+from .friction import FilmFields, confined_shear, disk_shear, eyring_shear, hydrodynamic_shear
 from .kinematics import disk_velocity, in_grid_frame
 from .lubricant import Lubricant
 from .thermal import ContactThermal, ThermalNotConverged, ThermalSettings, thermal_point
 from .viscosity import WaltherLaw
 
 __all__ = ["BoundaryLaw", "boundary_traction",
-           "confined_shear", "disk_shear", "eyring_shear", "hydrodynamic_shear",
+           "FilmFields", "confined_shear", "disk_shear", "eyring_shear", "hydrodynamic_shear",
            "disk_velocity", "in_grid_frame",
            "Lubricant",
            "ContactThermal", "ThermalNotConverged", "ThermalSettings", "thermal_point",

@@ -13,9 +13,11 @@ and what it reads: :func:`hydrodynamic_shear` asks the law.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from ...checks import arguments
+from ...checks import arguments, as_field, check
 from ...errors import InputError
 from ...numerics.graded_mesh import Mesh
 from .kinematics import rotate_tensor, rotations
@@ -31,6 +33,30 @@ _WEIGHTS = _WEIGHTS / _WEIGHTS.sum()
 READINGS = ("force", "torque")
 
 
+@dataclass(frozen=True, eq=False)
+class FilmFields:
+    """The lubricant film's fields its friction reads, each on the grid (ny, nx) or a
+    number: its ``pressure`` [Pa] (absolute), ``mean_gap`` h_m [m] (a resolved pad's own
+    gap), ``cavity_fraction`` theta [-] and ``viscosity`` [Pa s].  A converged point
+    (:class:`~fem_twin.macro.MixedResult`) has the same names and serves as well."""
+
+    pressure: np.ndarray
+    mean_gap: np.ndarray
+    cavity_fraction: np.ndarray
+    viscosity: np.ndarray
+
+
+def film_fields(name: str, film) -> FilmFields:
+    """``film`` checked for the fields :class:`FilmFields` names (pressure and gap as
+    fields), or :class:`~fem_twin.errors.InputError` naming the function ``name``."""
+    if not all(hasattr(film, f) for f in ("pressure", "mean_gap", "cavity_fraction",
+                                           "viscosity")):
+        check(f"{name}: film", film, FilmFields)
+    as_field(f"{name}: film pressure [Pa]", film.pressure)
+    as_field(f"{name}: film mean_gap [m]", film.mean_gap)
+    return film
+
+
 class PinForce:
     """The force on the pin (the default): ``(mu u_r / h_m) s_C (1 - theta) - (h_m/2)
     (2 e1 - b) . grad p - (p - p_amb) dh_m/dx1``, the last term the film pressure on the
@@ -42,13 +68,17 @@ class PinForce:
                    "flanks and the face's slope")
     #: whether the disk's drag, a torque reading's, is this law's force (:func:`disk_shear`)
     drag = True
+    #: whether the traction reads the entrainment speed u_m
+    reads_entrainment = False
 
-    def parts(self, grad, mean_gap, viscosity, shear, speeds, turn):
+    def parts(self, grad, film, shear, speeds, turn):
         """``(poiseuille, couette, across)`` [Pa]: the pressure-driven traction along x1,
         the Couette traction along the sliding before the cavity and Eyring, and the
-        Couette traction across it (0 here), at ``grad`` ``(dp/dx2, dp/dx1)``, ``speeds``
-        ``(u_r, u_m)`` and the sliding's ``turn`` ``(cos, sin, |v|)``."""
+        Couette traction across it (0 here), of the ``film`` (:class:`FilmFields`) at
+        ``grad`` ``(dp/dx2, dp/dx1)``, ``speeds`` ``(u_r, u_m)`` and the sliding's ``turn``
+        ``(cos, sin, |v|)``."""
         dp2, dp1 = grad
+        mean_gap, viscosity = film.mean_gap, film.viscosity
         f = shear.pressure_friction
         poiseuille = -mean_gap / 2 * (f[..., 0] * dp1 + f[..., 1] * dp2)
         return poiseuille, viscosity / mean_gap * (speeds[0] * shear.friction_factor) * turn[2], 0.0
@@ -70,9 +100,11 @@ class PaperShear(PinForce):
     name = "paper"
     description = "eq 31, the pin's wall shear (the paper's)"
     drag = False
+    reads_entrainment = True
 
-    def parts(self, grad, mean_gap, viscosity, shear, speeds, turn):
+    def parts(self, grad, film, shear, speeds, turn):
         dp2, dp1 = grad
+        mean_gap, viscosity = film.mean_gap, film.viscosity
         (speed, u_m), (c, s, v) = speeds, turn
         C = shear.C if turn is UNIFORM else rotate_tensor(shear.C, c, s)
         poiseuille = -mean_gap / 2 * (C[..., 0, 0] * dp1 + C[..., 0, 1] * dp2)
@@ -106,42 +138,46 @@ def friction_law(name: str):
                          f"{name!r}") from None
 
 
-@arguments(pressure="field", mean_gap="field", spacing="spacing", speed="number")
-def hydrodynamic_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing,
-                       speed, *, entrainment=None, eyring_stress=None, law: str = "pin",
-                       ambient_pressure: float = 0.0, face=None,
+@arguments(spacing="spacing", speed="number", entrainment="number")
+def hydrodynamic_shear(film, shear, spacing, speed, *, entrainment=None, eyring_stress=None,
+                       law: str = "pin", ambient_pressure: float = 0.0, face=None,
                        velocity=None) -> np.ndarray:
-    """The film's tangential traction on the pin along +x1 [Pa] by the friction ``law`` of
-    :data:`LAWS` (:class:`PinForce`, :class:`PaperShear`), the disk sliding at ``speed``
-    u_r along +x1 (``entrainment`` u_m, default u_r / 2: the pin at rest), or at ``speed``
-    times ``velocity`` (ny, nx, 2), a rotating disk's (:mod:`.kinematics`); the pin's
-    ``face`` (bool grid, default all; one-sided at its edge: not the rim's drop) for the
-    film pressure on its slope.  ``shear``: the :class:`~fem_twin.micro.LocalFactors` at
-    the point's h0; gradients by central differences; ``eyring_stress`` tau_0 [Pa]: the
+    """The ``film``'s (:class:`FilmFields`) tangential traction on the pin along +x1 [Pa]
+    by the friction ``law`` of :data:`LAWS` (:class:`PinForce`, :class:`PaperShear`), the
+    disk sliding at ``speed`` u_r along +x1, or at ``speed`` times ``velocity`` (ny, nx, 2),
+    a rotating disk's (:mod:`.kinematics`), the surfaces entraining the oil at
+    ``entrainment`` u_m (the operating point's, :attr:`~fem_twin.macro.OperatingPoint.u_m`;
+    eq 31 reads it); the pin's ``face`` (bool grid, default all; one-sided at its edge:
+    not the rim's drop) for the film pressure on its slope.  ``shear``: the
+    :class:`~fem_twin.micro.LocalFactors` at the point's h0; ``spacing`` (dx1, dx2) [m] or
+    a graded mesh; gradients by central differences; ``eyring_stress`` tau_0 [Pa]: the
     Couette part becomes ``tau_0 asinh(tau / tau_0)`` (Eyring) along the sliding.  On a
     rotating disk the cell-frame factors turn with the sliding (``C``, ``d``; ``2 e1 - b``
     completed isotropically commutes with the turn) and the traction is its x1 component.
     """
     model = friction_law(law)
-    p = np.asarray(pressure, float)
+    film = film_fields("hydrodynamic_shear", film)
+    if entrainment is None and model.reads_entrainment:
+        raise InputError(f"hydrodynamic_shear: law = {law!r} reads the entrainment speed u_m "
+                         "[m/s] (entrainment=, the operating point's u_m)")
+    p, theta = np.asarray(film.pressure, float), film.cavity_fraction
     turn = UNIFORM if velocity is None else rotations(velocity)
-    u_m = speed / 2 if entrainment is None else entrainment
-    poiseuille, couette, across = model.parts(gradient(p, spacing), mean_gap, viscosity,
-                                              shear, (speed, u_m), turn)
-    couette = couette * (1 - cavity_fraction)
+    poiseuille, couette, across = model.parts(gradient(p, spacing), film, shear,
+                                              (speed, entrainment), turn)
+    couette = couette * (1 - theta)
     if eyring_stress is not None:
         couette = eyring_shear(couette, eyring_stress, model.spread(shear))
-    couette = couette * turn[0] - across * (1 - cavity_fraction)
-    on_face = model.face_term(p, ambient_pressure, mean_gap, face, spacing)
+    couette = couette * turn[0] - across * (1 - theta)
+    on_face = model.face_term(p, ambient_pressure, film.mean_gap, face, spacing)
     if on_face is None:
         return poiseuille + couette
     return poiseuille + couette - on_face
 
 
-@arguments(pressure="field", mean_gap="field", spacing="spacing", speed="number")
-def disk_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing, speed, *,
-               eyring_stress=None, velocity=None) -> np.ndarray:
-    """The film's drag on the disk along its local sliding [Pa].
+@arguments(spacing="spacing", speed="number")
+def disk_shear(film, shear, spacing, speed, *, eyring_stress=None,
+               velocity=None) -> np.ndarray:
+    """The ``film``'s (:class:`FilmFields`) drag on the disk along its local sliding [Pa].
 
     ``(mu u_r s / h_m) s_C (1 - theta) + (h_m / 2) b . grad p``, with ``s`` the local speed
     over u_r, ``b`` from the shear factors' ``2 e1 - b`` and ``grad p`` in the sliding
@@ -149,11 +185,13 @@ def disk_shear(pressure, mean_gap, cavity_fraction, viscosity, shear, spacing, s
     :func:`hydrodynamic_shear`).  Under uniform sliding its integral along x1 is the force
     on the pin (docs/model.md, "Friction on the pin"); times ``s`` it is the disk's torque
     over the track radius."""
-    p = np.asarray(pressure, float)
+    film = film_fields("disk_shear", film)
+    p, mean_gap = np.asarray(film.pressure, float), film.mean_gap
     dp2, dp1 = gradient(p, spacing)
-    c, s, v = (1.0, 0.0, 1.0) if velocity is None else rotations(velocity)
+    c, s, v = UNIFORM if velocity is None else rotations(velocity)
     f = shear.pressure_friction                                 # 2 e1 - b
-    couette = viscosity / mean_gap * speed * v * shear.friction_factor * (1 - cavity_fraction)
+    couette = (film.viscosity / mean_gap * speed * v * shear.friction_factor
+               * (1 - film.cavity_fraction))
     if eyring_stress is not None:
         couette = eyring_shear(couette, eyring_stress, shear)
     return couette + mean_gap / 2 * ((2 - f[..., 0]) * (c * dp1 + s * dp2)

@@ -25,7 +25,7 @@ from ...checks import arguments, as_pair, check_ranges, plausible, setting
 from ...contact.elastic import love_rectangle
 from ...errors import InputError, NotConverged
 from ...numerics.graded_mesh import Mesh
-from .boundary import BoundaryLaw, heated_factor
+from .boundary import heated_factor
 
 #: sub-samples a side of a cell for the moving part of the kernel (it varies over 2 kappa / U)
 SUBSAMPLES = 8
@@ -175,15 +175,19 @@ class ContactThermal:
     """A run's thermal model: its ``settings``, the oil's viscosity-temperature ``law``
     (:class:`~.viscosity.WaltherLaw`; a curve's oil is at the temperature where the law
     gives the curve's mu_0); a point's boundary law (its settings') reads the film
-    temperature and the asperity spots' flash in its temperature term (:meth:`tempered`)."""
+    temperature and the asperity spots' flash in its temperature term (:meth:`tempered`).
+    Its methods take the converged ``result`` of an operating ``point``
+    (:class:`~fem_twin.macro.point.OperatingPoint`), whose surfaces' speeds share the heat
+    (:attr:`~fem_twin.macro.point.OperatingPoint.surface_speeds`), whose flow factors give
+    the contact fraction and whose settings give the boundary law."""
 
     settings: ThermalSettings
     law: object
 
-    def heat(self, result, speeds) -> dict:
+    def heat(self, result, point) -> dict:
         """The heat of a converged point ``result``: ``power`` F_T U [W], the face's
-        ``flash`` [K] and the pin's share ``pin_share`` of the heat; ``speeds`` (pin, disk)
-        of :func:`face_flash`."""
+        ``flash`` [K] and the pin's share ``pin_share`` of the heat, shared between the
+        ``point``'s surfaces (:func:`face_flash`)."""
         power = max(float(result.friction_force * result.speed), 0.0)
         face = np.asarray(result.face, bool)
         flux = np.where(face, np.maximum(result.shear_stress, 0.0), 0.0)
@@ -194,27 +198,26 @@ class ContactThermal:
         else:
             total = flux.sum() * result.spacing[0] * result.spacing[1]
         flux = flux * (power / total) if total > 0 else flux
-        flash, share = face_flash(flux, face, spacing, speeds, self.settings)
+        flash, share = face_flash(flux, face, spacing, point.surface_speeds, self.settings)
         return {"power": power, "flash": flash, "pin_share": share}
 
-    def spot(self, result, factors, speeds) -> float:
+    def spot(self, result, point) -> float:
         """An asperity spot's flash temperature [K] at the point ``result``: the flux of the
-        boundary shear over the real contact area (``factors``: the point's flow factors,
-        for the contact fraction) at the sliding speed."""
+        boundary shear over the real contact area (the ``point``'s flow factors give the
+        contact fraction) at the sliding speed."""
         face = np.asarray(result.face, bool)
         w = result.spacing.area[face] if isinstance(result.spacing, Mesh) else 1.0
-        fraction = (w * factors.at(result.h0).contact_fraction[face]).sum()
+        fraction = (w * point.factors.at(result.h0).contact_fraction[face]).sum()
         flux = (max((w * result.boundary_shear[face]).sum(), 0.0) / fraction
                 * abs(result.speed) if fraction > 0 else 0.0)
-        return spot_flash(flux, speeds, self.settings)
+        return spot_flash(flux, point.surface_speeds, self.settings)
 
-    def tempered(self, result, factors, speeds, temperature: float):
-        """``result`` with its boundary shear times its shear law's temperature factor at
-        the film ``temperature`` [C] and the spots' flash (:func:`~.boundary.temperature_factor`;
-        unchanged without a temperature term)."""
-        law = BoundaryLaw(**result.meta.get("settings", {}).get("boundary", {}))
-        return tempered(result, heated_factor(law, temperature,
-                                              self.spot(result, factors, speeds)))
+    def tempered(self, result, point, temperature: float):
+        """``result`` with its boundary shear times the ``point``'s boundary law's
+        temperature factor at the film ``temperature`` [C] and the spots' flash
+        (:func:`~.boundary.temperature_factor`; unchanged without a temperature term)."""
+        return tempered(result, heated_factor(point.settings.boundary, temperature,
+                                              self.spot(result, point)))
 
 
 @arguments(t="number")
@@ -233,10 +236,10 @@ def tempered(result, t: float):
                    meta={**result.meta, "boundary_temperature_factor": t})
 
 
-@arguments(solve=Callable, speeds="pair")
-def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
-                  near: dict | None = None) -> tuple:
-    """An operating point at the film temperature its own heat gives it.
+@arguments(solve=Callable)
+def thermal_point(solve, point, thermal: ContactThermal, near: dict | None = None) -> tuple:
+    """The operating ``point`` (:class:`~fem_twin.macro.point.OperatingPoint`, its
+    ``lubricant`` the oil) at the film temperature its own heat gives it.
 
     ``solve(lubricant, previous)`` returns the point's levels ``(result, *coarser)`` with
     the film's ``lubricant``, warm from ``previous`` (None first).  The film temperature
@@ -247,7 +250,7 @@ def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
     temperatures [C] (``oil``, ``film``, ``asperity``), rises [K], power [W], iterations
     and ``residual_slope`` (d(g - T)/dT [-], for the next point), or raises
     :class:`ThermalNotConverged` with the history."""
-    s, law = thermal.settings, thermal.law
+    s, law, lubricant = thermal.settings, thermal.law, point_lubricant(point)
     oil = float(law.temperature(lubricant.viscosity))
     same = bool(near) and near["oil_C"] == oil
     T = near["film_C"] if same else oil
@@ -256,17 +259,18 @@ def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
     for _ in range(s.max_iter):
         film = replace(lubricant, viscosity=float(law.viscosity(T)))
         levels = solve(film, previous)
-        levels = (thermal.tempered(levels[0], factors, speeds, T), *levels[1:])
-        heat = thermal.heat(levels[0], speeds)
+        levels = (thermal.tempered(levels[0], point, T), *levels[1:])
+        heat = thermal.heat(levels[0], point)
         target = oil + s.bulk_resistance * heat["power"] + heat["flash"]
         history.append(abs(target - T))
         if history[-1] < s.tol:
-            spot = thermal.spot(levels[0], factors, speeds)     # reported: once, at the end
+            spot = thermal.spot(levels[0], point)               # reported: once, at the end
             record = {"oil_C": oil, "film_C": T, "asperity_C": T + spot,
                       "bulk_rise_K": s.bulk_resistance * heat["power"],
                       "face_flash_K": heat["flash"], "spot_flash_K": spot,
                       "power_W": heat["power"], "pin_share": heat["pin_share"],
-                      "spot_rise_K_Pa": spot_flash(abs(levels[0].speed), speeds, s),
+                      "spot_rise_K_Pa": spot_flash(abs(levels[0].speed),
+                                                   point.surface_speeds, s),
                       "iterations": len(history),
                       "residual_slope": _slope([*pairs, (T, target - T)], slope)}
             return levels, film, record
@@ -275,6 +279,16 @@ def thermal_point(solve, lubricant, thermal: ContactThermal, factors, speeds,
     raise ThermalNotConverged(f"the film temperature did not settle within {s.tol:g} K in "
                               f"{s.max_iter} iterations (last change {history[-1]:.3g} K)",
                               history)
+
+
+def point_lubricant(point):
+    """The oil of an operating ``point`` (its ``lubricant``), or
+    :class:`~fem_twin.errors.InputError` for anything without one."""
+    lubricant = getattr(point, "lubricant", None)
+    if not hasattr(lubricant, "viscosity") or not hasattr(point, "surface_speeds"):
+        raise InputError("thermal_point: point: expected an OperatingPoint (its lubricant "
+                         f"and surface speeds), got {type(point).__name__}")
+    return lubricant
 
 
 #: the slopes of ``g(T) - T`` a first step may take from a neighbour's record (``g'`` from

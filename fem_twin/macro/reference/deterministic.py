@@ -30,6 +30,7 @@ from ...checks import (
     arguments,
     as_field,
     as_pair,
+    check,
     check_choices,
     check_ranges,
     number,
@@ -46,6 +47,7 @@ from ..film.cavitation import cavitation_model
 from ..film.couette import couette_matrix
 from ..film.reynolds import fe_poiseuille, trapezoid_weights
 from ..laws.boundary import BoundaryLaw, asperity_load, temperature_factor, traction
+from ..laws.friction import FilmFields, film_fields
 from ..laws.lubricant import Lubricant
 
 __all__ = ["DeterministicNotConverged", "DeterministicResult", "DeterministicSettings",
@@ -134,19 +136,21 @@ class DeterministicResult:
         return (self.film_friction + self.boundary_force) / self.load
 
 
-@arguments(pressure="field", gap="field", cavity_fraction="numbers", viscosity="numbers",
-           spacing="pair", speed="number", boundary_film="number")
-def pad_friction(pressure, gap, cavity_fraction, viscosity, spacing, speed: float,
-                 boundary_film: float) -> float:
-    """The film's force on the pin along +x1 [N]: ``int mu U / h (1 - theta) dA`` over the
-    films thicker than ``boundary_film`` [m] plus ``int (h / 2) dp/dx1 dA``, which is the
-    pin's wall shear and the film pressure on its surface (``-(h/2) dp/dx1 - p dh/dx1``)
+@arguments(spacing="pair", speed="number", boundary_film="number")
+def pad_friction(film, spacing, speed: float, boundary_film: float) -> float:
+    """The ``film``'s force on the pin along +x1 [N] (:class:`~.friction.FilmFields`: its
+    ``mean_gap`` the pad's resolved gap h): ``int mu U / h (1 - theta) dA`` over the films
+    thicker than ``boundary_film`` [m] plus ``int (h / 2) dp/dx1 dA``, which is the pin's
+    wall shear and the film pressure on its surface (``-(h/2) dp/dx1 - p dh/dx1``)
     integrated by parts with ``p = 0`` on the edge; trapezoidal rule, central differences;
     ``cavity_fraction`` theta [-] in [0, 1] and ``viscosity`` [Pa s] numbers or fields of the
     pressure's grid, the ``spacing`` [m] a plausible pitch."""
-    h, p = np.asarray(gap, float), np.asarray(pressure, float)
+    film = film_fields("pad_friction", film)
+    h, p = np.asarray(film.mean_gap, float), np.asarray(film.pressure, float)
+    cavity_fraction, viscosity = film.cavity_fraction, film.viscosity
     for name, value in (("gap", h), ("cavity_fraction", cavity_fraction),
                         ("viscosity", viscosity)):
+        check(f"pad_friction: {name}", value, "numbers")
         if np.ndim(value) and np.shape(value) != p.shape:
             raise InputError(f"pad_friction: {name} {np.shape(value)} and pressure {p.shape} "
                              "must share one grid")
@@ -156,16 +160,21 @@ def pad_friction(pressure, gap, cavity_fraction, viscosity, spacing, speed: floa
         raise InputError("pad_friction: viscosity [Pa s] is positive (66 mPa s is 0.066)")
     plausible("pad_friction: spacing [m]", spacing, "pitch")
     plausible("pad_friction: boundary_film [m]", boundary_film, "boundary_film")
-    return film_force(p, h, cavity_fraction, viscosity, spacing, speed, boundary_film)
+    return film_force(film, spacing, speed, boundary_film)
 
 
-def film_force(pressure, gap, cavity_fraction, viscosity, spacing, speed: float,
-               boundary_film: float) -> float:
+def film_force(film, spacing, speed: float, boundary_film: float) -> float:
     """:func:`pad_friction` without its checks, for the solvers' own fields [N]."""
-    h = np.asarray(gap, float)
-    dp1 = np.gradient(np.asarray(pressure, float), spacing[0], axis=1)
-    shear = np.where(h > boundary_film, viscosity * speed / h, 0.0) * (1 - cavity_fraction)
+    h = np.asarray(film.mean_gap, float)
+    dp1 = np.gradient(np.asarray(film.pressure, float), spacing[0], axis=1)
+    shear = np.where(h > boundary_film, film.viscosity * speed / h, 0.0) * (
+        1 - film.cavity_fraction)
     return float(np.sum(trapezoid_weights(h.shape, spacing) * (shear + h / 2 * dp1)))
+
+
+def state_film(state: dict) -> FilmFields:
+    """The film of a solved instant's fields ``state`` (:meth:`_Pad.at`)."""
+    return FilmFields(state["p"], state["gap"], state["theta"], state["mu"])
 
 
 #: the film deformation's scale in the mixed state [m]: its change per micrometre
@@ -299,7 +308,7 @@ class _Mixing:
 
 
 def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant: Lubricant,
-                        settings: DeterministicSettings,
+                        settings: DeterministicSettings = DeterministicSettings(),
                         initial: DeterministicResult | None = None) -> DeterministicResult:
     """Solve one operating point of the resolved pad (module docstring).
 
@@ -311,13 +320,13 @@ def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant:
     spacing : (dx1, dx2) [m]
     load : F_N [N]
     speed : the disk's U [m/s]
+    settings : the pad's materials and numerics (default: the paper's, Table 6)
     initial : a neighbouring point whose separation starts the bracket of h_d
     """
     s, dx, load, speed = _checked(shape, spacing, load, speed, lubricant, settings)
     pad = _Pad(s, dx, speed, lubricant, settings)
     h_d, st, history, _ = balance(pad, load, initial.separation if initial else None)
-    film = film_force(st["p"], st["gap"], st["theta"], st["mu"], dx, speed,
-                      viscous_cut(settings))
+    film = film_force(state_film(st), dx, speed, viscous_cut(settings))
     return DeterministicResult(speed, load, float(h_d), st["film_load"], st["contact_load"],
                                film, boundary_force(pad.area, st, settings, speed),
                                dx, st["p"], st["p_con"], st["theta"], st["gap"],

@@ -46,6 +46,7 @@ from .deterministic import (
     balance,
     boundary_force,
     film_force,
+    state_film,
     viscous_cut,
 )
 
@@ -118,21 +119,28 @@ def _slope(disk, dx1: float) -> np.ndarray:
     return (np.roll(disk, -1, axis=1) - np.roll(disk, 1, axis=1)) / (2 * dx1)
 
 
-def solve_time_resolved(shape, disk, spacing, *, load: float, speed: float,
-                        lubricant: Lubricant, settings: DeterministicSettings,
+def solve_time_resolved(surfaces, spacing, *, load: float, speed: float,
+                        lubricant: Lubricant,
+                        settings: DeterministicSettings = DeterministicSettings(),
                         time: TimeSettings | None = None,
                         initial: DeterministicResult | None = None) -> TimeResolvedResult:
     """The periodic state of the pad under the sliding rough disk (module docstring).
 
-    ``shape`` (ny, nx): the pad's form minus the pin's roughness [m] (what the gap has at
-    zero separation besides the disk); ``disk`` (ny, m): one period of the disk's heights
-    along x1 [m], periodic; ``spacing`` (dx1, dx2) [m]; ``load`` [N]; ``speed``: the
-    disk's U [m/s]; ``time``: :class:`TimeSettings`; ``initial``: a neighbouring point
+    ``surfaces``: ``(shape, disk)``, the pad's form minus the pin's roughness (ny, nx) [m]
+    (what the gap has at zero separation besides the disk) and one period of the disk's
+    heights along x1 (ny, m) [m], periodic; ``spacing`` (dx1, dx2) [m]; ``load`` [N];
+    ``speed``: the disk's U [m/s]; ``settings``: the pad's materials and numerics (default:
+    the paper's); ``time``: :class:`TimeSettings`; ``initial``: a neighbouring point
     whose separation starts the steady start's bracket (a time-resolved one's also moves
     the first period from the steady start as far as its own periodic state lay from its
     start).  Raises
     :class:`~fem_twin.macro.reference.deterministic.DeterministicNotConverged` with the history
     when the period means do not repeat within ``time.max_periods``."""
+    if not (isinstance(surfaces, (tuple, list)) and len(surfaces) == 2):
+        raise InputError("solve_time_resolved: surfaces: expected (shape, disk), the pad's "
+                         f"gap shape and the disk's periodic strip [m], got "
+                         f"{type(surfaces).__name__}")
+    shape, disk = surfaces
     s, dx, load, speed = _checked(shape, spacing, load, speed, lubricant, settings)
     z = as_field("disk [m]", disk, 2)
     plausible("disk [m] (its largest height)", float(np.max(np.abs(z))) or 1e-8, "height")
@@ -227,8 +235,7 @@ class _March:
         self.last = st
         s, dx = pad.settings, pad.spacing
         flank = float(np.sum(pad.area * st["p"] * disk_at(self.slopes, shift, self.nodes)))
-        film = film_force(st["p"], st["gap"], st["theta"], st["mu"], dx, pad.speed,
-                          viscous_cut(s)) + flank
+        film = film_force(state_film(st), dx, pad.speed, viscous_cut(s)) + flank
         return {"contact_load": st["contact_load"], "film_load": st["film_load"],
                 "film_friction": film,
                 "boundary_force": boundary_force(pad.area, st, s, pad.speed)}
