@@ -247,7 +247,7 @@ def film_moments(contact, cell: dict, settings: CellSettings) -> dict:
     |grad chi_1|^2>`` [1/m] (Couette shear and the sliding flow's pressure; ``cell``: the
     instant's cell moments, ``k = 2 u_m / u_r`` of the cell's frame), the friction on the
     pin times u_r (docs/model.md, "Friction on the pin"; ``<1/h>`` exact on the linear
-    interpolant of the gap, :mod:`.film`), over the film thicker than
+    interpolant of the gap, :mod:`fem_twin.micro.film`), over the film thicker than
     ``settings.boundary_film``, then half and twice it (:data:`FILM_CUTS`): contact spots
     carry the boundary shear (eq 32) instead, and thinner films near them are boundary
     films.  ``h3_g1_pin``: eq 14's ``<h^3 grad chi_1>`` with the pin at rest (``k`` times
