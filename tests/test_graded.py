@@ -182,6 +182,7 @@ def _mourier(n, method="fe", graded=True):
     return res, x1, x2
 
 
+@pytest.mark.integration
 def test_fe_and_fvm_differ_on_the_graded_mesh_as_on_the_grid():
     """The cross-check on the graded mesh over a 49^2 grid: FE and the FVM reference
     differ in the central and minimum films by at most 1.5x what they differ on the 49^2
