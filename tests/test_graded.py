@@ -14,7 +14,7 @@ import skfem
 from fem_twin.errors import InputError
 from fem_twin.macro import Lubricant, MacroSettings, OperatingPoint, solve_mixed
 from fem_twin.macro.coupling.result import MixedResult
-from fem_twin.macro.film.contact_load import POINTS, contact_load
+from fem_twin.macro.film.contact_load import GAUSS_ORDER, contact_load
 from fem_twin.macro.film.couette import couette, couette_matrix
 from fem_twin.macro.film.reynolds import fe_poiseuille, homogenised_poiseuille_form
 from fem_twin.macro.film.reynolds_fv import fvm_poiseuille
@@ -130,7 +130,7 @@ def test_the_contact_load_on_the_graded_mesh_is_the_integral_of_its_film():
     rough = _rough_factors()
     p = contact_load(GRADED.shape, GRADED).pressure(rough, h0_nodes)
     total = np.sum(GRADED.area * p)
-    x, w = np.polynomial.legendre.leggauss(POINTS)
+    x, w = np.polynomial.legendre.leggauss(GAUSS_ORDER)
     x, w = (x + 1) / 2, w / 2
     h1, h2 = GRADED.sizes
     ref = 0.0

@@ -12,7 +12,7 @@ from pathlib import Path
 from .. import tables as T
 from ..checks import check_ranges, setting
 from ..macro.coupling.settings import MacroSettings
-from ..macro.laws.boundary import BoundaryLaw
+from ..macro.laws.boundary import BoundaryLaw, boundary_friction_setting
 from ..macro.laws.friction import READINGS
 from ..macro.laws.thermal import ThermalSettings
 from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN, h0_candidates
@@ -61,9 +61,8 @@ class Tribometer:
     kinematics: str = setting("rotating", "the disk's motion under the face: turning about "
                               "its axis (u = omega x r over the face), or sliding uniformly "
                               "along x1 (the paper)", choices=("rotating", "uniform"))
-    boundary_friction: float = setting(
-        T.BOUNDARY_FRICTION, "C_f,b of eq 32 (the paper's 1/(3 sqrt 3)); also the scale of "
-        "C_f,dev (eq 35)", "friction")
+    boundary_friction: float = boundary_friction_setting(
+        "C_f,b of eq 32 (the paper's 1/(3 sqrt 3)); also the scale of C_f,dev (eq 35)")
     load_share: float = setting(
         1.0, "share of the load the pin face carries (film and contact, eq 28); C_f stays "
         "the friction force over the imposed load (1: the paper)", "load_share")

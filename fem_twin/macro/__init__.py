@@ -18,7 +18,7 @@ The rooms, each listing its modules in its own docstring:
     film       :mod:`fem_twin.macro.film`: the homogenised Reynolds solver with JFO
                cavitation, its Couette flux and the nodal contact pressure
     coupling   :mod:`fem_twin.macro.coupling`: the coupled point (settings, the assembled
-               problem, fixed-point and Newton couplings, the converged result)
+               problem, partitioned and Newton couplings, the converged result)
     reference  :mod:`fem_twin.macro.reference`: the deterministic and time-resolved
                references and the ball's point-contact formulas
 

@@ -7,8 +7,8 @@ cavitation (eqs 17-18) with the flow factors at the local separation ``h0``
 half-space (eqs 20-22); the contact pressure ``p_con(h0)`` (eqs 25-27), the load balance on
 ``h_d`` (eqs 28-30) and the friction (eqs 31-34).
 
-Three couplings reach the same state: ``"anderson"`` and the paper's ``"pid"`` fixed points
-(:mod:`.fixed_point`) and the monolithic ``"newton"`` (:mod:`.newton`); ``"auto"`` (default)
+Three couplings reach the same state: ``"anderson"`` and the paper's ``"pid"``, partitioned
+(:mod:`.partitioned`) and the monolithic ``"newton"`` (:mod:`.newton`); ``"auto"`` (default)
 takes Anderson and switches to Newton for elastically dominated contacts or when Anderson
 fails.  Converged when the changes of ``h_el`` / h_ref, ``p_con`` / p_ref and ``p`` / p_ref
 between two iterations and the load residual (eq 30) are all below ``tol``; otherwise
@@ -26,7 +26,7 @@ from ..micro.flow_factors import FlowFactors
 from ..micro.rolling import at_slide_to_roll
 from ..numerics.threads import one_thread
 from .coupling import newton
-from .coupling.fixed_point import Concentrated, solve_fixed_point
+from .coupling.partitioned import Concentrated, solve_partitioned
 from .coupling.problem import macro_problem
 from .coupling.result import Convergence, MixedResult, mixed_result, on_grid
 from .coupling.settings import MacroSettings
@@ -93,7 +93,7 @@ def seeded_point(point: OperatingPoint, *, initial: MixedResult | None = None, s
                  progress=None):
     """:func:`solve_point` whose Anderson coupling starts from ``secants``, the last
     differences of the same point's coupling on a coarser grid
-    (:class:`~fem_twin.macro.coupling.fixed_point.Secants`, interpolated).  Returns ``(result,
+    (:class:`~fem_twin.macro.coupling.partitioned.Secants`, interpolated).  Returns ``(result,
     secants)``, the second this solve's own (None where the coupling is not Anderson):
     :func:`~fem_twin.macro.nested.solve_nested` hands them from level to level.
     """
@@ -110,7 +110,7 @@ def seeded_point(point: OperatingPoint, *, initial: MixedResult | None = None, s
                                          and initial.meta.get("coupling") == "newton"):
         return _solve_newton(P, initial, progress, t0), None
     try:
-        ev, h_el, h_d, it, history, secants = solve_fixed_point(P, point.load, point.face,
+        ev, h_el, h_d, it, history, secants = solve_partitioned(P, point.load, point.face,
                                                                 initial, progress, secants)
     except (MixedNotConverged, Concentrated):
         if settings.coupling != "auto":

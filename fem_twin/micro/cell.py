@@ -41,12 +41,6 @@ def flow_form(u, v, w):
 
 
 @skfem.LinearForm
-def couette_form(v, w):
-    """Right-hand side of eq 8 without the time term: ``h dv/dx1``."""
-    return w.h * v.grad[0]
-
-
-@skfem.LinearForm
 def pressure_form_1(v, w):
     """Right-hand side of eq 9: ``-h^3 dv/dx1``."""
     return -w.a * v.grad[0]

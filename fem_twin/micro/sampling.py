@@ -78,8 +78,8 @@ def _midpoints(chosen, positions):
 
 def leave_one_out(full, half=None, quantities=tuple(QUANTITIES)) -> dict:
     """Relative miss per quantity at each interior point of ``full`` (a
-    :class:`FlowFactors`) of the interpolant through all the others (see
-    :func:`interpolation_misses`), zero where it is within ``JITTER`` times the
+    :class:`FlowFactors`) of the interpolant through all the others, ``|f - I f| /
+    max(|f|, FLOOR max |f|)`` (for d1 at least 1/3), zero where it is within ``JITTER`` times the
     time-sampling error ``|f - f_half|`` of that point or a neighbour (``half``: the
     factors over every other instant; one point's estimate may be small by chance where its
     neighbours' are not), for the named ``quantities``."""
@@ -96,15 +96,6 @@ def leave_one_out(full, half=None, quantities=tuple(QUANTITIES)) -> dict:
             miss = np.where(miss > JITTER * jitter, miss, 0.0)
         out[name] = _relative(name, miss, f, get(full))
     return out
-
-
-def interpolation_misses(coarse, dense) -> dict:
-    """Relative miss per quantity of the interpolant through ``coarse`` at the separations
-    of ``dense`` (both :class:`FlowFactors`): ``|f - I f| / max(|f|, FLOOR max |f|)``
-    (for d1 at least 1/3)."""
-    local = coarse.at(dense.h0)
-    return {name: _relative(name, np.abs(get(dense) - get(local)), get(dense), get(dense))
-            for name, get in QUANTITIES.items()}
 
 
 def _relative(name, miss, f, over):

@@ -84,11 +84,6 @@ def point_meta(path) -> tuple[dict, dict]:
         return json.loads(str(data["scalars"])), json.loads(str(data["meta"]))
 
 
-def point_speed(path) -> float:
-    """The sweep speed [m/s] in the name of a point checkpoint (:func:`point_file`)."""
-    return float(Path(path).stem.rsplit("_", 1)[1])
-
-
 @one_thread
 def stribeck_sweep(request: SweepRequest, progress: bool = False) -> StribeckCurve:
     """C_f over the ``request``'s speeds [m/s] at its viscosity (paper 3.2: from 2 m/s down

@@ -8,15 +8,16 @@ It reads the film solver (:mod:`fem_twin.macro.film`) and the laws
     problem      an operating point's assembled problem: grid, physics, eq 17's coefficients
     evaluation   the record of one evaluation of the coupled problem at a state
     start        cold starts: the rigid separations the iteration begins from
-    fixed_point  the fixed-point couplings: Anderson and the paper's PID
+    partitioned  the partitioned couplings (fixed-point iterations): Anderson and the
+                 paper's PID
     newton       the monolithic Newton coupling, for elastically dominated contacts
     jacobian     one Newton step's linear algebra: exact Jacobian, Schur preconditioner
     result       the converged point: fields, friction on the pin, files
 """
 
-from .evaluation import Evaluation, FixedPointEvaluation, NewtonEvaluation
-from .fixed_point import solve_fixed_point
+from .evaluation import Evaluation, NewtonEvaluation, PartitionedEvaluation
 from .jacobian import Preconditioner, newton_step
+from .partitioned import solve_partitioned
 from .problem import Problem, macro_problem
 from .result import FIELDS, MixedResult, friction_with, mixed_result, pin_friction
 from .settings import MacroSettings
@@ -24,8 +25,8 @@ from .start import dry_separation, rigid_separation
 
 __all__ = ["MacroSettings",
            "Problem", "macro_problem",
-           "Evaluation", "FixedPointEvaluation", "NewtonEvaluation",
+           "Evaluation", "PartitionedEvaluation", "NewtonEvaluation",
            "dry_separation", "rigid_separation",
-           "solve_fixed_point",
+           "solve_partitioned",
            "Preconditioner", "newton_step",
            "FIELDS", "MixedResult", "friction_with", "mixed_result", "pin_friction"]

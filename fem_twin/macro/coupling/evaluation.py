@@ -1,8 +1,8 @@
 """The record of one evaluation of the coupled macro problem (eqs 17-30) at a state: what
 the couplings compute and the converged point (:func:`.result.mixed_result`) reads.
 
-Both couplings produce an :class:`Evaluation`; the fixed point
-(:mod:`.fixed_point`) adds what its updates need (:class:`FixedPointEvaluation`), the
+Both couplings produce an :class:`Evaluation`; the partitioned ones
+(:mod:`.partitioned`) add what their updates need (:class:`PartitionedEvaluation`), the
 monolithic Newton coupling (:mod:`.newton`) its residuals and operators
 (:class:`NewtonEvaluation`).  Fields are SI: pressures [Pa] above ``p_cav`` for ``p``,
 absolute for ``p_con``; lengths [m]; loads [N].
@@ -37,10 +37,10 @@ class Evaluation:
 
 
 @dataclass(frozen=True, eq=False)
-class FixedPointEvaluation(Evaluation):
-    """... and for the fixed-point updates: ``p_prev``, the pressure the coefficients were
-    taken at; ``p_con_target``, ``p_con(h0)`` (eq 26's target); ``h_el_new``, the elastic
-    deformation of this pressure (eqs 20-22)."""
+class PartitionedEvaluation(Evaluation):
+    """... and for the partitioned couplings' updates: ``p_prev``, the pressure the
+    coefficients were taken at; ``p_con_target``, ``p_con(h0)`` (eq 26's target);
+    ``h_el_new``, the elastic deformation of this pressure (eqs 20-22)."""
 
     p_prev: np.ndarray
     p_con_target: np.ndarray

@@ -2,7 +2,7 @@
 motion.
 
 :func:`macro_problem` builds, from an :class:`~fem_twin.macro.point.OperatingPoint`, the
-:class:`Problem` that both couplings (:mod:`.fixed_point` and :mod:`.newton`) solve, which
+:class:`Problem` that both couplings (:mod:`.partitioned` and :mod:`.newton`) solve, which
 holds the point itself; :meth:`Problem.coefficients` evaluates eq 17's homogenised
 Poiseuille and Couette coefficients with Roelands (eq 23) and Dowson-Higginson (eq 24) at a
 pressure and a separation field.

@@ -13,7 +13,7 @@ from ...errors import InputError
 from ..film.cavitation import MODELS, cavitation_model
 from ..film.contact_load import RULES
 from ..film.couette import SCHEMES
-from ..laws.boundary import BoundaryLaw
+from ..laws.boundary import BoundaryLaw, boundary_friction_setting
 from ..laws.friction import LAWS, READINGS
 
 
@@ -27,8 +27,7 @@ class MacroSettings:
                                          "(Table 6)", "pressure")
     e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", "solver_modulus",
                                section="materials")
-    boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", "friction",
-                                       section="tribometer")
+    boundary_friction: float = boundary_friction_setting(section="tribometer")
     boundary: BoundaryLaw = setting(BoundaryLaw(), "the boundary shear's law (eq 32 or the "
                                     "shear law, fem_twin.macro.laws.boundary)", unit="a section",
                                     section="boundary")

@@ -9,9 +9,9 @@ default) gives each node the Galerkin load over the Q1 film, lumped:
 
     p_i = int p_con(h0_h(x)) phi_i(x) dx / int phi_i(x) dx,
 
-with ``h0_h`` the bilinear interpolant of the nodal separations and ``POINTS x POINTS``
-Gauss points per pixel; ``sum_i a_i p_i`` is then the contact load of the whole film
-(docs/accuracy.md, "The contact pressure on the macro grid")."""
+with ``h0_h`` the bilinear interpolant of the nodal separations, by the Gauss rule of
+:data:`GAUSS_ORDER` points a pixel side; ``sum_i a_i p_i`` is then the contact load of the
+whole film (docs/accuracy.md, "The contact pressure on the macro grid")."""
 
 from __future__ import annotations
 
@@ -26,9 +26,10 @@ from ...numerics.graded_mesh import Mesh
 
 #: the rules of ``MacroSettings.contact_quadrature``
 RULES = ("gauss", "nodal")
-#: Gauss points per pixel side: p_con varies by a factor of about 5 over a pixel at 128^2
-#: in the mixed regime; 3 points integrate its exponential-like profile there to 1e-4
-POINTS = 3
+#: the Gauss rule's order, its points per pixel side: p_con varies by a factor of about 5
+#: over a pixel at 128^2 in the mixed regime; 3 points integrate its exponential-like
+#: profile there to 1e-4
+GAUSS_ORDER = 3
 
 
 #: pixels evaluated at a time: bounds the transients (the film and p_con at the Gauss
@@ -42,11 +43,11 @@ class ContactLoad:
     block of rows at a time, their corners by slicing (:data:`fem_twin.numerics.assembly.CORNERS`),
     so nothing is kept per pixel."""
 
-    def __init__(self, shape, points: int = POINTS, area=None):
+    def __init__(self, shape, order: int = GAUSS_ORDER, area=None):
         ny, nx = shape
         self.shape, self.n = (ny, nx), ny * nx
         self.area = area            # a graded mesh's element areas (ny - 1, nx - 1) [m^2]
-        x, w = np.polynomial.legendre.leggauss(points)
+        x, w = np.polynomial.legendre.leggauss(order)
         x, w = (x + 1) / 2, w / 2                                         # on [0, 1]
         s, t = (v.ravel() for v in np.meshgrid(x, x))                     # s: x1, t: x2
         self.phi = np.stack([(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t])  # (4, nq)
@@ -76,7 +77,7 @@ class ContactLoad:
             return per_pixel
         return per_pixel * self.area[r0:r0 + per_pixel.shape[-2]]
 
-    def at_points(self, h0, r0, r1) -> np.ndarray:
+    def at_gauss(self, h0, r0, r1) -> np.ndarray:
         """The bilinear interpolant of the nodal ``h0`` at the Gauss points of the pixel rows
         ``r0 .. r1 - 1``, ``(nq, rows, nx - 1)``."""
         return at_points(self.phi, h0, r0, r1)
@@ -85,7 +86,7 @@ class ContactLoad:
         """Nodal contact pressure [Pa] of the film ``h0`` (ny, nx) [m] (module docstring)."""
         out = np.zeros(self.shape)
         for r0, r1 in self._blocks():
-            p = factors.contact_pressure(self.at_points(h0, r0, r1))
+            p = factors.contact_pressure(self.at_gauss(h0, r0, r1))
             self._to_nodes(out, (self.wphi @ p.reshape(p.shape[0], -1)).reshape(
                 4, *p.shape[1:]), r0)
         return out / self.mass
@@ -96,7 +97,7 @@ class ContactLoad:
         stencil = grid_stencil(self.shape)
         S = np.zeros((*self.shape, 3, 3))
         for r0, r1 in self._blocks():
-            hq = self.at_points(h0, r0, r1)
+            hq = self.at_gauss(h0, r0, r1)
             eps = REL_STEP * hq
             slope = (factors.contact_pressure(hq + eps)
                      - factors.contact_pressure(hq - eps)) / (2 * eps)        # (nq, rows, nx-1)

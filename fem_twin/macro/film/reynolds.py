@@ -21,7 +21,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 import skfem
-from skfem.helpers import dot, grad
+from skfem.helpers import grad
 
 from ...checks import arguments, as_field, as_pair
 from ...errors import InputError, ReynoldsNotConverged
@@ -56,12 +56,6 @@ class ReynoldsResult:
     load: float
     iterations: int
     history: tuple
-
-
-@skfem.BilinearForm
-def poiseuille_form(u, v, w):
-    """Pressure flow of eq 17 with a scalar coefficient ``g = rho h^3 / (12 mu)`` [m^3/(Pa s)]."""
-    return w.g * dot(grad(u), grad(v))
 
 
 @skfem.BilinearForm

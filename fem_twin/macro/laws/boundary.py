@@ -53,6 +53,16 @@ FADED = 0.5
 REFERENCE_REACH = 100.0
 
 
+def boundary_friction_setting(doc: str = "C_f,b of eq 32", **where):
+    """The one declaration of C_f,b, eq 32's boundary friction coefficient: its default
+    (:data:`BOUNDARY_FRICTION`, the paper's 1/(3 sqrt 3), exported as
+    ``fem_twin.macro.BOUNDARY_FRICTION``) and its quantity (a friction coefficient); the
+    case's ``[tribometer] boundary_friction``, :class:`~fem_twin.macro.MacroSettings` and
+    :class:`~fem_twin.macro.DeterministicSettings` declare their field with it (their own
+    ``doc``; ``where``: :func:`~fem_twin.checks.setting`'s ``section``)."""
+    return setting(BOUNDARY_FRICTION, doc, "friction", **where)
+
+
 class Fitted(NamedTuple):
     """What a fit may vary of a law: one parameter's ``low`` and ``high`` bounds and the
     ``quantity`` of :data:`fem_twin.checks.QUANTITIES` a fitted value is checked against."""

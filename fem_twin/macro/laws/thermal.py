@@ -257,8 +257,8 @@ def thermal_point(solve, point, thermal: ContactThermal, near: dict | None = Non
     slope = near.get("residual_slope") if same else None
     previous, history, pairs = None, [], []
     for _ in range(s.max_iter):
-        film = replace(lubricant, viscosity=float(law.viscosity(T)))
-        levels = solve(film, previous)
+        heated = replace(lubricant, viscosity=float(law.viscosity(T)))   # at the film's T
+        levels = solve(heated, previous)
         levels = (thermal.tempered(levels[0], point, T), *levels[1:])
         heat = thermal.heat(levels[0], point)
         target = oil + s.bulk_resistance * heat["power"] + heat["flash"]
@@ -273,7 +273,7 @@ def thermal_point(solve, point, thermal: ContactThermal, near: dict | None = Non
                                                    point.surface_speeds, s),
                       "iterations": len(history),
                       "residual_slope": _slope([*pairs, (T, target - T)], slope)}
-            return levels, film, record
+            return levels, heated, record
         pairs.append((T, target - T))
         T, previous = _next_temperature(pairs, slope), levels
     raise ThermalNotConverged(f"the film temperature did not settle within {s.tol:g} K in "

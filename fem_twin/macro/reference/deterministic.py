@@ -46,7 +46,13 @@ from ..coupling.problem import MAX_COEFFICIENT_PRESSURE
 from ..film.cavitation import cavitation_model
 from ..film.couette import couette_matrix
 from ..film.reynolds import fe_poiseuille, trapezoid_weights
-from ..laws.boundary import BoundaryLaw, asperity_load, temperature_factor, traction
+from ..laws.boundary import (
+    BoundaryLaw,
+    asperity_load,
+    boundary_friction_setting,
+    temperature_factor,
+    traction,
+)
 from ..laws.friction import FilmFields, film_fields
 from ..laws.lubricant import Lubricant
 
@@ -68,7 +74,7 @@ class DeterministicNotConverged(NotConverged):
 class DeterministicSettings:
     """Materials and numerics of :func:`solve_deterministic` (SI units)."""
 
-    boundary_friction: float = setting(T.BOUNDARY_FRICTION, "C_f,b of eq 32", "friction")
+    boundary_friction: float = boundary_friction_setting()
     e_reduced: float = setting(T.E_REDUCED, "E' of eq 22", "reduced_modulus")
     hardness: float = setting(T.HARDNESS, "the cap on the contact pressure", "hardness")
     boundary_film: float = setting(CellSettings.boundary_film, "films thinner than this "

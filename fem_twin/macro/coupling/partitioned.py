@@ -1,4 +1,5 @@
-"""The fixed-point couplings of the macro scale: ``"anderson"`` and the paper's ``"pid"``.
+"""The partitioned couplings of the macro scale, fixed-point iterations over the film and
+the solid: ``"anderson"`` and the paper's ``"pid"`` (the monolithic one: :mod:`.newton`).
 
 Each iteration solves the Reynolds complementarity problem (eqs 17-18) at the previous
 pressure's coefficients (lagged viscosity and density, warm-started), then updates the
@@ -24,7 +25,7 @@ from ...numerics.anderson import Anderson
 from ..film.cavitation import cavitation_model
 from ..film.couette import couette_matrix
 from ..film.reynolds import ReynoldsNotConverged
-from .evaluation import FixedPointEvaluation
+from .evaluation import PartitionedEvaluation
 from .result import resampled
 from .start import dry_separation, rigid_separation
 
@@ -79,7 +80,7 @@ class Concentrated(Exception):
     """The ``"auto"`` coupling's signal: the contact needs the Newton coupling."""
 
 
-def solve_fixed_point(P, load: float, face, initial=None, progress=None, secants=None):
+def solve_partitioned(P, load: float, face, initial=None, progress=None, secants=None):
     """Iterate the ``P.point.settings.coupling`` fixed point (``"auto"`` means ``"anderson"``, and
     raises :class:`Concentrated` at the first iterate of an elastically dominated contact);
     ``secants`` (:class:`Secants`, of a coarser grid's solve) seed the Anderson history.
@@ -153,7 +154,7 @@ class _Reynolds:
         """A cold inner start (the state is far from the last one)."""
         self.phi, self.p = None, np.full(self.P.shape, self.p_amb_rel)
 
-    def evaluate(self, h_el, h_d, p_con=None, steps=None, settle=0.0) -> FixedPointEvaluation:
+    def evaluate(self, h_el, h_d, p_con=None, steps=None, settle=0.0) -> PartitionedEvaluation:
         """Solve at ``h0 = h_d + h_g + h_el`` (eq 19); ``p_con`` [Pa] is used in the load and
         the deformation when given (``"pid"``), else ``p_con(h0)``; ``steps`` cuts the solve
         to that many Newton steps, ``settle`` stops it once its active set has settled
@@ -179,7 +180,7 @@ class _Reynolds:
         self.p = p
         p_con_used = loc.p_con if p_con is None else p_con
         p_tot = p + s.cavitation_pressure + p_con_used
-        return FixedPointEvaluation(
+        return PartitionedEvaluation(
             h0=h0, loc=loc, mu=mu, rho=rho, p=p, p_prev=p_prev, theta=theta,
             p_con_target=loc.p_con, p_con=p_con_used,
             F=float(np.sum(P.area * (p_tot - s.ambient_pressure))),
