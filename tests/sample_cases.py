@@ -29,7 +29,7 @@ def sample_factors():
     low = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_pin.npz")), (32, 32))
     up = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"), upper=True),
                        (32, 32))
-    return homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), n_steps=4)
+    return homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), steps=4)
 
 
 def smooth_factors():

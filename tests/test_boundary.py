@@ -94,7 +94,7 @@ def test_a_single_hertzian_asperity_carries_tau0_times_its_area_plus_alpha_times
     z -= z.mean()
     flat = Topography(np.zeros_like(z), size / n)
     ff = homogenise(Topography(z, size / n), flat, z.max() - np.array([0.2e-6, 0.1e-6]),
-                    n_steps=1, e_reduced=e_red, hardness=1e11, error_estimate=False)
+                    steps=1, e_reduced=e_red, hardness=1e11, error_estimate=False)
     load, area = ff.p_con * size ** 2, ff.contact_fraction * size ** 2
     hertz = np.pi * (3 * load * radius / (2 * e_red)) ** (2 / 3)
     assert np.all(np.abs(area / hertz - 1) < 0.05), area / hertz

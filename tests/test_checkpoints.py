@@ -42,7 +42,7 @@ def test_an_h0_checkpoint_copied_over_another_is_recomputed(tmp_path):
     dx = 40e-6 / 16
     pin = self_affine((16, 16), (dx, dx), 0.8, 0.1e-6, rng=4)
     disk = Topography(np.zeros((16, 16)), (dx, dx))
-    kw = dict(n_steps=2, error_estimate=False, checkpoint=tmp_path)
+    kw = dict(steps=2, error_estimate=False, checkpoint=tmp_path)
     first = homogenise(pin, disk, [0.2e-6, 0.4e-6], **kw)
     low, high = sorted(tmp_path.glob("*_h0_*.json"))
     low.write_text(high.read_text())

@@ -87,7 +87,7 @@ def test_homogenise_run_average_and_fields(tmp_path, capsys):
                      *extra]) == 0
         ff = FlowFactors.load(out / "flow_factors.npz")
         api = homogenise(read_topography(pin), read_topography(disk), np.geomspace(1e-7, 1e-6, 4),
-                         n_steps=4)
+                         steps=4)
         assert np.array_equal(ff.A, api.A) and (out / "flow_factors.png").stat().st_size > 0
         outs.append(ff)
     _, fields = read_vtu(tmp_path / "ff1" / "fields" / "cell_h0_200nm_003.vtu")
@@ -117,7 +117,7 @@ def test_homogenise_run_with_adaptive_h0(tmp_path, capsys):
     printed = json.loads(capsys.readouterr().out)
     ff = FlowFactors.load(tmp_path / "ff" / "flow_factors.npz")
     api = homogenise(read_topography(pin), read_topography(disk), np.geomspace(1e-7, 1e-6, 40),
-                     n_steps=4, h0_tol=0.01)
+                     steps=4, h0_tol=0.01)
     assert printed["points"] == len(ff) == len(api) < 40 and np.array_equal(ff.h0, api.h0)
     assert {"time", "grid", "h0"} <= set(printed["estimated_relative_error"])
     assert main(["homogenise", "run", str(pin), str(disk), "-o", str(tmp_path / "bad"),
@@ -136,7 +136,7 @@ def test_macro_point_step(tmp_path, capsys):
                  "--resolution", "32", "32"]) == 0
     rng = np.random.default_rng(3)
     rough = [Topography(rng.normal(size=(16, 16)) * 5e-8, 5e-7) for _ in range(2)]
-    ff = homogenise(*rough, np.geomspace(2e-8, 1e-6, 6), n_steps=2)
+    ff = homogenise(*rough, np.geomspace(2e-8, 1e-6, 6), steps=2)
     ff.save(tmp_path / "ff.npz")
     capsys.readouterr()
     assert main(["macro", "point", str(pin), str(tmp_path / "ff.npz"), "--disk", str(disk),

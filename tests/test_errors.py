@@ -53,7 +53,7 @@ def test_homogenise_refuses_a_patch_in_micrometres():
     disk = self_affine((16, 16), 1e-6, 0.8, 100e-9, rng=2)
     slip = Topography(pin.heights * 1e3, pin.spacing)
     with pytest.raises(InputError, match="Sq"):
-        homogenise(slip, disk, [1e-7, 2e-7], n_steps=2)
+        homogenise(slip, disk, [1e-7, 2e-7], steps=2)
 
 
 def test_every_error_class_is_a_fem_twin_error_and_pickles():
@@ -111,7 +111,7 @@ def _calls(bad):
     yield lambda: contact.solve(bad, 1e-6, e, load=1.0)
     yield lambda: contact.solve(z, bad, e, load=1.0)
     yield lambda: contact.solve(z, 1e-6, bad, load=1.0)
-    yield lambda: homogenise(Topography(z, 1e-6), Topography(z, 1e-6), bad, n_steps=2,
+    yield lambda: homogenise(Topography(z, 1e-6), Topography(z, 1e-6), bad, steps=2,
                              error_estimate=False)
     yield lambda: solve_reynolds(bad, (1e-4, 1e-4), 1.0, 0.066)
     yield lambda: solve_reynolds(GOOD_GAP, bad, 1.0, 0.066)

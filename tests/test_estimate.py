@@ -35,7 +35,7 @@ def patch_factors(n, steps, count):
     low = prepare_patch(read_topography(SAMPLE / "patch_1_pin.npz"))
     up = prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"), upper=True)
     return homogenise(resample_cell(low, (n, n)), resample_cell(up, (n, n)),
-                      np.geomspace(2e-8, 1e-6, count), n_steps=steps, workers=2)
+                      np.geomspace(2e-8, 1e-6, count), steps=steps, workers=2)
 
 
 @pytest.fixture(scope="module")

@@ -55,7 +55,7 @@ def test_striated_friction_is_the_closed_form_on_either_body(method):
     matched within 0.5 % at 64 px (measured FE 0.16 %, FVM 0.07 %; second order); eq 31's
     ``1 - 3 d1`` gives 0.56 and 1.44, a factor of 2.6 between the two."""
     exact = striated_closed_form()
-    s = {body: homogenise(*ridges(64, body), [H0], n_steps=8, method=method,
+    s = {body: homogenise(*ridges(64, body), [H0], steps=8, method=method,
                           error_estimate=False) for body in ("pin", "disk")}
     assert exact == pytest.approx(1.62375, abs=1e-5)
     for ff in s.values():
@@ -113,7 +113,7 @@ def test_friction_times_speed_is_the_dissipation_and_the_force_on_the_pin(method
     dx = 85e-6 / n
     pin = self_affine((n, n), (dx, dx), 0.8, 100e-9, rng=1)
     disk = self_affine((n, n), (dx, dx), 0.8, 100e-9, rng=2)
-    ff = homogenise(pin, disk, [0.6e-6], n_steps=8, method=method, error_estimate=False)
+    ff = homogenise(pin, disk, [0.6e-6], steps=8, method=method, error_estimate=False)
     energy, force, poiseuille = dissipation_and_force(pin, disk, 0.6e-6, method)
     assert ff.friction_factor[0] == pytest.approx(energy, rel=1e-12)
     assert force == pytest.approx(energy, rel=tol)
@@ -132,7 +132,7 @@ def test_the_friction_factor_is_positive_and_at_least_one_out_of_contact():
         low = prepare_patch(read_topography(SAMPLE / f"patch_{k}_pin.npz"))
         up = prepare_patch(read_topography(SAMPLE / f"patch_{k}_disk.npz"), upper=True)
         ff = homogenise(resample_cell(low, (48, 48)), resample_cell(up, (48, 48)),
-                        np.geomspace(0.1e-6, 1e-6, 8), n_steps=8, error_estimate=False)
+                        np.geomspace(0.1e-6, 1e-6, 8), steps=8, error_estimate=False)
         assert ff.contact_fraction[0] > 0.05 and ff.contact_fraction[-1] == 0
         assert np.all(ff.friction_factor > 0)
         assert np.all(ff.friction_factor[ff.contact_fraction == 0] >= 1)
@@ -204,7 +204,7 @@ def twin_slider(h_o, load, amplitude, law):
     z = np.tile(amplitude * np.cos(2 * np.pi * np.arange(n) / n), (4, 1))
     dx = SLIDER / 50 / n
     ff = homogenise(Topography(z, (dx, dx)), Topography(np.zeros_like(z), (dx, dx)),
-                    np.geomspace(0.95 * h_o, 1.05 * RATIO * h_o, 24), n_steps=4,
+                    np.geomspace(0.95 * h_o, 1.05 * RATIO * h_o, 24), steps=4,
                     e_reduced=4e12, error_estimate=False)
     x = np.linspace(0, SLIDER, 201)
     gap, dx = strip(h_o * (1 + (RATIO - 1) * (1 - x / SLIDER)))
@@ -313,7 +313,7 @@ def test_the_boundary_friction_is_cfb_times_the_contact_load():
     z = np.tile(0.5e-6 * np.cos(2 * np.pi * np.arange(n) / n)[:, None], (1, 4))
     dx = 20e-6 / n
     ff = homogenise(Topography(z, (dx, dx)), Topography(np.zeros_like(z), (dx, dx)),
-                    np.geomspace(0.05e-6, 3e-6, 40), n_steps=1, e_reduced=4e12,
+                    np.geomspace(0.05e-6, 3e-6, 40), steps=1, e_reduced=4e12,
                     hardness=1e9, error_estimate=False)
     x = np.linspace(0, 5e-3, 81)
     gap = np.tile(0.5e-6 * (1 - x / 5e-3), (81, 1))
@@ -347,7 +347,7 @@ def test_the_friction_factor_converges_through_contact_onset():
     y = (np.arange(400000) + 0.5) / 400000
     h = np.maximum(h0[:, None] - amplitude * np.cos(2 * np.pi * y), 1e-9)
     closed = h.mean(1) * np.mean(np.where(h > 10e-9, 1 / h, 0.0), 1)
-    rigid = {"n_steps": 1, "e_reduced": 4e12, "hardness": 1e9, "error_estimate": False}
+    rigid = {"steps": 1, "e_reduced": 4e12, "hardness": 1e9, "error_estimate": False}
     for n, tol in ((64, 0.04), (128, 0.025)):
         z = np.tile(amplitude * np.cos(2 * np.pi * np.arange(n) / n)[:, None], (1, 4))
         pin = Topography(z, (64e-6 / n,) * 2)
@@ -403,7 +403,7 @@ def test_pixel_centred_ridges_flattened_by_the_hardness_keep_finite_friction():
     for n, tol in ((64, 0.055), (128, 0.03)):
         z = np.tile(amplitude * np.cos(2 * np.pi * (np.arange(n) + 0.5) / n)[:, None], (1, 4))
         pin = Topography(z, (64e-6 / n,) * 2)
-        ff = homogenise(pin, pin.with_heights(np.zeros_like(z)), h0, n_steps=1,
+        ff = homogenise(pin, pin.with_heights(np.zeros_like(z)), h0, steps=1,
                         e_reduced=4e12, hardness=1e9, error_estimate=False)
         assert np.all(np.abs(ff.friction_factor / closed - 1) < tol)
 

@@ -71,7 +71,7 @@ def test_fast_assembly_equals_scikit_fem_forms():
 def test_smooth_limit_is_exact(method):
     n = 16
     flat = Topography(np.zeros((n, n)), (L / n, L / n))
-    ff = homogenise(flat, flat, [0.2e-6, 1e-6], n_steps=4, method=method)
+    ff = homogenise(flat, flat, [0.2e-6, 1e-6], steps=4, method=method)
     assert ff.smooth_limit_error() < 1e-12
     assert np.allclose(ff.h_m, ff.h0, rtol=1e-15) and np.all(ff.p_con == 0)
 
@@ -85,7 +85,7 @@ def test_striated_roughness_converges_second_order(method):
     errors = []
     for n in (16, 32, 64):
         pin, disk = ridges(n, "x1")
-        ff = homogenise(pin, disk, [H], n_steps=4, method=method)
+        ff = homogenise(pin, disk, [H], steps=4, method=method)
         errors.append([ff.A[0, 0, 0] * H ** 3 * hm3 - 1, ff.b[0, 0] * H * hm3 / hm2 - 1,
                        ff.A[0, 1, 1] * H ** 3 / h3 - 1])
     errors = np.abs(errors)
@@ -106,7 +106,7 @@ def test_longitudinal_ridges_on_the_moving_disk(method):
     errors = []
     for n in (16, 32):
         disk, pin = ridges(n, "x2")
-        ff = homogenise(pin, disk, [H], n_steps=4, method=method)
+        ff = homogenise(pin, disk, [H], steps=4, method=method)
         errors.append(abs(ff.A[0, 0, 0] * H ** 3 / h3 - 1))
         assert abs(ff.b[0, 0] - 1) < 1e-12 and abs(ff.A[0, 1, 1] * H ** 3 * hm3 - 1) < 3.5e-2
     assert errors[1] < 1.3e-3 and (errors[1] < 1e-13 or 3.5 < errors[0] / errors[1] < 4.5)
@@ -118,7 +118,7 @@ def test_wiener_bounds_and_symmetry(method):
     FE's upper bound is exact for its own quadrature; the FVM means are pixel means."""
     pin, _ = rough_pair(32)
     flat = pin.with_heights(np.zeros(pin.shape))
-    ff = homogenise(pin, flat, [0.25e-6, 0.6e-6], n_steps=2, method=method)
+    ff = homogenise(pin, flat, [0.25e-6, 0.6e-6], steps=2, method=method)
     from fem_twin.contact import solve
     for k, h0 in enumerate(ff.h0):
         gap = solve(-pin.heights, pin.spacing, ff.meta["e_reduced"], separation=h0,
@@ -132,7 +132,7 @@ def test_wiener_bounds_and_symmetry(method):
 
 def test_large_separation_limit_and_monotone_contact():
     pin, disk = rough_pair(32)
-    ff = homogenise(pin, disk, np.geomspace(0.1e-6, 1.5e-6, 6), n_steps=4)
+    ff = homogenise(pin, disk, np.geomspace(0.1e-6, 1.5e-6, 6), steps=4)
     assert ff.p_con[-1] == 0 and ff.contact_fraction[-1] == 0
     assert abs(ff.h_m[-1] / ff.h0[-1] - 1) < 1e-13
     assert np.all(np.diff(ff.p_con) <= 0) and ff.p_con[0] > 0
@@ -162,9 +162,9 @@ def moving_ridge(n, n_steps, method, moving="upper", **kw):
     z = 0.5e-6 * np.cos(2 * np.pi * np.arange(n) / n)
     rough = Topography(np.tile(z, (n, 1)), (dx, dx))
     flat = rough.with_heights(np.zeros((n, n)))
-    on_disk = homogenise(flat, rough, [1e-6], n_steps=n_steps, method=method, moving=moving,
+    on_disk = homogenise(flat, rough, [1e-6], steps=n_steps, method=method, moving=moving,
                          **kw)
-    at_rest = homogenise(rough.with_heights(-rough.heights), flat, [1e-6], n_steps=n_steps,
+    at_rest = homogenise(rough.with_heights(-rough.heights), flat, [1e-6], steps=n_steps,
                          method=method, moving=moving)
     return on_disk, at_rest
 
@@ -223,11 +223,11 @@ def test_frame_change_on_random_roughness():
     |b + b' - 2 e1| = 5.2e-3, |d + d'| = 5.3e-3 (d1 = 0.151)."""
     pin, disk = smooth_rough_pair()
     for method, tol in (("fvm", 1e-12), ("fe", 5e-4)):
-        a = homogenise(pin, disk, [1e-6], n_steps=16, method=method, moving="upper")
-        b = homogenise(pin, disk, [1e-6], n_steps=16, method=method, moving="lower")
+        a = homogenise(pin, disk, [1e-6], steps=16, method=method, moving="upper")
+        b = homogenise(pin, disk, [1e-6], steps=16, method=method, moving="lower")
         assert np.abs(a.b + b.b - [2, 0]).max() < tol and np.abs(a.d + b.d).max() < tol
-    a = homogenise(pin, disk, [0.2e-6], n_steps=16, moving="upper")
-    b = homogenise(pin, disk, [0.2e-6], n_steps=16, moving="lower")
+    a = homogenise(pin, disk, [0.2e-6], steps=16, moving="upper")
+    b = homogenise(pin, disk, [0.2e-6], steps=16, moving="lower")
     assert a.contact_fraction[0] > 0.02
     assert np.allclose(a.A, b.A, rtol=1e-12) and np.allclose(a.C, b.C, rtol=1e-12)
     assert np.allclose(a.p_con, b.p_con, rtol=1e-12) and np.allclose(a.h_m, b.h_m, rtol=1e-14)
@@ -244,8 +244,8 @@ def test_time_average_converges_with_the_exact_squeeze_term():
     per cent between samplings at 64 px (0.2 um: 1.1 %; 0.15 um: 4 %), a spatial limit."""
     pin, disk = smooth_rough_pair()
     h0 = [0.3e-6, 1e-6]
-    coarse = homogenise(pin, disk, h0, n_steps=32, moving="upper")
-    fine = homogenise(pin, disk, h0, n_steps=256, moving="upper")
+    coarse = homogenise(pin, disk, h0, steps=32, moving="upper")
+    fine = homogenise(pin, disk, h0, steps=256, moving="upper")
     assert coarse.contact_fraction[0] > 0.002
     assert np.all(np.abs(coarse.b[:, 0] / fine.b[:, 0] - 1) < 0.01)
     assert np.all(np.abs(coarse.d[:, 0] / fine.d[:, 0] - 1) < 0.01)
@@ -275,7 +275,7 @@ def test_grid_error_estimate_bounds_the_true_error():
     error by about 2^2 - 1 = 3 (it assumes first order, the order of rough contacts)."""
     h3, hm3, hm2 = exact_ridges()
     pin, disk = ridges(64, "x1")
-    ff = homogenise(pin, disk, [H], n_steps=4)
+    ff = homogenise(pin, disk, [H], steps=4)
     est = ff.meta["error_estimate"]
     true = {"A11": abs(ff.A[0, 0, 0] * H ** 3 * hm3 - 1), "b1": abs(ff.b[0, 0] * H * hm3 / hm2 - 1)}
     assert est["grid_shape"] == [32, 32]
@@ -286,10 +286,10 @@ def test_grid_error_estimate_bounds_the_true_error():
 def test_error_estimate_resumes_from_its_checkpoints(tmp_path):
     pin, disk = rough_pair(32)
     h0 = np.geomspace(0.15e-6, 0.8e-6, 4)
-    first = homogenise(pin, disk, h0, n_steps=4, checkpoint=tmp_path)
+    first = homogenise(pin, disk, h0, steps=4, checkpoint=tmp_path)
     assert len(list((tmp_path / "coarse").glob("*.json"))) == 4      # every separation
     stamps = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.json")}
-    again = homogenise(pin, disk, h0, n_steps=4, checkpoint=tmp_path)
+    again = homogenise(pin, disk, h0, steps=4, checkpoint=tmp_path)
     assert {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.json")} == stamps
     assert again.meta["error_estimate"] == first.meta["error_estimate"]
 
@@ -299,8 +299,8 @@ def test_fe_and_fvm_agree_better_under_refinement():
     diffs = []
     for n in (32, 64):
         pin, disk = rough_pair(n, seed=5, rms=80e-9)
-        fe = homogenise(pin, disk, [0.3e-6], n_steps=4, method="fe")
-        fv = homogenise(pin, disk, [0.3e-6], n_steps=4, method="fvm")
+        fe = homogenise(pin, disk, [0.3e-6], steps=4, method="fe")
+        fv = homogenise(pin, disk, [0.3e-6], steps=4, method="fvm")
         assert fe.h_m == pytest.approx(fv.h_m, rel=1e-14)
         diffs.append(max(np.abs(fe.A - fv.A).max(), np.abs(fe.b - fv.b).max()))
     assert diffs[1] < 0.7 * diffs[0]
@@ -354,7 +354,7 @@ def test_variants_carry_each_estimated_error():
     patches."""
     pin, disk = rough_pair(32)
     h0 = np.geomspace(0.12e-6, 0.8e-6, 5)
-    ff = homogenise(pin, disk, h0, n_steps=4)
+    ff = homogenise(pin, disk, h0, steps=4)
     v = ff.variants()
     assert sorted(v) == ["film_thick", "film_thin", "grid", "h0", "time"]
     est = ff.meta["error_estimate"]
@@ -396,7 +396,7 @@ def test_variants_carry_each_estimated_error():
 @pytest.fixture(scope="module")
 def small_factors():
     pin, disk = rough_pair(16)
-    return homogenise(pin, disk, np.geomspace(0.1e-6, 1e-6, 5), n_steps=2, patch_id="p1")
+    return homogenise(pin, disk, np.geomspace(0.1e-6, 1e-6, 5), steps=2, patch_id="p1")
 
 
 def test_save_load_round_trip(tmp_path, small_factors):
@@ -453,16 +453,16 @@ def test_checkpoint_resume_computes_only_missing(tmp_path):
     def files():
         return {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in tmp_path.glob("*.json")}
 
-    first = homogenise(pin, disk, h0[:2], n_steps=2, checkpoint=tmp_path, error_estimate=False)
+    first = homogenise(pin, disk, h0[:2], steps=2, checkpoint=tmp_path, error_estimate=False)
     before = files()
     assert len(before) == 2
-    again = homogenise(pin, disk, h0, n_steps=2, checkpoint=tmp_path, error_estimate=False)
+    again = homogenise(pin, disk, h0, steps=2, checkpoint=tmp_path, error_estimate=False)
     after = files()
     new = set(after) - set(before)
     assert len(new) == 1 and f"{h0[2]:.9e}" in new.pop()
     assert all(after[k] == v for k, v in before.items())
     assert np.array_equal(again.A[:2], first.A) and np.array_equal(again.p_con[:2], first.p_con)
-    other = homogenise(pin, disk, h0[:1], n_steps=4, checkpoint=tmp_path,   # other settings
+    other = homogenise(pin, disk, h0[:1], steps=4, checkpoint=tmp_path,   # other settings
                        error_estimate=False)
     new = set(files()) - set(after)
     assert len(new) == 1 and f"{h0[0]:.9e}" in new.pop() and other.meta["n_steps"] == 4
@@ -471,8 +471,8 @@ def test_checkpoint_resume_computes_only_missing(tmp_path):
 def test_process_pool_gives_the_serial_numbers():
     pin, disk = rough_pair(16)
     h0 = np.geomspace(0.12e-6, 0.6e-6, 4)
-    serial = homogenise(pin, disk, h0, n_steps=2)
-    pooled = homogenise(pin, disk, h0, n_steps=2, workers=2)
+    serial = homogenise(pin, disk, h0, steps=2)
+    pooled = homogenise(pin, disk, h0, steps=2, workers=2)
     for k in ("h_m", "p_con", "A", "b", "C", "d"):
         assert np.allclose(getattr(pooled, k), getattr(serial, k), rtol=1e-7, atol=1e-12), k
 
@@ -517,12 +517,12 @@ def test_adaptive_instants_reach_the_tolerance_where_contact_needs_them():
                  for n in ("pin", "disk"))
     h0 = [0.12e-6, 2e-6]
     kw = dict(error_estimate=False)
-    ad = homogenise(pin, disk, h0, n_steps=8, time_tol=0.005, **kw)
-    ref = homogenise(pin, disk, h0, n_steps=64, **kw)
-    fixed = homogenise(pin, disk, h0, n_steps=8, **kw)
+    ad = homogenise(pin, disk, h0, steps=8, time_tol=0.005, **kw)
+    ref = homogenise(pin, disk, h0, steps=64, **kw)
+    fixed = homogenise(pin, disk, h0, steps=8, **kw)
     used = ad.meta["steps_used"]
     assert used[1] == 8 and used[0] > 8 and ad.contact_fraction[0] > 0.2
-    same = homogenise(pin, disk, h0[:1], n_steps=used[0], **kw)
+    same = homogenise(pin, disk, h0[:1], steps=used[0], **kw)
     assert np.allclose(ad.b[0], same.b[0], rtol=1e-8) and np.allclose(ad.A[0], same.A[0],
                                                                         rtol=1e-8)
     err = abs(ad.b[0, 0] / ref.b[0, 0] - 1)
@@ -552,7 +552,7 @@ def test_grid_convergence_on_a_fixed_measured_surface_is_nearly_second_order():
     h0 = [0.14e-6, 0.3e-6, 1.5e-6]
     values = []
     for n in (32, 64, 128, 256):
-        ff = homogenise(*(resample_cell(t, (n, n)) for t in base), h0, n_steps=4,
+        ff = homogenise(*(resample_cell(t, (n, n)) for t in base), h0, steps=4,
                         error_estimate=False)
         values.append([ff.A[:, 0, 0], ff.p_con])
     d = np.abs(np.diff(np.array(values), axis=0))            # (3, quantity, h0)
@@ -635,8 +635,8 @@ def test_homogenise_with_adaptive_h0_matches_the_dense_run(tmp_path):
     from fem_twin.micro.sampling import JITTER, START
     pin, disk = rough_pair(32)
     h0 = np.geomspace(0.05e-6, 0.5e-6, 40)
-    dense = homogenise(pin, disk, h0, n_steps=8)
-    ad = homogenise(pin, disk, h0, n_steps=8, h0_tol=0.005, checkpoint=tmp_path)
+    dense = homogenise(pin, disk, h0, steps=8)
+    ad = homogenise(pin, disk, h0, steps=8, h0_tol=0.005, checkpoint=tmp_path)
     idx = np.searchsorted(h0, ad.h0)
     start = 2 * START - 1                                    # the start, bisected once
     assert np.allclose(h0[idx], ad.h0, rtol=1e-14) and start < len(ad) < 30
@@ -653,7 +653,7 @@ def test_homogenise_with_adaptive_h0_matches_the_dense_run(tmp_path):
                               ("d1", lambda f: f.d[:, 0], JITTER)):
         miss = np.abs(get(loc) - get(dense)).max() / np.abs(get(dense)).max()
         assert miss <= max(est["h0"][name], jitter * est["time"][name]), name
-    again = homogenise(pin, disk, h0, n_steps=8, h0_tol=0.005, checkpoint=tmp_path)
+    again = homogenise(pin, disk, h0, steps=8, h0_tol=0.005, checkpoint=tmp_path)
     assert again.meta["seconds"]["computed_h0"] == 0 and np.array_equal(again.A, ad.A)
     mean = average([ad, dense])
     assert mean.h0.size == h0.size and np.allclose(mean.A[idx], (ad.A + dense.A[idx]) / 2)
@@ -680,8 +680,8 @@ def test_zero_tolerances_mean_off_as_in_the_case_file():
     h0, n_steps everywhere), with the same factors and checkpoint key as None."""
     pin, disk = rough_pair(16)
     h0 = [1e-7, 2e-7, 4e-7]
-    off = homogenise(pin, disk, h0, n_steps=2, h0_tol=None, time_tol=None)
-    zero = homogenise(pin, disk, h0, n_steps=2, h0_tol=0, time_tol=0.0)
+    off = homogenise(pin, disk, h0, steps=2, h0_tol=None, time_tol=None)
+    zero = homogenise(pin, disk, h0, steps=2, h0_tol=0, time_tol=0.0)
     assert len(zero) == 3 and np.array_equal(zero.A, off.A)
     assert zero.meta["checkpoint_keys"] == off.meta["checkpoint_keys"]
 
@@ -724,5 +724,5 @@ def test_non_finite_cell_moments_are_reported_as_the_cells_failure(monkeypatch):
     monkeypatch.setattr(sliding, "mean_inverse_film", lambda gap, cut: np.nan)
     pin, disk = rough_pair(16)
     with pytest.raises(SolverError, match="non-finite s_(c|thin) at h0 = 5e-07") as caught:
-        homogenise(pin, disk, [5e-7], n_steps=2, error_estimate=False)
+        homogenise(pin, disk, [5e-7], steps=2, error_estimate=False)
     assert not isinstance(caught.value, InputError)

@@ -21,7 +21,7 @@ def pair(n=32, seed=1):
 
 
 def cell(pin, disk, method="fe", **kw):
-    return homogenise(pin, disk, H0, n_steps=16, method=method, error_estimate=False, **kw)
+    return homogenise(pin, disk, H0, steps=16, method=method, error_estimate=False, **kw)
 
 
 def flipped(t):
@@ -105,10 +105,10 @@ def test_pure_rolling_over_a_smooth_surface_has_only_the_kinematic_squeeze():
     errors = []
     for n in (32, 64, 128):
         rough, flat = ridge(n)
-        fv = homogenise(rough, flat, [1e-6], n_steps=8, method="fvm", moving="upper",
+        fv = homogenise(rough, flat, [1e-6], steps=8, method="fvm", moving="upper",
                         slide_to_roll=0.0, error_estimate=False)
         assert np.abs(fv.b - [1, 0]).max() < 1e-12 and np.abs(fv.d).max() < 1e-12
-        fe = homogenise(rough, flat, [1e-6], n_steps=8, moving="upper", slide_to_roll=0.0,
+        fe = homogenise(rough, flat, [1e-6], steps=8, moving="upper", slide_to_roll=0.0,
                         error_estimate=False)
         errors.append(np.abs(fe.b - [1, 0]).max())
     orders = np.log2(np.array(errors[:-1]) / errors[1:])

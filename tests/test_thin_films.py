@@ -29,7 +29,7 @@ def test_the_confined_films_shear_is_their_mean_inverse_gap_on_a_cosine_cell():
     ridge = np.tile(a * np.cos(2 * np.pi * x / period), (4, 1))
     h0 = a + crest                                   # the mean gap H: no contact
     ff = homogenise(Topography(np.zeros_like(ridge), period / n), Topography(ridge, period / n),
-                    [h0], n_steps=1, error_estimate=False)
+                    [h0], steps=1, error_estimate=False)
     assert ff.p_con[0] == 0 and ff.h_m[0] == pytest.approx(h0, rel=1e-12)
     start = np.arccos((10e-9 - h0) / a)
     root = np.sqrt(h0 ** 2 - a ** 2)

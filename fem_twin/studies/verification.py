@@ -181,7 +181,7 @@ def pad_factors(pad: RoughPad, h0, **cell):
     else:
         pin, disk, steps = pad.disk - pad.roughness, pad.disk, pad.roughness.shape[1]
     return homogenise(Topography(pin, dx), Topography(disk, dx), h0,
-                      **{"n_steps": steps, **cell}, e_reduced=s.e_reduced,
+                      **{"steps": steps, **cell}, e_reduced=s.e_reduced,
                       hardness=s.hardness, boundary_film=s.boundary_film,
                       gap_floor=s.gap_floor, error_estimate=False)
 
