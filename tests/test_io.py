@@ -57,6 +57,39 @@ def test_ascii_round_trips_are_exact(tmp_path, topo, suffix):
     assert np.allclose(back.origin, topo.origin, rtol=1e-12)
 
 
+def test_every_written_format_reads_back(tmp_path, topo):
+    """fem_twin.io.files.WRITERS: each suffix written has its reader in READERS."""
+    from fem_twin.io.files import READERS, WRITERS
+    assert set(WRITERS) <= set(READERS)
+    for suffix in WRITERS:
+        back = read_topography(write_topography(tmp_path / f"a{suffix}", topo),
+                               spacing=topo.spacing)
+        assert np.array_equal(back.heights, topo.heights, equal_nan=True), suffix
+
+
+def test_a_new_format_is_one_writer_and_one_reader_line(tmp_path, topo, monkeypatch):
+    """A toy format registered in WRITERS and READERS round-trips through
+    write_topography and read_topography; an unregistered suffix is refused before any
+    file is made, naming the suffixes that are written."""
+    from fem_twin.errors import InputError
+    from fem_twin.io import files
+
+    def write_toy(path, t, height_scale=None):
+        with open(path, "wb") as f:
+            np.save(f, t.heights)
+
+    def read_toy(path, spacing, scale):
+        return Topography(np.load(path) * scale, spacing)
+
+    monkeypatch.setitem(files.WRITERS, ".toy", write_toy)
+    monkeypatch.setitem(files.READERS, ".toy", read_toy)
+    back = read_topography(write_topography(tmp_path / "a.toy", topo), spacing=topo.spacing)
+    assert np.array_equal(back.heights, topo.heights, equal_nan=True)
+    with pytest.raises(InputError, match=r"cannot write '\.tiff'; use .*\.toy"):
+        write_topography(tmp_path / "a.tiff", topo)
+    assert not list(tmp_path.glob("*tiff*"))
+
+
 def test_plain_matrix_and_npy_need_spacing_and_convert_units(tmp_path):
     z_um = np.arange(12.0).reshape(3, 4) * 0.1          # heights in um
     np.savetxt(tmp_path / "m.txt", z_um)

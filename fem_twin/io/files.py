@@ -71,27 +71,20 @@ def read_topography(path, *, spacing=None, unit: str = "m") -> Topography:
 
 @arguments(path="path", topo=Topography)
 def write_topography(path, topo: Topography, *, height_scale: float | None = None) -> Path:
-    """Write ``topo`` atomically; the format follows the suffix (.npz, .npy, .txt, .xyz).
+    """Write ``topo`` atomically in the format of the suffix (:data:`WRITERS`: .npz, .npy,
+    .txt, .asc, .csv, .xyz).
 
     For ``.npz``, ``height_scale`` [m] stores heights as int32 multiples of that quantum
     (as instruments do), which makes files smaller; rounding error <= height_scale / 2.
     """
     path = Path(path)
     suffix = path.suffix.lower()
+    writer = WRITERS.get(suffix)
+    if writer is None:
+        *others, last = WRITERS
+        raise InputError(f"cannot write {suffix!r}; use {', '.join(others)} or {last}")
     with atomic_path(path) as tmp:
-        if suffix == ".npz":
-            _write_npz(tmp, topo, height_scale)
-        elif suffix == ".npy":
-            np.save(tmp, topo.heights)
-        elif suffix in {".txt", ".asc", ".csv"}:
-            np.savetxt(tmp, topo.heights, header=_ascii_header(topo),
-                       delimiter="," if suffix == ".csv" else " ")
-        elif suffix == ".xyz":
-            x1, x2 = topo.coordinates()
-            np.savetxt(tmp, np.column_stack([x1.ravel(), x2.ravel(), topo.heights.ravel()]),
-                       header=_ascii_header(topo))
-        else:
-            raise InputError(f"cannot write {suffix!r}; use .npz, .npy, .txt, .csv or .xyz")
+        writer(tmp, topo, height_scale)
     return path
 
 
@@ -191,6 +184,24 @@ def _read_npy(path: Path, spacing, scale) -> Topography:
     return Topography(h * scale, _need_spacing(path, spacing), meta={"source": str(path)})
 
 
+def _write_npy(path: Path, topo: Topography, height_scale=None):
+    np.save(path, topo.heights)
+
+
+def _write_ascii(path: Path, topo: Topography, height_scale=None):
+    """A matrix of heights (``,``-separated in a ``.csv``) under a header with the pitch
+    and origin."""
+    np.savetxt(path, topo.heights, header=_ascii_header(topo),
+               delimiter="," if path.suffix.lower() == ".csv" else " ")
+
+
+def _write_xyz(path: Path, topo: Topography, height_scale=None):
+    """One ``x1 x2 height`` row per pixel under the header of :func:`_write_ascii`."""
+    x1, x2 = topo.coordinates()
+    np.savetxt(path, np.column_stack([x1.ravel(), x2.ravel(), topo.heights.ravel()]),
+               header=_ascii_header(topo))
+
+
 def _ascii_header(topo: Topography) -> str:
     return (f"fem_twin topography; unit = m; spacing = {topo.spacing[0]!r} {topo.spacing[1]!r};"
             f" origin = {topo.origin[0]!r} {topo.origin[1]!r}")
@@ -284,3 +295,8 @@ def _read_instrument(path: Path, spacing, scale=None) -> Topography:
 #: goes to the instrument readers of SurfaceTopography (the ``instruments`` extra)
 READERS = {".npz": _read_npz, ".npy": _read_npy,
            **{suffix: _read_ascii for suffix in ASCII_SUFFIXES}}
+#: file suffix -> writer ``(path, topography, height_scale) -> None`` (``height_scale``: the
+#: ``.npz`` heights' int32 quantum, or None; the other formats ignore it); no other suffix
+#: is written
+WRITERS = {".npz": _write_npz, ".npy": _write_npy, ".txt": _write_ascii,
+           ".asc": _write_ascii, ".csv": _write_ascii, ".xyz": _write_xyz}
