@@ -109,10 +109,9 @@ MACRO_OPTIONS = ("method", "coupling", "couette", "complementarity", "inner_step
 
 
 def homogenise_run(args):
-    import numpy as np
-
     from ..io.files import read_topography
     from ..micro import CellSettings, homogenise
+    from ..micro.homogenisation import h0_candidates
     from ..micro.output import write_cell_fields
     lo, hi, n = args.h0
     plausible("--h0 MIN MAX [m]", [lo, hi], "separation")
@@ -121,7 +120,7 @@ def homogenise_run(args):
     workers = int(number("--workers", args.workers, "workers")) or os.cpu_count() or 1
     pin, disk = read_topography(args.pin), read_topography(args.disk)
     settings = CellSettings(**{k: getattr(args, k) for k in CELL_OPTIONS})
-    ff = homogenise(pin, disk, np.geomspace(lo, hi, int(n)), settings=settings,
+    ff = homogenise(pin, disk, h0_candidates(lo, hi, int(n)), settings=settings,
                     h0_tol=args.h0_tol, workers=workers,
                     checkpoint=args.output / "checkpoints", progress=not args.no_progress,
                     patch_id=f"{args.pin.stem}/{args.disk.stem}")
