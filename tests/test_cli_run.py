@@ -329,6 +329,35 @@ def test_sweep_refinement_adds_speeds_where_the_curve_turns(tmp_path):
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps
 
 
+@pytest.mark.integration
+def test_the_main_process_reads_each_point_whole_at_most_once(tmp_path, monkeypatch):
+    """A run on two workers, at 72^2 (the smallest grid with a guide) and with one
+    refinement pass, reads each main point's checkpoint whole at most once in the main
+    process (MixedResult.load, counted there): the curves come from the index's scalars on
+    every pass, the fields (VTU, PVD, their figure, fields.nc) from one pass on a worker.
+    Measured: no point read whole here (the run before read 10 of its 14 points twice), nor
+    on the bundled case (36 points; 60 reads before)."""
+    import collections
+    import os
+
+    from fem_twin.macro import MixedResult
+    from fem_twin.stages import pipeline
+    case = tmp_path / "guided.toml"
+    case.write_text(small_case(tmp_path, workers=2).read_text()
+                    .replace("resolution = [48, 48] #", "resolution = [72, 72] #")
+                    .replace("refine = 0 ", "refine = 1 "))
+    main_process, loads, real = os.getpid(), collections.Counter(), MixedResult.load.__func__
+    monkeypatch.setattr(MixedResult, "load", classmethod(
+        lambda cls, path: (os.getpid() == main_process and loads.update([str(path)]),
+                           real(cls, path))[1]))
+    out = tmp_path / "out"
+    pipeline.run(load_case(case), out, progress=False)
+    assert "sweep refinement 1" in (out / "run.log").read_text()
+    rows = read_stribeck_csv(out / "stribeck.csv")
+    assert len(list((out / "fields").glob("*.vtu"))) == sum(c.speed.size for c in rows) > 10
+    assert max(loads.values(), default=0) <= 1, loads
+
+
 def test_the_band_grid_is_coarsened_to_48_95_nodes_a_side():
     """[run] band_grid = "coarsest" sweeps the band on the grid coarsened down to
     sides of 48-95 px, whose C_f the main points keep: 64^2 for the macro grids 128^2 to

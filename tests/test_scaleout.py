@@ -16,6 +16,9 @@ from fem_twin.stribeck import SweepRequest
 from fem_twin.topography import resample_cell
 from fem_twin.topography.prepare import MacroOptions, prepare_disk, prepare_patch, prepare_pin
 
+sys.path.insert(0, str(Path(__file__).parent))
+from sample_cases import macro_case, smooth_factors  # noqa: E402
+
 SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "sample"
 
 
@@ -283,6 +286,7 @@ def test_a_sweep_longer_than_a_workers_share_runs_as_chains(monkeypatch):
     fields = [replace(task, fields="somewhere") for task in tasks]
     assert len(curves.chains(fields, 2)) == len(tasks)
     assert len(curves.chains(tasks, 1)) == len(tasks)
+    assert len(curves.chains(tasks, 2, whole=True)) == len(tasks)      # a refinement's last
 
 
 @pytest.mark.integration
@@ -395,3 +399,39 @@ def test_ctrl_c_while_a_side_thread_is_in_native_code_exits_130(tmp_path):
     assert done.stderr.strip().splitlines() == [
         "fem-twin run: interrupted; finished work is kept, run the same command again to "
         "resume"], done.stderr
+
+
+def test_a_guided_sweeps_curve_is_read_from_the_index_not_the_checkpoints(tmp_path,
+                                                                          monkeypatch):
+    """stages.sweeps.run_sweeps on a pool reads a guided sweep's curve from its points'
+    scalars and meta in the index (point_index), not from their checkpoints in full: over
+    two passes, the second adding a midpoint as a refinement does, the main process loads
+    no point whole, and the curve is the one stribeck_sweep reads from the checkpoints,
+    bit for bit (sample pin 1 at 72^2, the smallest grid with a guide; smooth factors)."""
+    import dataclasses
+    import os
+
+    from fem_twin.macro import MacroSettings, MixedResult
+    from fem_twin.numerics.threads import executor_for
+    from fem_twin.stages.sweeps import guide_of
+    from fem_twin.stribeck import stribeck_sweep
+    gap, dx, face = macro_case(72)
+    request = SweepRequest(gap, dx, smooth_factors(), [1.0, 0.25], load=150.0,
+                           lubricant=Lubricant(0.066), face=face,
+                           settings=MacroSettings(tol=1e-6), checkpoint=tmp_path,
+                           factors_key="smooth")
+    assert guide_of(request) is not None
+    main, loads, real = os.getpid(), [], MixedResult.load.__func__
+    monkeypatch.setattr(MixedResult, "load", classmethod(
+        lambda cls, path: (os.getpid() == main and loads.append(path), real(cls, path))[1]))
+    refined = replace(request, speeds=[1.0, 0.5, 0.25])
+    with executor_for(2) as pool:
+        run_sweeps([request], pool, progress=False)
+        (curve,), points = run_sweeps([refined], pool, progress=False, whole=True)
+    assert loads == [] and [p.speed for p in points] == [1.0, 0.5, 0.25]
+    read = stribeck_sweep(refined)
+    assert len(loads) == 3                                   # stribeck_sweep reads them whole
+    for field in dataclasses.fields(curve):
+        mine, theirs = getattr(curve, field.name), getattr(read, field.name)
+        assert (mine is None and theirs is None) or np.array_equal(
+            mine, theirs, equal_nan=True), field.name

@@ -230,10 +230,11 @@ def macro_geometry(case: Case, out: RunLayout):
     return disk.heights - pin.heights, pin.spacing, face, pin.origin
 
 
-def ball_grid(case: Case) -> tuple:
+def ball_grid(case: Case, contact: PointContact | None = None) -> tuple:
     """A ball's ``(gap, spacing, x1, x2)`` on its ``[macro] grid``, or on the mesh graded
-    over it (``[macro] mesh``, :meth:`.PointContact.mesh`)."""
-    contact = ball_contact(case)
+    over it (``[macro] mesh``, :meth:`.PointContact.mesh`), of its ``contact`` (None: the
+    case's, :func:`ball_contact`)."""
+    contact = ball_contact(case) if contact is None else contact
     build = contact.mesh if case.macro.mesh == "graded" else contact.grid
     return build(case.macro.grid)
 

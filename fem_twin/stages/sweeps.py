@@ -6,29 +6,42 @@ from __future__ import annotations
 from concurrent.futures import wait
 from dataclasses import dataclass, replace
 from pathlib import Path
+from types import SimpleNamespace
 from typing import NamedTuple
 
 import numpy as np
 from tqdm import tqdm
 
+from ..errors import ForeignCheckpoint
+from ..io.checkpoint import check_made_for
 from ..macro.nested import nested_levels
 from ..numerics.threads import worker_heap
 from ..runtime.cost import sweep_cost
 from ..stribeck import stribeck_sweep
 from ..stribeck.curve import joined
-from ..stribeck.sweep import checkpointed, point_file, point_files, point_key, readable_meta
+from ..stribeck.sweep import (
+    _curve,
+    _record,
+    checkpointed,
+    point_file,
+    point_files,
+    point_key,
+    readable_meta,
+)
 
 
 @dataclass(frozen=True)
 class SweptPoint:
     """A checkpointed point of a sweep: the ``sweep`` (the request's index in the tasks),
     its sweep ``speed`` [m/s] (sliding, or entrainment, by the request's motion), its
-    checkpoint ``path`` and its ``meta`` (read once, without the fields)."""
+    checkpoint ``path``, and its ``meta`` and ``scalars`` (those of
+    :meth:`~fem_twin.macro.MixedResult.scalars`), read once without the fields."""
 
     sweep: int
     speed: float
     path: Path
     meta: dict
+    scalars: dict
 
 
 class Swept(NamedTuple):
@@ -52,42 +65,94 @@ def point_index(tasks) -> tuple[SweptPoint, ...]:
                 continue
             scalars, meta = read
             found.append(SweptPoint(i, task.motion.sweep_speed(scalars["speed"], meta), path,
-                                    meta))
+                                    meta, scalars))
         out += sorted(found, key=lambda p: -p.speed)
     return tuple(out)
 
 
+class Plan(NamedTuple):
+    """The work of :func:`run_sweeps`' tasks (:func:`plan`), in the order it runs: the
+    ``guides``' chains of their missing points, first; the unguided sweeps as ``chains``,
+    each ``(sweep, request)`` (the sweep: its task's index), beside them; then the guided
+    sweeps' missing ``points``, each a task after its guide's point there, and the
+    ``followers``' chains (:func:`missing_chains`), each after the guides' points at its
+    speeds."""
+
+    guides: list
+    chains: list
+    points: list
+    followers: list
+
+
+def plan(tasks, workers: int, followers=(), whole: bool = False) -> Plan:
+    """The :class:`Plan` of the sweeps ``tasks`` and ``followers`` on ``workers`` workers
+    (``whole``: each unguided sweep one chain, :func:`chains`)."""
+    guides = [guide_of(task) for task in tasks]
+    unguided = [i for i, guide in enumerate(guides) if guide is None]
+    pieces = chains([tasks[i] for i in unguided], workers, whole)
+    return Plan(guides=[chain for guide in guides if guide is not None
+                        for chain in missing_chains(guide)],
+                chains=[(unguided[j], piece) for j, piece in pieces],
+                points=[point for task, guide in zip(tasks, guides) if guide is not None
+                        for point in guided_points(task, guide.key)],
+                followers=[chain for sweep in followers for chain in missing_chains(sweep)])
+
+
 def run_sweeps(tasks, executor=None, progress: bool = True, desc: str = "Stribeck points",
-               followers=()):
+               followers=(), whole: bool = False) -> Swept:
     """The sweep requests ``tasks``, serial or as process tasks on ``executor``: their curves
     in the order of ``tasks`` and the index of their checkpointed points (:class:`Swept`).
     ``followers``: sweeps that start from the guides' points (the patch band), run beside
     the guided points as chains of their missing speeds (:func:`missing_chains`) and left
     in their checkpoints.  On a pool each guided sweep starts as soon as its guide's points
-    at its speeds are checkpointed, not after every guide (:func:`_run`).
+    at its speeds are checkpointed, not after every guide (:func:`_run`).  ``whole``: each
+    sweep without a guide runs as one chain, each missing point warm from the one before
+    (a refinement's last pass), however many the workers.
 
     A checkpointed sweep without a guide runs as guided points: first its guide
     (:func:`guide_of`, a chain on the coarsest nested grid), then every speed a task of its
     own, started from the guide's point there (``solve_nested``'s guide), then its curve
-    read back from the checkpoints (with its fields, in this process).  The others run as
-    chains of speeds (:func:`chains`): a band sweep, each point warm from its previous one
-    and its guide's change (a band point from its guide alone can take ten times as long in
-    the mixed regime), a sweep without checkpoints or coarser levels.  Tasks go largest
-    first; the work is the same whatever the workers, so the curves do not depend on them."""
-    guides = [guide_of(task) for task in tasks]
+    read from the index's scalars, without the points' fields (:func:`indexed_curve`).  The
+    others run as chains of speeds (:func:`chains`): a band sweep, each point warm from its
+    previous one and its guide's change (a band point from its guide alone can take ten
+    times as long in the mixed regime), a sweep without checkpoints or coarser levels.
+    Tasks go largest first; the work is the same whatever the workers, so the curves do
+    not depend on them."""
     workers = 1 if executor is None else getattr(executor, "n_workers", 1)
-    unguided = [i for i, guide in enumerate(guides) if guide is None]
-    pieces = chains([tasks[i] for i in unguided], workers)     # (index in unguided, piece)
-    leading = [piece for g in guides if g is not None for piece in missing_chains(g)]
-    swept = _run(leading + [piece for _, piece in pieces], executor, progress, desc,
-                 [point for i, (task, guide) in enumerate(zip(tasks, guides))
-                  if i not in unguided for point in guided_points(task, guide.key)]
-                 + [piece for f in followers for piece in missing_chains(f)])[len(leading):]
+    work = plan(tasks, workers, followers, whole)
+    ran = _run([*work.guides, *(chain for _, chain in work.chains)], executor, progress,
+               desc, [*work.points, *work.followers])
     own = {}
-    for (j, _), curve in zip(pieces, swept):
-        own.setdefault(unguided[j], []).append(curve)
-    return Swept([joined(own[i]) if i in own else stribeck_sweep(task)  # from the checkpoints
-                  for i, task in enumerate(tasks)], point_index(tasks))
+    for (sweep, _), curve in zip(work.chains, ran[len(work.guides):]):  # not the guides'
+        own.setdefault(sweep, []).append(curve)
+    points = point_index(tasks)
+    curves = [joined(own[i]) if i in own else indexed_curve(task, i, points)
+              for i, task in enumerate(tasks)]
+    if any(curve is None for curve in curves):      # read whole, which may add estimates
+        curves = [stribeck_sweep(task) if curve is None else curve
+                  for task, curve in zip(tasks, curves)]
+        points = point_index(tasks)
+    return Swept(curves, points)
+
+
+def indexed_curve(task, sweep: int, points):
+    """The curve of the checkpointed ``task`` from the scalars and meta of its points in
+    ``points`` (:func:`point_index`; ``sweep``: its index there), without their fields; or
+    None where :func:`~fem_twin.stribeck.stribeck_sweep` must read them whole: a speed
+    without a point made for it, a point without the error estimate the task asks for, or a
+    task that writes fields."""
+    if task.checkpoint is None or task.fields is not None:
+        return None
+    own = {p.path: p for p in points if p.sweep == sweep}
+    found = [own.get(point_file(task.checkpoint, task.key, u)) for u in task.speeds]
+    try:
+        for point, u in zip(found, task.speeds):
+            if point is None or (task.error_estimate and "error_estimate" not in point.meta):
+                return None
+            check_made_for(point.meta, task.key, u, point.path)
+    except ForeignCheckpoint:
+        return None
+    return _curve([_record(SimpleNamespace(**p.scalars, meta=p.meta)) for p in found], task)
 
 
 def guide_of(request):
@@ -168,23 +233,23 @@ def _guide_done(request) -> bool:
     return guide is None or all(point_file(folder, guide, u).exists() for u in request.speeds)
 
 
-def chains(tasks, workers: int) -> list:
+def chains(tasks, workers: int, whole: bool = False) -> list:
     """``[(task, request)]``: each sweep of ``tasks`` as chains of consecutive speeds, in
-    order.  A sweep that writes no fields and costs (:func:`_cost`) more than an even
-    share of the total over ``workers`` is cut into chains of about equal length, each
-    costing at most half such a share (one point at least), so that a largest-first
-    schedule keeps every worker busy to the end.  A chain's first point starts cold (from
-    the coarsest nested level), about as fast as a warm one on fine grids and with the same
-    C_f to 2e-6 (the resolution study's 999^2 sweep, ``fem-twin calibrate --study
-    resolution``; the cutting: ``tests/test_scaleout.py::
+    order.  Unless ``whole``, a sweep that writes no fields and costs (:func:`_cost`) more
+    than an even share of the total over ``workers`` is cut into chains of about equal
+    length, each costing at most half such a share (one point at least), so that a
+    largest-first schedule keeps every worker busy to the end.  A chain's first point
+    starts cold (from the coarsest nested level), about as fast as a warm one on fine grids
+    and with the same C_f to 2e-6 (the resolution study's 999^2 sweep, ``fem-twin
+    calibrate --study resolution``; the cutting: ``tests/test_scaleout.py::
     test_a_sweep_longer_than_a_workers_share_runs_as_chains``).  A sweep that writes fields
     stays whole (one VTU per speed, numbered along the sweep, and one PVD)."""
     share = sum(map(sweep_cost, tasks)) / max(workers, 1)
     out = []
     for i, task in enumerate(tasks):
         n = task.speeds.size
-        whole = workers <= 1 or task.fields is not None or sweep_cost(task) <= share
-        count = 1 if whole else min(n, int(np.ceil(2 * sweep_cost(task) / share)))
+        one = whole or workers <= 1 or task.fields is not None or sweep_cost(task) <= share
+        count = 1 if one else min(n, int(np.ceil(2 * sweep_cost(task) / share)))
         out += [(i, replace(task, speeds=task.speeds[part]))
                 for part in np.array_split(np.arange(n), count)]
     return out
