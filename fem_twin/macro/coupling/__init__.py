@@ -8,8 +8,7 @@ It reads the film solver (:mod:`fem_twin.macro.film`) and the laws
     problem      an operating point's assembled problem: grid, physics, eq 17's coefficients
     evaluation   the record of one evaluation of the coupled problem at a state
     start        cold starts: the rigid separations the iteration begins from
-    partitioned  the partitioned couplings (fixed-point iterations): Anderson and the
-                 paper's PID
+    partitioned  the partitioned couplings (fixed-point iterations): Anderson, paper's PID
     newton       the monolithic Newton coupling, for elastically dominated contacts
     jacobian     one Newton step's linear algebra: exact Jacobian, Schur preconditioner
     result       the converged point: fields, friction on the pin, files

@@ -58,8 +58,8 @@ def film_fields(name: str, film) -> FilmFields:
 
 
 class PinForce:
-    """The force on the pin (the default): ``(mu u_r / h_m) s_C (1 - theta) - (h_m/2)
-    (2 e1 - b) . grad p - (p - p_amb) dh_m/dx1``, the last term the film pressure on the
+    """The force on the pin, the default law; its traction ``(mu u_r / h_m) s_C (1 - theta)
+    - (h_m/2) (2 e1 - b)·grad p - (p - p_amb) dh_m/dx1``, the last term the film pressure on the
     slope of the pin's face; its Eyring shear spread over the cell's local shear
     (:func:`eyring_shear`); the disk's drag (``reading = "torque"``) is its force too."""
 
