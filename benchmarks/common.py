@@ -65,7 +65,7 @@ def macro_factors():
                            (64, 64))
     up = tp.resample_cell(prepare_patch(read_topography(os.path.join(SAMPLE, "patch_1_disk.npz")),
                                         upper=True), (64, 64))
-    return homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), n_steps=8)
+    return homogenise(low, up, np.geomspace(2e-8, 1e-6, 30), steps=8)
 
 
 def macro_gap(n):

@@ -61,7 +61,7 @@ def separations(low, up, targets=TARGETS) -> list[float]:
 
 def factors(low, up, n, steps, h0, moving):
     low, up = resample_cell(low, (n, n)), resample_cell(up, (n, n))
-    f = homogenise(low, up, h0, n_steps=steps, moving=moving, error_estimate=False, workers=2)
+    f = homogenise(low, up, h0, steps=steps, moving=moving, error_estimate=False, workers=2)
     return f.b[:, 0], f.d[:, 0], f.contact_fraction
 
 

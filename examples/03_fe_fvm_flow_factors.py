@@ -120,7 +120,7 @@ def main():
                 if path.is_file():                 # reloaded: no time to report
                     ff, t0 = FlowFactors.load(path), float("nan")
                 else:
-                    ff = homogenise(pin, disk, H0, n_steps=args.steps, method=method,
+                    ff = homogenise(pin, disk, H0, steps=args.steps, method=method,
                                     workers=args.workers)
                     ff.save(path)
                 seconds[method] = time.perf_counter() - t0
@@ -178,7 +178,7 @@ def against_reference(out, args, patches):
             ref = FlowFactors.load(path)
         else:
             pin, disk = (resample_cell(t, (512, 512)) for t in patch_pair(k))
-            ref = homogenise(pin, disk, H0, n_steps=2 * args.steps, workers=args.workers,
+            ref = homogenise(pin, disk, H0, steps=2 * args.steps, workers=args.workers,
                              error_estimate=False)
             ref.save(path)
         fe = flow_factor_differences(patches["fe"][k - 1], ref)

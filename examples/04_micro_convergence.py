@@ -69,7 +69,7 @@ def relative(a, ref):
 def study(k, workers, size=FULL):
     out = {"time": {}, "grid": {}}
     pin, disk = patch_pair(k, size["cell"])
-    runs = {nt: values(homogenise(pin, disk, H0, n_steps=nt, workers=workers))
+    runs = {nt: values(homogenise(pin, disk, H0, steps=nt, workers=workers))
             for nt in (*size["steps"], size["ref_steps"])}
     ref = size["ref_steps"]
     for nt in size["steps"]:
@@ -81,7 +81,7 @@ def study(k, workers, size=FULL):
             print(f"patch {k} {name:>22} vs exact {ref}: " + _row(row["error"])
                   + f"  time x{row['time_ratio']:.2f} of exact 32", flush=True)
     top = size["ref_grid"]
-    grids = {n: values(homogenise(*patch_pair(k, n), H0, n_steps=size["grid_steps"],
+    grids = {n: values(homogenise(*patch_pair(k, n), H0, steps=size["grid_steps"],
                                   workers=workers)) for n in (*size["grids"], top)}
     for n in size["grids"]:
         out["grid"][n] = relative(grids[n], grids[top]).tolist()
@@ -122,12 +122,12 @@ def schemes(pin, disk, reference, workers):
     """The paper's backward difference (32 and 128 steps), the exact scheme (32) and the
     adaptive instants (from 32, time_tol 0.005) against the exact scheme at 128 steps (every
     pixel translation of the 128 px cell), with wall times relative to exact 32."""
-    variants = {"backward, 32 steps": dict(n_steps=32, time_derivative="backward",
+    variants = {"backward, 32 steps": dict(steps=32, time_derivative="backward",
                                            moving="upper"),
-                "backward, 128 steps": dict(n_steps=128, time_derivative="backward",
+                "backward, 128 steps": dict(steps=128, time_derivative="backward",
                                             moving="upper"),
-                "exact, 32 steps": dict(n_steps=32),
-                "adaptive, tol 0.005": dict(n_steps=32, time_tol=0.005)}
+                "exact, 32 steps": dict(steps=32),
+                "adaptive, tol 0.005": dict(steps=32, time_tol=0.005)}
     out, seconds = {}, {}
     for name, kw in variants.items():
         t0 = time.perf_counter()

@@ -43,7 +43,7 @@ def striated(h0, body, n=64):
     flat = Topography(np.zeros_like(z), (dx, dx))
     rough = Topography(z if body == "pin" else -z, (dx, dx))
     pair = (rough, flat) if body == "pin" else (flat, rough)
-    return homogenise(*pair, h0, n_steps=8, error_estimate=False)
+    return homogenise(*pair, h0, steps=8, error_estimate=False)
 
 
 def closed_form(h0):
@@ -80,7 +80,7 @@ def twin(h_o, load):
     z = np.tile(RIDGE * np.cos(2 * np.pi * np.arange(n) / n), (4, 1))
     dx = SLIDER / 50 / n
     ff = homogenise(Topography(z, (dx, dx)), Topography(np.zeros_like(z), (dx, dx)),
-                    np.geomspace(0.95 * h_o, 1.05 * RATIO * h_o, 24), n_steps=4,
+                    np.geomspace(0.95 * h_o, 1.05 * RATIO * h_o, 24), steps=4,
                     e_reduced=4e12, error_estimate=False)
     gap, dx = strip(h_o * (1 + (RATIO - 1) * (1 - np.linspace(0, SLIDER, 201) / SLIDER)))
     out = {}

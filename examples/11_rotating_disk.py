@@ -60,7 +60,7 @@ def main(out="out/rotating_disk", quick=False):
     low = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_pin.npz")), (32, 32))
     up = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"), upper=True),
                        (32, 32))
-    factors = homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), n_steps=4)
+    factors = homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), steps=4)
     gap, dx, face = geometry(48 if quick else 96)
     speeds = np.geomspace(1.0, 0.005, 8 if quick else 16)
     uniform = sweep(gap, dx, face, factors, speeds, None)

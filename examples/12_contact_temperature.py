@@ -61,7 +61,7 @@ def sample_sweep(n, speeds):
     low = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_pin.npz")), (32, 32))
     up = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_1_disk.npz"), upper=True),
                        (32, 32))
-    factors = homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), n_steps=4)
+    factors = homogenise(low, up, np.geomspace(2e-8, 1e-6, 14), steps=4)
     return SweepRequest(disk.heights - pin.heights, pin.spacing, factors, speeds, load=150.0,
                         lubricant=Lubricant(0.066), face=pin_face(pin, opts.holder_height),
                         settings=MacroSettings(track_radius=30e-3))

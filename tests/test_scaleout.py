@@ -41,7 +41,7 @@ def small_sweep():
     low = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_2_pin.npz")), (16, 16))
     up = resample_cell(prepare_patch(read_topography(SAMPLE / "patch_2_disk.npz"), upper=True),
                   (16, 16))
-    ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 8), n_steps=4)
+    ff = homogenise(low, up, np.geomspace(2e-8, 1e-6, 8), steps=4)
     return dict(gap=disk.heights - pin.heights, spacing=pin.spacing, factors=ff,
                 speeds=np.geomspace(1.0, 0.02, 4), load=150.0,
                 face=pin.heights > -0.5e-3)
@@ -106,7 +106,7 @@ def test_micro_tasks_follow_the_cluster_size():
     h0 = np.geomspace(2e-7, 1e-6, 40)
     for workers, tasks in ((2, 8), (16, 40)):
         Recorder.sizes = []
-        homogenise(low, up, h0, n_steps=2, executor=Recorder(), workers=workers,
+        homogenise(low, up, h0, steps=2, executor=Recorder(), workers=workers,
                    error_estimate=False)
         assert len(Recorder.sizes) == tasks and sum(Recorder.sizes) == h0.size
 

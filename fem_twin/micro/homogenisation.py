@@ -54,9 +54,9 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
     ``pin`` and ``disk``: periodic cells on one grid, zero mean plane, the disk flipped over
     the pin (:func:`fem_twin.topography.prepare.prepare_patch`); the gap is ``h0 + disk -
     pin + deformation``.  ``h0`` default: 100 values in [0.1, 1] um.  ``settings``: a
-    :class:`~fem_twin.micro.CellSettings`, or its fields as ``**shortcuts`` (``n_steps``:
-    ``steps``).  ``workers`` processes, or any ``executor`` (Dask's), take the h0 values as
-    ``4 workers`` warm-started tasks; ``checkpoint``: a folder keeping each finished h0 (a
+    :class:`~fem_twin.micro.CellSettings`, or its fields as ``**shortcuts``.  ``workers``
+    processes, or any ``executor`` (Dask's), take the h0 values as ``4 workers``
+    warm-started tasks; ``checkpoint``: a folder keeping each finished h0 (a
     rerun resumes); ``progress``: a bar, or a bar to share; ``patch_id``: for the metadata.
     ``error_estimate``: the time and grid errors (:mod:`fem_twin.micro.estimate`).
     ``h0_tol``: solve only the subset of ``h0`` the log-h0 interpolant needs to miss the
@@ -128,10 +128,7 @@ def _estimated(factors, moments, coarse, settings, bound):
 
 def _settings(settings: CellSettings | None, shortcuts: dict) -> CellSettings:
     """``settings`` (default ``CellSettings()``) with the keyword ``shortcuts`` replacing
-    its fields (``n_steps``: the historical keyword of ``steps``); a typo is refused."""
-    if "n_steps" in shortcuts:
-        shortcuts = {**shortcuts, "steps": shortcuts["n_steps"]}
-        del shortcuts["n_steps"]
+    its fields; a typo is refused."""
     names = [f.name for f in fields(CellSettings)]
     unknown = set(shortcuts) - set(names)
     if unknown:
