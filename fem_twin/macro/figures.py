@@ -9,7 +9,6 @@ import numpy as np
 
 from ..io.figure import save_figure
 from ..numerics.graded_mesh import Mesh
-from .coupling.result import MixedResult
 from .laws.kinematics import node_lines
 
 #: (field, colour-bar label, scale to the plotted unit)
@@ -19,8 +18,8 @@ PANELS = (("pressure_gauge", "hydrodynamic pressure $p - p_{amb}$ [MPa]", 1e-6),
 
 
 def plot_point_fields(results, path, titles=None) -> Path:
-    """One row per :class:`MixedResult`: the three fields on the pin face (the holder is
-    blank), x1 (sliding) to the right, in mm; written atomically."""
+    """One row per :class:`~fem_twin.macro.MixedResult`: the three fields on the pin face
+    (the holder is blank), x1 (sliding) to the right, in mm; written atomically."""
     import matplotlib.pyplot as plt
     results = list(results)
     fig, ax = plt.subplots(len(results), 3, figsize=(12, 3.4 * len(results)),
@@ -50,13 +49,3 @@ def _draw(ax, x1, x2, field, graded: bool):
     pitch1, pitch2 = x1[1] - x1[0], x2[1] - x2[0]
     extent = (0, x1.size * pitch1, 0, x2.size * pitch2)
     return ax.imshow(field, origin="lower", extent=extent, cmap="viridis")
-
-
-def plot_point_files(files, path, viscosity: float) -> Path:
-    """:func:`plot_point_fields` of the points checkpointed in ``files`` (one
-    :class:`MixedResult` each), titled with the viscosity ``viscosity`` [Pa s], the speed
-    and C_f: a figure a worker process draws from the files alone."""
-    results = [MixedResult.load(f) for f in files]
-    return plot_point_fields(results, path, titles=[
-        f"$\\mu_0$ = {viscosity:g} Pa s, U = {r.speed:.3g} m/s, "
-        f"$C_f$ = {r.friction_coefficient:.4f}" for r in results])
