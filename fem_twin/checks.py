@@ -109,8 +109,8 @@ def plausible(name: str, value, quantity: str):
 
 
 #: peak memory a grid point takes in one process [B]: a macro node (the 2048^2 point of
-#: ``benchmarks/run.py scale``) and a cell pixel (PARDISO, 256^2 to 1024^2; both in
-#: benchmarks/README.md), and a pixel of a resampled map (its two coordinate grids, the
+#: ``benchmarks/run.py scale``) and a cell pixel (PARDISO, 256^2 to 1024^2: ``micro``),
+#: and a pixel of a resampled map (its two coordinate grids, the
 #: interpolated heights and the topography's copy, float64 each)
 BYTES_PER_POINT = {"macro": 1.9e3, "cell": 3.2e3, "map": 32.0}
 

@@ -228,7 +228,8 @@ class RunSpec:
     patch_band: bool = setting(True, "one more sweep per patch: the roughness scatter band "
                                "(Figure 13)", unit="true or false")
     # "coarsest": a patch's C_f within 0.45 % C_f,b of the band swept on the full grid,
-    # on a band about 46 % C_f,b wide, at a third of the time (benchmarks/README.md)
+    # on a band about 46 % C_f,b wide, at a third of the time (docs/accuracy.md, "The patch
+    # scatter band"; python benchmarks/run.py paper)
     band_grid: str = setting("coarsest", "the band's macro grid, C_f corrected by the "
                              "average curve's relative change to the full grid: \"coarsest\" (the "
                              "grid coarsened down to 48-95 px a side: 64^2 from 128^2 to "
@@ -236,7 +237,7 @@ class RunSpec:
                              unit="coarsest, coarse or full",
                              choices=("coarsest", "coarse", "full"))
     # 1e-3: the patches' C_f within 0.04 % C_f,b of 1e-4, far below the band's own grid
-    # error, in fewer Newton steps (benchmarks/README.md)
+    # error, in fewer Newton steps (python benchmarks/run.py paper)
     band_tol: float = setting(1e-3, "coupling tolerance of the band's sweeps ([macro] tol "
                               "for the main curves, which carry the error estimates)",
                               "solver_tolerance")

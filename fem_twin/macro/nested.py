@@ -86,7 +86,7 @@ def _film_from(coarse: MixedResult, start: MixedResult) -> MixedResult:
     interpolated: where film and cavity meet.  Moved by the coarse change instead, the
     previous point's free boundary lies farther from the new one than the coarse solution's
     does: its first Reynolds solve switches about twice the nodes in twice the
-    factorisations (benchmarks/README.md, "macro/nested")."""
+    factorisations (``python benchmarks/run.py scale``)."""
     shape, spacing = start.pressure.shape, start.spacing
     return replace(start, pressure=resampled(coarse.pressure, coarse.spacing, shape, spacing),
                    cavity_fraction=np.clip(resampled(coarse.cavity_fraction, coarse.spacing,

@@ -34,8 +34,8 @@ ARRAYS = ("h0", "h_m", "p_con", "A", "b", "C", "d", "friction_factor", "pressure
 OPTIONAL = ("film_fraction", "log_friction", "thin_friction", "thin_area")
 #: p_con is interpolated as ``log(p_con + P_CON_FLOOR max p_con)``: it falls by a factor of
 #: about 3 per 40 nm of h0, so its logarithm interpolates seven times closer than p_con
-#: itself (benchmarks/README.md); the floor keeps the log finite where the surfaces
-#: separate (p_con = 0)
+#: itself (the measurement is in the commit that chose it, 6d49f8d); the floor keeps the
+#: log finite where the surfaces separate (p_con = 0)
 P_CON_FLOOR = 1e-6
 #: what the friction needs beyond the Reynolds equation (eqs 31-32, the force on the pin)
 SHEAR = ("C", "d", "friction_factor", "pressure_friction", "contact_fraction", "film_fraction",

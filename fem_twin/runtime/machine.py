@@ -12,7 +12,7 @@ with the sparse backend and the heap the run's workers will use, and divides eac
 time at the calibration.  Each miniature runs in as many processes at once as the run has
 local workers (at most one a core), so a load on another core slows the probes as it will
 slow the workers.  It sees the machine for about two seconds, so the estimate carries the
-scatter of the machine's speed within a minute (benchmarks/README.md, "speed").
+scatter of the machine's speed within a minute (``python benchmarks/run.py estimates``).
 """
 
 from __future__ import annotations
@@ -35,8 +35,8 @@ from ..topography.synthetic import self_affine
 
 #: the miniatures' times on the calibration machine, the hour the estimate's costs were
 #: measured (best of five, PARDISO) [s]: the cells' was timed then; the macro point's is
-#: the cells' times their ratio on that machine, timed back to back (benchmarks/README.md,
-#: "The run-time cost model")
+#: the cells' times their ratio on that machine, timed back to back (``python
+#: benchmarks/run.py estimates`` checks the estimate against the run)
 REFERENCE_SECONDS = {"micro": 0.18, "macro": 0.84, "ball": 0.88}
 #: timed repeats of each miniature (the best counts: the machine's speed, not a hiccup)
 REPEATS = {"micro": 5, "macro": 3, "ball": 3}

@@ -38,7 +38,7 @@ RETRIES = 12
 STAGNATION = 25
 #: the inner Reynolds solves stop after ``MacroSettings.inner_steps`` Newton steps while the
 #: coupling residual exceeds this multiple of ``tol``: about twice as fast as exact inner
-#: solves, C_f the same to 3e-7 C_f,b (benchmarks/README.md, "fixed_point")
+#: solves, C_f the same to 3e-7 C_f,b (``python benchmarks/run.py macro``)
 INEXACT = 10.0
 #: the last Anderson differences of a coarser grid's solve that seed a finer one's
 #: (:class:`Secants`; sample pin 1 at 0.03 m/s, cold nested points: the 512^2 grid 10
@@ -49,8 +49,8 @@ SEED_PAIRS = 4
 #: most this fraction of the nodes its first step switched (``settle`` of
 #: :func:`.switch.solve_complementarity`), instead of solving to convergence: from a coarser
 #: grid's film the last steps switch a handful of nodes each and cost a fifth of the fine
-#: level; 0.01 saves it without more coupling iterations (benchmarks/README.md,
-#: "fixed_point")
+#: level; 0.01 saves it without more coupling iterations (``python benchmarks/run.py
+#: scale``)
 SETTLE = 0.01
 
 
@@ -276,7 +276,7 @@ def elastic_ratio(ev, op, s) -> float:
     the 63^2 coarse start of sample pin 1 at 500, 999 and 1997 px (0.003 and 0.03 m/s),
     whose levels then all took the Newton coupling, and a 1997^2 point ran out of 24 GB.
     Without them smooth balls give 11-241 and the sample pin 0.22-13.3
-    (benchmarks/README.md, "fixed_point")."""
+    (``python benchmarks/run.py scale`` and ``newton``)."""
     p_gauge = ev.p + s.cavitation_pressure - s.ambient_pressure
     film = ev.h0[(p_gauge > 0) & (ev.h0 > 2 * s.gap_floor)]
     if not film.size:

@@ -64,7 +64,7 @@ class MacroSettings:
     anderson_depth: int = setting(8, "iterates the Anderson acceleration keeps",
                                  "history")
     # 0.5: fewer coupling iterations than undamped, C_f the same to 3.3e-5 C_f,b
-    # (benchmarks/README.md, "macro/coupling/settings")
+    # (``python benchmarks/run.py newton``)
     anderson_damping: float = setting(0.5, "damping beta of the Anderson step (1: undamped)",
                                       "relaxation")
     inner_steps: int = setting(1, "Newton steps per Reynolds solve while far from the fixed "

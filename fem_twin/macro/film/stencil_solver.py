@@ -9,8 +9,8 @@ next steps of the same inner solve: a matrix that differs in the ``m`` columns o
 switched since is solved with them updated by the Woodbury identity (Hager 1989) as the
 refinement's preconditioner, when that takes at most :meth:`_Grid.budget` solves.  A step
 is returned only when it solves ``J x = rhs`` to ``STEP_RTOL``; the factors are freed when
-the inner solve ends (``step.release()``).  Measurements: ``benchmarks/README.md``
-("stencil_solver")."""
+the inner solve ends (``step.release()``).  Measured by ``python benchmarks/run.py scale``
+and ``amg``."""
 
 from __future__ import annotations
 
