@@ -202,7 +202,7 @@ def test_example_case_ships_with_the_package(tmp_path, capsys):
 def test_run_time_estimates_hold():
     """Fem-twin run's estimate lies within 0.8-1.25x of the wall time measured on 2 cores,
     the calibration machine's costs scaled by the two probes of fem_twin.runtime.machine
-    taken before the same run (`benchmarks/run.py estimates`, 2026-11-29, AMD EPYC): the
+    taken before the same run (`benchmarks/run.py estimates`, AMD EPYC): the
     bundled, ball and paper cases with PARDISO, quiet and beside a busy loop on one of the
     two cores (a slower machine, the probes run side by side as the workers), and with
     SuperLU (FEM_TWIN_SPARSE=superlu, a machine without MKL, where the cells slow down

@@ -395,7 +395,7 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
     grid.  On the bundled case (64^2 against 128^2) a patch's C_f is then within 0.31 %
     C_f,b on a band up to 46.2 % C_f,b wide (docs/accuracy.md); here, at 24^2 against 48^2
     (a coarse grid of 24^2 nodes over the pin), 2.9 % of the band's width (0.00072 on
-    0.025, 2026-11-26); asserted below a tenth of it."""
+    0.025); asserted below a tenth of it."""
     from fem_twin.macro import MixedResult
     from fem_twin.results import open_run
     from fem_twin.stribeck.curve import HEADERS

@@ -5,7 +5,7 @@ patch 1 at 32^2 pixels with 16 h0 x 8 steps.  The reference doubles the resoluti
 scales (96^2 macro, 64^2 cell), doubles the h0 density (31 h0) and takes four times the
 steps (32).  At every speed from full film to the boundary regime the estimate is never
 below the change to the reference, or both are below 0.05 % C_f,b (floor).  Measured
-(2026-11-26, Galerkin contact load, p_con interpolated in log): effectivities 1.27, both
+(Galerkin contact load, p_con interpolated in log): effectivities 1.27, both
 below the floor, 1.76, 7.8, 2.87, 1.44 from 1 to 0.01 m/s.  The bar of issue 27 is 1 to 3;
 at 0.03 m/s the grid part (the 32^2 cell against its 16^2 coarsening, -2.57 % C_f,b)
 overstates the micro error (+0.26 % from the refined factors alone) and has the other

@@ -14,7 +14,7 @@ SHARED = ROOT.parent / "shared" / "topographies"
 
 
 #: one number per example, read from its output at ``--quick`` size, and the range it
-#: must fall in with the reason (measured 2026-11-29); the two examples on the shared
+#: must fall in with the reason (measured); the two examples on the shared
 #: instrument files have none (they skip in a fresh clone)
 PINNED = {
     "01_topography_pipeline": (r"pin 3: .*Sq=([\d.e-]+) m", 3.88e-4, 4.04e-4,

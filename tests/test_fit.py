@@ -97,7 +97,7 @@ def test_prediction_at_another_temperature_holds_the_twin(twin):
     """Fitted at 35 C (C_f,b = 0.15, noise 1 %), predicted at 45 C from simulated curves at
     24 and 50 C: the twin run at mu(45 C) directly lies within 0.5 % C_f,b of the predicted
     95 % band (the parameters' interval plus the spread of the two rescaled curves).
-    Measured (2026-11-26, 20 simulated speeds): inside the band at all 9 speeds; with 14
+    Measured (20 simulated speeds): inside the band at all 9 speeds; with 14
     simulated speeds and p_con read at the nodes it was outside at 4, by at most 0.21 %
     C_f,b: the Hersey collapse is not exact in the mixed regime (elasticity and Roelands do
     not scale with mu U), and two curves that agree with each other need not bound it."""
@@ -188,7 +188,7 @@ def test_a_curve_no_parameters_fit_is_refused_naming_its_residual(twin, factors)
     """A curve rising with speed cannot be fitted by C_f,b and the temperature, nor one
     measured at 600 N (four times the case's load) with a +-2 % scatter band at the known
     temperature: InputError with the rms and the largest C_f,dev.  Without a band, the
-    600 N curve fits C_f,b within 3.2 % rms of C_f,b (measured 2026-11-26): scatter of that
+    600 N curve fits C_f,b within 3.2 % rms of C_f,b (measured): scatter of that
     size cannot be told from a wrong load, and with the temperature free the Hersey collapse
     absorbs part of the load (29.0 C fitted for 24 C; the fit flags a temperature more
     than TEMPERATURE_OFFSET = 15 K from its curve's)."""

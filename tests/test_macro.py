@@ -501,7 +501,7 @@ def test_nested_levels_each_start_from_the_next_coarser_change(factors, monkeypa
     """fem_twin.macro.nested on three levels (the coarse start lowered to 28 nodes: 112^2,
     56^2, 28^2): every level of a warm point starts from the previous point's same level
     moved by the change one level down, so the middle level needs fewer iterations than
-    from the previous point's middle level alone (measured 2026-11-26: 21 against 26), and
+    from the previous point's middle level alone (measured: 21 against 26), and
     every level reaches the point a plain warm start reaches (C_f within 1e-6 C_f,b: both
     stop at the coupling tolerance 1e-6)."""
     from fem_twin.macro import mixed
@@ -537,7 +537,7 @@ def test_the_patch_band_starts_from_the_main_points_nested_levels(tmp_path, fact
     sweep then solves nothing), and a sweep of other factors on that grid guided by them
     reaches the points an unguided sweep reaches (C_f within 1e-6 C_f,b: both stop at the
     coupling tolerance 1e-6) in fewer coupling iterations (96^2 main grid, band at 48^2,
-    measured 2026-11-26: 81 against 110 over four speeds, C_f within 3.6e-7 C_f,b)."""
+    measured: 81 against 110 over four speeds, C_f within 3.6e-7 C_f,b)."""
     from dataclasses import replace as moved
 
     from fem_twin.macro import nested
@@ -617,7 +617,7 @@ def test_contact_quadrature_converges_on_the_pin(factors):
     """On sample pin 1 in the mixed regime (0.03 m/s, a fifth of the load on the
     asperities) C_f from 48^2 to 96^2 (each prepared from the measured map) moves by
     0.26 % C_f,b with the "gauss" contact quadrature and by 2.1 % read at the nodes (64^2
-    to 128^2: 0.28 and 2.4 %; 2026-11-25): asserted below a quarter; and the two rules
+    to 128^2: 0.28 and 2.4 %): asserted below a quarter; and the two rules
     approach each other."""
     cf = {}
     for n in (48, 96):
@@ -636,7 +636,7 @@ def test_a_cold_nested_point_starts_from_the_coarse_levels_anderson_pairs(factor
     from the coarse level's last differences (Secants), interpolated, and converges to the
     point that the same start without them reaches (C_f within 1e-6 C_f,b: both stop at
     the coupling tolerance 1e-6) in fewer iterations (sample pin 1 at 192^2, 0.03 m/s,
-    measured 2026-11-27: 18 against 22)."""
+    measured: 18 against 22)."""
     from fem_twin.macro.mixed import seeded_point
     from fem_twin.macro.nested import solve_nested
     from fem_twin.macro.point import OperatingPoint
