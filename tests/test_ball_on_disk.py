@@ -70,6 +70,8 @@ def test_ball_on_disk_stribeck_curve_from_ehl_to_boundary(tmp_path):
     ("ball_radius = 9.525e-3", "ball_radius = 9.525e-3\npin_diameter = 8e-3",
      r"\[tribometer\] pin_diameter: a pin's setting, unused by a ball"),
     ("grid = 73", "grid = 73\npin = 2", r"\[macro\] pin: a pin's setting"),
+    ("grid = 73", 'grid = 72\nmesh = "graded"', r"\[macro\] grid = 72: a graded mesh needs an odd"),
+    ("grid = 73", 'grid = 73\nmesh = "fine"', "mesh"),
     ("[micro]\nresolution", "[preprocessing]\nresolution = [48, 48]\n[micro]\nresolution",
      r"\[preprocessing\] resolution: a pin's setting")])
 def test_ball_case_keys_are_validated_with_units(tmp_path, old, new, key):

@@ -269,7 +269,8 @@ def test_a_balls_slide_to_roll_has_one_range_and_a_pin_case_has_none(tmp_path, s
     with pytest.raises(CaseError, match=r"in \(0, 2\]"):
         load_case(tmp_path / "ball.toml")
     pin = small_case(tmp_path).read_text()
-    for key, line in (("slide_to_roll", "slide_to_roll = 0.5"), ("grid", "grid = 97")):
+    for key, line in (("slide_to_roll", "slide_to_roll = 0.5"), ("grid", "grid = 97"),
+                      ("mesh", 'mesh = "graded"')):
         section = "[tribometer]" if key == "slide_to_roll" else "[macro]"
         (tmp_path / "pin.toml").write_text(pin.replace(section, f"{section}\n{line}", 1))
         with pytest.raises(CaseError, match=f"{key}: a ball-on-disk setting"):

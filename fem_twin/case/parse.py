@@ -125,7 +125,9 @@ UNUSED = {"pin-on-disk": {
     for key in ("slide_to_roll", "ball_radius", "track_radius")} | {
     ("macro", "grid"): "a ball-on-disk setting, unused in a pin case; remove it, or set "
                        '[tribometer] kind = "ball-on-disk" (a pin\'s grid is [preprocessing] '
-                       "resolution)"},
+                       "resolution)",
+    ("macro", "mesh"): "a ball-on-disk setting, unused in a pin case (a pin's face fills "
+                       "its grid); remove it, or set [tribometer] kind = \"ball-on-disk\""},
     "ball-on-disk": {("tribometer", "sliding_radius"): "a pin's track, unused by a ball; a "
                                                        "ball's is track_radius"} | {
     key: "a pin's setting, unused by a ball (its macro gap is its sphere, on [macro] grid); "
@@ -292,6 +294,10 @@ def _macro(data, where, tribometer, geometry) -> MacroSpec:
     if not 9 <= macro.grid <= 1025:
         raise CaseError(f"{where} [macro] grid: nodes per side of the ball's grid, 9 to 1025 "
                         f"(e.g. 97), got {macro.grid}")
+    if macro.mesh == "graded" and macro.grid % 2 == 0:
+        raise CaseError(f"{where} [macro] grid = {macro.grid}: a graded mesh needs an odd "
+                        "number of nodes (its error estimate's coarser mesh halves the grid), "
+                        f"e.g. {macro.grid + 1}")
     if tribometer.reading == "torque" and not FRICTION_LAWS[macro.friction].drag:
         raise CaseError(f"{where} [tribometer] reading = \"torque\": the disk's drag is the "
                         "force law's; it needs [macro] friction = \"pin\"")
