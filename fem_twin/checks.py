@@ -320,8 +320,13 @@ def _whole(default) -> bool:
 
 
 def check_choice(name: str, value, choices) -> None:
-    """Refuse ``value`` outside ``choices`` (none: any), naming ``name``."""
-    if choices and value not in choices:
+    """Refuse ``value`` outside ``choices`` (none: any; a registry: its keys), naming
+    ``name``; an unhashable value (a list) is outside a registry too."""
+    try:
+        inside = not choices or value in choices
+    except TypeError:                                  # a list looked up in a registry
+        inside = False
+    if not inside:
         raise InputError(f"{name}: one of {', '.join(map(repr, choices))}, got {value!r}")
 
 

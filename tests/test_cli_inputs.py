@@ -544,3 +544,15 @@ def test_negative_numbers_in_exponent_form_are_values(tmp_path, capsys):
     assert main(["topography", "clip", str(ROOT / "meshes/sample/patch_1_pin.npz"), str(out),
                  "--lower", "1e-6", "--upper", "-1e-6"]) == 2
     assert "lower < upper" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("line", ["friction = []", 'friction = ["pin"]'])
+def test_a_list_where_a_registered_law_is_named_is_refused_with_the_choices(tmp_path, line):
+    """A law's key takes one of its registry's names; a list there (a hypothesis example
+    that had raised TypeError, unhashable, out of the parser) is a CaseError naming the
+    choices."""
+    text = small_case(tmp_path).read_text()
+    assert 'friction = "pin"' in text
+    (tmp_path / "bad.toml").write_text(text.replace('friction = "pin"', line, 1))
+    with pytest.raises(CaseError, match="friction: one of 'pin', 'paper'"):
+        load_case(tmp_path / "bad.toml")
