@@ -30,6 +30,10 @@ class Check:
     holds: bool | None
     text: str
 
+    def __post_init__(self):        # a numpy bool would not go into the results' JSON
+        if self.holds is not None:
+            object.__setattr__(self, "holds", bool(self.holds))
+
     def line(self) -> str:
         if self.holds is None:
             return f"check: {self.text}: skipped"

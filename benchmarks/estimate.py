@@ -1,38 +1,61 @@
-"""Group ``estimate``: the honesty of the C_f error estimate at full size, on the bundled
-case; ``estimate-paper`` runs it on the paper case.  Checked: the estimate is nowhere below
-the change to the reference (or both are under the 0.05 % C_f,b floor); the rows mark each
-speed ``ok`` (effectivity 1 to 3, or both under the floor) or ``OUTSIDE``."""
+"""Group ``estimate``: the C_f error estimate against refined runs, in total and part by part,
+on the bundled pin; ``estimate-paper`` and ``estimate-ball`` run it on the paper case and
+the bundled ball.
+
+    FEM_TWIN_BENCH_DIR=DIR python benchmarks/run.py estimate    # about 6 min on 2 cores
+
+The case with its first patch pair, its first viscosity, isothermal, no speed refinement and
+no band.  The reference refines everything at once: the macro grid twice as fine (a ball's
+``[macro] grid`` 2n - 1), the cells twice, four times the steps, twice the h0 candidates
+(a pin's and a ball's every one of them).  Each part's own change refines that alone.  Rows,
+per speed: the estimate, the change to the reference (the truth) and their ratio, the
+effectivity (``ok``: 1 to 3, or both under 0.05 % C_f,b); then each part's signed estimate
+over its own signed change (negative: the wrong sign).  Checked: the estimate is nowhere below
+the truth (or both are under the floor).  ``$FEM_TWIN_BENCH_DIR`` keeps the refined runs and
+reads a finished one again; the base run is always made anew."""
 
 from __future__ import annotations
 
 import os
+import shutil
 import time
+from dataclasses import replace
 
+import numpy as np
 from common import Check
 
 DEFAULT = False
 HERE = os.path.dirname(os.path.abspath(__file__))
+#: the truth's floor: below it on both sides a speed is ``ok`` [fraction of C_f,b]
+FLOOR = 5e-4
+#: the parts refined one at a time, each against its own part of the estimate
+PARTS = ("macro", "time", "grid", "h0")
 
 
-def _refined(case, scale, steps, h0, every_h0=False):
-    """``case`` with both grids ``scale`` times finer, ``steps`` x the instants and the h0
-    candidates refined ``h0`` times (old candidates kept), all of them solved with
-    ``every_h0``."""
-    from dataclasses import replace
+def _refined(case, parts, every_h0):
+    """``case`` with the ``parts`` refined: ``"macro"`` (a pin's maps resampled twice as
+    fine, a ball's grid 2n - 1), ``"grid"`` (cells twice as fine), ``"time"`` (four times the
+    steps), ``"h0"`` (twice the candidates, all of them solved with ``every_h0``)."""
+    pre, micro, macro = case.preprocessing, case.micro, case.macro
+    if "macro" in parts and case.tribometer.ball:
+        macro = replace(macro, grid=2 * macro.grid - 1)
+    elif "macro" in parts:
+        pre = replace(pre, resolution=tuple(2 * n for n in pre.resolution))
+    if "grid" in parts:
+        micro = replace(micro, resolution=tuple(2 * n for n in micro.resolution))
+    if "time" in parts:
+        micro = replace(micro, steps=4 * micro.steps)
+    if "h0" in parts:
+        micro = replace(micro, h0_count=2 * (micro.h0_count - 1) + 1,
+                        h0_tol=0.0 if every_h0 else micro.h0_tol)
+    return replace(case, preprocessing=pre, micro=micro, macro=macro)
 
-    res = tuple(scale * n for n in case.preprocessing.resolution)
-    cell = tuple(scale * n for n in case.micro.resolution)
-    return replace(case, preprocessing=replace(case.preprocessing, resolution=res),
-                   micro=replace(case.micro, resolution=cell, steps=steps * case.micro.steps,
-                                 h0_count=h0 * (case.micro.h0_count - 1) + 1,
-                                 h0_tol=0.0 if every_h0 else case.micro.h0_tol))
 
-
-def _run_kept(case, name, reuse=False):
-    """Run ``case`` into ``$FEM_TWIN_BENCH_DIR/name`` (kept, so an interrupted reference
-    resumes from its checkpoints) or a temporary directory; wall time [s] and the curve.
-    ``reuse``: a kept folder that holds a finished run is read as it is (its wall time from
-    its summary.json), even when the code has changed since: a reference solution."""
+def _run_kept(case, name, reuse=True):
+    """Run ``case`` into ``$FEM_TWIN_BENCH_DIR/name`` (or a temporary folder, then read);
+    ``(wall time [s], curve, signed estimate parts by speed)``.  ``reuse``: a kept folder
+    holding a finished run is read as it is (its wall time from its summary.json), even when
+    the code has changed since; otherwise the folder is made anew."""
     import json
     import tempfile
 
@@ -46,54 +69,82 @@ def _run_kept(case, name, reuse=False):
         if reuse and os.path.isfile(summary):
             seconds = json.load(open(summary))["wall_time_s"]
         else:
+            if keep and not reuse:
+                shutil.rmtree(out, ignore_errors=True)
             t0 = time.perf_counter()
             pipeline.run(case, out, progress=False)
             seconds = time.perf_counter() - t0
-        return seconds, read_stribeck_csv(os.path.join(out, "stribeck.csv"))[0]
+        return (seconds, read_stribeck_csv(os.path.join(out, "stribeck.csv"))[0],
+                _signed_parts(out))
 
 
-def run(case_file="pin_on_disk.toml", viscosity=0.066):
-    """Honesty of the C_f error estimate at full size: a case with its first patch pair and
-    first viscosity (no speed refinement, no band) against a reference at twice the
-    resolution on both scales, four times the steps and twice the h0 candidates.  The
-    bundled case (its 128^2 macro grid and 96^2 cells, 16 h0, 20 steps; reference 256^2 /
-    192^2, every one of 31 h0, 80 steps) or, as
-    ``estimate-paper``, the paper case (256^2, 100 h0, 32 steps; reference 512^2, 199 h0,
-    128 steps, a few hours on 2 cores).  Rows: per speed, the estimate over the change to
-    the reference (goal: 1 to 3, or both below 0.05 % C_f,b).  Baseline: the base run.
-    ``$FEM_TWIN_BENCH_DIR`` keeps both runs (and resumes them); a finished reference there
-    is read, not run again."""
-    from dataclasses import replace
+def _signed_parts(folder) -> dict:
+    """``{speed: signed estimate parts}`` of a run's main points (their checkpoints)."""
+    from fem_twin.stribeck.sweep import point_files, readable_meta
 
-    from fem_twin.case import load_case
+    out = {}
+    for path in point_files(os.path.join(folder, "stribeck", "checkpoints")):
+        read = readable_meta(path)
+        if read and "signed" in read[1].get("error_estimate", {}):
+            out[round(float(read[0]["speed"]), 9)] = read[1]["error_estimate"]["signed"]
+    return out
 
-    case = load_case(os.path.join(HERE, "..", "examples", case_file))
-    case = replace(case, geometry=replace(case.geometry, patches=case.geometry.patches[:1]),
+
+def _subset(case, viscosity):
+    """The case's first patch pair at ``viscosity``, isothermal, no refinement, no band."""
+    return replace(case, geometry=replace(case.geometry, patches=case.geometry.patches[:1]),
                    thermal=replace(case.thermal, model="none"),
                    lubricant=replace(case.lubricant, viscosities=(viscosity,),
                                      temperatures=case.lubricant.temperatures[:1]),
                    sweep=replace(case.sweep, refine=0), measured=(),
                    run=replace(case.run, patch_band=False))
-    fine = _refined(case, 2, 4, 2, every_h0=case_file == "pin_on_disk.toml")
+
+
+def run(case_file="pin_on_disk.toml", viscosity=0.066):
+    """The estimate of ``case_file`` (in examples/) at ``viscosity`` [Pa s] against its
+    reference and each part against its own change (module docstring).  Baseline: the base
+    run."""
+    from fem_twin.case import load_case
+
+    case = _subset(load_case(os.path.join(HERE, "..", "examples", case_file)), viscosity)
+    every_h0 = case_file != "paper.toml"
     stem = os.path.splitext(case_file)[0]
-    t_base, base = _run_kept(case, f"{stem}_base")
-    t_ref, ref = _run_kept(fine, f"{stem}_reference", reuse=True)
+    t_base, base, signed = _run_kept(case, f"{stem}_base", reuse=False)
+    fine = _refined(case, PARTS, every_h0)
+    t_ref, ref, _ = _run_kept(fine, f"{stem}_reference")
+    own = {part: _run_kept(_refined(case, (part,), every_h0), f"{stem}_{part}")
+           for part in PARTS}
     cb = case.tribometer.boundary_friction
-    res, cell = fine.preprocessing.resolution[0], fine.micro.resolution[0]
     rows = [(f"baseline: {stem}, 1 patch, 1 viscosity", t_base, ""),
-            (f"reference: {res}^2 / {cell}^2, {fine.micro.h0_count} h0, "
-             f"{fine.micro.steps} steps", t_ref, "")]
+            (f"reference: all refined ({fine.micro.steps} steps, {fine.micro.h0_count} h0)",
+             t_ref, "")]
+    rows += [(f"{part} refined alone", t, "") for part, (t, *_) in own.items()]
     within = below = 0
-    for u, cf, err, cf_ref in zip(base.speed, base.friction_coefficient, base.friction_error,
-                                  ref.friction_coefficient):
-        actual = abs(cf - cf_ref)
-        floor = err < 5e-4 * cb and actual < 5e-4 * cb
+    ratios = {part: [] for part in PARTS}
+    for i, u in enumerate(base.speed):
+        cf, err = base.friction_coefficient[i], base.friction_error[i]
+        actual = abs(cf - ref.friction_coefficient[i])
+        floor = err < FLOOR * cb and actual < FLOOR * cb
         ok = floor or 1 <= err / actual <= 3
         within, below = within + ok, below + (not floor and err < actual)
-        rows.append((f"  {u:.4g} m/s: C_f {cf:.5f}, reference {cf_ref:.5f}", 0.0,
-                     f"estimate {err / cb:.3%}, actual {actual / cb:.3%} C_f,b, "
-                     f"effectivity {err / actual:.2f} {'ok' if ok else 'OUTSIDE'}"))
-    return t_base, rows, Check(below == 0, f"the C_f estimate below the change to the "
-                                           f"reference at {below} of {base.speed.size} speeds "
-                                           f"(within 1-3 or both under 0.05 % C_f,b at "
-                                           f"{within})")
+        parts = signed.get(round(float(u), 9), {})
+        notes = []
+        for part in PARTS:
+            change = cf - own[part][1].friction_coefficient[i]
+            est = parts.get(part, np.nan)
+            notes.append(f"{part} {est / cb:+.3%}/{change / cb:+.3%}")
+            if abs(change) >= FLOOR * cb:
+                ratios[part].append(est / change)
+        notes.append(f"film {parts.get('film', np.nan) / cb:+.3%}")
+        rows.append((f"  {u:.4g} m/s: C_f {cf:.5f}, reference {ref.friction_coefficient[i]:.5f}",
+                     0.0, f"estimate {err / cb:.3%}, truth {actual / cb:.3%} C_f,b, "
+                          f"effectivity {err / actual:.2f} {'ok' if ok else 'OUTSIDE'}; "
+                          f"part / own change: {', '.join(notes)}"))
+    lines = [f"{part}: its estimate over its own change where that exceeds 0.05 % C_f,b: "
+             + (f"{min(r):.2f} to {max(r):.2f}, the wrong sign at {sum(x < 0 for x in r)} "
+                f"of {len(r)} speeds" if r else "nowhere above")
+             for part, r in ratios.items()]
+    return t_base, rows, *lines, Check(below == 0, f"the C_f estimate below the truth at "
+                                                   f"{below} of {base.speed.size} speeds "
+                                                   f"(within 1-3 or both under 0.05 % C_f,b "
+                                                   f"at {within})")

@@ -79,3 +79,34 @@ def test_the_accuracy_warning_names_the_cases_macro_grid_key(caplog):
         with caplog.at_level(logging.WARNING, logger="fem_twin"):
             summary = error_summary([curve], 0.19245, 0.005, ball)
         assert summary["points_above"] == 2 and key in caplog.text
+
+
+@pytest.mark.integration
+def test_the_variants_looser_tolerance_leaves_the_parts(runs, monkeypatch):
+    """The variant solves stop at ``VARIANT_TOL`` (1e-3) instead of the run's 1e-4: each part
+    moves by less than a fifth of the 0.05 % C_f,b from which a part matters, in fewer
+    coupling iterations (the CPU it saves: ``benchmarks/run.py estimate``)."""
+    import fem_twin.macro.estimate as estimate
+
+    (gap, dx, face), factors = runs[0]
+    kw = dict(load=150.0, lubricant=Lubricant(0.066), settings=MacroSettings())
+    solve, iterations = estimate.solve_point, []
+
+    def counted(point, initial=None):
+        out = solve(point, initial=initial)
+        iterations.append(out.iterations)
+        return out
+
+    monkeypatch.setattr(estimate, "solve_point", counted)
+    for speed in (0.1, 0.03, 0.01):
+        point = solve_mixed(gap, dx, factors, face=face, speed=speed, **kw)
+        op = OperatingPoint(gap, dx, factors, face=face, speed=speed, **kw)
+        parts = {}
+        for tol in (MacroSettings().tol, estimate.VARIANT_TOL):
+            monkeypatch.setattr(estimate, "VARIANT_TOL", tol)
+            iterations.clear()
+            parts[tol] = (friction_error(point, op)["signed"], sum(iterations))
+        (tight, n_tight), (loose, n_loose) = parts.values()
+        moved = max(abs(tight[k] - loose[k]) for k in ("time", "grid", "h0"))
+        assert moved < 1e-4 * BOUNDARY_FRICTION, (speed, moved / BOUNDARY_FRICTION)
+        assert n_loose <= n_tight

@@ -4,8 +4,8 @@ Each part is a change of C_f [-] (the measurements behind each choice: docs/accu
 "The error bar on every friction coefficient"): ``"macro"``, the point on the macro grid
 coarsened by two, ``|C_f(h) - C_f(2h)| / (2^p - 1)`` with ``p = MACRO_ORDER``; ``"time"``,
 ``"grid"``, ``"h0"``, the flow factors' own estimates carried into C_f (the point solved
-with each variant of the factors, :meth:`FlowFactors.variants`, on the level
-:func:`micro_parts_level` gives, minus the point there; ``"h0"`` over
+with each variant of the factors, :meth:`FlowFactors.variants`, to :data:`VARIANT_TOL`
+on the level :func:`micro_parts_level` gives, minus the point there; ``"h0"`` over
 ``H0_SPACING_RATIO``); ``"film"``, the point's fields re-evaluated with the friction factor
 of half and twice the boundary film, times ``FILM_COUPLING`` (a model part; no solve).
 
@@ -51,6 +51,10 @@ SCREENING = ("the average-flow screening model: its C_f has no error bar, its ga
              "deterministic reference is measured in docs/peers.md")
 #: the parts of an estimate, in the order of the CSV and NetCDF outputs
 PARTS = ("macro", "time", "grid", "h0", "film")
+#: the coupling tolerance of the variant solves (the run's where that is looser): a part
+#: matters from 0.05 % C_f,b, and the looser tolerance moves it far less than that for two
+#: thirds of the variants' CPU (``tests/test_estimate.py``, ``benchmarks/run.py estimate``)
+VARIANT_TOL = 1e-3
 #: the fewest nodes a side of the grid the micro parts are solved on: there their sum is
 #: within a few per cent of the next finer level's at a seventh of the time
 #: (docs/accuracy.md)
@@ -154,8 +158,10 @@ class _Levels:
         point = self.point(level)
         if initial is None:
             initial = self.known.get(level - 1, self.result)
-        solved = solve_point(point if factors is None else replace(point, factors=factors),
-                             initial=initial)
+        if factors is not None:
+            tol = max(point.settings.tol, VARIANT_TOL)
+            point = replace(point, factors=factors, settings=replace(point.settings, tol=tol))
+        solved = solve_point(point, initial=initial)
         if factors is None:
             self.known[level] = solved
         return solved

@@ -1,0 +1,48 @@
+"""Group ``cell-resolution``: C_f of the bundled pin over its cells' resolution, against the
+patches' own 256 pixels.
+
+    FEM_TWIN_BENCH_DIR=DIR python benchmarks/run.py cell-resolution    # about 5 min on 2 cores
+
+The ``estimate`` group's base case (first patch pair, 0.066 Pa s, isothermal) with ``[micro]
+resolution`` n^2 for n in ``SIDES``, each patch resampled from its 256 px.  Rows, per speed in
+contact (contact load share above 1 %): C_f(n) - C_f(256) [% C_f,b] for every n, and the
+base run's (96^2) grid part of the estimate, signed.  Baseline: the 96^2 run.  Checked: the
+96^2 cells within 0.5 % C_f,b of the patches' own pixels at every speed."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import replace
+
+from common import Check
+from estimate import HERE, _run_kept, _subset
+
+DEFAULT = False
+#: the cells' sides [px]; the last is the patches' own
+SIDES = (48, 64, 96, 128, 192, 256)
+#: the side of the bundled case's cells
+BASE = 96
+
+
+def run():
+    from fem_twin.case import load_case
+
+    case = _subset(load_case(os.path.join(HERE, "..", "examples", "pin_on_disk.toml")), 0.066)
+    runs = {n: _run_kept(replace(case, micro=replace(case.micro, resolution=(n, n))),
+                         f"pin_on_disk_cells{n}", reuse=n != BASE) for n in SIDES}
+    cb = case.tribometer.boundary_friction
+    own, base = runs[SIDES[-1]][1], runs[BASE][1]
+    rows = [(f"cells {n}^2", t, "") for n, (t, *_) in runs.items()]
+    worst = 0.0
+    for i, u in enumerate(base.speed):
+        worst = max(worst, abs(base.friction_coefficient[i] - own.friction_coefficient[i]) / cb)
+        if base.contact_load_fraction[i] < 0.01:
+            continue
+        ref = own.friction_coefficient[i]
+        moved = ", ".join(f"{n}: {(c.friction_coefficient[i] - ref) / cb:+.3%}"
+                          for n, (_, c, _) in runs.items() if n != SIDES[-1])
+        grid = runs[BASE][2].get(round(float(u), 9), {}).get("grid", float("nan")) / cb
+        rows.append((f"  {u:.4g} m/s", 0.0, f"C_f(n) - C_f(256): {moved}; the 96^2 run's "
+                                            f"grid part {grid:+.3%}"))
+    return runs[BASE][0], rows, Check(worst < 5e-3, f"the {BASE}^2 cells at most {worst:.3%} "
+                                                    f"C_f,b from the patches' own pixels")
