@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 from dataclasses import replace
 
+import numpy as np
 from common import Check
 from estimate import HERE, _run_kept, _subset
 
@@ -41,7 +42,8 @@ def run():
         ref = own.friction_coefficient[i]
         moved = ", ".join(f"{n}: {(c.friction_coefficient[i] - ref) / cb:+.3%}"
                           for n, (_, c, _) in runs.items() if n != SIDES[-1])
-        grid = runs[BASE][2].get(round(float(u), 9), {}).get("grid", float("nan")) / cb
+        grid = next((v["grid"] for k, v in runs[BASE][2].items() if np.isclose(k, u, rtol=1e-6)),
+                    np.nan) / cb
         rows.append((f"  {u:.4g} m/s", 0.0, f"C_f(n) - C_f(256): {moved}; the 96^2 run's "
                                             f"grid part {grid:+.3%}"))
     return runs[BASE][0], rows, Check(worst < 5e-3, f"the {BASE}^2 cells at most {worst:.3%} "

@@ -75,18 +75,21 @@ def _run_kept(case, name, reuse=True):
             pipeline.run(case, out, progress=False)
             seconds = time.perf_counter() - t0
         return (seconds, read_stribeck_csv(os.path.join(out, "stribeck.csv"))[0],
-                _signed_parts(out))
+                _signed_parts(out, case.tribometer.ball))
 
 
-def _signed_parts(folder) -> dict:
-    """``{speed: signed estimate parts}`` of a run's main points (their checkpoints)."""
+def _signed_parts(folder, ball) -> dict:
+    """``{speed: signed estimate parts}`` of a run's main points (their checkpoints), over the
+    curve's speed (a ``ball``'s entrainment)."""
     from fem_twin.stribeck.sweep import point_files, readable_meta
 
     out = {}
     for path in point_files(os.path.join(folder, "stribeck", "checkpoints")):
         read = readable_meta(path)
         if read and "signed" in read[1].get("error_estimate", {}):
-            out[round(float(read[0]["speed"]), 9)] = read[1]["error_estimate"]["signed"]
+            scalars, meta = read            # a ball's curve is over its entrainment speed
+            speed = meta["entrainment"] if ball else scalars["speed"]
+            out[float(speed)] = meta["error_estimate"]["signed"]
     return out
 
 
@@ -127,7 +130,7 @@ def run(case_file="pin_on_disk.toml", viscosity=0.066):
         floor = err < FLOOR * cb and actual < FLOOR * cb
         ok = floor or 1 <= err / actual <= 3
         within, below = within + ok, below + (not floor and err < actual)
-        parts = signed.get(round(float(u), 9), {})
+        parts = next((v for k, v in signed.items() if np.isclose(k, u, rtol=1e-6)), {})
         notes = []
         for part in PARTS:
             change = cf - own[part][1].friction_coefficient[i]
