@@ -6,7 +6,7 @@ Below the Stribeck knee the asperities carry the load and their shear sets C_f. 
 constant C_f,b cannot tell two loads apart there. The shear law of ``[boundary]``,
 ``tau_0 a_r + alpha (p_con + p a_r)`` on the real contact area, can: the real area and the
 asperity load grow at different rates with the load
-(:mod:`fem_twin.macro.laws.boundary`, docs/model.md "Boundary friction").
+(:mod:`fem_twin.macro.laws.boundary_laws`, docs/model.md "Boundary friction").
 
     python examples/14_boundary_law.py [OUT] [--quick]
 

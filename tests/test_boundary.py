@@ -1,6 +1,6 @@
-"""The boundary shear law (fem_twin.macro.laws.boundary, docs/model.md "Boundary friction"):
-its constant limit bit for bit, a single Hertzian asperity, one decade of speed, and the
-case file's [boundary] section."""
+"""The boundary shear law (fem_twin.macro.laws.boundary_laws and .boundary_friction,
+docs/model.md "Boundary friction"): its constant limit bit for bit, a single Hertzian
+asperity, one decade of speed, and the case file's [boundary] section."""
 
 import numpy as np
 import pytest
@@ -17,7 +17,7 @@ from fem_twin.macro import (
     OperatingPoint,
     solve_mixed,
 )
-from fem_twin.macro.laws.boundary import boundary_area, boundary_traction
+from fem_twin.macro.laws.boundary_friction import boundary_area, boundary_traction
 from fem_twin.micro import homogenise
 
 SHEAR = BoundaryLaw(law="shear", shear_strength=50e6, pressure_coefficient=0.1,
@@ -44,7 +44,7 @@ def test_a_new_law_is_one_class_and_one_registry_line(factors, monkeypatch):
     of the [boundary] section, the macro scale's boundary force follows it (half the
     constant law's on the same fields, which the boundary shear does not move) and the
     fit lists its parameter, with its start and bounds."""
-    from fem_twin.macro.laws.boundary import LAWS, ConstantLaw, Fitted, fitted_law
+    from fem_twin.macro.laws.boundary_laws import LAWS, ConstantLaw, Fitted, fitted_law
     from fem_twin.stribeck.fit import FitModel, _unknowns, parameters
 
     class Half(ConstantLaw):

@@ -145,7 +145,8 @@ PUBLIC = ["fem_twin", "fem_twin.topography", "fem_twin.contact", "fem_twin.micro
 #: modules without an ``__all__`` whose own public functions are walked too (issue 87
 #: item 7: the new round's functions)
 MODULES = ["fem_twin.results", "fem_twin.studies.verification", "fem_twin.stribeck.analysis",
-           "fem_twin.macro.laws.boundary", "fem_twin.macro.laws.thermal",
+           "fem_twin.macro.laws.boundary_friction", "fem_twin.macro.laws.boundary_laws",
+           "fem_twin.macro.laws.thermal",
            "fem_twin.macro.reference.deterministic",
            "fem_twin.macro.point", "fem_twin.runtime.machine", "fem_twin.topography.statistics",
            "fem_twin.peers.patir_cheng", "fem_twin.peers.greenwood_tripp",
@@ -354,7 +355,7 @@ def test_unit_slips_and_impossible_values_of_the_round_six_functions():
 def _round_five_api_probes():
     """``(probe id, call, words)`` of issue 87's API probes that returned a result, raised a
     bare error or named neither the argument nor its unit."""
-    from fem_twin.macro.laws.boundary import (
+    from fem_twin.macro.laws.boundary_friction import (
         BoundaryLaw,
         asperity_load,
         boundary_area,
@@ -482,7 +483,7 @@ def test_a_kelvin_reference_temperature_is_refused_where_it_meets_a_temperature(
     Celsius (it lies in -40 to 300 C); at a film temperature of 50 C its factor was 1.49,
     the shear raised 49 %.  temperature_factor refuses a temperature more than 100 K from
     T_ref, as the case parser does at every oil."""
-    from fem_twin.macro.laws.boundary import BoundaryLaw, temperature_factor
+    from fem_twin.macro.laws.boundary_friction import BoundaryLaw, temperature_factor
     law = BoundaryLaw(law="shear", shear_strength=1e7, pressure_coefficient=0.1,
                       temperature_coefficient=0.002, reference_temperature=297.15)
     with pytest.raises(InputError, match="not kelvin"):

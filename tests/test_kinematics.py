@@ -188,9 +188,9 @@ def test_a_far_axis_is_uniform_sliding(factors):
 
 def test_the_boundary_shear_acts_along_the_local_sliding(factors):
     """On the turning disk the contacts' shear C_f,b (p_con + p a_r) (eq 32 on the
-    asperities' load, :mod:`fem_twin.macro.laws.boundary`) acts along the local sliding, and
-    the load cell reads its x1 part: that times cos(phi) over the face, less than C_f,b
-    times the asperity load by at most 1 - cos 7.6 degrees (0.9 %)."""
+    asperities' load, :mod:`fem_twin.macro.laws.boundary_friction`) acts along the local
+    sliding, and the load cell reads its x1 part: that times cos(phi) over the face, less
+    than C_f,b times the asperity load by at most 1 - cos 7.6 degrees (0.9 %)."""
     gap, dx, face = macro_case(32)
     res = solve_mixed(gap, dx, factors, load=150.0, speed=0.01, face=face,
                       lubricant=Lubricant(0.066), settings=MacroSettings(track_radius=30e-3))

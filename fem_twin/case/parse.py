@@ -11,7 +11,8 @@ from pathlib import Path
 from ..checks import arguments, memory_shortfall
 from ..errors import InputError
 from ..io.files import topography_shape
-from ..macro.laws.boundary import COMMON_KEYS, LAWS, BoundaryLaw, thin_films_choice
+from ..macro.laws.boundary_friction import COMMON_KEYS, BoundaryLaw, thin_films_choice
+from ..macro.laws.boundary_laws import LAWS
 from ..macro.laws.friction import LAWS as FRICTION_LAWS
 from ..macro.laws.thermal import ThermalSettings
 from ..stribeck.curve import read_measured_csv

@@ -12,7 +12,7 @@ from pathlib import Path
 from .. import tables as T
 from ..checks import check_ranges, setting
 from ..macro.coupling.settings import MacroSettings
-from ..macro.laws.boundary import BoundaryLaw, boundary_friction_setting
+from ..macro.laws.boundary_friction import BoundaryLaw, boundary_friction_setting
 from ..macro.laws.friction import READINGS
 from ..macro.laws.thermal import ThermalSettings
 from ..micro.homogenisation import H0_COUNT, H0_MAX, H0_MIN, h0_candidates

@@ -236,10 +236,10 @@ def validate(args):
 
     from ..case import load_case
     from ..io.table import write_csv
-    from ..macro.laws.boundary import BOUNDARY_FRICTION
     from ..stribeck import deviation_from_measured, plot_stribeck, read_measured_csv
     from ..stribeck.curve import read_stribeck_csv
     from ..stribeck.validation import check_like_with_like
+    from ..tables import BOUNDARY_FRICTION
     if args.radius is not None:
         number("--radius [m]", args.radius, "length")
     run = RunLayout(args.run)

@@ -13,8 +13,8 @@ porch (the modules of ``macro/`` itself) sits on top of them all; no room import
 
 The rooms, each listing its modules in its own docstring:
 
-    laws       :mod:`fem_twin.macro.laws`: lubricant, viscosity, friction, boundary,
-               thermal and kinematics
+    laws       :mod:`fem_twin.macro.laws`: lubricant, viscosity, friction, boundary laws,
+               boundary friction, thermal and kinematics
     film       :mod:`fem_twin.macro.film`: the homogenised Reynolds solver with JFO
                cavitation, its Couette flux and the nodal contact pressure
     coupling   :mod:`fem_twin.macro.coupling`: the coupled point (settings, the assembled
@@ -31,8 +31,9 @@ The porch, what a caller uses:
     figures    the fields of operating points as PNG
 """
 
+from ..tables import BOUNDARY_FRICTION
 from .film.reynolds import ReynoldsNotConverged, ReynoldsResult, solve_reynolds
-from .laws.boundary import BOUNDARY_FRICTION, BoundaryLaw, boundary_traction
+from .laws.boundary_friction import BoundaryLaw, boundary_traction
 from .laws.friction import FilmFields, hydrodynamic_shear
 from .laws.kinematics import disk_velocity
 from .laws.lubricant import Lubricant

@@ -25,7 +25,7 @@ HEADERS = dict(zip(COLUMNS, ("speed_m_s", "hersey", "friction_coefficient", "vis
 LEGACY = {"boundary_friction_N": "boundary_force_N", "boundary_friction": "boundary_force"}
 #: the columns a curve has when its run gives them: a thermal run's temperatures [C] and
 #: spots' flash per pascal of boundary shear [K/Pa] (:mod:`fem_twin.macro.laws.thermal`), the
-#: boundary law's integrals (:mod:`fem_twin.macro.laws.boundary`): their CSV header, unit in
+#: boundary law's integrals (:mod:`fem_twin.macro.laws.boundary_laws`): their CSV header, unit in
 #: ``results.nc`` and long name
 OPTIONAL = {"contact_temperature": ("contact_temperature_C", "degC", "the film's temperature: "
                                     "oil, bulk rise and the face's flash temperature"),
@@ -160,11 +160,11 @@ def joined(curves) -> StribeckCurve:
 
 def parameter_shares(curve: StribeckCurve, law) -> dict:
     """C_f's relative sensitivity to each parameter of the boundary ``law`` (a
-    :class:`~fem_twin.macro.laws.boundary.BoundaryLaw`) at each point of ``curve``, ``d ln C_f /
-    d ln q`` [-] by name ``share_q``, the law's split of :attr:`StribeckCurve.boundary_share`
-    (:meth:`~fem_twin.macro.laws.boundary.Law.shares`): C_f,b's is all of it; the shear law
-    splits it between tau_0 (``tau_0 A_r``) and alpha (``alpha W``), from the curve's real
-    contact area and asperity load (none without them)."""
+    :class:`~fem_twin.macro.laws.boundary_friction.BoundaryLaw`) at each point of
+    ``curve``, ``d ln C_f / d ln q`` [-] by name ``share_q``, the law's split of
+    :attr:`StribeckCurve.boundary_share` (:meth:`~fem_twin.macro.laws.boundary_laws.Law.shares`):
+    C_f,b's is all of it; the shear law splits it between tau_0 (``tau_0 A_r``) and alpha
+    (``alpha W``), from the curve's real contact area and asperity load (none without them)."""
     return law.model.shares(law, curve.boundary_share, curve.real_contact_area,
                             curve.asperity_load)
 

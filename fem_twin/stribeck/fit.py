@@ -1,9 +1,9 @@
 """Fitting the twin's unknowns to measured Stribeck curves, with 95 % intervals.
 
 Parameters, by their case-file keys (none re-runs the micro stage): a boundary law's
-(:func:`fem_twin.macro.laws.boundary.fitted_parameters`: ``boundary_friction``, C_f,b of eq
+(:func:`fem_twin.macro.laws.boundary_laws.fitted_parameters`: ``boundary_friction``, C_f,b of eq
 32, from a simulated curve's force parts, or the shear law's, from its real contact area and
-asperity load; the law owns them, :meth:`~fem_twin.macro.laws.boundary.Law.fit_force`);
+asperity load; the law owns them, :meth:`~fem_twin.macro.laws.boundary_laws.Law.fit_force`);
 ``temperature``, one oil temperature
 per curve through the case's Walther law, the simulated curve at ``mu_S`` giving the one at
 ``mu`` at the speeds ``U mu / mu_S`` (the Hersey collapse, eq 46); ``load_share``, the pin
@@ -25,7 +25,8 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from ..errors import InputError, NotConverged
-from ..macro.laws.boundary import LAWS, BoundaryLaw, fitted_law, fitted_parameters
+from ..macro.laws.boundary_friction import BoundaryLaw
+from ..macro.laws.boundary_laws import LAWS, fitted_law, fitted_parameters
 from ..macro.laws.viscosity import WaltherLaw
 from .curve import SPEED_MATCH, MeasuredCurve, StribeckCurve
 from .fit_statistics import correlation, covariance, interval, temperature_warnings
@@ -38,7 +39,7 @@ OWN = ("temperature", "load_share", "bulk_resistance")
 def parameters() -> tuple:
     """The parameters :func:`fit_curves` can fit (case-file keys), in the order of a fit's
     unknowns: the default boundary law's (eq 32's C_f,b), the fit's own (:data:`OWN`),
-    then the other registered laws' (:data:`~fem_twin.macro.laws.boundary.LAWS`)."""
+    then the other registered laws' (:data:`~fem_twin.macro.laws.boundary_laws.LAWS`)."""
     first = LAWS[BoundaryLaw().law]
     return (*first.fitted, *OWN, *(name for name in fitted_parameters()
                                    if name not in first.fitted))
@@ -57,7 +58,7 @@ RANGE_OF_THREE = 1.693
 @dataclass(frozen=True)
 class Readings:
     """What a boundary law's fit reads of one simulated curve at the measured speeds
-    (:meth:`~fem_twin.macro.laws.boundary.Law.fit_force`): the ``speed`` [m/s], ``read(name)``
+    (:meth:`~fem_twin.macro.laws.boundary_laws.Law.fit_force`): the ``speed`` [m/s], ``read(name)``
     the curve's column ``name`` there (None where the curve has none), the simulated
     curves' C_f,b ``boundary_friction``, the law's section ``base`` whose unfitted values
     the fit keeps, and ``film_temperature()`` [C] of the points at the fitted oil."""
@@ -65,7 +66,7 @@ class Readings:
     speed: np.ndarray
     read: Callable
     boundary_friction: float
-    base: BoundaryLaw | None
+    base: BoundaryLaw
     film_temperature: Callable
 
 
@@ -81,7 +82,7 @@ class FitModel:
     curve's imposed load [N] (empty: ``load`` for all); ``boundary``: the case's boundary
     law (its ``[boundary]`` section; None: eq 32's constant law at ``boundary_friction``),
     from which a fit of a law's parameters starts and whose unfitted values it keeps
-    (:meth:`~fem_twin.macro.laws.boundary.Law.start`: the shear law from a constant case is
+    (:meth:`~fem_twin.macro.laws.boundary_laws.Law.start`: the shear law from a constant case is
     tau_0 = 0 and alpha = ``boundary_friction``).
     """
 
@@ -96,13 +97,19 @@ class FitModel:
     boundary: BoundaryLaw | None = None
     loads: tuple = ()
 
+    @property
+    def section(self) -> BoundaryLaw:
+        """The case's ``[boundary]`` section, eq 32's constant law where it gives none."""
+        return self.boundary or BoundaryLaw()
+
     def friction(self, k: int, speed, viscosity: float, values: dict | None = None,
                  share: float | None = None, resistance: float | None = None):
         """C_f of curve ``k`` at ``speed`` [m/s] for mu_0 [Pa s], a boundary law's fitted
-        ``values`` (case-file keys of one law's :attr:`~fem_twin.macro.laws.boundary.Law.fitted`;
-        None or empty: the curves' own boundary force), the face's ``share`` of the load and
-        the rig's thermal ``resistance`` [K/W] (None: the curves' own); and the mask of
-        speeds whose Hersey number lies inside the simulated range (ends held outside)."""
+        ``values`` (case-file keys of one law's
+        :attr:`~fem_twin.macro.laws.boundary_laws.Law.fitted`; None or empty: the curves' own
+        boundary force), the face's ``share`` of the load and the rig's thermal
+        ``resistance`` [K/W] (None: the curves' own); and the mask of speeds whose Hersey
+        number lies inside the simulated range (ends held outside)."""
         load = self.loads[k] if self.loads else self.load
         at = lambda c: self._at(c, speed, viscosity, values, load)  # noqa: E731
         cf, inside = at(self.curves[k])
@@ -139,7 +146,7 @@ class FitModel:
         law = fitted_law(values)
         readings = Readings(
             speed, lambda name: None if getattr(c, name) is None else at(getattr(c, name)),
-            self.boundary_friction, law.start(self.boundary, self.boundary_friction),
+            self.boundary_friction, law.start(self.section, self.boundary_friction),
             lambda: self._film_temperature(c, at, viscosity))
         return (hd + law.fit_force(readings, values)) / load, inside
 
@@ -152,7 +159,7 @@ class FitModel:
             shift = oil(viscosity) - oil(c.viscosity) if oil else 0.0
             return at(c.contact_temperature) + shift
         if oil is None:
-            return (self.boundary or BoundaryLaw()).reference_temperature
+            return self.section.reference_temperature
         return oil(viscosity)
 
 
@@ -244,12 +251,12 @@ def fit_curves(model: FitModel, measured, params, *, start_temperatures,
 
 def _unknowns(model, params, n_curves, start_temperatures):
     """Names, start values and bounds of the unknowns, in the order of :func:`parameters`:
-    the boundary law's (:meth:`~fem_twin.macro.laws.boundary.Law.unknowns`: C_f,b in [1e-4,
+    the boundary law's (:meth:`~fem_twin.macro.laws.boundary_laws.Law.unknowns`: C_f,b in [1e-4,
     1]), a temperature per curve in [-30, 250] C, the load share over
     :attr:`FitModel.share_curves`, R_b over :attr:`FitModel.resistance_curves`."""
     law = fitted_law(params)
     boundary = {} if law is None else {
-        row[0]: row for row in law.unknowns(model.boundary, model.boundary_friction)}
+        row[0]: row for row in law.unknowns(model.section, model.boundary_friction)}
     rows = []
     for name in parameters():
         if name not in params:
@@ -338,7 +345,7 @@ def _check_model(model: FitModel, measured, params, start_temperatures) -> None:
 
 def _check_columns(model: FitModel, params) -> None:
     """Refuse a boundary law's fit on curves without the columns the law reads
-    (:attr:`~fem_twin.macro.laws.boundary.Law.columns`: the shear law's integrals, absent
+    (:attr:`~fem_twin.macro.laws.boundary_laws.Law.columns`: the shear law's integrals, absent
     from a run of an older fem_twin) or, for a temperature term, without a temperature that
     varies: the spots' flash of the thermal model, or, isothermal, oils at two temperatures
     (a Walther law)."""

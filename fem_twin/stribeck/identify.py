@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ..macro.laws.boundary import fitted_law
+from ..macro.laws.boundary_laws import fitted_law
 
 #: the shear law's pair that one Stribeck curve set may not separate
 PAIR = ("shear_strength", "pressure_coefficient")
@@ -27,7 +27,7 @@ def separability(model, measured, viscosities, sigma) -> dict:
     (None: equal weights, the residuals' variance): ``real_pressure`` min, mean and max
     [Pa], ``correlation``, ``intervals`` (95 %, per name) and ``alpha_eff`` [-] with the
     ``mean`` p_r it holds at."""
-    base = fitted_law(PAIR).start(model.boundary, model.boundary_friction)
+    base = fitted_law(PAIR).start(model.section, model.boundary_friction)
     cols, rhs, weights = [], [], []
     for k, (m, mu) in enumerate(zip(measured, viscosities)):
         c, load = model.curves[k], model.loads[k] if model.loads else model.load

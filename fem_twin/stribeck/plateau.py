@@ -15,7 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import InputError
-from ..macro.laws.boundary import fitted_parameters
+from ..macro.laws.boundary_laws import fitted_parameters
 from .curve import MeasuredCurve
 from .fit import FitModel, fit_curves
 from .prediction import finish_fit_figure, predict
@@ -25,7 +25,7 @@ PLATEAU_SHARE = 0.9
 
 def check_plateau(params, share: float) -> None:
     """Refuse a plateau fit of anything but a boundary law's parameters
-    (:func:`~fem_twin.macro.laws.boundary.fitted_parameters`: what it may vary), or a share
+    (:func:`~fem_twin.macro.laws.boundary_laws.fitted_parameters`: what it may vary), or a share
     outside (0, 1)."""
     boundary = fitted_parameters()
     other = [p for p in params if p not in boundary]

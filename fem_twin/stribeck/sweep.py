@@ -15,7 +15,7 @@ from ..io.checkpoint import check_made_for, load_or_none, made_for
 from ..io.mesh import write_pvd
 from ..macro import MixedResult
 from ..macro.estimate import PARTS, friction_error
-from ..macro.laws.boundary import temperature_factor
+from ..macro.laws.boundary_friction import temperature_factor
 from ..macro.laws.thermal import tempered, thermal_point
 from ..macro.nested import corrected, solve_nested
 from ..numerics.threads import one_thread

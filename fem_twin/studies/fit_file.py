@@ -11,7 +11,7 @@ import numpy as np
 
 from ..checks import OFF_AT_ZERO, QUANTITIES, plausible
 from ..errors import InputError
-from ..macro.laws.boundary import LAWS
+from ..macro.laws.boundary_laws import LAWS
 from ..macro.laws.viscosity import WaltherLaw
 from ..stribeck.fit import parameters
 

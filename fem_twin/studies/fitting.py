@@ -17,7 +17,7 @@ from ..errors import InputError
 from ..io.atomic import atomic_path
 from ..io.layout import RunLayout
 from ..io.table import write_csv
-from ..macro.laws.boundary import fitted_law
+from ..macro.laws.boundary_laws import fitted_law
 from ..macro.laws.viscosity import WaltherLaw
 from ..numerics.threads import executor_for
 from ..runtime.taskgraph import fit_scaling

@@ -27,7 +27,7 @@ from ..checks import arguments, check, plausible, whole
 from ..errors import InputError
 from ..io.files import read_topography
 from ..macro import Lubricant, MacroSettings, MixedResult, solve_mixed
-from ..macro.laws.boundary import temperature_factor
+from ..macro.laws.boundary_friction import temperature_factor
 from ..macro.laws.thermal import tempered
 from ..macro.reference.deterministic import (
     DeterministicResult,

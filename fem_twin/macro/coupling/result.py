@@ -13,7 +13,7 @@ from ...io.atomic import atomic_path
 from ...micro.rolling import at_slide_to_roll
 from ...numerics.graded_mesh import Mesh
 from ..film.reynolds import trapezoid_weights
-from ..laws.boundary import asperity_load, boundary_area, traction
+from ..laws.boundary_friction import asperity_load, boundary_area, traction
 from ..laws.friction import FilmFields, confined_shear, disk_shear, hydrodynamic_shear
 from ..laws.kinematics import disk_velocity, rotations
 

@@ -13,7 +13,7 @@ from ...errors import InputError
 from ..film.cavitation import MODELS, cavitation_model
 from ..film.contact_load import RULES
 from ..film.couette import SCHEMES
-from ..laws.boundary import BoundaryLaw, boundary_friction_setting
+from ..laws.boundary_friction import BoundaryLaw, boundary_friction_setting
 from ..laws.friction import LAWS, READINGS
 
 
@@ -29,8 +29,8 @@ class MacroSettings:
                                section="materials")
     boundary_friction: float = boundary_friction_setting(section="tribometer")
     boundary: BoundaryLaw = setting(BoundaryLaw(), "the boundary shear's law (eq 32 or the "
-                                    "shear law, fem_twin.macro.laws.boundary)", unit="a section",
-                                    section="boundary")
+                                    "shear law, fem_twin.macro.laws.boundary_friction)",
+                                    unit="a section", section="boundary")
     reading: str = setting("force", "what the rig reads: the tangential force on the pin "
                            "holder, or the disk's reaction torque over the track radius",
                            choices=READINGS, section="tribometer")

@@ -25,7 +25,7 @@ from ...checks import arguments, as_pair, check_ranges, plausible, setting
 from ...contact.elastic import love_rectangle
 from ...errors import InputError, NotConverged
 from ...numerics.graded_mesh import Mesh
-from .boundary import heated_factor
+from .boundary_friction import heated_factor
 
 #: sub-samples a side of a cell for the moving part of the kernel (it varies over 2 kappa / U)
 SUBSAMPLES = 8

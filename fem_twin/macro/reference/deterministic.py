@@ -46,7 +46,7 @@ from ..coupling.problem import MAX_COEFFICIENT_PRESSURE
 from ..film.cavitation import cavitation_model
 from ..film.couette import couette_matrix
 from ..film.reynolds import fe_poiseuille, trapezoid_weights
-from ..laws.boundary import (
+from ..laws.boundary_friction import (
     BoundaryLaw,
     asperity_load,
     boundary_friction_setting,
@@ -83,7 +83,7 @@ class DeterministicSettings:
     gap_floor: float = setting(CellSettings.gap_floor, "the film in a contact spot (the "
                                "cells' default)", "gap_floor")
     boundary: BoundaryLaw = setting(BoundaryLaw(), "the boundary shear's law, the twin's "
-                                    "(fem_twin.macro.laws.boundary), node by node on the "
+                                    "(fem_twin.macro.laws.boundary_friction), node by node on the "
                                     "resolved spots", unit="a section")
     temperature: float = setting(24.0, "the oil's temperature [C], where the shear law's "
                                  "temperature factor is read (isothermal)", "temperature_C")
