@@ -20,12 +20,12 @@ from ..runtime.cost import sweep_cost
 from ..stribeck import stribeck_sweep
 from ..stribeck.curve import joined
 from ..stribeck.sweep import (
-    _curve,
-    _record,
     checkpointed,
+    curve_of_records,
     point_file,
     point_files,
     point_key,
+    point_record,
     readable_meta,
 )
 
@@ -152,7 +152,8 @@ def indexed_curve(task, sweep: int, points):
             check_made_for(point.meta, task.key, u, point.path)
     except ForeignCheckpoint:
         return None
-    return _curve([_record(SimpleNamespace(**p.scalars, meta=p.meta)) for p in found], task)
+    return curve_of_records([point_record(SimpleNamespace(**p.scalars, meta=p.meta))
+                             for p in found], task)
 
 
 def guide_of(request):

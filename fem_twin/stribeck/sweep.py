@@ -115,11 +115,11 @@ def stribeck_sweep(request: SweepRequest, progress: bool = False) -> StribeckCur
         if fields is not None:
             vtu = res.write_vtu(fields / f"mu{mu:g}_{i:03d}.vtu", r.origin)
             entries.append((float(res.speed), vtu))            # ParaView time = U [m/s]
-        records.append(_record(res))
+        records.append(point_record(res))
         previous = (res, *coarser)
     if fields is not None:
         write_pvd(fields / f"stribeck_mu{mu:g}.pvd", entries)
-    return _curve(records, r)
+    return curve_of_records(records, r)
 
 
 def _folder(path) -> Path:
@@ -170,10 +170,11 @@ class _Point:
         return res
 
 
-def _curve(records, request: SweepRequest) -> StribeckCurve:
-    """The :class:`StribeckCurve` of a sweep's point ``records`` (:func:`_record`), C_f,
-    its error estimates and the Hersey number referred to the imposed load (each point's
-    C_f is its face's, ``load_share`` of it)."""
+def curve_of_records(records, request: SweepRequest) -> StribeckCurve:
+    """The :class:`StribeckCurve` of a sweep's point ``records`` (:func:`point_record`, one
+    per speed of ``request``), C_f, its error estimates and the Hersey number referred to
+    the imposed load (each point's C_f is its face's, ``load_share`` of it).  The sweep
+    builds it from its solved points, the stages from a checkpoint index's scalars."""
     get = lambda name: np.array([r[name] for r in records])  # noqa: E731
     share = request.load_share
     errors = ({part: share * np.array([r["error_estimate"][part] for r in records])
@@ -268,8 +269,11 @@ def film_lubricant(res: MixedResult, lubricant):
                                                     viscosity=record["viscosity_Pa_s"])
 
 
-def _record(res: MixedResult) -> dict:
-    """The numbers of a point the curve keeps (no fields)."""
+def point_record(res: MixedResult) -> dict:
+    """The numbers of a point ``res`` its curve keeps, by name (no fields): its C_f and
+    force parts, film and iterations, coarsened C_f, error estimate and thermal readings
+    (NaN without them), what :func:`curve_of_records` reads.  ``res`` may be anything
+    with those attributes and a ``meta``: a checkpointed point's scalars."""
     return {**{name: getattr(res, name) for name in (
         "friction_coefficient", "hydrodynamic_friction", "boundary_force", "contact_load",
         "h_d", "iterations")}, COARSE_CF: np.atleast_1d(res.meta.get(COARSE_CF, np.nan)),
