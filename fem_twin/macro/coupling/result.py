@@ -32,14 +32,14 @@ class MixedResult:
     ``h_d`` [m], ``friction_force`` F_T (eq 33) with its ``hydrodynamic_friction`` and
     ``boundary_force`` parts [N], ``friction_coefficient`` C_f (eq 34),
     ``contact_load`` (integral of p_con) [N]; the asperities' ``asperity_load`` (of
-    p_con + p a_r, :func:`.boundary.asperity_load`) [N] and ``real_contact_area`` (of the
+    p_con + p a_r, :func:`.boundary_friction.asperity_load`) [N] and ``real_contact_area`` (of the
     dry contact fraction a_c, which tau_0 multiplies) [m^2] over the face, each node
     weighted by the x1 share of its sliding direction (1 under uniform sliding): the
     integrals the boundary law reads along the load cell.
     Fields (ny, nx): ``pressure`` p_hd, ``contact_pressure`` p_con [Pa], ``cavity_fraction``,
     ``h0``, ``mean_gap`` h_m, ``elastic_deformation`` h_el [m], ``viscosity`` [Pa s],
     ``density_ratio`` rho/rho_0, ``shear_stress`` tau_tot and its ``boundary_shear`` part
-    (x1, :mod:`.boundary`) [Pa], ``face`` (pin face mask).
+    (x1, :mod:`.boundary_friction`) [Pa], ``face`` (pin face mask).
     ``history``: rows (iteration, r_hel, r_pcon, r_p, r_F, h_d, newton steps).
     """
 
@@ -205,7 +205,7 @@ def pin_friction(fields, point, factors, velocity=None):
     or the disk's drag times ``|v|`` (its torque over the track radius,
     :func:`.friction.disk_shear`), with the flow ``factors`` at the point's slide-to-roll
     ratio and the disk's ``velocity`` (:func:`.kinematics.disk_velocity`; None: along x1);
-    and the asperities' load field (:func:`.boundary.asperity_load`) [Pa] and the dry
+    and the asperities' load field (:func:`.boundary_friction.asperity_load`) [Pa] and the dry
     contact fraction a_c [-] the law reads, each weighted alike (the x1 share of the
     sliding, or ``|v|``).  The confined films' viscous shear (``thin_films = "viscous"``)
     joins the film's traction."""

@@ -1,5 +1,5 @@
 """Friction on the pin: the tangential force of the film (eqs 31, 33-34); the contacts'
-(eq 32) is :mod:`.boundary`'s.
+(eq 32) is :mod:`.boundary_friction`'s.
 
 The default law (``"pin"``) is the force a load cell on the pin holder reads: the wall
 shear plus the film pressure on the pin's asperity flanks (the micro scale's friction

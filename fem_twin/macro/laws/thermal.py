@@ -215,7 +215,7 @@ class ContactThermal:
     def tempered(self, result, point, temperature: float):
         """``result`` with its boundary shear times the ``point``'s boundary law's
         temperature factor at the film ``temperature`` [C] and the spots' flash
-        (:func:`~.boundary.temperature_factor`; unchanged without a temperature term)."""
+        (:func:`~.boundary_friction.temperature_factor`; unchanged without a temperature term)."""
         return tempered(result, heated_factor(point.settings.boundary, temperature,
                                               self.spot(result, point)))
 
@@ -223,7 +223,7 @@ class ContactThermal:
 @arguments(t="number")
 def tempered(result, t: float):
     """``result`` (a MixedResult) with its boundary shear and force times the temperature
-    factor ``t`` [-] (:func:`~.boundary.temperature_factor`), its friction with them;
+    factor ``t`` [-] (:func:`~.boundary_friction.temperature_factor`), its friction with them;
     ``result`` itself where ``t`` is 1."""
     if t == 1.0:
         return result

@@ -12,10 +12,11 @@ Ambient and cavitation pressure 0 (gauge).  Each pass solves the contact against
 deformed by the film pressure, then the film on the contact's gap (floored at ``gap_floor``,
 as in the cells); the film's deformation, viscosity and density are mixed (Anderson) until
 they settle; ``h_d`` balances the load (Brent on the log of the load).  Friction on the pin
-(:func:`pad_friction`) plus the twin's boundary law (:class:`.boundary.BoundaryLaw`) node by
-node (:func:`boundary_force`): eq 32's ``C_f,b`` times the contact load and the film's where
-the gap is at most the boundary film (the twin's ``p a_r``), or the shear law with tau_0 on
-the resolved spots; integrals by the trapezoidal rule."""
+(:func:`pad_friction`) plus the twin's boundary law
+(:class:`.boundary_friction.BoundaryLaw`) node by node (:func:`boundary_force`): eq 32's
+``C_f,b`` times the contact load and the film's where the gap is at most the boundary film
+(the twin's ``p a_r``), or the shear law with tau_0 on the resolved spots; integrals by the
+trapezoidal rule."""
 
 from __future__ import annotations
 
@@ -354,7 +355,7 @@ def _checked(shape, spacing, load, speed, lubricant, settings):
 
 @arguments(area="field", state=dict, settings=DeterministicSettings, speed="number")
 def boundary_force(area, state: dict, settings: DeterministicSettings, speed: float) -> float:
-    """The boundary law's force [N] (eq 32 or the shear law, :mod:`.boundary`) node by
+    """The boundary law's force [N] (eq 32 or the shear law, :mod:`.boundary_laws`) node by
     node on the resolved pad: the spots (``p_con > 0``, a_c = 1) carry ``p_con``, and with
     ``film_on_contacts`` the film's pressure there and, under ``thin_films =
     "boundary"``, where the gap is at most the boundary film; tau_0 on the spots alone;
