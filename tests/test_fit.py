@@ -303,7 +303,7 @@ def test_a_fit_file_is_read_as_numbers_and_checked_against_the_case(tmp_path):
 def test_a_fitted_interval_stays_inside_the_parameters_bounds():
     """A 95 % interval wider than the parameter's range (a thermal resistance below 0 K/W,
     a load share above 1) is clipped to its bounds and says so; one inside is kept."""
-    from fem_twin.stribeck.fit import interval
+    from fem_twin.stribeck.fit_statistics import interval
     wide = interval(1.0, 21.0, 0.25, 4.0)
     assert (wide["low"], wide["high"], wide["clipped_to_bounds"]) == (0.25, 4.0, [0.25, 4.0])
     inside = interval(0.15, 0.01, 1e-4, 1.0)

@@ -1,10 +1,12 @@
 """The statistics of a least-squares fit (:mod:`.fit`): 95 % intervals clipped to the
-parameters' bounds, the parameters' covariance and correlation, and the warnings on
-fitted contact temperatures."""
+parameters' bounds, the parameters' covariance and correlation, the warnings on fitted
+contact temperatures, and the summary of a solved fit (:func:`fit_summary`)."""
 
 from __future__ import annotations
 
 import numpy as np
+
+from ..errors import InputError
 
 #: a fitted contact temperature this far [K] from its curve's oil temperature is flagged
 TEMPERATURE_OFFSET = 15.0
@@ -56,3 +58,55 @@ def temperature_warnings(model, out: dict, n: int) -> list[str]:
                             "usual; a larger offset may stand for another load or lubricant "
                             "(the Hersey collapse trades the two)")
     return warnings
+
+
+def fit_summary(model, measured, names, sol, weighted, unpack, bounds) -> dict:
+    """The result of a solved least-squares fit ``sol`` of the unknowns ``names`` within
+    ``bounds`` ``(lower, upper)`` to the ``measured`` curves of ``model`` (a
+    :class:`.fit.FitModel`; ``unpack``: the unknowns' vector as the boundary law's values,
+    the curves' viscosities, the load share and R_b): each value with its 95 % interval, the
+    fitted temperatures' viscosities, the residuals and the fit's statistics (``"fit"``).
+    Refuses unknowns the points do not constrain."""
+    n, p = sol.fun.size, sol.x.size
+    dof = n - p
+    # each column over its parameter's range: C_f,b and tau_0 [Pa] differ by 1e9 in units
+    size = np.linalg.norm(sol.jac * (np.array(bounds[1]) - np.array(bounds[0])), axis=0)
+    blind = [name for name, s in zip(names, size) if not s > 1e-9 * max(size.max(), 1e-300)]
+    if blind or dof < 1:
+        raise InputError(f"the measured points do not constrain {', '.join(blind) or 'the fit'}"
+                         f" ({n} residuals for {p} unknowns): they lie where C_f does not "
+                         "depend on it (C_f,b in full film), or are too few; measure the "
+                         "speeds where it acts")
+    scale = np.array(bounds[1]) - np.array(bounds[0])      # unknowns of like size
+    cov = covariance(sol.jac * scale, sol.fun, weighted) * np.outer(scale, scale)
+    from scipy import stats
+    half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
+    out = {name: interval(v, h, lo, hi)
+           for name, v, h, lo, hi in zip(names, sol.x, half, *bounds)}
+    values, mus, share, resistance = unpack(sol.x)
+    for k in range(len(measured)):
+        t = out.get(f"temperature_{k + 1}")
+        if t is not None:                       # viscosity falls as temperature rises
+            mu = model.law.viscosity([t["value"], t["high"], t["low"]])
+            out[f"viscosity_{k + 1}"] = {"value": float(mu[0]), "low": float(mu[1]),
+                                         "high": float(mu[2])}
+    rows, outside = [], 0
+    for k, m in enumerate(measured):
+        cf, inside = model.friction(k, m.speed, mus[k], values, share, resistance)
+        outside += int((~inside).sum())
+        rows.append({"curve": k + 1, "speed_m_s": m.speed.tolist(),
+                     "measured_cf": m.friction_coefficient.tolist(), "fitted_cf": cf.tolist(),
+                     "cf_dev": ((cf - m.friction_coefficient)
+                                / model.boundary_friction).tolist()})
+    dev = np.concatenate([r["cf_dev"] for r in rows])
+    out["fit"] = {"parameters": names, "points": n, "degrees_of_freedom": dof,
+                  "chi2": float(sol.fun @ sol.fun),
+                  "weights": "measured scatter (cf_min/cf_max)" if weighted else "equal",
+                  "rms_cf_dev": float(np.sqrt(np.mean(dev ** 2))),
+                  "max_abs_cf_dev": float(np.abs(dev).max()),
+                  "points_outside_simulated_range": outside,
+                  "correlation": correlation(cov).tolist(), "covariance": cov.tolist(),
+                  "t_factor": float(stats.t.ppf(0.975, dof))}
+    out["residuals"] = rows
+    out["fit"]["warnings"] = temperature_warnings(model, out, len(measured))
+    return out
