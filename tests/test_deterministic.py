@@ -17,9 +17,9 @@ from fem_twin.macro import FilmFields, Lubricant, MacroSettings, solve_mixed, so
 from fem_twin.macro.reference.deterministic import (
     DeterministicNotConverged,
     DeterministicSettings,
-    pad_friction,
     solve_deterministic,
 )
+from fem_twin.macro.reference.film_friction import pad_friction
 from fem_twin.micro import FlowFactors
 
 sys.path.insert(0, str(Path(__file__).parent))

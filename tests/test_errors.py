@@ -147,7 +147,7 @@ PUBLIC = ["fem_twin", "fem_twin.topography", "fem_twin.contact", "fem_twin.micro
 MODULES = ["fem_twin.results", "fem_twin.studies.verification", "fem_twin.stribeck.analysis",
            "fem_twin.macro.laws.boundary_friction", "fem_twin.macro.laws.boundary_laws",
            "fem_twin.macro.laws.thermal",
-           "fem_twin.macro.reference.deterministic",
+           "fem_twin.macro.reference.deterministic", "fem_twin.macro.reference.film_friction",
            "fem_twin.macro.point", "fem_twin.runtime.machine", "fem_twin.topography.statistics",
            "fem_twin.peers.patir_cheng", "fem_twin.peers.greenwood_tripp",
            "fem_twin.peers.average_flow"]
@@ -366,7 +366,8 @@ def _round_five_api_probes():
     from fem_twin.macro.laws.lubricant import Lubricant
     from fem_twin.macro.laws.thermal import ThermalSettings, face_flash, spot_flash
     from fem_twin.macro.laws.viscosity import WaltherLaw
-    from fem_twin.macro.reference.deterministic import DeterministicSettings, pad_friction
+    from fem_twin.macro.reference.deterministic import DeterministicSettings
+    from fem_twin.macro.reference.film_friction import pad_friction
     from fem_twin.macro.reference.time_resolved import disk_at, solve_time_resolved
     from fem_twin.peers import Summits, average_flow_factors, contact_pressure, mean_gap
     from fem_twin.peers import patir_cheng as pc

@@ -6,6 +6,7 @@ They read the laws (:mod:`fem_twin.macro.laws`), the film solver
 (:mod:`fem_twin.macro.coupling.problem`); nothing of the twin's solve imports them.
 
     deterministic  mixed lubrication with the roughness resolved (``solve_deterministic``)
+    film_friction  the resolved film's force on the pin (``pad_friction``)
     time_resolved  the same with both bodies rough, the disk sliding over the pin in time
     point_contact  ball-on-disk contacts: Hertz, Moes parameters, Hamrock-Dowson films
 """

@@ -12,7 +12,7 @@ Ambient and cavitation pressure 0 (gauge).  Each pass solves the contact against
 deformed by the film pressure, then the film on the contact's gap (floored at ``gap_floor``,
 as in the cells); the film's deformation, viscosity and density are mixed (Anderson) until
 they settle; ``h_d`` balances the load (Brent on the log of the load).  Friction on the pin
-(:func:`pad_friction`) plus the twin's boundary law
+(:func:`.film_friction.pad_friction`) plus the twin's boundary law
 (:class:`.boundary_friction.BoundaryLaw`) node by node (:func:`boundary_force`): eq 32's
 ``C_f,b`` times the contact load and the film's where the gap is at most the boundary film
 (the twin's ``p a_r``), or the shear law with tau_0 on the resolved spots; integrals by the
@@ -31,7 +31,6 @@ from ...checks import (
     arguments,
     as_field,
     as_pair,
-    check,
     check_choices,
     check_ranges,
     number,
@@ -54,11 +53,12 @@ from ..laws.boundary_friction import (
     temperature_factor,
     traction,
 )
-from ..laws.friction import FilmFields, film_fields
+from ..laws.friction import FilmFields
 from ..laws.lubricant import Lubricant
+from .film_friction import film_force
 
 __all__ = ["DeterministicNotConverged", "DeterministicResult", "DeterministicSettings",
-           "boundary_force", "pad_friction", "solve_deterministic"]
+           "boundary_force", "solve_deterministic"]
 
 
 #: Anderson mixing of the film's deformation, viscosity and density (the micro-EHL
@@ -141,42 +141,6 @@ class DeterministicResult:
     def friction_coefficient(self) -> float:
         """C_f = (film friction + boundary force) / load (eq 34) [-]."""
         return (self.film_friction + self.boundary_force) / self.load
-
-
-@arguments(spacing="pair", speed="number", boundary_film="number")
-def pad_friction(film, spacing, speed: float, boundary_film: float) -> float:
-    """The ``film``'s force on the pin along +x1 [N] (:class:`~.friction.FilmFields`: its
-    ``mean_gap`` the pad's resolved gap h): ``int mu U / h (1 - theta) dA`` over the films
-    thicker than ``boundary_film`` [m] plus ``int (h / 2) dp/dx1 dA``, which is the pin's
-    wall shear and the film pressure on its surface (``-(h/2) dp/dx1 - p dh/dx1``)
-    integrated by parts with ``p = 0`` on the edge; trapezoidal rule, central differences;
-    ``cavity_fraction`` theta [-] in [0, 1] and ``viscosity`` [Pa s] numbers or fields of the
-    pressure's grid, the ``spacing`` [m] a plausible pitch."""
-    film = film_fields("pad_friction", film)
-    h, p = np.asarray(film.mean_gap, float), np.asarray(film.pressure, float)
-    cavity_fraction, viscosity = film.cavity_fraction, film.viscosity
-    for name, value in (("gap", h), ("cavity_fraction", cavity_fraction),
-                        ("viscosity", viscosity)):
-        check(f"pad_friction: {name}", value, "numbers")
-        if np.ndim(value) and np.shape(value) != p.shape:
-            raise InputError(f"pad_friction: {name} {np.shape(value)} and pressure {p.shape} "
-                             "must share one grid")
-    if np.any(np.abs(np.asarray(cavity_fraction) - 0.5) > 0.5 + 1e-9):
-        raise InputError("pad_friction: cavity_fraction is theta, a fraction in [0, 1]")
-    if not np.all(np.asarray(viscosity) > 0):
-        raise InputError("pad_friction: viscosity [Pa s] is positive (66 mPa s is 0.066)")
-    plausible("pad_friction: spacing [m]", spacing, "pitch")
-    plausible("pad_friction: boundary_film [m]", boundary_film, "boundary_film")
-    return film_force(film, spacing, speed, boundary_film)
-
-
-def film_force(film, spacing, speed: float, boundary_film: float) -> float:
-    """:func:`pad_friction` without its checks, for the solvers' own fields [N]."""
-    h = np.asarray(film.mean_gap, float)
-    dp1 = np.gradient(np.asarray(film.pressure, float), spacing[0], axis=1)
-    shear = np.where(h > boundary_film, film.viscosity * speed / h, 0.0) * (
-        1 - film.cavity_fraction)
-    return float(np.sum(trapezoid_weights(h.shape, spacing) * (shear + h / 2 * dp1)))
 
 
 def state_film(state: dict) -> FilmFields:

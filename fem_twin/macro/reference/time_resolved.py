@@ -16,7 +16,7 @@ and moved between periods by the secant of the period-mean log load (first the s
 solution's ``d log W / d h_d``) until the period-mean load balances; the run starts from
 the steady solution with the disk frozen at its first instant and ends when the period
 means repeat (:class:`TimeSettings`).
-Friction on the pin: :func:`.deterministic.pad_friction` plus the film pressure on the
+Friction on the pin: :func:`.film_friction.pad_friction` plus the film pressure on the
 disk's slopes (the pin's surface is the gap minus the disk's), and the boundary law's
 force (:func:`.deterministic.boundary_force`)."""
 
@@ -45,10 +45,10 @@ from .deterministic import (
     _Pad,
     balance,
     boundary_force,
-    film_force,
     state_film,
     viscous_cut,
 )
+from .film_friction import film_force
 
 __all__ = ["TimeResolvedResult", "TimeSettings", "disk_at", "solve_time_resolved"]
 
