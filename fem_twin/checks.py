@@ -330,6 +330,13 @@ def check_choice(name: str, value, choices) -> None:
         raise InputError(f"{name}: one of {', '.join(map(repr, choices))}, got {value!r}")
 
 
+def registered(name: str, registry, key):
+    """The entry ``key`` of ``registry`` (a law or model registry), refused by
+    :func:`check_choice` naming ``name`` and the registered keys when it has none."""
+    check_choice(name, key, registry)
+    return registry[key]
+
+
 def describe(f) -> dict:
     """What :func:`setting` declared of the dataclass field ``f``: ``doc``, ``unit``,
     ``range`` (lowest, highest, or None) and ``choices``."""

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import InputError
+from ...checks import registered
 from .fbns import solve_complementarity_fb
 from .switch import solve_complementarity
 
@@ -66,8 +66,4 @@ MODELS = {model.name: model() for model in (PThetaSwitch, FischerBurmeister)}
 
 def cavitation_model(name: str):
     """The registered model called ``name`` (:data:`MODELS`)."""
-    try:
-        return MODELS[name]
-    except KeyError:
-        raise InputError(f"complementarity must be one of {sorted(MODELS)}, got "
-                         f"{name!r}") from None
+    return registered("complementarity", MODELS, name)

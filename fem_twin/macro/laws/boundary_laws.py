@@ -22,7 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ...checks import arguments, plausible
+from ...checks import arguments, plausible, registered
 from ...errors import InputError
 
 #: the largest fall of the boundary shear the temperature term may give before any heat
@@ -298,10 +298,7 @@ LAWS = {law.name: law() for law in (ConstantLaw, ShearLaw)}
 @arguments(name=str)
 def boundary_law(name: str) -> Law:
     """The registered law called ``name`` (:data:`LAWS`)."""
-    try:
-        return LAWS[name]
-    except KeyError:
-        raise InputError(f"law: one of {', '.join(map(repr, LAWS))}, got {name!r}") from None
+    return registered("law", LAWS, name)
 
 
 def fitted_parameters() -> tuple:

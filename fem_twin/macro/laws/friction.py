@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...checks import arguments, as_field, check
+from ...checks import arguments, as_field, check, registered
 from ...errors import InputError
 from ...numerics.graded_mesh import Mesh
 from .kinematics import rotate_tensor, rotations
@@ -131,11 +131,7 @@ UNIFORM = (1.0, 0.0, 1.0)
 @arguments(name=str)
 def friction_law(name: str):
     """The registered friction law called ``name`` (:data:`LAWS`)."""
-    try:
-        return LAWS[name]
-    except KeyError:
-        raise InputError(f"friction: one of {', '.join(map(repr, LAWS))}, got "
-                         f"{name!r}") from None
+    return registered("friction", LAWS, name)
 
 
 @arguments(spacing="spacing", speed="number", entrainment="number")
