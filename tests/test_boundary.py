@@ -241,6 +241,7 @@ def test_a_fit_recovers_the_shear_laws_pressure_and_speed_coefficients(factors):
             fit_curves(model, [MeasuredCurve(speeds, noisy)], bad, start_temperatures=None)
 
 
+@pytest.mark.integration
 def test_two_loads_separate_the_shear_strength_from_the_pressure_coefficient(factors):
     """Synthetic truth at 150 and 300 N with both oils (0.066 and 0.024 Pa s): the twin
     with tau_0 = 30 MPa and alpha = 0.08, fitted by the constant-law twin's four curves (20

@@ -261,6 +261,7 @@ def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     assert [duration(s) for s in (85, 250, 1529)] == ["85 s", "4.2 min", "25 min"]
 
 
+@pytest.mark.integration
 def test_the_probes_run_side_by_side_as_the_workers_will(monkeypatch):
     """With two workers each probe runs in two processes at once, their repeats started
     together, so a load on another core slows the probes as it slows the run's workers

@@ -183,6 +183,7 @@ def test_the_verification_pads_refuse_what_they_cannot_pose():
     assert V.to_zero([0.25], [0.01]) == (0.01, None)      # one point: itself, no order
 
 
+@pytest.mark.integration
 def test_the_twin_meets_the_deterministic_pad():
     """The mixed regime: sample patch pair 1 at 16 px tiled 8 x 8 on the crowned pad of
     fem_twin.studies.verification (1 MPa, 0.075 m/s, the bundled oil at 24 C): the deterministic

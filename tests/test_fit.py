@@ -55,6 +55,7 @@ def test_walther_law_through_table_3():
         WaltherLaw.through([24.0, 50.0], [0.024, 0.066], 850.0)      # rises with T
 
 
+@pytest.mark.integration
 def test_fit_recovers_boundary_friction_and_temperature(twin):
     sim, cf = twin
     noisy = cf[35.0] * (1 + 0.01 * np.random.default_rng(3).standard_normal(SPEEDS.size))
@@ -155,6 +156,7 @@ def shares(twin, factors):
     return grid, (direct.hydrodynamic_friction + CFB_TRUE / CFB * direct.boundary_force) / 150
 
 
+@pytest.mark.integration
 def test_fit_recovers_the_load_share(twin, shares):
     """C_f,b and the pin face's share of the load (0.8, between the swept 0.75 and 0.875)
     at the known temperature.  Noiseless, the share interpolation and the speed
@@ -184,6 +186,7 @@ def test_fit_recovers_the_load_share(twin, shares):
     assert np.all(p["cf_high"] - p["cf_low"] > 0)
 
 
+@pytest.mark.integration
 def test_a_curve_no_parameters_fit_is_refused_naming_its_residual(twin, factors):
     """A curve rising with speed cannot be fitted by C_f,b and the temperature, nor one
     measured at 600 N (four times the case's load) with a +-2 % scatter band at the known

@@ -55,6 +55,7 @@ def test_torque_residuals_need_contact():
         torque_residuals(x, x, x)
 
 
+@pytest.mark.integration
 def test_a_fine_pin_is_levelled_on_every_other_pixel(tmp_path):
     """fem_twin.stages.geometry.levelled_pin: a pin of more than LEVELLING_GRID pixels a
     side is levelled on every k-th pixel and tilted by the result.  Sample pin 1 on disk 1

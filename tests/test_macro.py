@@ -466,6 +466,7 @@ def test_the_micro_parts_of_a_fine_grid_are_solved_on_a_coarser_level(factors, m
                                             - base.friction_coefficient), rel=1e-9)
 
 
+@pytest.mark.integration
 def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors):
     """fem_twin.macro.nested: a sweep point started from the previous one moved by the
     coarse grid's change (FAS correction) converges to the point a plain warm start
@@ -501,6 +502,7 @@ def test_nested_sweep_points_reach_the_plain_points_in_fewer_iterations(factors)
     assert est["total"] == pytest.approx(ref["total"], rel=1e-3, abs=1e-6 * 0.19245)
 
 
+@pytest.mark.integration
 def test_nested_levels_each_start_from_the_next_coarser_change(factors, monkeypatch):
     """fem_twin.macro.nested on three levels (the coarse start lowered to 28 nodes: 112^2,
     56^2, 28^2): every level of a warm point starts from the previous point's same level
@@ -635,6 +637,7 @@ def test_contact_quadrature_converges_on_the_pin(factors):
     assert abs(cf[96, "gauss"] - cf[96, "nodal"]) < abs(cf[48, "gauss"] - cf[48, "nodal"])
 
 
+@pytest.mark.integration
 def test_a_cold_nested_point_starts_from_the_coarse_levels_anderson_pairs(factors):
     """fem_twin.macro.nested: the fine level of a cold point starts its Anderson coupling
     from the coarse level's last differences (Secants), interpolated, and converges to the
@@ -680,6 +683,7 @@ def test_the_newton_merit_of_an_overflowing_trial_step_is_inf():
     assert merit(ev, (1.0, 2.0, 1.0)) == pytest.approx(np.sqrt(1 + 0.25 + 9), rel=1e-14)
 
 
+@pytest.mark.integration
 def test_a_sweeps_points_run_in_parallel_from_its_guide(factors, tmp_path):
     """A checkpointed sweep runs as its guide (the same sweep on the
     coarsest nested grid, one warm-started chain) and then every speed as a task of its

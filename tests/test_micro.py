@@ -169,6 +169,7 @@ def moving_ridge(n, n_steps, method, moving="upper", **kw):
     return on_disk, at_rest
 
 
+@pytest.mark.integration
 @pytest.mark.parametrize("method", ["fe", "fvm"])
 @pytest.mark.parametrize("frame", ["upper", "both"])
 def test_moving_ridge_obeys_the_frame_change_whatever_the_step(method, frame):
@@ -234,6 +235,7 @@ def test_frame_change_on_random_roughness():
     assert np.abs(a.b + b.b - [2, 0]).max() < 0.01 and np.abs(a.d + b.d).max() < 0.01
 
 
+@pytest.mark.integration
 def test_time_average_converges_with_the_exact_squeeze_term():
     """Self-convergence in time (issue 13 bar: b1 and d1 at N_t = 32 within 1 % of 256).
     With the exact squeeze term the time average is the trapezoidal rule of a periodic
@@ -499,6 +501,7 @@ def test_bad_input_is_refused():
         CellSolver((8, 8), (1e-7, 1e-7)).solve(np.zeros((8, 8)))
 
 
+@pytest.mark.integration
 def test_adaptive_instants_reach_the_tolerance_where_contact_needs_them():
     """time_tol: at each h0 the midpoints are added while A11, b1 or d1 (relative to at
     least 1/3) still change by more than the tolerance.  Without contact nothing is added; a refined
@@ -626,6 +629,7 @@ def test_adaptive_separations_do_not_chase_time_sampling_jitter():
     assert len(aware) <= len(ref) + 2 < len(blind)
 
 
+@pytest.mark.integration
 def test_homogenise_with_adaptive_h0_matches_the_dense_run(tmp_path):
     """homogenise(h0_tol=...): a subset of the candidates is solved, each point as in the
     dense run; the interpolant of the subset reads the dense factors within the larger of
