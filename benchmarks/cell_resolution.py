@@ -16,7 +16,7 @@ from dataclasses import replace
 
 import numpy as np
 from common import Check
-from estimate import HERE, _run_kept, _subset
+from estimate import HERE, run_kept, subset_case
 
 DEFAULT = False
 #: the cells' sides [px]; the last is the patches' own
@@ -28,8 +28,8 @@ BASE = 96
 def run():
     from fem_twin.case import load_case
 
-    case = _subset(load_case(os.path.join(HERE, "..", "examples", "pin_on_disk.toml")), 0.066)
-    runs = {n: _run_kept(replace(case, micro=replace(case.micro, resolution=(n, n))),
+    case = subset_case(load_case(os.path.join(HERE, "..", "examples", "pin_on_disk.toml")), 0.066)
+    runs = {n: run_kept(replace(case, micro=replace(case.micro, resolution=(n, n))),
                          f"pin_on_disk_cells{n}", reuse=n != BASE) for n in SIDES}
     cb = case.tribometer.boundary_friction
     own, base = runs[SIDES[-1]][1], runs[BASE][1]

@@ -51,7 +51,7 @@ def _refined(case, parts, every_h0):
     return replace(case, preprocessing=pre, micro=micro, macro=macro)
 
 
-def _run_kept(case, name, reuse=True):
+def run_kept(case, name, reuse=True):
     """Run ``case`` into ``$FEM_TWIN_BENCH_DIR/name`` (or a temporary folder, then read);
     ``(wall time [s], curve, signed estimate parts by speed)``.  ``reuse``: a kept folder
     holding a finished run is read as it is (its wall time from its summary.json), even when
@@ -93,7 +93,7 @@ def _signed_parts(folder, ball) -> dict:
     return out
 
 
-def _subset(case, viscosity):
+def subset_case(case, viscosity):
     """The case's first patch pair at ``viscosity``, isothermal, no refinement, no band."""
     return replace(case, geometry=replace(case.geometry, patches=case.geometry.patches[:1]),
                    thermal=replace(case.thermal, model="none"),
@@ -109,13 +109,13 @@ def run(case_file="pin_on_disk.toml", viscosity=0.066):
     run."""
     from fem_twin.case import load_case
 
-    case = _subset(load_case(os.path.join(HERE, "..", "examples", case_file)), viscosity)
+    case = subset_case(load_case(os.path.join(HERE, "..", "examples", case_file)), viscosity)
     every_h0 = case_file != "paper.toml"
     stem = os.path.splitext(case_file)[0]
-    t_base, base, signed = _run_kept(case, f"{stem}_base", reuse=False)
+    t_base, base, signed = run_kept(case, f"{stem}_base", reuse=False)
     fine = _refined(case, PARTS, every_h0)
-    t_ref, ref, _ = _run_kept(fine, f"{stem}_reference")
-    own = {part: _run_kept(_refined(case, (part,), every_h0), f"{stem}_{part}")
+    t_ref, ref, _ = run_kept(fine, f"{stem}_reference")
+    own = {part: run_kept(_refined(case, (part,), every_h0), f"{stem}_{part}")
            for part in PARTS}
     cb = case.tribometer.boundary_friction
     rows = [(f"baseline: {stem}, 1 patch, 1 viscosity", t_base, ""),
