@@ -14,6 +14,8 @@ dense ``J_OO^-1`` columns of every neighbour took more than 16 GiB).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.linalg as la
 import scipy.sparse as sp
@@ -28,8 +30,9 @@ from .evaluation import NewtonEvaluation
 from .problem import MAX_COEFFICIENT_PRESSURE, Problem
 
 #: a node joins the dense elastic block when its elastic coupling exceeds this fraction of
-#: its pressure-flow coupling
-DENSE_THRESHOLD = 0.02
+#: its pressure-flow coupling (the fastest on the ball's points: ``benchmarks/run.py
+#: ball-newton``)
+DENSE_THRESHOLD = 1.0
 
 
 #: most nodes in the dense block (a 4000^2 LU takes about 2 s here)
@@ -103,6 +106,38 @@ def jacobian(P: Problem, ev: NewtonEvaluation) -> dict:
     return out
 
 
+@dataclass(frozen=True, eq=False)
+class ElasticBlock:
+    """The dense elastic block of a :class:`Preconditioner` on its node set ``S``:
+    ``E = E_SS`` [m/Pa], the LU of ``I - E_SS p_con'`` (None without contact stiffness on
+    ``S``) and ``ME = M E_SS`` with ``M`` that matrix's inverse, in single precision (a
+    preconditioner's accuracy: GMRES runs on the exact action).  The cubic part of a
+    build, kept by the rebuilds whose set it covers."""
+
+    S: np.ndarray
+    E: np.ndarray
+    lu: tuple | None
+    ME: np.ndarray
+
+    @classmethod
+    def build(cls, P: Problem, S: np.ndarray, dpc: np.ndarray) -> ElasticBlock:
+        """The block on the flat nodes ``S`` with contact stiffness ``dpc = dp_con/dh0``
+        [Pa/m] there."""
+        E = P.dense_elastic(S).astype(np.float32)
+        if not np.any(dpc):
+            return cls(S, E, None, E)
+        lu = la.lu_factor(np.eye(S.size, dtype=np.float32) - E * dpc.astype(np.float32),
+                          overwrite_a=True, check_finite=False)
+        return cls(S, E, lu, la.lu_solve(lu, E, check_finite=False))
+
+    def M(self, r, transpose=False):
+        """``M r`` (``M^T r``) in double."""
+        if self.lu is None:
+            return r
+        return la.lu_solve(self.lu, r.astype(np.float32), trans=int(transpose),
+                           check_finite=False).astype(float)
+
+
 class Preconditioner:
     """Approximate inverse of the Newton matrix: the Jacobian with ``E`` kept on ``S x S``.
 
@@ -113,28 +148,27 @@ class Preconditioner:
     the Schur complement on ``S``.
     """
 
-    def __init__(self, P: Problem, jac: dict):
+    def __init__(self, P: Problem, jac: dict, elastic: ElasticBlock | None = None):
         I, n = P.interior, P.point.gap.size
         J_pp, J_ph, pos, dpc = jac["J_pp"], jac["J_ph"], jac["pos"], jac["dpc"]
         sI = dense_set(P, jac)
-        S = I[sI]
-        self.P, self.jac, self.sI, self.S = P, jac, sI, S
-        E = P.dense_elastic(S)
-        if np.any(dpc[S]):                                # contact stiffness on S
-            self.M = la.inv(np.eye(S.size) - E * dpc[S])
-            self.ME = self.M @ E                          # M_S E_SS
+        if elastic is not None and np.isin(I[sI], elastic.S).all():
+            sI = np.searchsorted(I, elastic.S)            # a set that covers this step's
         else:
-            self.M, self.ME = None, E
+            elastic = ElasticBlock.build(P, I[sI], dpc[I[sI]])
+        S = I[sI]
+        self.P, self.jac, self.sI, self.S, self.elastic = P, jac, sI, S, elastic
+        E, self.ME = elastic.E, elastic.ME
         W = self.ME * pos[S]                              # M_S E_SS D_S
         self.JphS = J_ph[:, S].tocsr()
         a = P.area.ravel()
-        self.v = self._M(a[S] * dpc[S], transpose=True)
+        self.v = self.elastic.M(a[S] * dpc[S], transpose=True)
         l = a[I] * pos[I]
-        l[sI] += pos[S] * (E.T @ self.v)
+        l[sI] += pos[S] * _mv(E.T, self.v)
         self.l = l
-        self.delta = float(a @ dpc + self.v @ (E @ dpc[S]))
+        self.delta = float(a @ dpc + self.v @ _mv(E, dpc[S]))
         self._factor(J_pp, W)
-        c = J_ph @ np.ones(n) + self.JphS @ (self.ME @ dpc[S])
+        c = J_ph @ np.ones(n) + self.JphS @ _mv(self.ME, dpc[S])
         self.y2 = self.solve_pressure(c)
 
     def _factor(self, J_pp, W):
@@ -158,7 +192,8 @@ class Preconditioner:
         cols = np.flatnonzero(np.diff(C.indptr))          # the nodes of O that C reads
         inverse = self._inverse_block(cols, self.ring)    # J_OO^-1 [cols, ring]
         D = JS[:, sI].toarray() + self.JphS[sI] @ W
-        self.schur = la.lu_factor(D - (C[:, cols] @ inverse) @ self.B_ring)
+        self.schur = la.lu_factor((D - (C[:, cols] @ inverse) @ self.B_ring)
+                                  .astype(np.float32), overwrite_a=True, check_finite=False)
 
     def _inverse_block(self, rows, cols):
         """``J_OO^-1[rows, cols]``, from solves of at most ``SOLVE_BLOCK`` entries at once."""
@@ -171,11 +206,6 @@ class Preconditioner:
             out[:, k:k + step] = self.lu.solve(unit)[rows]
         return out
 
-    def _M(self, r, transpose=False):
-        if self.M is None:
-            return r
-        return (self.M.T if transpose else self.M) @ r
-
     def solve_pressure(self, r):
         """``(J_pp + J_ph[:, S] W)^-1 r`` by the block elimination (two sparse solves)."""
         x = np.empty_like(r)
@@ -183,7 +213,7 @@ class Preconditioner:
         if self.sI.size == 0:
             x[self.O] = yO
             return x
-        xS = la.lu_solve(self.schur, r[self.sI] - self.C @ yO)
+        xS = la.lu_solve(self.schur, (r[self.sI] - self.C @ yO).astype(np.float32))
         rO = r[self.O].copy()
         rO[self.ring] -= self.B_ring @ xS
         x[self.O] = self.lu.solve(rO)
@@ -196,15 +226,21 @@ class Preconditioner:
         a = self.P.area.ravel()
         r_GO = r_G.copy()
         r_GO[S] = 0.0
-        MrS = self._M(r_G[S])
+        MrS = self.elastic.M(r_G[S])
         r_t = r_R - self.jac["J_ph"] @ r_GO - self.JphS @ MrS
         r_tL = r_L - float(np.sum(a * dpc * r_GO)) - float(self.v @ r_G[S])
         y1 = self.solve_pressure(r_t)
         dhd = (r_tL - self.l @ y1) / (self.delta - self.l @ self.y2)
         dphi = y1 - self.y2 * dhd
         dw = r_GO
-        dw[S] = MrS + self.ME @ (self.jac["pos"][S] * dphi[sI] + dpc[S] * dhd)
+        dw[S] = MrS + _mv(self.ME, self.jac["pos"][S] * dphi[sI] + dpc[S] * dhd)
         return dphi, dw, dhd
+
+
+def _mv(matrix, vector):
+    """``matrix @ vector`` in the matrix's precision (no upcast copy of a single-precision
+    block), returned in double."""
+    return (matrix @ vector.astype(matrix.dtype)).astype(float)
 
 
 def _grid_lu(A, shape, nodes):
@@ -267,13 +303,15 @@ def apply_jacobian(P: Problem, jac: dict, dphi, dw, dhd):
             dw - P.elastic(dpt.reshape(P.shape)).ravel(), float(P.area.ravel() @ dpt))
 
 
-def newton_step(P: Problem, ev: NewtonEvaluation, load: float, rtol: float, pre=None):
+def newton_step(P: Problem, ev: NewtonEvaluation, load: float, rtol: float, pre=None,
+                elastic: ElasticBlock | None = None):
     """The Newton update ``(dphi, dw, dhd)``, the GMRES iteration count and the
-    preconditioner (built from this step's Jacobian unless ``pre`` is given).  GMRES runs on
-    the system scaled by the residuals' natural sizes (:func:`scales`) to ``rtol``."""
+    preconditioner (built from this step's Jacobian, with the ``elastic`` block where its
+    set is this step's, unless ``pre`` is given).  GMRES runs on the system scaled by the
+    residuals' natural sizes (:func:`scales`) to ``rtol``."""
     s = P.point.settings
     jac = jacobian(P, ev)
-    pre = Preconditioner(P, jac) if pre is None else pre
+    pre = Preconditioner(P, jac, elastic) if pre is None else pre
     nI, n = P.interior.size, P.point.gap.size
     size, h_s, _ = scales(ev, s, load)
     row = np.r_[1 / size, np.full(n, 1 / h_s), 1 / load]                 # residual scales

@@ -101,15 +101,15 @@ def solve(P: Problem, x: State, load: float, *, tol: float, max_iter: int, progr
     """
     s = P.point.settings
     ev = evaluate(P, x, load)
-    history, pre, uphill, short = [], None, 0, 0
+    history, pre, elastic, uphill, short = [], None, None, 0, 0
     for it in range(1, max_iter + 1):
         measure = Merit(load, scales(ev, s, load))
         f = measure(ev)
         try:
-            step, gm, pre = newton_step(P, ev, load, pre=pre,
+            step, gm, pre = newton_step(P, ev, load, pre=pre, elastic=elastic,
                                         rtol=min(1e-3, max(1e-8, 0.1 * f)))
             if gm > REBUILD_AFTER:
-                pre = None
+                pre, elastic = None, pre.elastic
             trial, ev_t, f_t, alpha, downhill = line_search(P, x, ev, step, measure)
             short = short + 1 if alpha < SHORT_STEP else 0
             if not downhill or short >= STALL:
