@@ -65,7 +65,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
     """
     settings = _settings(settings, shortcuts)
     h0_tol = h0_tol or None                                  # 0 means off, as in the case
-    z_low, z_up, spacing = _check_patches(pin, disk)
+    z_low, z_up, spacing = check_patches(pin, disk)
     plausible("reduced modulus e_reduced [Pa]", settings.e_reduced, "reduced_modulus")
     plausible("hardness [Pa]", settings.hardness, "hardness")
     h0 = _check_separations(DEFAULT_H0 if h0 is None else h0)
@@ -201,7 +201,10 @@ def _film_variant(factors, moments, k) -> FlowFactors:
     return replace(factors, meta={}, **out)
 
 
-def _check_patches(pin, disk):
+def check_patches(pin, disk):
+    """The checked ``(z_low, z_up, spacing)`` of a cell's pin and disk patches
+    (:class:`~fem_twin.topography.Topography`: finite, of one shape and pitch [m], at least
+    4 x 4 pixels); :class:`~fem_twin.errors.InputError` otherwise."""
     for name, t in (("pin", pin), ("disk", disk)):
         if not isinstance(t, Topography):
             raise InputError(f"{name} must be a Topography, got {type(t).__name__}")

@@ -9,7 +9,7 @@ import numpy as np
 from ..io.figure import save_figure
 from ..io.mesh import grid_mesh, write_pvd, write_vtu
 from .flow_factors import FlowFactors
-from .homogenisation import _check_patches
+from .homogenisation import check_patches
 from .sliding import (
     CellSettings,
     cell_solver,
@@ -86,7 +86,7 @@ def cell_fields(pin, disk, h0: float, *, n_steps: int = 32, method: str = "fe",
     """
     settings = CellSettings(steps=n_steps, method=method, moving=moving, first_step=first_step,
                             time_derivative=time_derivative, **materials)
-    z_low, z_up, spacing = _check_patches(pin, disk)
+    z_low, z_up, spacing = check_patches(pin, disk)
     sliding = sliding_pass(z_low, z_up, spacing, settings)
     solver = cell_solver(z_low.shape, spacing, method)
     contacts = sliding_contacts(sliding.shapes, spacing, settings, h0)
@@ -106,7 +106,7 @@ def write_cell_fields(folder, pin, disk, h0: float, **kwargs) -> Path:
     """VTU per time step and a PVD time series of :func:`cell_fields` (SI units)."""
     folder = Path(folder)
     steps = cell_fields(pin, disk, h0, **kwargs)
-    _, _, spacing = _check_patches(pin, disk)
+    _, _, spacing = check_patches(pin, disk)
     gm = grid_mesh(pin.shape, spacing, periodic=True)
     name = f"cell_h0_{h0 * 1e9:.0f}nm"
     entries = [(n / len(steps), write_vtu(folder / f"{name}_{n:03d}.vtu", gm, fields))

@@ -1,19 +1,17 @@
 """Fitting the twin's unknowns to measured Stribeck curves, with 95 % intervals.
 
-Parameters, by their case-file keys (none re-runs the micro stage): a boundary law's
-(:func:`fem_twin.macro.laws.boundary_laws.fitted_parameters`: ``boundary_friction``, C_f,b of eq
-32, from a simulated curve's force parts, or the shear law's, from its real contact area and
-asperity load; the law owns them, :meth:`~fem_twin.macro.laws.boundary_laws.Law.fit_force`);
-``temperature``, one oil temperature
-per curve through the case's Walther law, the simulated curve at ``mu_S`` giving the one at
-``mu`` at the speeds ``U mu / mu_S`` (the Hersey collapse, eq 46); ``load_share``, the pin
-face's share of the load, the first viscosity swept at :data:`LOAD_SHARES`;
-``bulk_resistance``, the thermal twin's R_b [K/W], every curve swept at
-:data:`RESISTANCES` (both interpolated by PCHIP, per speed).
+Parameters by their case-file keys (none re-runs the micro stage): a boundary law's
+(:func:`fem_twin.macro.laws.boundary_laws.fitted_parameters`; the law owns them,
+:meth:`~fem_twin.macro.laws.boundary_laws.Law.fit_force`), e.g. ``boundary_friction``
+(C_f,b of eq 32); ``temperature``, one oil temperature per curve through the case's Walther
+law (the curve at ``mu_S`` gives the one at ``mu`` at speeds ``U mu / mu_S``: the Hersey
+collapse, eq 46); ``load_share``, the pin face's share of the load (swept at
+:data:`LOAD_SHARES`); ``bulk_resistance``, the thermal twin's R_b [K/W] (swept at
+:data:`RESISTANCES`); swept parameters are interpolated by PCHIP per speed.
 
 Least squares on C_f,dev (eq 35) at the measured speeds (PCHIP in log speed), weighted by
-``sigma = (cf_max - cf_min) / 1.693`` where the measured CSV gives its scatter, else equal
-weights with the HC3 covariance (:func:`.fit_statistics.covariance`); intervals
+``sigma = (cf_max - cf_min) / 1.693`` where the CSV gives its scatter, else equal weights
+with the HC3 covariance (:func:`.fit_statistics.covariance`); intervals
 ``t_{0.975, n - p}`` times its diagonal's root."""
 
 from __future__ import annotations

@@ -2,21 +2,17 @@
 reference the homogenised twin is verified against in the mixed regime (docs/accuracy.md,
 "The mixed regime against a deterministic solution").  Nothing here is homogenised.
 
-The pin at rest over the disk sliding at U along +x1 (steady: the roughness is the pin's);
-on one node grid the gap is ``h = h_d + shape + K (p + p_con)`` (eqs 19-22 resolved), with
-``p`` the film pressure of Reynolds with JFO cavitation (eqs 17-18 with A = I, b = e1; Q1
-Poiseuille and the central Couette flux, the cells' discretisation; eqs 23-24 at the local
-pressure), ``p_con`` the asperity pressure (CG-FFT with the hardness cap at imposed
-separation, :func:`fem_twin.contact.solve`) and ``K`` the non-periodic half-space.
-Ambient and cavitation pressure 0 (gauge).  Each pass solves the contact against the shape
-deformed by the film pressure, then the film on the contact's gap (floored at ``gap_floor``,
-as in the cells); the film's deformation, viscosity and density are mixed (Anderson) until
-they settle; ``h_d`` balances the load (Brent on the log of the load).  Friction on the pin
-(:func:`.film_friction.pad_friction`) plus the twin's boundary law
-(:class:`.boundary_friction.BoundaryLaw`) node by node (:func:`boundary_force`): eq 32's
-``C_f,b`` times the contact load and the film's where the gap is at most the boundary film
-(the twin's ``p a_r``), or the shear law with tau_0 on the resolved spots; integrals by the
-trapezoidal rule."""
+The pin at rest over the disk sliding at U along +x1 (steady: the roughness is the
+pin's); ``h = h_d + shape + K (p + p_con)`` (eqs 19-22 resolved): ``p`` from Reynolds, JFO
+cavitation (eqs 17-18 with A = I, b = e1; the cells' Q1 Poiseuille and central Couette
+flux; eqs 23-24 at the local pressure), ``p_con`` from the CG-FFT contact with the hardness
+cap (:func:`fem_twin.contact.solve`), ``K`` the non-periodic half-space; gauge pressures.
+Each pass solves the contact against the shape deformed by the film, then the film on the
+contact's gap (floored at ``gap_floor``); deformation, viscosity and density are mixed
+(Anderson) until they settle; ``h_d`` balances the load (Brent on its log).  Friction:
+:func:`.film_friction.pad_friction` plus the twin's boundary law node by node
+(:func:`boundary_force`: eq 32 on the contact load and the film's where the gap is at most
+the boundary film, or the shear law with tau_0 on the resolved spots; trapezoidal rule)."""
 
 from __future__ import annotations
 
@@ -144,7 +140,7 @@ class DeterministicResult:
 
 
 def state_film(state: dict) -> FilmFields:
-    """The film of a solved instant's fields ``state`` (:meth:`_Pad.at`)."""
+    """The film of a solved instant's fields ``state`` (:meth:`Pad.at`)."""
     return FilmFields(state["p"], state["gap"], state["theta"], state["mu"])
 
 
@@ -153,7 +149,7 @@ H_REF = 1e-6
 
 
 @dataclass
-class _Pad:
+class Pad:
     """What one solve keeps between evaluations: the grid's operators and the warm starts,
     ``coupled``: the film's deformation over ``H_REF``, its log viscosity ratio and its
     density ratio, stacked (the fixed point's unknowns)."""
@@ -294,8 +290,8 @@ def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant:
     settings : the pad's materials and numerics (default: the paper's, Table 6)
     initial : a neighbouring point whose separation starts the bracket of h_d
     """
-    s, dx, load, speed = _checked(shape, spacing, load, speed, lubricant, settings)
-    pad = _Pad(s, dx, speed, lubricant, settings)
+    s, dx, load, speed = checked_point(shape, spacing, load, speed, (lubricant, settings))
+    pad = Pad(s, dx, speed, lubricant, settings)
     h_d, st, history, _ = balance(pad, load, initial.separation if initial else None)
     film = film_force(state_film(st), dx, speed, viscous_cut(settings))
     return DeterministicResult(speed, load, float(h_d), st["film_load"], st["contact_load"],
@@ -304,8 +300,11 @@ def solve_deterministic(shape, spacing, *, load: float, speed: float, lubricant:
                                tuple(history))
 
 
-def _checked(shape, spacing, load, speed, lubricant, settings):
-    """The checked ``(shape, spacing, load, speed)`` of a deterministic point (SI)."""
+def checked_point(shape, spacing, load, speed, models):
+    """The checked ``(shape, spacing, load, speed)`` of a deterministic point (SI), with
+    ``models = (lubricant, settings)``; an :class:`~fem_twin.errors.InputError` before any
+    work otherwise."""
+    lubricant, settings = models
     s = as_field("shape [m]", shape, 5)
     plausible("shape [m] (its height range: form plus roughness)", float(np.ptp(s)) or 1e-8,
               "height")
@@ -340,7 +339,7 @@ def viscous_cut(settings: DeterministicSettings) -> float:
         settings.boundary_film
 
 
-def balance(pad: _Pad, load: float, start: float | None = None):
+def balance(pad: Pad, load: float, start: float | None = None):
     """``(h_d, state, history, slope)``: the separation [m] at which ``pad`` carries
     ``load`` [N] (Brent on the log of the load, bracketed from ``start``), its solved
     state, the log load residual of each evaluation and ``d log W / d h_d`` [1/m] from the

@@ -41,10 +41,10 @@ from .deterministic import (
     DeterministicNotConverged,
     DeterministicResult,
     DeterministicSettings,
-    _checked,
-    _Pad,
+    Pad,
     balance,
     boundary_force,
+    checked_point,
     state_film,
     viscous_cut,
 )
@@ -141,13 +141,13 @@ def solve_time_resolved(surfaces, spacing, *, load: float, speed: float,
                          f"gap shape and the disk's periodic strip [m], got "
                          f"{type(surfaces).__name__}")
     shape, disk = surfaces
-    s, dx, load, speed = _checked(shape, spacing, load, speed, lubricant, settings)
+    s, dx, load, speed = checked_point(shape, spacing, load, speed, (lubricant, settings))
     z = as_field("disk [m]", disk, 2)
     plausible("disk [m] (its largest height)", float(np.max(np.abs(z))) or 1e-8, "height")
     time = TimeSettings() if time is None else time
     if not isinstance(time, TimeSettings) or z.shape[0] != s.shape[0]:
         raise InputError("time must be TimeSettings and disk (ny, m) with the pad's ny rows")
-    pad = _Pad(s + disk_at(z, 0, s.shape[1]), dx, speed, lubricant,
+    pad = Pad(s + disk_at(z, 0, s.shape[1]), dx, speed, lubricant,
                replace(settings, tol=time.step_tol))
     march = _March(pad, s, z, load, SCHEMES[time.scheme], time.substeps)
     offset = (initial.separation - initial.frozen_separation
@@ -181,7 +181,7 @@ class _March:
     """The march over roughness periods at a separation moved between them: each step's
     warm start is the same instant of the period before."""
 
-    def __init__(self, pad: _Pad, shape, disk, load: float, weights, substeps: int):
+    def __init__(self, pad: Pad, shape, disk, load: float, weights, substeps: int):
         self.pad, self.shape, self.disk, self.load, self.weights = pad, shape, disk, load, weights
         self.substeps, self.nodes = substeps, shape.shape[1]
         self.steps = disk.shape[1] * substeps
