@@ -14,13 +14,14 @@ from fem_twin.stages.geometry import ball_contact
 
 
 def small_ball_case(tmp_path):
-    """examples/ball_on_disk.toml reduced (one patch at 32^2 x 8 h0 x 4 steps, a 49^2 ball
-    grid, 6 speeds) so that the whole pipeline runs in seconds."""
+    """examples/ball_on_disk.toml reduced (one patch at 32^2 x 8 h0 x 4 steps, a uniform
+    49^2 ball grid, 6 speeds) so that the whole pipeline runs in seconds."""
     text = (ROOT / "examples" / "ball_on_disk.toml").read_text()
     text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
     for old, new in (("resolution = [128, 128]", "resolution = [32, 32]"),
                      ("h0_count = 16", "h0_count = 8"), ("steps = 16", "steps = 4"),
-                     ("grid = 73", "grid = 49"), ("count = 12", "count = 6"),
+                     ("grid = 145", "grid = 49"), ('mesh = "graded"', ""),
+                     ("count = 12", "count = 6"),
                      ("refine = 1 ", "refine = 0 "), ("workers = 0", "workers = 1")):
         assert old in text
         text = text.replace(old, new)

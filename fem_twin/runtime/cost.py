@@ -15,13 +15,14 @@ from dataclasses import replace
 
 from ..macro.nested import nested_levels
 from ..micro.schedule import halves
+from ..numerics.graded_mesh import point_contact_mesh
 from .schedule import Task, makespan
 
 #: a guided Stribeck point of a pin at 128^2 [s], its growth with the nodes, and the cost
 #: of a main-curve point with its C_f error estimate in plain points
 POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 0.56, 0.91, 1.28
 #: a ball's point at 73^2, started from its 37^2 guide (Newton coupling) [s], and its
-#: growth with the grid's side
+#: growth with the grid's side (with the square root of a mesh's nodes)
 BALL_POINT_SECONDS, BALL_POINT_GROWTH = 3.5, 2.4
 #: a band point in main-curve points, by ``[run] band_grid`` (the band's sweeps converge to
 #: ``[run] band_tol`` and carry no error estimate; "coarse" runs them on the coarsened grid)
@@ -165,9 +166,14 @@ def _micro_tasks(case) -> list[Task]:
 
 def _point_seconds(case) -> float:
     """A warm Stribeck point on one core [s]: a pin's by its macro grid, a ball's (Newton
-    coupling) by its grid's side."""
+    coupling) by its mesh's nodes (a uniform grid's side squared, or the graded mesh's)."""
     if case.tribometer.ball:
-        return BALL_POINT_SECONDS * (case.macro.grid / 73) ** BALL_POINT_GROWTH
+        nodes = case.macro.grid ** 2
+        if case.macro.mesh == "graded":
+            shape = point_contact_mesh(case.macro.grid, ((-4.0, 2.0), (-3.0, 3.0)),
+                                       (1.0, 1.0)).shape
+            nodes = shape[0] * shape[1]
+        return BALL_POINT_SECONDS * (nodes / 73 ** 2) ** (BALL_POINT_GROWTH / 2)
     res = case.macro_shape
     return POINT_SECONDS * ((res[0] * res[1]) / 128 ** 2) ** POINT_GROWTH
 
