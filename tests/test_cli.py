@@ -211,11 +211,11 @@ def test_run_time_estimates_hold():
     from fem_twin.runtime.machine import Slowdown
     cases = {name: load_case(ROOT / "examples" / f"{name}.toml")
              for name in ("pin_on_disk", "paper", "ball_on_disk")}
-    runs = [("pin_on_disk", 49.6, (0.56, 0.63)), ("ball_on_disk", 57.1, (0.60, 0.59)),
+    runs = [("pin_on_disk", 49.6, (0.56, 0.63)), ("ball_on_disk", 89.7, (0.71, 0.63)),
             ("paper", 137.6, (0.57, 0.62)),
-            ("pin_on_disk", 75.3, (1.10, 1.00)), ("ball_on_disk", 85.2, (0.90, 0.93)),
+            ("pin_on_disk", 75.3, (1.10, 1.00)), ("ball_on_disk", 131.3, (1.10, 0.93)),
             ("paper", 201.9, (0.91, 0.99)),                         # beside a busy loop
-            ("pin_on_disk", 67.3, (0.69, 0.79)), ("ball_on_disk", 63.1, (0.70, 0.58)),
+            ("pin_on_disk", 67.3, (0.69, 0.79)), ("ball_on_disk", 101.8, (0.92, 0.66)),
             ("paper", 197.3, (0.67, 0.73))]                         # SuperLU
     for name, wall, factors in runs:
         estimate = estimated_seconds(cases[name], 2, Slowdown(*factors))

@@ -23,7 +23,7 @@ from .schedule import Task, makespan
 POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 0.56, 0.91, 1.28
 #: a ball's point at 73^2, started from its 37^2 guide (Newton coupling) [s], and its
 #: growth with the grid's side (with the square root of a mesh's nodes)
-BALL_POINT_SECONDS, BALL_POINT_GROWTH = 3.5, 2.4
+BALL_POINT_SECONDS, BALL_POINT_GROWTH = 2.8, 2.4
 #: a band point in main-curve points, by ``[run] band_grid`` (the band's sweeps converge to
 #: ``[run] band_tol`` and carry no error estimate; "coarse" runs them on the coarsened grid)
 BAND_POINT_COST = {"coarse": 0.22, "full": 0.54}
