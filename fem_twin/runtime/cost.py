@@ -14,6 +14,7 @@ import math
 from dataclasses import replace
 
 from ..macro.nested import nested_levels
+from ..macro.reference.point_contact import EXTENT
 from ..micro.schedule import halves
 from ..numerics.graded_mesh import point_contact_mesh
 from .schedule import Task, makespan
@@ -170,8 +171,7 @@ def _point_seconds(case) -> float:
     if case.tribometer.ball:
         nodes = case.macro.grid ** 2
         if case.macro.mesh == "graded":
-            shape = point_contact_mesh(case.macro.grid, ((-4.0, 2.0), (-3.0, 3.0)),
-                                       (1.0, 1.0)).shape
+            shape = point_contact_mesh(case.macro.grid, EXTENT, (1.0, 1.0)).shape
             nodes = shape[0] * shape[1]
         return BALL_POINT_SECONDS * (nodes / 73 ** 2) ** (BALL_POINT_GROWTH / 2)
     res = case.macro_shape

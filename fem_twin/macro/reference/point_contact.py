@@ -23,6 +23,10 @@ import numpy as np
 from ...errors import InputError
 from ...numerics.graded_mesh import point_contact_mesh
 
+#: a ball's macro domain in its Hertz half-widths a and b = k a: the inlet, the exit
+#: constriction and the side lobes
+EXTENT = ((-4.0, 2.0), (-3.0, 3.0))
+
 
 @dataclass(frozen=True)
 class PointContact:
@@ -104,7 +108,7 @@ class PointContact:
         h_min = 3.63 * U ** 0.68 * G ** 0.49 * W ** -0.073 * (1 - np.exp(-0.68 * k))
         return h_c * self.radius, h_min * self.radius
 
-    def grid(self, n: int, extent=((-4.0, 2.0), (-3.0, 3.0))):
+    def grid(self, n: int, extent=EXTENT):
         """The rigid gap ``x1^2/(2R_x) + x2^2/(2R_y)`` [m] on ``n x n`` nodes over ``extent``
         (in the Hertz half-widths a and b = k a, x1 the entrainment direction), its spacing
         and node coordinates.  ``n - 1`` divisible by the extents' lengths puts a node on
@@ -117,7 +121,7 @@ class PointContact:
         return gap, (x1[1] - x1[0], x2[1] - x2[0]), x1, x2
 
 
-    def mesh(self, n: int, extent=((-4.0, 2.0), (-3.0, 3.0))):
+    def mesh(self, n: int, extent=EXTENT):
         """:meth:`grid`'s ``(gap, spacing, x1, x2)`` on the mesh graded over that grid
         (:func:`~fem_twin.numerics.graded_mesh.point_contact_mesh`): ``spacing`` is the
         :class:`~fem_twin.numerics.graded_mesh.Mesh`, whose grid is ``n x n``."""
