@@ -6,13 +6,15 @@ the bundled ball.
 
 The case with its first patch pair, its first viscosity, isothermal, no speed refinement and
 no band.  The reference refines everything at once: the macro grid twice as fine (a ball's
-``[macro] grid`` 2n - 1), the cells twice, four times the steps, twice the h0 candidates
-(a pin's and a ball's every one of them).  Each part's own change refines that alone.  Rows,
-per speed: the estimate, the change to the reference (the truth) and their ratio, the
-effectivity (``ok``: 1 to 3, or both under 0.05 % C_f,b); then each part's signed estimate
-over its own signed change (negative: the wrong sign).  Checked: the estimate is nowhere below
-the truth (or both are under the floor).  ``$FEM_TWIN_BENCH_DIR`` keeps the refined runs and
-reads a finished one again; the base run is always made anew."""
+``[macro] grid`` 2n - 1), the cells on the patches' own pixels (the measurement holds no
+finer surface; twice as fine where that is finer), four times the steps, twice the h0
+candidates (a pin's and a ball's every one of them).  Each part's own change refines that
+alone.  Rows, per speed: the estimate (``cf_err``), the change to the reference (the truth)
+and their ratio, the effectivity (``ok``: 1 to 3, or both under 0.05 % C_f,b); then each
+part's signed estimate over its own signed change (negative: the wrong sign), and the film
+sensitivity.  Checked: the estimate is nowhere below the truth (or both are under the
+floor).  ``$FEM_TWIN_BENCH_DIR`` keeps the refined runs and reads a finished one again; the
+base run is always made anew."""
 
 from __future__ import annotations
 
@@ -34,15 +36,17 @@ PARTS = ("macro", "time", "grid", "h0")
 
 def _refined(case, parts, every_h0):
     """``case`` with the ``parts`` refined: ``"macro"`` (a pin's maps resampled twice as
-    fine, a ball's grid 2n - 1), ``"grid"`` (cells twice as fine), ``"time"`` (four times the
-    steps), ``"h0"`` (twice the candidates, all of them solved with ``every_h0``)."""
+    fine, a ball's grid 2n - 1), ``"grid"`` (cells on the patches' own pixels, or twice as
+    fine where that is finer), ``"time"`` (four times the steps), ``"h0"`` (twice the
+    candidates, all of them solved with ``every_h0``)."""
     pre, micro, macro = case.preprocessing, case.micro, case.macro
     if "macro" in parts and case.tribometer.ball:
         macro = replace(macro, grid=2 * macro.grid - 1)
     elif "macro" in parts:
         pre = replace(pre, resolution=tuple(2 * n for n in pre.resolution))
-    if "grid" in parts:
-        micro = replace(micro, resolution=tuple(2 * n for n in micro.resolution))
+    if "grid" in parts:                                 # the patches' own pixels, or 2n
+        micro = replace(micro, resolution=tuple(max(2 * n, own) for n, own in zip(
+            micro.resolution, case.geometry.patch_shape)))
     if "time" in parts:
         micro = replace(micro, steps=4 * micro.steps)
     if "h0" in parts:

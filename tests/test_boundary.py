@@ -305,6 +305,7 @@ def test_the_error_estimate_carries_the_real_contact_fractions_error(factors):
                                             lubricant=Lubricant(0.066), error_estimate=True,
                                             settings=MacroSettings(boundary=law)))
         parts[law.law] = {k: float(v[0]) for k, v in curve.friction_error_parts.items()}
+        parts[law.law]["film"] = float(curve.film_sensitivity[0])
     assert abs(parts["shear"]["grid"] / parts["constant"]["grid"] - 1) > 0.1
     assert parts["shear"]["film"] == pytest.approx(parts["constant"]["film"], rel=1e-9)
 

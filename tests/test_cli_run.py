@@ -441,8 +441,11 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
     for r in rows:
         point = st.sel(viscosity=float(r["viscosity_Pa_s"]), speed=float(r["speed_m_s"]),
                        method="nearest")
-        parts = [float(point[f"cf_err_{p}"]) for p in ("macro", "time", "grid", "h0", "film")]
+        parts = [float(point[f"cf_err_{p}"]) for p in ("macro", "time", "grid", "h0")]
         assert float(r["cf_err"]) == pytest.approx(sum(parts), rel=1e-9)
+        # the boundary film's model sensitivity beside it, in both files
+        assert float(point.film_sensitivity) == pytest.approx(float(r["cf_film"]), rel=1e-9)
+        assert float(r["cf_film"]) > 0
         assert float(r["cf_err"]) > 0
         assert float(point.cf_err) == pytest.approx(float(r["cf_err"]), rel=1e-9)
         assert float(r["cf_err"]) <= err["max_relative"] * 0.1924500897 * (1 + 1e-9)

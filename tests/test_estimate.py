@@ -62,8 +62,10 @@ def test_estimate_bounds_the_change_to_a_refined_run(runs, speed):
 
 def test_the_accuracy_warning_names_the_cases_macro_grid_key(caplog):
     """Points above the tolerance: the warning names the key that sets the macro grid, a
-    pin's ``[preprocessing] resolution`` or a ball's ``[macro] grid``."""
+    pin's ``[preprocessing] resolution`` or a ball's ``[macro] grid``.  The boundary film's
+    sensitivity, which no refinement reduces, is reported beside it and does not warn."""
     import logging
+    from dataclasses import replace
 
     import numpy as np
 
@@ -79,6 +81,12 @@ def test_the_accuracy_warning_names_the_cases_macro_grid_key(caplog):
         with caplog.at_level(logging.WARNING, logger="fem_twin"):
             summary = error_summary([curve], 0.19245, 0.005, ball)
         assert summary["points_above"] == 2 and key in caplog.text
+    caplog.clear()
+    film = replace(curve, friction_error=0.0005 * one, film_sensitivity=0.01 * one)
+    with caplog.at_level(logging.WARNING, logger="fem_twin"):
+        summary = error_summary([film], 0.19245, 0.005)
+    assert summary["points_above"] == 0 and not caplog.text
+    assert summary["film_max_relative"] == pytest.approx(0.01 / 0.19245)
 
 
 @pytest.mark.integration

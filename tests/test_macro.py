@@ -419,6 +419,8 @@ def test_friction_error_parts(case32, factors):
     assert est_film == pytest.approx(
         FILM_COUPLING * max(abs(f.friction_coefficient - res.friction_coefficient)
                             for f in films), rel=1e-4)
+    # the total sums the discretisation parts; the film is a model sensitivity beside it
+    assert "film" not in PARTS and est["film"] > 0
     assert est["total"] == pytest.approx(sum(est[p] for p in PARTS))
     assert all(est[p] > 0 for p in PARTS) and "missing" not in est
     bare = replace(factors, meta={})

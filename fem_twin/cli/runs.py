@@ -125,6 +125,8 @@ def traction(args):
 
 def _short_summary(summary: dict, out: Path) -> str:
     """A few lines for the terminal; everything is in ``OUT/summary.json``."""
+    from ..stribeck.accuracy import film_clause
+
     stages = summary["stages"]
     estimated = (f"estimated {duration(summary['estimated_s'])}; "
                  if summary.get("estimated_s") else "")
@@ -151,7 +153,7 @@ def _short_summary(summary: dict, out: Path) -> str:
                      f"{err['max_relative']:.2%} of C_f,b (" + ", ".join(
                          f"{k} {v:.2%}" for k, v in err["parts_max_relative"].items())
                      + f"; tolerance {err['tolerance']:.2%}; flow-factor estimates in "
-                     "summary.json)")
+                     "summary.json)" + film_clause(err))
     graph = summary.get("task_graph")
     if graph:
         wall = graph["wall_s"]

@@ -1,19 +1,18 @@
 """The discretisation error of an operating point's friction coefficient C_f (eq 34).
 
-Each part is a change of C_f [-] (the measurements behind each choice: docs/accuracy.md,
-"The error bar on every friction coefficient"): ``"macro"``, the point on the macro grid
-coarsened by two, ``|C_f(h) - C_f(2h)| / (2^p - 1)`` with ``p = MACRO_ORDER``; ``"time"``,
-``"grid"``, ``"h0"``, the flow factors' own estimates carried into C_f (the point solved
-with each variant of the factors, :meth:`FlowFactors.variants`, to :data:`VARIANT_TOL`
-on the level :func:`micro_parts_level` gives, minus the point there; ``"h0"`` over
-``H0_SPACING_RATIO``); ``"film"``, the point's fields re-evaluated with the friction factor
-of half and twice the boundary film, times ``FILM_COUPLING`` (a model part; no solve).
-
-``"total"`` sums the parts' magnitudes (a root sum of squares fell below the truth where
-the parts' errors add with one sign); ``"signed"`` keeps each part's sign.  A part that
-could not be estimated is NaN, left out of the total and named in ``"missing"``, with the
-reason in ``"failed"``.  Smooth factors have no micro parts (0); a screening model's
-point (:attr:`FlowFactors.screening`) has no estimate at all (NaN, :data:`SCREENING`)."""
+Each part is a change of C_f [-] (why each is so: docs/accuracy.md, "The error bar on
+every friction coefficient"): ``"macro"``, the point on the macro grid coarsened by two,
+``|C_f(h) - C_f(2h)| / (2^p - 1)``, ``p = MACRO_ORDER``; ``"time"``, ``"grid"``, ``"h0"``,
+the flow factors' own estimates carried into C_f (the point solved with each variant of
+the factors, :meth:`FlowFactors.variants`, to :data:`VARIANT_TOL` on the level
+:func:`micro_parts_level` gives, minus the point there; ``"h0"`` over
+``H0_SPACING_RATIO``).  ``"total"`` sums their magnitudes (a root sum of squares fell
+below the truth where they add with one sign), ``"signed"`` keeps their signs.  Beside
+them, ``"film"``: the friction of the point's fields with half and twice the boundary
+film, times ``FILM_COUPLING``, a model sensitivity no refinement reduces (not in the
+total).  A part not estimated is NaN, left out of the total and named in ``"missing"``
+(the reason in ``"failed"``).  Smooth factors have no micro parts (0); a screening
+model's point (:attr:`FlowFactors.screening`) has no estimate (NaN, :data:`SCREENING`)."""
 
 from __future__ import annotations
 
@@ -49,8 +48,11 @@ FILM_COUPLING = 2.0
 #: why a screening model's point (:attr:`FlowFactors.screening`) has no estimate
 SCREENING = ("the average-flow screening model: its C_f has no error bar, its gap to the "
              "deterministic reference is measured in docs/peers.md")
-#: the parts of an estimate, in the order of the CSV and NetCDF outputs
-PARTS = ("macro", "time", "grid", "h0", "film")
+#: the discretisation parts of an estimate, which its total sums, in the order of the
+#: NetCDF output
+PARTS = ("macro", "time", "grid", "h0")
+#: the model sensitivity reported beside them: C_f's change with the boundary film
+FILM = "film"
 #: the coupling tolerance of the variant solves (the run's where that is looser): a part
 #: matters from 0.05 % C_f,b, and the looser tolerance moves it far less than that for two
 #: thirds of the variants' CPU (``tests/test_estimate.py``, ``benchmarks/run.py estimate``)
@@ -80,13 +82,13 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
     first), which are then not solved again."""
     factors = point.factors
     if factors.screening:                         # a statistical model: no error bar
-        return {**{part: np.nan for part in PARTS}, "total": np.nan,
+        return {**{part: np.nan for part in (*PARTS, FILM)}, "total": np.nan,
                 "failed": [SCREENING]}
     solve = _Levels(result, point, levels)
     try:
         base = solve(1)
     except MixedNotConverged as err:
-        return {**{part: np.nan for part in PARTS}, "total": np.nan,
+        return {**{part: np.nan for part in (*PARTS, FILM)}, "total": np.nan,
                 "failed": [f"coarse grid: {err.args[0]}"]}
     signed = {"macro": (base.friction_coefficient - result.friction_coefficient)
               / (2 ** MACRO_ORDER - 1)}
@@ -96,14 +98,15 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
     if films:                                 # the friction factor alone: no solve
         own = friction_with(result, factors, point)
         moved = [friction_with(result, v, point) - own for v in films]
-        signed["film"] = FILM_COUPLING * max(moved, key=abs)
+        signed[FILM] = FILM_COUPLING * max(moved, key=abs)
     smooth = factors.meta.get("smooth", False)              # no roughness: no micro error
-    for kind in set(PARTS) - set(signed):
+    parts = (*PARTS, FILM)
+    for kind in set(parts) - set(signed):
         signed[kind] = 0.0 if smooth else np.nan
-    out = {part: abs(float(signed[part])) for part in PARTS}
-    out["total"] = float(np.nansum(list(out.values())))
-    out["signed"] = {part: float(signed[part]) for part in PARTS}
-    missing = [part for part in PARTS if np.isnan(out[part])]
+    out = {part: abs(float(signed[part])) for part in parts}
+    out["total"] = float(np.nansum([out[part] for part in PARTS]))
+    out["signed"] = {part: float(signed[part]) for part in parts}
+    missing = [part for part in parts if np.isnan(out[part])]
     if missing:
         out["missing"] = missing
     if failed:

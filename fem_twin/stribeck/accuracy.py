@@ -2,7 +2,8 @@
 
 Each point of a sweep run with ``error_estimate=True`` carries the estimated discretisation
 error of its friction coefficient, in total and per part (macro grid; the flow factors'
-time, grid and h0 sampling: :mod:`fem_twin.macro.estimate`).  Here they are put relative to
+time, grid and h0 sampling: :mod:`fem_twin.macro.estimate`), and beside it C_f's
+sensitivity to the boundary film.  Here they are put relative to
 the boundary friction coefficient C_f,b, the scale of eq 35's deviations, and the points
 above a tolerance are named.  :func:`range_summary` checks what the estimate cannot see:
 contact carried at separations below the micro scale's range, where p_con is extrapolated.
@@ -27,7 +28,8 @@ def error_summary(curves, boundary_friction: float, tolerance: float,
                   ball: bool = False) -> dict:
     """The largest estimated C_f error of ``curves`` over C_f,b, in total and per part, and
     the number of points above ``tolerance`` (a fraction of C_f,b), with a logged warning
-    naming the worst one and the keys to refine (``ball``: its macro grid's)."""
+    naming the worst one and the keys to refine (``ball``: its macro grid's); beside them
+    the largest sensitivity to the boundary film, a model part no refinement reduces."""
     def largest(values):
         values = np.concatenate(values) / boundary_friction
         return float(np.nanmax(values)) if np.isfinite(values).any() else float("nan")
@@ -42,9 +44,11 @@ def error_summary(curves, boundary_friction: float, tolerance: float,
                     "steps or h0_count", 100 * tolerance, len(above),
                     sum(c.speed.size for c in curves), 100 * worst[0], worst[1], worst[2],
                     MACRO_GRID_KEYS[ball])
+    films = [c.film_sensitivity for c in curves if c.film_sensitivity is not None]
     return {"max_relative": largest([c.friction_error for c in curves]),
             "parts_max_relative": {part: largest([c.friction_error_parts[part]
                                                   for c in curves]) for part in PARTS},
+            "film_max_relative": largest(films) if films else float("nan"),
             "tolerance": tolerance, "points_above": len(above)}
 
 
@@ -70,3 +74,13 @@ def range_summary(shares, h0_min: float) -> dict:
     return {"h0_min_m": float(h0_min), "max_load_share_below": float(worst),
             "worst_point": where, "tolerance": EXTRAPOLATED_LOAD, "points": len(shares),
             "points_above": int(above)}
+
+
+def film_clause(err: dict) -> str:
+    """The clause on the largest sensitivity to the boundary film of an
+    :func:`error_summary` ``err``, for the run's summary line and report ("" without)."""
+    film = err.get("film_max_relative", float("nan"))
+    if not np.isfinite(film):
+        return ""
+    return (f"; the boundary film's model sensitivity (cf_film, not in cf_err) at most "
+            f"{film:.2%} of C_f,b")

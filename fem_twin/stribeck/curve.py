@@ -36,7 +36,9 @@ OPTIONAL = {"contact_temperature": ("contact_temperature_C", "degC", "the film's
             "real_contact_area": ("real_contact_area_m2", "m2", "the real contact area "
                                   "along the sliding"),
             "spot_rise": ("spot_rise_K_Pa", "K/Pa", "an asperity spot's flash per pascal "
-                          "of boundary shear")}
+                          "of boundary shear"),
+            "film_sensitivity": ("cf_film", "1", "C_f's change with half and twice [micro] "
+                                 "boundary_film: a model sensitivity, not in cf_err")}
 #: the unit and meaning of each variable over (viscosity, speed) in ``results.nc``
 #: (:func:`fem_twin.results.stribeck_dataset`; speed and viscosity are its coordinates)
 UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
@@ -90,7 +92,8 @@ class StribeckCurve:
     nested solves' coarse points, finest first; NaN where none was solved), when the sweep
     kept them; the :data:`OPTIONAL` columns where the run gives them (temperatures [C]
     and the spots' flash per shear [K/Pa] of a thermal run, the boundary law's asperity
-    load [N] and real contact area [m^2]; None otherwise).
+    load [N] and real contact area [m^2], C_f's sensitivity to the boundary film [-] of an
+    estimating sweep; None otherwise).
     """
 
     speed: np.ndarray
@@ -110,6 +113,7 @@ class StribeckCurve:
     asperity_load: np.ndarray | None = None
     real_contact_area: np.ndarray | None = None
     spot_rise: np.ndarray | None = None
+    film_sensitivity: np.ndarray | None = None
 
     @property
     def boundary_share(self) -> np.ndarray:

@@ -19,11 +19,11 @@ def predict(model: FitModel, result: dict, speeds, temperature: float | None,
     ``temperature`` (None: at the viscosity of the simulated ``curve``).  The simulated
     curve of the nearest viscosity, or ``curve``, is rescaled (Hersey); without ``curve``
     the band adds the spread of all the simulated curves so rescaled (the Hersey collapse's
-    own error, when there are two or more); it adds their C_f error estimates
-    (``cf_err``, NaN where the curves have none).  The band is clipped to C_f in [0, 1]
-    (``band_clipped`` marks where: the linearised band is wider than C_f).  A fitted
-    load share and thermal resistance move C_f along ``model.share_curves`` and
-    ``model.resistance_curves``."""
+    own error, when there are two or more); it adds their C_f error estimates and
+    sensitivity to the boundary film (``cf_err``, ``cf_film``; NaN without the first).
+    The band is clipped to C_f in [0, 1] (``band_clipped`` marks where: the linearised
+    band is wider than C_f).  A fitted load share and thermal resistance move C_f along
+    ``model.share_curves`` and ``model.resistance_curves``."""
     names = result["fit"]["parameters"]
     x = np.array([result[n]["value"] for n in names])
     cov = np.asarray(result["fit"]["covariance"])
@@ -41,16 +41,16 @@ def predict(model: FitModel, result: dict, speeds, temperature: float | None,
                               v.get("bulk_resistance"))
 
     value, inside = cf(x)
-    discretisation = _error_at(model, speeds) + (_collapse_error(model, cf, x)
-                                                 if curve is None else 0.0)
+    twin = _error_at(model, speeds) + (_collapse_error(model, cf, x)
+                                       if curve is None else 0.0)
     grad = np.stack([(cf(x + step)[0] - value) / step[i]
                      for i, step in enumerate(np.diag(np.maximum(1e-6 * np.abs(x), 1e-6)))],
                     axis=1)
     half = result["fit"]["t_factor"] * np.sqrt(np.einsum("ij,jk,ik->i", grad, cov, grad))
-    half = half + np.nan_to_num(discretisation)  # the twin's own error (cf_err), when known
+    half = half + np.nan_to_num(twin)        # the twin's own error (cf_err, cf_film), if known
     return {"speed_m_s": np.asarray(speeds, float), "cf": value,
             "cf_low": np.maximum(value - half, 0.0), "cf_high": np.minimum(value + half, 1.0),
-            "cf_err": discretisation, "inside_simulated_range": inside,
+            "cf_err": twin, "inside_simulated_range": inside,
             "band_clipped": (value - half < 0) | (value + half > 1)}
 
 
@@ -63,15 +63,18 @@ def _collapse_error(model: FitModel, cf, x) -> np.ndarray:
 
 
 def _error_at(model: FitModel, speeds) -> np.ndarray:
-    """The simulated curves' C_f error estimate at ``speeds`` (the largest over the curves;
-    NaN without estimates: missing, not zero)."""
+    """The simulated curves' C_f error estimate at ``speeds``, with their sensitivity to the
+    boundary film where they carry it (the largest over the curves; NaN without estimates:
+    missing, not zero)."""
     curves = [c for c in model.curves if c.friction_error is not None]
     if not curves:
         return np.full(np.shape(speeds), np.nan)
     out = []
     for c in curves:
         order = np.argsort(c.speed)
-        out.append(np.interp(np.log(speeds), np.log(c.speed[order]), c.friction_error[order]))
+        error = c.friction_error + (0.0 if c.film_sensitivity is None
+                                    else np.nan_to_num(c.film_sensitivity))
+        out.append(np.interp(np.log(speeds), np.log(c.speed[order]), error[order]))
     return np.max(out, axis=0)
 
 

@@ -14,7 +14,7 @@ from ..checks import check
 from ..io.checkpoint import check_made_for, load_or_none, made_for
 from ..io.mesh import write_pvd
 from ..macro import MixedResult
-from ..macro.estimate import PARTS, friction_error
+from ..macro.estimate import FILM, PARTS, friction_error
 from ..macro.laws.boundary_friction import temperature_factor
 from ..macro.laws.thermal import tempered, thermal_point
 from ..macro.nested import corrected, solve_nested
@@ -178,7 +178,7 @@ def curve_of_records(records, request: SweepRequest) -> StribeckCurve:
     get = lambda name: np.array([r[name] for r in records])  # noqa: E731
     share = request.load_share
     errors = ({part: share * np.array([r["error_estimate"][part] for r in records])
-               for part in (*PARTS, "total")} if request.error_estimate else None)
+               for part in (*PARTS, FILM, "total")} if request.error_estimate else None)
     thermal = ({k: get(k) for k in ("contact_temperature", "asperity_temperature",
                                     "spot_rise")} if request.thermal is not None else {})
     speeds, mu, load = request.speeds, request.lubricant.viscosity, request.load
@@ -192,6 +192,7 @@ def curve_of_records(records, request: SweepRequest) -> StribeckCurve:
         contact_load_fraction=get("contact_load") / request.face_load, h_d=get("h_d"),
         iterations=get("iterations"),
         friction_error=None if errors is None else errors.pop("total"),
+        film_sensitivity=None if errors is None else errors.pop(FILM),
         friction_error_parts=errors,
         coarse_friction_coefficient=share * _levels([r[COARSE_CF] for r in records]))
 
