@@ -446,6 +446,8 @@ def test_results_as_data_and_the_patch_scatter_band(tmp_path):
         # the boundary film's model sensitivity beside it, in both files
         assert float(point.film_sensitivity) == pytest.approx(float(r["cf_film"]), rel=1e-9)
         assert float(r["cf_film"]) > 0
+        # the signed estimate, which the warning reads: its parts summed with their signs
+        assert abs(float(r["cf_err_signed"])) <= float(r["cf_err"]) * (1 + 1e-9)
         assert float(r["cf_err"]) > 0
         assert float(point.cf_err) == pytest.approx(float(r["cf_err"]), rel=1e-9)
         assert float(r["cf_err"]) <= err["max_relative"] * 0.1924500897 * (1 + 1e-9)

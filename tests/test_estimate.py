@@ -62,8 +62,10 @@ def test_estimate_bounds_the_change_to_a_refined_run(runs, speed):
 
 def test_the_accuracy_warning_names_the_cases_macro_grid_key(caplog):
     """Points above the tolerance: the warning names the key that sets the macro grid, a
-    pin's ``[preprocessing] resolution`` or a ball's ``[macro] grid``.  The boundary film's
-    sensitivity, which no refinement reduces, is reported beside it and does not warn."""
+    pin's ``[preprocessing] resolution`` or a ball's ``[macro] grid``.  It reads the signed
+    estimate where the curves have one: a bound above the tolerance whose parts' signs
+    leave the estimate below it is an info line.  The boundary film's sensitivity, which no
+    refinement reduces, is reported beside them and does not warn."""
     import logging
     from dataclasses import replace
 
@@ -81,6 +83,18 @@ def test_the_accuracy_warning_names_the_cases_macro_grid_key(caplog):
         with caplog.at_level(logging.WARNING, logger="fem_twin"):
             summary = error_summary([curve], 0.19245, 0.005, ball)
         assert summary["points_above"] == 2 and key in caplog.text
+    caplog.clear()
+    cancelled = replace(curve, friction_error_signed=np.array([0.0005, -0.0008]))
+    with caplog.at_level(logging.INFO, logger="fem_twin"):
+        summary = error_summary([cancelled], 0.19245, 0.005)
+    assert summary["points_above"] == 0 and summary["bound_points_above"] == 2
+    assert "WARNING" not in caplog.text and "cf_err exceeds 0.5 % of C_f,b at 2 of 2" in caplog.text
+    assert summary["max_signed_relative"] == pytest.approx(0.0008 / 0.19245)
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="fem_twin"):
+        summary = error_summary([replace(cancelled, friction_error_signed=-0.002 * one)],
+                                0.19245, 0.001)
+    assert summary["points_above"] == 2 and "above 0.1 % of C_f,b at 2 of 2" in caplog.text
     caplog.clear()
     film = replace(curve, friction_error=0.0005 * one, film_sensitivity=0.01 * one)
     with caplog.at_level(logging.WARNING, logger="fem_twin"):

@@ -382,7 +382,13 @@ def test_friction_error_parts(case32, factors):
     from dataclasses import replace
 
     from fem_twin.macro import estimate as E
-    from fem_twin.macro.estimate import FILM_COUPLING, MACRO_ORDER, PARTS, friction_error
+    from fem_twin.macro.estimate import (
+        FILM_COUPLING,
+        MACRO_ORDER,
+        PARTS,
+        friction_error,
+        signed_total,
+    )
     from fem_twin.macro.point import OperatingPoint, coarsened
     gap, dx, face = case32
     kw = dict(load=150.0, lubricant=Lubricant(0.066), settings=MacroSettings())
@@ -422,6 +428,8 @@ def test_friction_error_parts(case32, factors):
     # the total sums the discretisation parts; the film is a model sensitivity beside it
     assert "film" not in PARTS and est["film"] > 0
     assert est["total"] == pytest.approx(sum(est[p] for p in PARTS))
+    assert signed_total(est) == pytest.approx(sum(est["signed"][p] for p in PARTS))
+    assert abs(signed_total(est)) <= est["total"]
     assert all(est[p] > 0 for p in PARTS) and "missing" not in est
     bare = replace(factors, meta={})
     est = friction_error(res, replace(point, factors=bare))

@@ -125,7 +125,7 @@ def traction(args):
 
 def _short_summary(summary: dict, out: Path) -> str:
     """A few lines for the terminal; everything is in ``OUT/summary.json``."""
-    from ..stribeck.accuracy import film_clause
+    from ..stribeck.accuracy import error_clause, film_clause
 
     stages = summary["stages"]
     estimated = (f"estimated {duration(summary['estimated_s'])}; "
@@ -149,9 +149,8 @@ def _short_summary(summary: dict, out: Path) -> str:
     if stages.get("micro", {}).get("model") == "average-flow":
         lines.append(f"  C_f by {SCREENING}")
     elif err:
-        lines.append(f"  C_f estimated discretisation error: at most "
-                     f"{err['max_relative']:.2%} of C_f,b (" + ", ".join(
-                         f"{k} {v:.2%}" for k, v in err["parts_max_relative"].items())
+        lines.append(f"  C_f estimated discretisation error: {error_clause(err)} ("
+                     + ", ".join(f"{k} {v:.2%}" for k, v in err["parts_max_relative"].items())
                      + f"; tolerance {err['tolerance']:.2%}; flow-factor estimates in "
                      "summary.json)" + film_clause(err))
     graph = summary.get("task_graph")

@@ -6,8 +6,9 @@ every friction coefficient"): ``"macro"``, the point on the macro grid coarsened
 the flow factors' own estimates carried into C_f (the point solved with each variant of
 the factors, :meth:`FlowFactors.variants`, to :data:`VARIANT_TOL` on the level
 :func:`micro_parts_level` gives, minus the point there; ``"h0"`` over
-``H0_SPACING_RATIO``).  ``"total"`` sums their magnitudes (a root sum of squares fell
-below the truth where they add with one sign), ``"signed"`` keeps their signs.  Beside
+``H0_SPACING_RATIO``).  ``"total"`` sums their magnitudes, a bound (a root sum of squares
+fell below the truth where they add with one sign); ``"signed"`` keeps their signs, whose
+sum (:func:`signed_total`) the accuracy warning reads.  Beside
 them, ``"film"``: the friction of the point's fields with half and twice the boundary
 film, times ``FILM_COUPLING``, a model sensitivity no refinement reduces (not in the
 total).  A part not estimated is NaN, left out of the total and named in ``"missing"``
@@ -136,6 +137,17 @@ def _micro_parts(solve, factors, level) -> tuple[dict, list]:
         signed[kind] = (moved.friction_coefficient - base.friction_coefficient) / (
             H0_SPACING_RATIO if kind == "h0" else 1.0)
     return signed, failed
+
+
+def signed_total(estimate: dict) -> float:
+    """The sum of an estimate's discretisation parts with their signs [-], the estimate of
+    C_f minus its converged value where the parts add (docs/accuracy.md measures how far);
+    the accuracy warning reads it, and ``"total"``, the sum of their magnitudes, bounds
+    it.  NaN for an estimate without signed parts."""
+    signed = estimate.get("signed")
+    if not signed:
+        return float("nan")
+    return float(np.nansum([signed[part] for part in PARTS]))
 
 
 class _Levels:

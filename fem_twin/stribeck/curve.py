@@ -38,7 +38,11 @@ OPTIONAL = {"contact_temperature": ("contact_temperature_C", "degC", "the film's
             "spot_rise": ("spot_rise_K_Pa", "K/Pa", "an asperity spot's flash per pascal "
                           "of boundary shear"),
             "film_sensitivity": ("cf_film", "1", "C_f's change with half and twice [micro] "
-                                 "boundary_film: a model sensitivity, not in cf_err")}
+                                 "boundary_film: a model sensitivity, not in cf_err"),
+            "friction_error_signed": ("cf_err_signed", "1", "the estimate of C_f minus its "
+                                      "converged value, cf_err's parts summed with their "
+                                      "signs: the accuracy warning reads it, cf_err bounds "
+                                      "it")}
 #: the unit and meaning of each variable over (viscosity, speed) in ``results.nc``
 #: (:func:`fem_twin.results.stribeck_dataset`; speed and viscosity are its coordinates)
 UNITS = {"hersey": ("1", "Hersey number mu_0 U D / F_N (eq 46)"),
@@ -92,8 +96,8 @@ class StribeckCurve:
     nested solves' coarse points, finest first; NaN where none was solved), when the sweep
     kept them; the :data:`OPTIONAL` columns where the run gives them (temperatures [C]
     and the spots' flash per shear [K/Pa] of a thermal run, the boundary law's asperity
-    load [N] and real contact area [m^2], C_f's sensitivity to the boundary film [-] of an
-    estimating sweep; None otherwise).
+    load [N] and real contact area [m^2], C_f's sensitivity to the boundary film and the
+    signed estimate of its error [-] of an estimating sweep; None otherwise).
     """
 
     speed: np.ndarray
@@ -114,6 +118,7 @@ class StribeckCurve:
     real_contact_area: np.ndarray | None = None
     spot_rise: np.ndarray | None = None
     film_sensitivity: np.ndarray | None = None
+    friction_error_signed: np.ndarray | None = None
 
     @property
     def boundary_share(self) -> np.ndarray:

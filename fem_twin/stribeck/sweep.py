@@ -14,7 +14,7 @@ from ..checks import check
 from ..io.checkpoint import check_made_for, load_or_none, made_for
 from ..io.mesh import write_pvd
 from ..macro import MixedResult
-from ..macro.estimate import FILM, PARTS, friction_error
+from ..macro.estimate import FILM, PARTS, friction_error, signed_total
 from ..macro.laws.boundary_friction import temperature_factor
 from ..macro.laws.thermal import tempered, thermal_point
 from ..macro.nested import corrected, solve_nested
@@ -193,6 +193,8 @@ def curve_of_records(records, request: SweepRequest) -> StribeckCurve:
         iterations=get("iterations"),
         friction_error=None if errors is None else errors.pop("total"),
         film_sensitivity=None if errors is None else errors.pop(FILM),
+        friction_error_signed=None if errors is None else share * np.array(
+            [signed_total(r["error_estimate"]) for r in records]),
         friction_error_parts=errors,
         coarse_friction_coefficient=share * _levels([r[COARSE_CF] for r in records]))
 

@@ -24,7 +24,7 @@ from ..io.files import read_topography
 from ..io.layout import RunLayout
 from ..io.render import render_views
 from ..macro.laws.friction import LAWS
-from ..stribeck.accuracy import film_clause
+from ..stribeck.accuracy import error_clause, film_clause
 from .fit_file import read_fit
 
 
@@ -234,7 +234,7 @@ def cf_error_paragraph(err) -> str:
                f"above at {err['points_above']} points of")
     return (f"<h3>Accuracy of C_f</h3><p>Estimated discretisation error of every point's "
             f"friction coefficient (error bars of the Stribeck plots, <code>cf_err</code> in "
-            f"stribeck.csv): at most {err['max_relative']:.2%} of C_f,b ({parts}), "
+            f"stribeck.csv): {error_clause(err)} ({parts}), "
             f"{verdict} the tolerance {err['tolerance']:.2%} of C_f,b{film_clause(err)}.</p>")
 
 
