@@ -105,6 +105,7 @@ def test_traction_curve_of_the_ball(tmp_path, capsys):
         assert float(r[0]["boundary_force_N"]) == 0.0 < float(r[1]["boundary_force_N"])
         assert float(r[1]["sliding_speed_m_s"]) == pytest.approx(0.05)
         assert all(0 < float(x["cf_err"]) < 0.1 * cf[2] for x in r)
+        assert float(r[0]["cf_film"]) == 0.0 < float(r[1]["cf_film"])   # no boundary: none
     points = sorted((out / "traction" / "checkpoints").glob("point_*.npz"))
     stamps = [p.stat().st_mtime_ns for p in points]
     before = (out / "traction.csv").read_text()

@@ -22,7 +22,7 @@ from ..io.checkpoint import made_for
 from ..io.figure import save_figure
 from ..io.table import write_csv
 from ..macro import solve_point
-from ..macro.estimate import friction_error
+from ..macro.estimate import FILM, friction_error
 from ..numerics.threads import one_thread
 from .request import RollingSliding, SweepRequest
 from .sweep import load_point, point_file
@@ -31,6 +31,7 @@ from .sweep import load_point, point_file
 HEADERS = {"slide_to_roll": "slide_to_roll", "sliding_speed": "sliding_speed_m_s",
            "entrainment": "entrainment_m_s", "viscosity": "viscosity_Pa_s",
            "friction_coefficient": "friction_coefficient", "friction_error": "cf_err",
+           "film_sensitivity": "cf_film",
            "hydrodynamic_friction": "hydrodynamic_friction_N",
            "boundary_force": "boundary_force_N",
            "contact_load_fraction": "contact_load_fraction", "h_d": "h_d_m"}
@@ -42,14 +43,17 @@ DEFAULT_RATIOS = (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0)
 class TractionCurve:
     """C_f versus SRR at one entrainment speed ``entrainment`` [m/s] and viscosity mu_0
     [Pa s]; arrays over ``slide_to_roll`` (increasing): friction_coefficient [-] with its
-    estimated discretisation error friction_error [-], the F_T parts hydrodynamic_friction
-    and boundary_force [N], contact_load_fraction [-] and the separation h_d [m]."""
+    estimated discretisation error friction_error and its sensitivity to the boundary film
+    film_sensitivity [-] (:mod:`fem_twin.macro.estimate`), the F_T parts
+    hydrodynamic_friction and boundary_force [N], contact_load_fraction [-] and the
+    separation h_d [m]."""
 
     slide_to_roll: np.ndarray
     entrainment: float
     viscosity: float
     friction_coefficient: np.ndarray
     friction_error: np.ndarray
+    film_sensitivity: np.ndarray
     hydrodynamic_friction: np.ndarray
     boundary_force: np.ndarray
     contact_load_fraction: np.ndarray
@@ -106,6 +110,8 @@ def traction_sweep(request: SweepRequest, slide_to_roll=DEFAULT_RATIOS,
         slide_to_roll=ratios, entrainment=float(entrainment), viscosity=lubricant.viscosity,
         friction_coefficient=get("friction_coefficient"),
         friction_error=np.array([results[s].meta["error_estimate"]["total"] for s in ratios]),
+        film_sensitivity=np.array([results[s].meta["error_estimate"].get(FILM, np.nan)
+                                   for s in ratios]),
         hydrodynamic_friction=get("hydrodynamic_friction"),
         boundary_force=get("boundary_force"),
         contact_load_fraction=get("contact_load") / load, h_d=get("h_d"))
