@@ -315,9 +315,12 @@ def test_ctrl_c_during_the_cells_ends_at_once_in_one_line(tmp_path, scheduler):
         f'\nscheduler = "{scheduler}"' if scheduler else "")))
     out = tmp_path / "out"
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", FEM_TWIN_SLOWDOWN="1")
+    # Ctrl-C from a terminal starts at its default: a SIGINT the test process ignores (a
+    # shell's background job) would be inherited, and the run would never see it
     proc = subprocess.Popen([sys.executable, "-m", "fem_twin.cli", "run", str(case), "-o",
                              str(out), "--no-progress"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
+                            stderr=subprocess.PIPE, text=True, env=env, start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 300
     while not list(out.glob("micro/*/checkpoints/*.json")) and proc.poll() is None:
         assert time.monotonic() < deadline, "the micro stage never started"
