@@ -126,53 +126,58 @@ def run(case_file="pin_on_disk.toml", viscosity=0.066):
             (f"reference: all refined ({fine.micro.steps} steps, {fine.micro.h0_count} h0)",
              t_ref, "")]
     rows += [(f"{part} refined alone", t, "") for part, (t, *_) in own.items()]
-    tally = {"within": 0, "below": 0, "signed": [], "warned": [0, 0, 0], "ratios": {
-        part: [] for part in PARTS}}
-    for i, u in enumerate(base.speed):
-        parts = next((v for k, v in signed.items() if np.isclose(k, u, rtol=1e-6)), {})
-        rows.append(_row(i, u, base, ref, parts, {p: c for p, (_, c, _) in own.items()},
-                         cb, case.sweep.error_tolerance, tally))
-    lines = [f"{part}: its estimate over its own change where that exceeds 0.05 % C_f,b: "
-             + (f"{min(r):.2f} to {max(r):.2f}, the wrong sign at {sum(x < 0 for x in r)} "
-                f"of {len(r)} speeds" if r else "nowhere above")
-             for part, r in tally["ratios"].items()]
-    r = tally["signed"]
+    own = {part: c for part, (_, c, _) in own.items()}
+    speeds = [_speed(i, base, ref, own, next((v for k, v in signed.items()
+                                              if np.isclose(k, u, rtol=1e-6)), {}), cb)
+              for i, u in enumerate(base.speed)]
+    rows += [x["row"] for x in speeds]
+    lines = []
+    for part in PARTS:
+        r = [x["ratios"][part] for x in speeds if part in x["ratios"]]
+        lines.append(f"{part}: its estimate over its own change where that exceeds 0.05 % "
+                     "C_f,b: " + (f"{min(r):.2f} to {max(r):.2f}, the wrong sign at "
+                                  f"{sum(x < 0 for x in r)} of {len(r)} speeds"
+                                  if r else "nowhere above"))
+    r = [x["signed"] for x in speeds if "signed" in x]
     lines.append("signed estimate over the signed truth where that exceeds 0.05 % C_f,b: "
                  + (f"{min(r):.2f} to {max(r):.2f}, within 1-3 at "
                     f"{sum(1 <= x <= 3 for x in r)} of {len(r)}" if r else "nowhere above"))
+    tol = case.sweep.error_tolerance
+    above = [sum(x["sizes"][k] > tol * cb for x in speeds) for k in range(3)]
     lines.append("above the tolerance {:.2%} C_f,b: the bound at {}, the signed estimate at "
-                 "{}, the truth at {} speeds".format(case.sweep.error_tolerance,
-                                                     *tally["warned"]))
-    return t_base, rows, *lines, Check(tally["below"] == 0, (
-        f"the C_f estimate below the truth at {tally['below']} of {base.speed.size} speeds "
-        f"(within 1-3 or both under 0.05 % C_f,b at {tally['within']})"))
+                 "{}, the truth at {} speeds".format(tol, *above))
+    below = sum(x["below"] for x in speeds)
+    return t_base, rows, *lines, Check(below == 0, (
+        f"the C_f estimate below the truth at {below} of {base.speed.size} speeds "
+        f"(within 1-3 or both under 0.05 % C_f,b at {sum(x['ok'] for x in speeds)})"))
 
 
-def _row(i, u, base, ref, parts, own, cb, tolerance, tally):
-    """The row of speed ``u`` (index ``i``): the bound ``cf_err`` and the signed estimate
-    against the truth, each part against its ``own`` run's change; counts into ``tally``."""
+def _speed(i, base, ref, own, parts, cb):
+    """Speed ``i`` of the ``base`` curve against the ``ref`` curve and each part's ``own``
+    run, with the base's signed estimate ``parts``: its row, whether the bound ``cf_err``
+    is ``ok`` or ``below`` the truth, the sizes of bound, signed estimate and truth, and the
+    ratios of the signed estimate and of each part to their truths (where above 0.05 %)."""
     from fem_twin.macro.estimate import signed_total
 
-    cf, err = base.friction_coefficient[i], base.friction_error[i]
+    u, cf, err = base.speed[i], base.friction_coefficient[i], base.friction_error[i]
     truth = cf - ref.friction_coefficient[i]
     estimate = signed_total({"signed": parts}) if parts else np.nan
     floor = err < FLOOR * cb and abs(truth) < FLOOR * cb
     ok = floor or 1 <= err / abs(truth) <= 3
-    tally["within"] += ok
-    tally["below"] += not floor and err < abs(truth)
+    out = {"ok": ok, "below": not floor and err < abs(truth), "ratios": {},
+           "sizes": (err, abs(estimate), abs(truth))}
     if abs(truth) >= FLOOR * cb:
-        tally["signed"].append(estimate / truth)
-    for k, value in enumerate((err, abs(estimate), abs(truth))):
-        tally["warned"][k] += value > tolerance * cb
+        out["signed"] = estimate / truth
     notes = []
     for part in PARTS:
         change = cf - own[part].friction_coefficient[i]
         est = parts.get(part, np.nan)
         notes.append(f"{part} {est / cb:+.3%}/{change / cb:+.3%}")
         if abs(change) >= FLOOR * cb:
-            tally["ratios"][part].append(est / change)
+            out["ratios"][part] = est / change
     notes.append(f"film {parts.get('film', np.nan) / cb:+.3%}")
-    return (f"  {u:.4g} m/s: C_f {cf:.5f}, reference {ref.friction_coefficient[i]:.5f}", 0.0,
-            f"estimate {err / cb:.3%} (signed {estimate / cb:+.3%}), truth {truth / cb:+.3%} "
-            f"C_f,b, effectivity {err / abs(truth):.2f} {'ok' if ok else 'OUTSIDE'}; "
-            f"part / own change: {', '.join(notes)}")
+    out["row"] = (f"  {u:.4g} m/s: C_f {cf:.5f}, reference {ref.friction_coefficient[i]:.5f}",
+                  0.0, f"estimate {err / cb:.3%} (signed {estimate / cb:+.3%}), truth "
+                       f"{truth / cb:+.3%} C_f,b, effectivity {err / abs(truth):.2f} "
+                       f"{'ok' if ok else 'OUTSIDE'}; part / own change: {', '.join(notes)}")
+    return out

@@ -83,14 +83,12 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
     first), which are then not solved again."""
     factors = point.factors
     if factors.screening:                         # a statistical model: no error bar
-        return {**{part: np.nan for part in (*PARTS, FILM)}, "total": np.nan,
-                "failed": [SCREENING]}
+        return _not_estimated(SCREENING)
     solve = _Levels(result, point, levels)
     try:
         base = solve(1)
     except MixedNotConverged as err:
-        return {**{part: np.nan for part in (*PARTS, FILM)}, "total": np.nan,
-                "failed": [f"coarse grid: {err.args[0]}"]}
+        return _not_estimated(f"coarse grid: {err.args[0]}")
     signed = {"macro": (base.friction_coefficient - result.friction_coefficient)
               / (2 ** MACRO_ORDER - 1)}
     micro, failed = _micro_parts(solve, factors, micro_parts_level(point.gap.shape))
@@ -137,6 +135,11 @@ def _micro_parts(solve, factors, level) -> tuple[dict, list]:
         signed[kind] = (moved.friction_coefficient - base.friction_coefficient) / (
             H0_SPACING_RATIO if kind == "h0" else 1.0)
     return signed, failed
+
+
+def _not_estimated(reason: str) -> dict:
+    """An estimate with every part NaN, for ``reason``."""
+    return {**{part: np.nan for part in (*PARTS, FILM)}, "total": np.nan, "failed": [reason]}
 
 
 def signed_total(estimate: dict) -> float:
