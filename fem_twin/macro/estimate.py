@@ -3,9 +3,9 @@
 Each part is a change of C_f [-] (why each is so: docs/accuracy.md, "The error bar on
 every friction coefficient"): ``"macro"``, the point on the macro grid coarsened by two,
 ``|C_f(h) - C_f(2h)| / (2^p - 1)``, ``p = MACRO_ORDER``; ``"time"``, ``"grid"``, ``"h0"``,
-the flow factors' own estimates carried into C_f (the point solved with each variant of
-the factors, :meth:`FlowFactors.variants`, to :data:`VARIANT_TOL` on the level
-:func:`micro_parts_level` gives, minus the point there; ``"h0"`` over
+the flow factors' own estimates carried into C_f (the linear response of the point, on
+the level :func:`micro_parts_level` gives, to each variant of the factors,
+:meth:`FlowFactors.variants`: :mod:`.coupling.linearised`; ``"h0"`` over
 ``H0_SPACING_RATIO``).  ``"total"`` sums their magnitudes, a bound (a root sum of squares
 fell below the truth where they add with one sign); ``"signed"`` keeps their signs, whose
 sum (:func:`signed_total`) the accuracy warning reads.  Beside
@@ -17,12 +17,11 @@ model's point (:attr:`FlowFactors.screening`) has no estimate (NaN, :data:`SCREE
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
-from ..errors import MixedNotConverged
+from ..errors import MixedNotConverged, SolverError
 from ..micro.estimate import FILM_VARIANTS
+from .coupling.linearised import friction_responses
 from .coupling.result import friction_with
 from .mixed import solve_point
 from .point import OperatingPoint
@@ -54,10 +53,6 @@ SCREENING = ("the average-flow screening model: its C_f has no error bar, its ga
 PARTS = ("macro", "time", "grid", "h0")
 #: the model sensitivity reported beside them: C_f's change with the boundary film
 FILM = "film"
-#: the coupling tolerance of the variant solves (the run's where that is looser): a part
-#: matters from 0.05 % C_f,b, and the looser tolerance moves it far less than that for two
-#: thirds of the variants' CPU (``tests/test_estimate.py``, ``benchmarks/run.py estimate``)
-VARIANT_TOL = 1e-3
 #: the fewest nodes a side of the grid the micro parts are solved on: there their sum is
 #: within a few per cent of the next finer level's at a seventh of the time
 #: (docs/accuracy.md)
@@ -114,27 +109,20 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
 
 
 def _micro_parts(solve, factors, level) -> tuple[dict, list]:
-    """``({kind: signed change of C_f}, failures)`` of the factors' variants, solved on
-    the grid coarsened ``level`` times, warm from the point there (NaN where a solve
-    failed)."""
+    """``({kind: signed change of C_f}, failures)`` of the factors' variants, each the
+    linear response (:func:`.coupling.linearised.friction_responses`) of the point on the
+    grid coarsened ``level`` times (NaN where that failed)."""
     variants = {k: v for k, v in factors.variants().items() if k not in FILM_VARIANTS}
     if not variants:
         return {}, []
     try:
-        base = solve(level)
+        moved = friction_responses(solve.point(level), solve(level), variants)
     except MixedNotConverged as err:
         return {kind: np.nan for kind in variants}, [f"level {level}: {err.args[0]}"]
-    signed, failed = {}, []
-    for kind, variant in variants.items():
-        try:
-            moved = solve(level, variant, base)
-        except MixedNotConverged as err:
-            signed[kind] = np.nan
-            failed.append(f"{kind}: {err.args[0]}")
-            continue
-        signed[kind] = (moved.friction_coefficient - base.friction_coefficient) / (
-            H0_SPACING_RATIO if kind == "h0" else 1.0)
-    return signed, failed
+    except (SolverError, ValueError) as err:          # a singular Jacobian, NaN in a step
+        return {kind: np.nan for kind in variants}, [f"level {level}: {err}"]
+    return {kind: change / (H0_SPACING_RATIO if kind == "h0" else 1.0)
+            for kind, change in moved.items()}, []
 
 
 def _not_estimated(reason: str) -> dict:
@@ -154,9 +142,8 @@ def signed_total(estimate: dict) -> float:
 
 
 class _Levels:
-    """``solve(level, factors=None, initial=None)``: the point on the grid coarsened
-    ``level`` times, with ``factors`` (default: the point's own) warm from ``initial``; a
-    known level of the point's own factors is taken, not solved again (nor twice)."""
+    """``solve(level)``: the point on the grid coarsened ``level`` times, warm from the
+    next finer level; a known level is taken, not solved again (nor twice)."""
 
     def __init__(self, result, point, levels):
         self.result, self.points, self.known = result, [point], {}
@@ -170,16 +157,8 @@ class _Levels:
             self.points.append(self.points[-1].coarsened())
         return self.points[level]
 
-    def __call__(self, level, factors=None, initial=None):
-        if factors is None and level in self.known:
-            return self.known[level]
-        point = self.point(level)
-        if initial is None:
-            initial = self.known.get(level - 1, self.result)
-        if factors is not None:
-            tol = max(point.settings.tol, VARIANT_TOL)
-            point = replace(point, factors=factors, settings=replace(point.settings, tol=tol))
-        solved = solve_point(point, initial=initial)
-        if factors is None:
-            self.known[level] = solved
-        return solved
+    def __call__(self, level):
+        if level not in self.known:
+            self.known[level] = solve_point(self.point(level),
+                                            initial=self.known.get(level - 1, self.result))
+        return self.known[level]

@@ -304,13 +304,15 @@ def apply_jacobian(P: Problem, jac: dict, dphi, dw, dhd):
 
 
 def newton_step(P: Problem, ev: NewtonEvaluation, load: float, rtol: float, pre=None,
-                elastic: ElasticBlock | None = None):
+                elastic: ElasticBlock | None = None, jac: dict | None = None, residual=None):
     """The Newton update ``(dphi, dw, dhd)``, the GMRES iteration count and the
     preconditioner (built from this step's Jacobian, with the ``elastic`` block where its
     set is this step's, unless ``pre`` is given).  GMRES runs on the system scaled by the
-    residuals' natural sizes (:func:`scales`) to ``rtol``."""
+    residuals' natural sizes (:func:`scales`) to ``rtol``.  ``jac`` (default: the
+    Jacobian at ``ev``) and ``residual`` (default: ``ev``'s ``(R, G, L)``) are for a
+    linear response (:mod:`.linearised`): the step that cancels another residual."""
     s = P.point.settings
-    jac = jacobian(P, ev)
+    jac = jacobian(P, ev) if jac is None else jac
     pre = Preconditioner(P, jac, elastic) if pre is None else pre
     nI, n = P.interior.size, P.point.gap.size
     size, h_s, _ = scales(ev, s, load)
@@ -327,7 +329,7 @@ def newton_step(P: Problem, ev: NewtonEvaluation, load: float, rtol: float, pre=
     def matvec(y):
         return _stack(apply_jacobian(P, jac, *split(precondition(y)))) * row
 
-    b = -_stack((ev.R, ev.G.ravel(), ev.L)) * row
+    b = -_stack((ev.R, ev.G.ravel(), ev.L) if residual is None else residual) * row
     op = spla.LinearOperator((b.size, b.size), matvec=matvec)
     count = [0]
     y, info = spla.gmres(op, b, rtol=rtol, atol=0.0, restart=60, maxiter=4,
