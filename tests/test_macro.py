@@ -381,7 +381,6 @@ def test_friction_error_parts(case32, factors):
     the total)."""
     from dataclasses import replace
 
-    from fem_twin.macro import estimate as E
     from fem_twin.macro.estimate import (
         FILM_COUPLING,
         MACRO_ORDER,

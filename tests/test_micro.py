@@ -725,7 +725,7 @@ def test_non_finite_cell_moments_are_reported_as_the_cells_failure(monkeypatch):
     that blames the caller's FlowFactors."""
     from fem_twin.errors import InputError, SolverError
     from fem_twin.micro import sliding
-    monkeypatch.setattr(sliding, "mean_inverse_film", lambda gap, cut: np.nan)
+    monkeypatch.setattr(sliding.Triangles, "mean_inverse", lambda self, cut: np.nan)
     pin, disk = rough_pair(16)
     with pytest.raises(SolverError, match="non-finite s_(c|thin) at h0 = 5e-07") as caught:
         homogenise(pin, disk, [5e-7], steps=2, error_estimate=False)
