@@ -4,13 +4,13 @@ Time: the result over ``N_t`` instants against the pass of every other instant (
 run's moments; the paper's backward difference solves the even instants again over the
 doubled step): ``|f_N - f_{N/2}|`` estimates the error of ``f_N`` at first order and bounds
 it when faster.  Grid: the cell coarsened by two with half the instants, against the pass
-of as many instants of the run (about an eighth of its cost); a measured patch's factors
-change at first order in the pixel size, so ``|f_h - f_{2h}|`` estimates the error of
-``f_h``.  Each estimate is normwise per quantity (``max |f - g| / max |f|`` over the
-separations).  For the macro scale (:mod:`fem_twin.macro.estimate`) :func:`variants` keeps
-the factors with each error added: ``"time"``, ``"grid"``, ``"h0"`` (every other
-separation) and ``"film_thin"``/``"film_thick"`` (the friction factor at half and twice
-the boundary film, a model sensitivity; docs/accuracy.md)."""
+of as many instants of the run (a sixth of the cells' CPU on the bundled cases); a
+measured patch's factors change at first order in the pixel size, so ``|f_h - f_{2h}|``
+estimates the error of ``f_h``.  Each estimate is normwise per quantity (``max |f - g| /
+max |f|`` over the separations).  For the macro scale (:mod:`fem_twin.macro.estimate`)
+:func:`variants` keeps the factors with each error added: ``"time"``, ``"grid"``, ``"h0"``
+(every other separation) and ``"film_thin"``/``"film_thick"`` (the friction factor at half
+and twice the boundary film, a model sensitivity; docs/accuracy.md)."""
 
 from __future__ import annotations
 

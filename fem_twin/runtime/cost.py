@@ -21,10 +21,10 @@ from .schedule import Task, makespan
 
 #: a guided Stribeck point of a pin at 128^2 [s], its growth with the nodes, and the cost
 #: of a main-curve point with its C_f error estimate in plain points
-POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 0.56, 0.91, 1.28
+POINT_SECONDS, POINT_GROWTH, ESTIMATE_COST = 0.48, 0.91, 1.28
 #: a ball's point at 73^2, started from its 37^2 guide (Newton coupling) [s], and its
 #: growth with the grid's side (with the square root of a mesh's nodes)
-BALL_POINT_SECONDS, BALL_POINT_GROWTH = 2.8, 2.4
+BALL_POINT_SECONDS, BALL_POINT_GROWTH = 2.4, 2.4
 #: a band point in main-curve points, by ``[run] band_grid`` (the band's sweeps converge to
 #: ``[run] band_tol`` and carry no error estimate; "coarse" runs them on the coarsened grid)
 BAND_POINT_COST = {"coarse": 0.22, "full": 0.54}
@@ -49,7 +49,7 @@ MICRO = "patch"
 H0_ROUNDS = 3
 #: micro stage cost per cell pixel, time step and separation on one core [s] (the cell
 #: problems, the periodic contact and the coarsened cell of the error estimate)
-MICRO_SECONDS = 3.5e-6
+MICRO_SECONDS = 2.6e-6
 #: separations an adaptive h0 sample solves per patch pair: ``a + k / sqrt(h0_tol)`` (at
 #: most the candidates)
 ADAPTIVE_H0 = (5.5, 2.7)

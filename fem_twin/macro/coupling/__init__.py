@@ -11,6 +11,7 @@ It reads the film solver (:mod:`fem_twin.macro.film`) and the laws
     partitioned  the partitioned couplings (fixed-point iterations): Anderson, paper's PID
     newton       the monolithic Newton coupling, for elastically dominated contacts
     jacobian     one Newton step's linear algebra: exact Jacobian, Schur preconditioner
+    linearised   the linear response of a converged point's C_f to a change of its factors
     result       the converged point: fields, friction on the pin, files
 """
 

@@ -23,8 +23,13 @@ from .problem import macro_problem
 from .result import Convergence, mixed_result, on_grid
 
 #: GMRES's relative tolerance for a response: a part matters from 5e-4 of C_f, and its
-#: change is at most a few per cent of C_f, so 1e-6 leaves it exact to far below that
+#: change is at most a few per cent of C_f, so 1e-4 leaves it exact to far below that (the
+#: parts of the ``estimate`` subsets move by at most 1e-6 C_f,b from 1e-6)
 RESPONSE_RTOL = 1e-4
+#: the most steps of a response: the Newton step, then chord steps with the same Jacobian
+#: kept while the residual falls (in the boundary regime a second step can move away): on
+#: the ``estimate-ball`` subset the parts lie within 0.045 % C_f,b of the converged
+#: variants' changes after one step, within 0.007 % after two (docs/accuracy.md)
 CHORD_STEPS = 2
 
 
