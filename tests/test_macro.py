@@ -441,6 +441,28 @@ def test_friction_error_parts(case32, factors):
     assert est["total"] == est["macro"] > 0
 
 
+def test_a_micro_part_that_fails_is_missing_with_its_reason(case32, factors, monkeypatch):
+    """Where the linear response cannot be solved (a singular Jacobian), the three micro parts
+    are NaN, named in ``missing`` with the reason in ``failed``, and the total is the
+    macro part alone: no silent zero."""
+    from fem_twin.errors import SolverError
+    from fem_twin.macro import estimate as E
+    from fem_twin.macro.point import OperatingPoint
+
+    def singular(*args, **kwargs):
+        raise SolverError("the Jacobian is singular")
+
+    monkeypatch.setattr(E, "friction_responses", singular)
+    gap, dx, face = case32
+    kw = dict(load=150.0, lubricant=Lubricant(0.066), settings=MacroSettings())
+    res = solve_mixed(gap, dx, factors, speed=0.05, face=face, **kw)
+    est = E.friction_error(res, OperatingPoint(gap, dx, factors, speed=0.05, face=face, **kw))
+    assert all(np.isnan(est[k]) for k in ("time", "grid", "h0"))
+    assert est["missing"] == ["time", "grid", "h0"]
+    assert est["failed"] == ["level 1: the Jacobian is singular"]
+    assert est["total"] == pytest.approx(est["macro"]) and est["film"] > 0
+
+
 def test_the_micro_parts_of_a_fine_grid_are_solved_on_a_coarser_level(factors, monkeypatch):
     """fem_twin.macro.estimate: on grids of more than twice ``MICRO_PARTS_SIDE`` a side the
     micro parts are solved on the coarsest nested level with at least that many nodes a
