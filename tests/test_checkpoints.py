@@ -2,6 +2,7 @@
 another's (another speed, another h0) is set aside as damaged and recomputed."""
 
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -119,3 +120,28 @@ def test_the_sweep_key_changes_with_every_field_that_sets_the_points():
     for name, value in (("speeds", [2.0]), ("hersey_length", 9e-3), ("origin", (1.0, 0.0)),
                         ("error_estimate", True), ("keep_level", 1), ("guide", "abc")):
         assert replace(base, **{name: value}).key == key, name
+
+
+def test_a_point_whose_estimate_was_made_another_way_is_estimated_again(tmp_path):
+    """A Stribeck point checkpointed with a C_f error estimate of another method (an
+    earlier fem_twin's: no ``"method"``, the film's sensitivity in its total) keeps its
+    solution on a resumed run but gets its estimate made again, equal to the first run's;
+    a current estimate is read back as it is."""
+    from fem_twin.io.checkpoint import load_or_none
+    from fem_twin.macro import MixedResult
+    from fem_twin.macro.estimate import METHOD
+
+    gap, dx, face = macro_case(32)
+    request = SweepRequest(gap, dx, smooth_factors(), [0.5], load=150.0,
+                           lubricant=Lubricant(0.066), face=face, checkpoint=tmp_path,
+                           settings=MacroSettings(tol=1e-6), error_estimate=True)
+    first = stribeck_sweep(request)
+    (path,) = point_files(tmp_path)
+    res = load_or_none(path, MixedResult.load)
+    assert res.meta["error_estimate"]["method"] == METHOD
+    old = {k: v for k, v in res.meta["error_estimate"].items() if k != "method"}
+    old["total"] = 1.0                                     # an older total: not this one
+    replace(res, meta={**res.meta, "error_estimate": old}).save(path)
+    again = stribeck_sweep(request)
+    assert again.friction_error[0] == first.friction_error[0] != 1.0
+    assert load_or_none(path, MixedResult.load).meta["error_estimate"]["method"] == METHOD

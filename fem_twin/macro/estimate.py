@@ -53,6 +53,10 @@ SCREENING = ("the average-flow screening model: its C_f has no error bar, its ga
 PARTS = ("macro", "time", "grid", "h0")
 #: the model sensitivity reported beside them: C_f's change with the boundary film
 FILM = "film"
+#: how the estimate is made, kept with it as ``"method"``: a checkpointed point whose
+#: estimate was made another way (by an earlier fem_twin: the film's sensitivity in the
+#: total, the micro parts' variants solved to 1e-3) gets it made again when a run resumes
+METHOD = "discretisation parts, micro parts as linear responses"
 #: the fewest nodes a side of the grid the micro parts are solved on: there their sum is
 #: within a few per cent of the next finer level's at a seventh of the time
 #: (docs/accuracy.md)
@@ -100,6 +104,7 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
     out = {part: abs(float(signed[part])) for part in parts}
     out["total"] = float(np.nansum([out[part] for part in PARTS]))
     out["signed"] = {part: float(signed[part]) for part in parts}
+    out["method"] = METHOD
     missing = [part for part in parts if np.isnan(out[part])]
     if missing:
         out["missing"] = missing
@@ -127,7 +132,14 @@ def _micro_parts(solve, factors, level) -> tuple[dict, list]:
 
 def _not_estimated(reason: str) -> dict:
     """An estimate with every part NaN, for ``reason``."""
-    return {**{part: np.nan for part in (*PARTS, FILM)}, "total": np.nan, "failed": [reason]}
+    return {**{part: np.nan for part in (*PARTS, FILM)}, "total": np.nan, "failed": [reason],
+            "method": METHOD}
+
+
+def is_current(meta: dict) -> bool:
+    """Whether a point's metadata ``meta`` holds a C_f error estimate made by this
+    :data:`METHOD` (a resumed run makes any other again)."""
+    return (meta.get("error_estimate") or {}).get("method") == METHOD
 
 
 def signed_total(estimate: dict) -> float:

@@ -14,6 +14,7 @@ from tqdm import tqdm
 
 from ..errors import ForeignCheckpoint
 from ..io.checkpoint import check_made_for
+from ..macro.estimate import is_current
 from ..macro.nested import nested_levels
 from ..numerics.threads import worker_heap
 from ..runtime.cost import sweep_cost
@@ -147,7 +148,7 @@ def indexed_curve(task, sweep: int, points):
     found = [own.get(point_file(task.checkpoint, task.key, u)) for u in task.speeds]
     try:
         for point, u in zip(found, task.speeds):
-            if point is None or (task.error_estimate and "error_estimate" not in point.meta):
+            if point is None or (task.error_estimate and not is_current(point.meta)):
                 return None
             check_made_for(point.meta, task.key, u, point.path)
     except ForeignCheckpoint:

@@ -14,7 +14,7 @@ from ..checks import check
 from ..io.checkpoint import check_made_for, load_or_none, made_for
 from ..io.mesh import write_pvd
 from ..macro import MixedResult
-from ..macro.estimate import FILM, PARTS, friction_error, signed_total
+from ..macro.estimate import FILM, PARTS, friction_error, is_current, signed_total
 from ..macro.laws.boundary_friction import temperature_factor
 from ..macro.laws.thermal import tempered, thermal_point
 from ..macro.nested import corrected, solve_nested
@@ -110,7 +110,7 @@ def stribeck_sweep(request: SweepRequest, progress: bool = False) -> StribeckCur
         if res is None:
             res, *coarser = point.solve(float(speed), guided.start(r.speeds, i, previous),
                                         path, (folder, kept, r.keep_level, key))
-        if r.error_estimate and "error_estimate" not in res.meta:
+        if r.error_estimate and not is_current(res.meta):
             res = point.estimated(float(speed), res, coarser, path)
         if fields is not None:
             vtu = res.write_vtu(fields / f"mu{mu:g}_{i:03d}.vtu", r.origin)

@@ -22,7 +22,7 @@ from ..io.checkpoint import made_for
 from ..io.figure import save_figure
 from ..io.table import write_csv
 from ..macro import solve_point
-from ..macro.estimate import FILM, friction_error
+from ..macro.estimate import FILM, friction_error, is_current
 from ..numerics.threads import one_thread
 from .request import RollingSliding, SweepRequest
 from .sweep import load_point, point_file
@@ -95,11 +95,11 @@ def traction_sweep(request: SweepRequest, slide_to_roll=DEFAULT_RATIOS,
                     disable=not progress, unit="point"):
         path = None if folder is None else point_file(folder, key, srr)
         res = None if path is None else load_point(path, key, srr)
+        point = replace(rolling, speed=float(srr * entrainment))
         if res is None:
-            point = replace(rolling, speed=float(srr * entrainment))
             res = solve_point(point, initial=previous)
-            estimate = friction_error(res, point)
-            res = replace(res, meta={**res.meta, "error_estimate": estimate,
+        if not is_current(res.meta):                       # new, or an older estimate
+            res = replace(res, meta={**res.meta, "error_estimate": friction_error(res, point),
                                      **made_for(key, srr)})
             if path is not None:
                 res.save(path)
