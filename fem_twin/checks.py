@@ -79,6 +79,7 @@ QUANTITIES = {
     "relaxation": (1e-6, 1.0, "a relaxation factor in (0, 1]"),
     "pid_gain": (0.0, 100.0, "(the paper's K_P, K_I, K_D: 0.012, 0.024, 0.0015)"),
     "solver_tolerance": (1e-15, 0.1, "a relative tolerance (e.g. 1e-6)"),
+    "convergence_order": (0.5, 4.0, "an order of convergence (2: second order)"),
     "adaptive_tolerance": (0.0, 0.5, "a fraction (1 % is 0.01; 0: off)"),
     "share": (1e-6, 0.999, "a fraction of C_f,b (0.5 % is 0.005)"),
     "shear_strength": (1e4, 1e9, "Pa (a boundary film's tau_0, 10 MPa is 1e7; 0: none)"),

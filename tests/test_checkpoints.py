@@ -84,7 +84,8 @@ def test_the_sweep_key_changes_with_every_field_that_sets_the_points():
     """A sweep's checkpoint key is derived from its request: changing any field outside the
     declared exclusions (where points are written, the speeds, the Hersey length, the
     starts), or any field of its settings, lubricant, thermal model or factors, changes the
-    key; changing an excluded one does not.  A new physics field can therefore not reuse
+    key; changing an excluded one does not (nor the settings' order of the error
+    estimate's macro part, which the estimate records).  A new physics field can therefore not reuse
     stale checkpoints."""
     from dataclasses import fields, replace
 
@@ -118,7 +119,8 @@ def test_the_sweep_key_changes_with_every_field_that_sets_the_points():
     from fem_twin.stribeck.request import RollingSliding
     assert replace(base, motion=RollingSliding(1.0)).key != key
     for name, value in (("speeds", [2.0]), ("hersey_length", 9e-3), ("origin", (1.0, 0.0)),
-                        ("error_estimate", True), ("keep_level", 1), ("guide", "abc")):
+                        ("error_estimate", True), ("keep_level", 1), ("guide", "abc"),
+                        ("settings", replace(base.settings, grid_order=2.0))):
         assert replace(base, **{name: value}).key == key, name
 
 
@@ -145,3 +147,8 @@ def test_a_point_whose_estimate_was_made_another_way_is_estimated_again(tmp_path
     again = stribeck_sweep(request)
     assert again.friction_error[0] == first.friction_error[0] != 1.0
     assert load_or_none(path, MixedResult.load).meta["error_estimate"]["method"] == METHOD
+    # another macro order: the same points (the same key), the estimate made again
+    second = replace(request, settings=replace(request.settings, grid_order=2.0))
+    assert second.key == request.key
+    assert stribeck_sweep(second).friction_error[0] != first.friction_error[0]
+    assert load_or_none(path, MixedResult.load).meta["error_estimate"]["macro_order"] == 2.0

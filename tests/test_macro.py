@@ -375,7 +375,7 @@ def test_inexact_inner_solves_reach_the_exact_state(case32, factors, speed):
 
 def test_friction_error_parts(case32, factors):
     """The C_f error estimate of a point (fem_twin.macro.estimate): the macro part is the
-    change to the grid coarsened by two over 2^1.5 - 1; each micro part the change of the
+    change to the grid coarsened by two over 2^p - 1 (p = 1, or ``grid_order``); each micro part the change of the
     coarse point with that variant of the factors (its linear response); smooth factors have
     no micro parts and factors without variants report theirs as missing (NaN, left out of
     the total)."""
@@ -399,6 +399,9 @@ def test_friction_error_parts(case32, factors):
     assert est["macro"] == pytest.approx(abs(res.friction_coefficient
                                              - base.friction_coefficient)
                                          / (2 ** MACRO_ORDER - 1), rel=1e-4)
+    # a ball's second order ([macro] grid_order): a third of the change, not all of it
+    second = friction_error(res, replace(point, settings=MacroSettings(grid_order=2.0)))
+    assert MACRO_ORDER == 1.0 and second["macro"] == pytest.approx(est["macro"] / 3, rel=1e-4)
     # the time part: the coarse point's linear response to its variant of the factors,
     # against that point solved to 1e-8 (tests/test_linearised.py: within 1 %)
     time = solve_mixed(gap2, dx2, factors.variants()["time"], speed=0.05, face=face2,

@@ -2,18 +2,18 @@
 
 Each part is a change of C_f [-] (why each is so: docs/accuracy.md, "The error bar on
 every friction coefficient"): ``"macro"``, the point on the macro grid coarsened by two,
-``|C_f(h) - C_f(2h)| / (2^p - 1)``, ``p = MACRO_ORDER``; ``"time"``, ``"grid"``, ``"h0"``,
-the flow factors' own estimates carried into C_f (the linear response of the point, on
-the level :func:`micro_parts_level` gives, to each variant of the factors,
-:meth:`FlowFactors.variants`: :mod:`.coupling.linearised`; ``"h0"`` over
-``H0_SPACING_RATIO``).  ``"total"`` sums their magnitudes, a bound (a root sum of squares
-fell below the truth where they add with one sign); ``"signed"`` keeps their signs, whose
-sum (:func:`signed_total`) the accuracy warning reads.  Beside
-them, ``"film"``: the friction of the point's fields with half and twice the boundary
-film, times ``FILM_COUPLING``, a model sensitivity no refinement reduces (not in the
-total).  A part not estimated is NaN, left out of the total and named in ``"missing"``
-(the reason in ``"failed"``).  Smooth factors have no micro parts (0); a screening
-model's point (:attr:`FlowFactors.screening`) has no estimate (NaN, :data:`SCREENING`)."""
+``|C_f(h) - C_f(2h)| / (2^p - 1)``, ``p`` the settings' ``grid_order`` or
+``MACRO_ORDER``; ``"time"``, ``"grid"``, ``"h0"``, the flow factors' own estimates carried
+into C_f (the linear response of the point, on the level :func:`micro_parts_level` gives,
+to each variant of the factors, :meth:`FlowFactors.variants`: :mod:`.coupling.linearised`;
+``"h0"`` over ``H0_SPACING_RATIO``).  ``"total"`` sums their magnitudes, a bound (a root
+sum of squares fell below the truth where they add with one sign); ``"signed"`` keeps
+their signs, whose sum (:func:`signed_total`) the accuracy warning reads.  Beside them,
+``"film"``: the friction of the point's fields with half and twice the boundary film,
+times ``FILM_COUPLING``, a model sensitivity no refinement reduces (not in the total).  A
+part not estimated is NaN, left out of the total and named in ``"missing"`` (the reason
+in ``"failed"``).  Smooth factors have no micro parts (0); a screening model's point
+(:attr:`FlowFactors.screening`) has no estimate (NaN, :data:`SCREENING`)."""
 
 from __future__ import annotations
 
@@ -26,13 +26,17 @@ from .coupling.result import friction_with
 from .mixed import solve_point
 from .point import OperatingPoint
 
-#: the order assumed in ``|C_f(h) - C_f(2h)| / (2^p - 1)``.  The scheme's is 2 (bundled
-#: pin at 0.03 m/s: 1.97, 1.95 on 128 -> 255 -> 509 -> 1017 px refined in place), but
-#: between grids resampled from the measured pin the face edge moves by a pixel, and the
-#: mixed regime converges at order 0.8-1.15 from 64 to 128 px.  With 1.5 the bundled
-#: case's macro part is 1.2-2.5 times its change to a 256 px run (mixed regime) and
-#: 1.2-1.7 times it in full film.
-MACRO_ORDER = 1.5
+#: the macro grid's order of convergence in C_f, ``p`` of ``|C_f(h) - C_f(2h)| / (2^p - 1)``,
+#: where ``[macro] grid_order`` (``MacroSettings.grid_order``) does not set it: a pin's map,
+#: resampled from the measured pin, converges at first order in the mixed regime, where
+#: the face's edge moves by a fraction of a pixel from grid to grid (observed 0.69-1.10 on
+#: the paper pair's maps at 128^2, 256^2 and 512^2, 0.8-1.15 on the bundled pin's from 64
+#: to 128 px; ``benchmarks/run.py estimate-paper``)
+MACRO_ORDER = 1.0
+#: the order of a ball's sphere, smooth on every grid: observed 1.77-2.15 in the mixed
+#: regime on its meshes graded over 73^2, 145^2 and 289^2 (``benchmarks/run.py
+#: estimate-ball``); a ball's run sets ``grid_order`` to it
+SPHERE_ORDER = 2.0
 #: the C_f change of the interpolant through every other separation over the error of the
 #: whole sample: 4, as for factors smooth in log h0 (:mod:`fem_twin.micro.sampling`).
 #: Measured on the bundled case (16 h0 against 61, which is within 0.03 % C_f,b of 31): the
@@ -56,7 +60,7 @@ FILM = "film"
 #: how the estimate is made, kept with it as ``"method"``: a checkpointed point whose
 #: estimate was made another way (by an earlier fem_twin: the film's sensitivity in the
 #: total, the micro parts' variants solved to 1e-3) gets it made again when a run resumes
-METHOD = "discretisation parts, micro parts as linear responses"
+METHOD = "discretisation parts, micro parts as linear responses, macro order by geometry"
 #: the fewest nodes a side of the grid the micro parts are solved on: there their sum is
 #: within a few per cent of the next finer level's at a seventh of the time
 #: (docs/accuracy.md)
@@ -88,8 +92,9 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
         base = solve(1)
     except MixedNotConverged as err:
         return _not_estimated(f"coarse grid: {err.args[0]}")
+    order = point.settings.grid_order or MACRO_ORDER
     signed = {"macro": (base.friction_coefficient - result.friction_coefficient)
-              / (2 ** MACRO_ORDER - 1)}
+              / (2 ** order - 1)}
     micro, failed = _micro_parts(solve, factors, micro_parts_level(point.gap.shape))
     signed.update(micro)
     films = [v for k, v in factors.variants().items() if k in FILM_VARIANTS]
@@ -104,7 +109,7 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
     out = {part: abs(float(signed[part])) for part in parts}
     out["total"] = float(np.nansum([out[part] for part in PARTS]))
     out["signed"] = {part: float(signed[part]) for part in parts}
-    out["method"] = METHOD
+    out["method"], out["macro_order"] = METHOD, order
     missing = [part for part in parts if np.isnan(out[part])]
     if missing:
         out["missing"] = missing
@@ -136,10 +141,13 @@ def _not_estimated(reason: str) -> dict:
             "method": METHOD}
 
 
-def is_current(meta: dict) -> bool:
+def is_current(meta: dict, settings) -> bool:
     """Whether a point's metadata ``meta`` holds a C_f error estimate made by this
-    :data:`METHOD` (a resumed run makes any other again)."""
-    return (meta.get("error_estimate") or {}).get("method") == METHOD
+    :data:`METHOD` at the macro order of ``settings`` (a resumed run makes any other
+    again; a screening model's estimate, which has no macro part, at any order)."""
+    estimate = meta.get("error_estimate") or {}
+    order = estimate.get("macro_order", settings.grid_order or MACRO_ORDER)
+    return estimate.get("method") == METHOD and order == (settings.grid_order or MACRO_ORDER)
 
 
 def signed_total(estimate: dict) -> float:

@@ -9,6 +9,7 @@ from dataclasses import fields, replace
 from ..case import Case
 from ..io.layout import RunLayout
 from ..macro import MacroSettings
+from ..macro.estimate import SPHERE_ORDER
 from ..macro.laws.thermal import ContactThermal
 from ..macro.laws.viscosity import WaltherLaw
 from ..micro import FlowFactors
@@ -66,12 +67,15 @@ def macro_settings(case: Case, method: str | None = None) -> MacroSettings:
 
     A ball's contact cavitates at the ambient pressure: the 0.2 bar between p_amb and p_cav
     of Table 6 is nothing beside its GPa, and the thin pressurised layer it forces along
-    the sides of the outlet cavity makes the Newton coupling cycle between two states."""
+    the sides of the outlet cavity makes the Newton coupling cycle between two states.
+    Its smooth sphere converges at second order on the macro grid, which the C_f error
+    estimate assumes unless ``[macro] grid_order`` says otherwise."""
     own = {f.name: getattr(case.macro, f.name) for f in fields(MacroSettings)}
     settings = MacroSettings(**{**own, **({"method": method} if method else {})})
     settings = case.filled(settings)
     if case.tribometer.ball:
-        settings = replace(settings, cavitation_pressure=settings.ambient_pressure)
+        settings = replace(settings, cavitation_pressure=settings.ambient_pressure,
+                           grid_order=settings.grid_order or SPHERE_ORDER)
     return settings
 
 

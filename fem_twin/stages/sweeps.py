@@ -148,7 +148,7 @@ def indexed_curve(task, sweep: int, points):
     found = [own.get(point_file(task.checkpoint, task.key, u)) for u in task.speeds]
     try:
         for point, u in zip(found, task.speeds):
-            if point is None or (task.error_estimate and not is_current(point.meta)):
+            if point is None or (task.error_estimate and not is_current(point.meta, task.settings)):
                 return None
             check_made_for(point.meta, task.key, u, point.path)
     except ForeignCheckpoint:

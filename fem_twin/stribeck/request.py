@@ -138,6 +138,9 @@ class SweepRequest:
     def key_with(self, motion_key) -> str:
         """:attr:`key` with ``motion_key`` for the motion's (a traction curve's)."""
         keyed = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in NOT_KEYED}
+        keyed["settings"] = {"class": type(self.settings).__name__,      # as a dataclass's
+                             **{f.name: getattr(self.settings, f.name)
+                                for f in fields(self.settings) if f.name not in ESTIMATE_ONLY}}
         keyed["motion"] = motion_key
         if self.factors_key is None:            # the factors' own values, not their meta
             keyed["factors"] = {f.name: getattr(self.factors, f.name)
@@ -164,6 +167,9 @@ class SweepRequest:
 #: not results) and the factors when ``factors_key`` names their inputs instead
 NOT_KEYED = frozenset({"checkpoint", "fields", "origin", "error_estimate", "speeds",
                        "hersey_length", "keep_level", "guide", "factors"})
+#: the macro settings that set only the points' C_f error estimate, which records them
+#: (:func:`fem_twin.macro.estimate.is_current` makes it again where they changed)
+ESTIMATE_ONLY = frozenset({"grid_order"})
 
 
 def sweep_key(keyed: dict) -> str:

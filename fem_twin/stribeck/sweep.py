@@ -110,7 +110,7 @@ def stribeck_sweep(request: SweepRequest, progress: bool = False) -> StribeckCur
         if res is None:
             res, *coarser = point.solve(float(speed), guided.start(r.speeds, i, previous),
                                         path, (folder, kept, r.keep_level, key))
-        if r.error_estimate and not is_current(res.meta):
+        if r.error_estimate and not is_current(res.meta, r.settings):
             res = point.estimated(float(speed), res, coarser, path)
         if fields is not None:
             vtu = res.write_vtu(fields / f"mu{mu:g}_{i:03d}.vtu", r.origin)

@@ -98,7 +98,7 @@ def traction_sweep(request: SweepRequest, slide_to_roll=DEFAULT_RATIOS,
         point = replace(rolling, speed=float(srr * entrainment))
         if res is None:
             res = solve_point(point, initial=previous)
-        if not is_current(res.meta):                       # new, or an older estimate
+        if not is_current(res.meta, r.settings):                       # new, or an older estimate
             res = replace(res, meta={**res.meta, "error_estimate": friction_error(res, point),
                                      **made_for(key, srr)})
             if path is not None:

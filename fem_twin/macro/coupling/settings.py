@@ -79,6 +79,10 @@ class MacroSettings:
     max_iter: int = setting(300, "iterations of the coupling before it gives up",
                            "iterations")
     gap_floor: float = setting(1e-9, "smallest h0 passed to the flow factors", "gap_floor")
+    grid_order: float | None = setting(
+        None, "the macro grid's order of convergence in C_f that the error estimate's macro "
+        "part assumes; none: 1 for a pin's measured map, 2 for a ball's sphere (measured, "
+        "docs/accuracy.md)", "convergence_order")
 
     def __post_init__(self):
         check_choices(self)
