@@ -12,9 +12,12 @@ candidates (a pin's and a ball's every one of them).  Each part's own change ref
 alone.  Rows, per speed: the estimate (``cf_err``), the change to the reference (the truth)
 and their ratio, the effectivity (``ok``: 1 to 3, or both under 0.05 % C_f,b); then each
 part's signed estimate over its own signed change (negative: the wrong sign), and the film
-sensitivity.  Checked: the estimate is nowhere below the truth (or both are under the
-floor).  ``$FEM_TWIN_BENCH_DIR`` keeps the refined runs and reads a finished one again; the
-base run is always made anew."""
+sensitivity; and, from a third run on the macro grid coarsened by two, the macro order
+observed at each speed and the truth against the limit (the reference's own macro error
+extrapolated at that order, :func:`limit_error`) with the bound over it.  Checked: the
+estimate is nowhere below the truth (or both are under the floor).
+``$FEM_TWIN_BENCH_DIR`` keeps the refined runs and reads a finished one again; the base run
+is always made anew."""
 
 from __future__ import annotations
 
@@ -32,6 +35,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 FLOOR = 5e-4
 #: the parts refined one at a time, each against its own part of the estimate
 PARTS = ("macro", "time", "grid", "h0")
+#: the macro orders taken as asymptotic in the extrapolation to the limit (the scheme's is 2)
+ORDERS = (0.5, 4.0)
 
 
 def _refined(case, parts, every_h0):
@@ -53,6 +58,29 @@ def _refined(case, parts, every_h0):
         micro = replace(micro, h0_count=2 * (micro.h0_count - 1) + 1,
                         h0_tol=0.0 if every_h0 else micro.h0_tol)
     return replace(case, preprocessing=pre, micro=micro, macro=macro)
+
+
+def _coarsened(case):
+    """``case`` with the macro grid coarsened by two (a pin's maps at half the resolution, a
+    ball's grid (n + 1) / 2): the third grid of the macro order."""
+    pre, macro = case.preprocessing, case.macro
+    if case.tribometer.ball:
+        macro = replace(macro, grid=(macro.grid + 1) // 2)
+    else:
+        pre = replace(pre, resolution=tuple(n // 2 for n in pre.resolution))
+    return replace(case, preprocessing=pre, macro=macro)
+
+
+def limit_error(coarse, base, fine):
+    """``(order, error)``: the macro order observed at one speed from C_f on three grids
+    (``coarse``, ``base``, ``fine``, each twice as fine), and the ``fine`` grid's own error
+    C_f(fine) - C_f(limit) it gives, ``(C_f(base) - C_f(fine)) / (2^p - 1)``; None where
+    the changes differ in sign or the order lies outside ``ORDERS`` (no asymptotic range)."""
+    d1, d2 = coarse - base, base - fine
+    if d1 * d2 <= 0:
+        return None
+    order = float(np.log2(d1 / d2))
+    return (order, d2 / (2 ** order - 1)) if ORDERS[0] <= order <= ORDERS[1] else None
 
 
 def run_kept(case, name, reuse=True):
@@ -126,9 +154,12 @@ def run(case_file="pin_on_disk.toml", viscosity=0.066):
             (f"reference: all refined ({fine.micro.steps} steps, {fine.micro.h0_count} h0)",
              t_ref, "")]
     rows += [(f"{part} refined alone", t, "") for part, (t, *_) in own.items()]
+    t_coarse, coarse, _ = run_kept(_coarsened(case), f"{stem}_macro_coarse")
+    rows.append(("macro coarsened by two (the macro order)", t_coarse, ""))
     own = {part: c for part, (_, c, _) in own.items()}
     speeds = [_speed(i, base, ref, own, next((v for k, v in signed.items()
-                                              if np.isclose(k, u, rtol=1e-6)), {}), cb)
+                                              if np.isclose(k, u, rtol=1e-6)), {}), cb,
+                     coarse.friction_coefficient[i])
               for i, u in enumerate(base.speed)]
     rows += [x["row"] for x in speeds]
     lines = []
@@ -142,6 +173,13 @@ def run(case_file="pin_on_disk.toml", viscosity=0.066):
     lines.append("signed estimate over the signed truth where that exceeds 0.05 % C_f,b: "
                  + (f"{min(r):.2f} to {max(r):.2f}, within 1-3 at "
                     f"{sum(1 <= x <= 3 for x in r)} of {len(r)}" if r else "nowhere above"))
+    r = [x["limit"] for x in speeds if "limit" in x]
+    lines.append("against the limit (the reference's macro error at the observed order): the "
+                 "bound over the truth where that exceeds 0.05 % C_f,b: " + (
+                     f"{min(r):.2f} to {max(r):.2f}, within 1-3 at "
+                     f"{sum(1 <= x <= 3 for x in r)} of {len(r)}; no asymptotic order at "
+                     f"{sum('no order' in x['row'][2] for x in speeds)} of {len(speeds)} "
+                     "speeds" if r else "nowhere above"))
     tol = case.sweep.error_tolerance
     above = [sum(x["sizes"][k] > tol * cb for x in speeds) for k in range(3)]
     lines.append("above the tolerance {:.2%} C_f,b: the bound at {}, the signed estimate at "
@@ -152,11 +190,13 @@ def run(case_file="pin_on_disk.toml", viscosity=0.066):
         f"(within 1-3 or both under 0.05 % C_f,b at {sum(x['ok'] for x in speeds)})"))
 
 
-def _speed(i, base, ref, own, parts, cb):
+def _speed(i, base, ref, own, parts, cb, coarse):
     """Speed ``i`` of the ``base`` curve against the ``ref`` curve and each part's ``own``
     run, with the base's signed estimate ``parts``: its row, whether the bound ``cf_err``
-    is ``ok`` or ``below`` the truth, the sizes of bound, signed estimate and truth, and the
-    ratios of the signed estimate and of each part to their truths (where above 0.05 %)."""
+    is ``ok`` or ``below`` the truth, the sizes of bound, signed estimate and truth, the
+    ratios of the signed estimate and of each part to their truths (where above 0.05 %),
+    and the bound over the truth against the limit (``coarse``: C_f on the macro grid
+    coarsened by two, :func:`limit_error`)."""
     from fem_twin.macro.estimate import signed_total
 
     u, cf, err = base.speed[i], base.friction_coefficient[i], base.friction_error[i]
@@ -176,6 +216,15 @@ def _speed(i, base, ref, own, parts, cb):
         if abs(change) >= FLOOR * cb:
             out["ratios"][part] = est / change
     notes.append(f"film {parts.get('film', np.nan) / cb:+.3%}")
+    limit = limit_error(coarse, cf, own["macro"].friction_coefficient[i])
+    if limit is None:
+        notes.append("against the limit: no order")
+    else:
+        to_limit = truth + limit[1]
+        notes.append(f"against the limit (order {limit[0]:.2f}): truth {to_limit / cb:+.3%}, "
+                     f"effectivity {err / abs(to_limit):.2f}")
+        if abs(to_limit) >= FLOOR * cb:
+            out["limit"] = err / abs(to_limit)
     out["row"] = (f"  {u:.4g} m/s: C_f {cf:.5f}, reference {ref.friction_coefficient[i]:.5f}",
                   0.0, f"estimate {err / cb:.3%} (signed {estimate / cb:+.3%}), truth "
                        f"{truth / cb:+.3%} C_f,b, effectivity {err / abs(truth):.2f} "
