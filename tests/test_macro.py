@@ -377,9 +377,8 @@ def test_friction_error_parts(case32, factors):
     """The C_f error estimate of a point (fem_twin.macro.estimate): the macro part is the
     change to the grid coarsened by two over 2^p - 1 (p = 1, or ``grid_order``); each micro
     part the change of the coarse point with that variant of the factors (its linear
-    response); smooth factors have
-    no micro parts and factors without variants report theirs as missing (NaN, left out of
-    the total)."""
+    response); smooth factors have no micro parts and factors without variants report
+    theirs as missing (NaN, left out of the total)."""
     from dataclasses import replace
 
     from fem_twin.macro.estimate import (
