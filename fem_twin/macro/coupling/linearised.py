@@ -8,7 +8,8 @@ elastic deformation, load balance) and ``J`` its exact Jacobian at ``x`` with th
 factors, built and preconditioned once for every change.  The change of C_f is the friction
 of ``x + dx`` with ``f + df`` minus that of ``x`` with ``f``; the converged state's own
 residual (its coupling's tolerance) cancels in the difference.  Against the variants solved
-to convergence: ``tests/test_estimate.py`` and ``benchmarks/run.py estimate``."""
+to convergence: ``tests/test_linearised.py``, ``tests/test_estimate.py`` and, on the
+bundled cases, docs/accuracy.md ("The micro parts are linear responses")."""
 
 from __future__ import annotations
 
