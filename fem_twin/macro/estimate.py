@@ -92,7 +92,7 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
         base = solve(1)
     except MixedNotConverged as err:
         return _not_estimated(f"coarse grid: {err.args[0]}")
-    order = point.settings.grid_order or MACRO_ORDER
+    order = macro_order(point.settings)
     signed = {"macro": (base.friction_coefficient - result.friction_coefficient)
               / (2 ** order - 1)}
     micro, failed = _micro_parts(solve, factors, micro_parts_level(point.gap.shape))
@@ -125,12 +125,10 @@ def _micro_parts(solve, factors, level) -> tuple[dict, list]:
     variants = {k: v for k, v in factors.variants().items() if k not in FILM_VARIANTS}
     if not variants:
         return {}, []
-    try:
+    try:                                # the coarse point, or a singular Jacobian, NaN
         moved = friction_responses(solve.point(level), solve(level), variants)
-    except MixedNotConverged as err:
+    except (MixedNotConverged, SolverError, ValueError) as err:
         return {kind: np.nan for kind in variants}, [f"level {level}: {err.args[0]}"]
-    except (SolverError, ValueError) as err:          # a singular Jacobian, NaN in a step
-        return {kind: np.nan for kind in variants}, [f"level {level}: {err}"]
     return {kind: change / (H0_SPACING_RATIO if kind == "h0" else 1.0)
             for kind, change in moved.items()}, []
 
@@ -145,9 +143,14 @@ def is_current(meta: dict, settings) -> bool:
     """Whether a point's metadata ``meta`` holds a C_f error estimate made by this
     :data:`METHOD` at the macro order of ``settings`` (a resumed run makes any other
     again; a screening model's estimate, which has no macro part, at any order)."""
-    estimate = meta.get("error_estimate") or {}
-    order = estimate.get("macro_order", settings.grid_order or MACRO_ORDER)
-    return estimate.get("method") == METHOD and order == (settings.grid_order or MACRO_ORDER)
+    estimate, order = meta.get("error_estimate") or {}, macro_order(settings)
+    return estimate.get("method") == METHOD and estimate.get("macro_order", order) == order
+
+
+def macro_order(settings) -> float:
+    """The macro part's order ``p`` for the macro ``settings``: their ``grid_order``, or
+    :data:`MACRO_ORDER`."""
+    return settings.grid_order or MACRO_ORDER
 
 
 def signed_total(estimate: dict) -> float:
