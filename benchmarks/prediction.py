@@ -1,6 +1,6 @@
 """A prediction at a second temperature and load, checked on data the fit did not see.
 
-    python benchmarks/prediction.py OUT      # about 1.5 h on 2 cores (the fine twin)
+    python benchmarks/prediction.py OUT      # hours on 2 cores (the fine twin)
 
 "Measured" curves from a finer twin than the default (256 px cells, every h0 candidate,
 4x the time steps) under a known shear law (alpha 0.12, c_T 0.003 /K about 24 C, thermal
@@ -32,14 +32,14 @@ LAW = ('law = "shear"\npressure_coefficient = 0.12\ntemperature_coefficient = 0.
 
 def case(text: str, fine: bool, load: float = 150.0) -> str:
     """The bundled case file with the shear law (fine: the truth's, 256 px cells, all h0,
-    80 steps; else the fit's start) at ``load`` [N]."""
+    128 steps; else the fit's start) at ``load`` [N]."""
     text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
     text = text.replace('law = "constant"', LAW if fine else
                         'law = "shear"\ntemperature_coefficient = 0.001\n#')
     text = text.replace("load = 150.0 ", f"load = {load:g} ")
     if fine:
-        for old, new in (("resolution = [96, 96]", "resolution = [256, 256]"),
-                         ("steps = 20 ", "steps = 80 "), ("h0_tol = 0.01", "h0_tol = 0   ")):
+        for old, new in (("resolution = [128, 128]      # patches", "resolution = [256, 256] #"),
+                         ("steps = 32 ", "steps = 128 "), ("h0_tol = 0.01", "h0_tol = 0   ")):
             assert old in text
             text = text.replace(old, new)
     return text

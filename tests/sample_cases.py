@@ -49,8 +49,8 @@ def small_case(tmp_path, workers=1, band=False):
     text = (ROOT / "examples" / "pin_on_disk.toml").read_text()
     text = text.replace("../meshes/", str(ROOT / "meshes") + "/")
     for old, new in (("resolution = [128, 128]      # reduced", "resolution = [48, 48] #"),
-                     ("resolution = [96, 96]        # patches", "resolution = [16, 16] #"),
-                     ("h0_count = 16", "h0_count = 6"), ("steps = 20", "steps = 4"),
+                     ("resolution = [128, 128]      # patches", "resolution = [16, 16] #"),
+                     ("h0_count = 16", "h0_count = 6"), ("steps = 32", "steps = 4"),
                      ("count = 12", "count = 5"), ("speed_min = 0.005", "speed_min = 0.01"),
                      ("refine = 1 ", "refine = 0 "),
                      ("workers = 0", f"workers = {workers}"),

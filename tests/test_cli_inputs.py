@@ -108,6 +108,8 @@ def test_inconsistent_case_values_are_refused_saying_what_is_wrong(tmp_path, old
     ("count = 5", "count = 4.5", "count"), ("h0_count = 6", "h0_count = 6.5", "h0_count"),
     ("resolution = [16, 16]", "resolution = [2, 2]", "resolution"),
     ("resolution = [16, 16]", "resolution = [16.5, 16]", "resolution"),
+    ("steps = 4", "steps = 5", r"steps = 5, resolution = \[16, 16\]: .*fraction of a pixel.*"
+     r"e\.g\. 4 or 8 steps"),
     ("resolution = [48, 48]", "resolution = [16000, 16000]", "GiB"),
     ("resolution = [16, 16]", "resolution = [16000, 16000]", "GiB"),
     ("level_radius = 3e-3", "level_radius = 3", "level_radius"),
@@ -150,7 +152,7 @@ def test_a_truncated_case_says_what_it_defaults_and_asks_before_hours(tmp_path, 
                                                                       monkeypatch, slowdown):
     """A case cut off after [geometry] (here with 100 speeds) is valid TOML;
     the defaults (the paper's 256^2 macro grid, cells at 128^2, 100 h0 x 32 steps) are
-    named before work starts, and a run estimated at more than seven times the bundled case
+    named before work starts, and a run estimated at more than four times the bundled case
     stops with exit 2 unless --yes is given.
     Issue 64 item 0: the question does not depend on the machine's speed (the probe forced
     fast and slow), and the bundled case's figure it quotes is the estimate's."""

@@ -296,7 +296,7 @@ def test_ctrl_c_during_the_cells_ends_at_once_in_one_line(tmp_path, scheduler):
     their tracebacks and hung the cluster's close (the run lived on for minutes).  They
     now ignore it; the run stops, closes them and exits 130 with one line.  The signal is
     sent once the cells compute (the first h0 checkpoint), on the LocalCluster and on the
-    process pool, with minutes of cell work still queued (64 px, 16 h0 x 20 steps): the
+    process pool, with minutes of cell work still queued (64 px, 16 h0 x 16 steps): the
     patches' threads waited for all of it before the pool was closed (probe: 30 s and
     more after Ctrl-C at 20-35 s on the bundled case); now within 20 s."""
     import os
@@ -310,7 +310,7 @@ def test_ctrl_c_during_the_cells_ends_at_once_in_one_line(tmp_path, scheduler):
         pytest.importorskip("distributed")
     case = small_case(tmp_path)
     text = case.read_text().replace("resolution = [16, 16] #", "resolution = [64, 64] #")
-    text = text.replace("h0_count = 6", "h0_count = 16").replace("steps = 4", "steps = 20")
+    text = text.replace("h0_count = 6", "h0_count = 16").replace("steps = 4", "steps = 16")
     case.write_text(text.replace("workers = 1", "workers = 2" + (
         f'\nscheduler = "{scheduler}"' if scheduler else "")))
     out = tmp_path / "out"

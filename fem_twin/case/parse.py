@@ -15,6 +15,7 @@ from ..macro.laws.boundary_friction import COMMON_KEYS, BoundaryLaw, thin_films_
 from ..macro.laws.boundary_laws import LAWS
 from ..macro.laws.friction import LAWS as FRICTION_LAWS
 from ..macro.laws.thermal import ThermalSettings
+from ..micro.sliding import whole_pixel_steps
 from ..stribeck.curve import read_measured_csv
 from ..stribeck.validation import check_like_with_like
 from ..topography.prepare import MacroOptions
@@ -278,6 +279,12 @@ def _micro(data, where) -> MicroSpec:
     if not (0 < micro.h0_min < micro.h0_max < 1e-3) or micro.h0_count < 2 or micro.steps < 1:
         raise CaseError(f"{where} [micro]: need 0 < h0_min < h0_max [m] (e.g. 1e-7, 1e-6), "
                         "h0_count >= 2 and steps >= 1")
+    if micro.model != "average-flow":
+        try:
+            whole_pixel_steps(micro.resolution[1], micro.steps)
+        except InputError as err:
+            raise CaseError(f"{where} [micro] steps = {micro.steps}, resolution = "
+                            f"{list(micro.resolution)}: {err}") from None
     if micro.boundary_film >= micro.h0_min:
         raise CaseError(f"{where} [micro] boundary_film = {micro.boundary_film:g} m is not "
                         f"below h0_min = {micro.h0_min:g} m: the boundary film must be thinner "

@@ -26,7 +26,7 @@ from .estimate import QUANTITIES, discrepancy, variants, watched
 from .flow_factors import ARRAYS, FlowFactors
 from .sampling import adaptive_separations
 from .schedule import Separations, coarse_moments, progress_bar
-from .sliding import CellSettings, factors_from_moments, film_spread
+from .sliding import CellSettings, factors_from_moments, film_spread, whole_pixel_steps
 from .store import cell_key
 
 #: the paper's separations: 100 values geometrically spaced in [0.1, 1] um
@@ -71,6 +71,7 @@ def homogenise(pin: Topography, disk: Topography, h0=None, *,
     h0 = _check_separations(DEFAULT_H0 if h0 is None else h0)
     if h0_tol is not None and not 0 < h0_tol < 1:
         raise InputError(f"h0_tol is a relative tolerance in (0, 1), got {h0_tol}")
+    whole_pixel_steps(z_low.shape[1], settings.steps)
     key = cell_key(z_low, z_up, spacing, settings)
     args = dict(z_low=z_low, z_up=z_up, spacing=spacing, settings=settings,
                 folder=None if checkpoint is None else str(checkpoint), key=key,

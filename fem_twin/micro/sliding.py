@@ -130,7 +130,8 @@ def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | No
                  offset: float = 0.0) -> SlidingPass:
     """The moving surface shifts by ``s = L_r1 / N_t`` per step (``+s`` for the disk, ``-s``
     for the pin in the disk's frame); ``u_m dt = (shift_up + shift_low) / 2``.  The instants
-    are ``(k + offset) s`` for ``k < N_t`` (``offset = 1/2``: the midpoints).
+    are ``(k + offset) s`` for ``k < N_t`` (``offset = 1/2``: the midpoints), each a shift by
+    whole pixels (:func:`whole_pixel_steps`: a measured surface has no other positions).
 
     Both surfaces moving (``settings.slide_to_roll`` = SRR < 2, :mod:`.rolling`): the pin at
     ``u_1 = u_m (1 - SRR/2)`` and the disk at ``u_2 = u_m (1 + SRR/2)``.  The cell averages
@@ -139,8 +140,9 @@ def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | No
     squeeze term is that of both translations at each instant."""
     nx = z_low.shape[1]
     n_steps = settings.steps if n_steps is None else n_steps
-    px = nx / n_steps                            # pixels per step
-    n = [(k + offset) * px for k in range(n_steps)]
+    whole_pixel_steps(nx, n_steps, offset)
+    px = nx // n_steps                           # pixels per step
+    n = [int((k + offset) * px) for k in range(n_steps)]
     if settings.moving == "both":
         moving = [_shift(z_up, k) for k in n]
         lower = _d_dx1(z_low, spacing[0])
@@ -160,15 +162,24 @@ def sliding_pass(z_low, z_up, spacing, settings: CellSettings, n_steps: int | No
     return SlidingPass(shapes, moving, um_dt, rates)
 
 
-def _shift(z, px):
-    """Periodic translation of ``z`` by ``px`` pixels along x1 (Fourier for fractions)."""
-    if px == 0:
-        return z
-    if float(px).is_integer():
-        return np.roll(z, int(px), axis=1)
-    k = np.fft.rfftfreq(z.shape[1])
-    return np.fft.irfft(np.fft.rfft(z, axis=1) * np.exp(-2j * np.pi * k * px), n=z.shape[1],
-                        axis=1)
+def whole_pixel_steps(nx: int, steps: int, offset: float = 0.0) -> None:
+    """Refuse ``steps`` instants over ``nx`` pixels along x1 unless each instant (at
+    ``offset`` steps) shifts the moving surface by whole pixels: a fraction would sample an
+    interpolated surface, not the measured one, and bias the flow factors (its size on the
+    bundled pin: docs/accuracy.md, "Whole-pixel instants")."""
+    if nx % steps or not float(offset * (nx // steps)).is_integer():
+        near = [d for d in range(1, nx + 1) if nx % d == 0]
+        both = {max(d for d in near if d <= steps), min((d for d in near if d >= steps),
+                                                         default=nx)}
+        raise InputError(f"{steps} time steps over a cell of {nx} pixels along the sliding "
+                         "direction shift the surface by a fraction of a pixel, an "
+                         "interpolated surface that biases the flow factors; take a divisor "
+                         f"of {nx} (e.g. {' or '.join(map(str, sorted(both)))} steps)")
+
+
+def _shift(z, px: int):
+    """Periodic translation of ``z`` by ``px`` whole pixels along x1."""
+    return np.roll(z, px, axis=1) if px else z
 
 
 def _d_dx1(z, dx1):
@@ -311,12 +322,12 @@ def _time_error(steps) -> float:
 def refine_instants(contacts, steps, h0, z_low, z_up, solver, spacing, settings, midpoints):
     """Adaptive instants (``settings.time_tol``, exact scheme): while A11, b1 or d1 change by
     more than the tolerance from every other instant to all, add the midpoints (the time
-    average is then over twice the instants), up to one pixel per step.  In heavy contact
+    average is then over twice the instants) while they fall on whole pixels.  In heavy contact
     the integrand jumps whenever a pixel enters contact, and a fixed N_t samples it
     unevenly; light contact stops at ``steps``.  ``midpoints`` keeps each level's pass and
     warm starts across the separations of a chunk."""
     seconds = [0.0, 0.0]
-    while _time_error(steps) > settings.time_tol and 2 * len(steps) <= z_low.shape[1]:
+    while _time_error(steps) > settings.time_tol and z_low.shape[1] % (2 * len(steps)) == 0:
         n = len(steps)
         if n not in midpoints:
             midpoints[n] = (sliding_pass(z_low, z_up, spacing, settings, n_steps=n,

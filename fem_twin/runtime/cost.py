@@ -1,7 +1,7 @@
 """The run-time cost model: a case's wall time on the calibration machine, before it runs.
 
 ``fem-twin run`` prints it scaled to this machine by :func:`fem_twin.runtime.machine.slowdown` and
-asks for ``--yes`` above seven times the bundled case's.  The constants were fitted to the
+asks for ``--yes`` above four times the bundled case's.  The constants were fitted to the
 bundled, paper and ball cases on the calibration machine (``python benchmarks/run.py
 estimates`` sets each example's estimate beside its run and checks 0.8-1.25x);
 ``tests/test_cli.py::test_run_time_estimates_hold`` holds the estimate within 0.8-1.25x of
