@@ -233,10 +233,10 @@ def test_the_estimate_follows_the_machine_speed(monkeypatch, capsys):
     from fem_twin.cli.runs import _confirm_cost, duration
     from fem_twin.runtime.cost import MICRO, cost_tasks
     monkeypatch.delenv("FEM_TWIN_SLOWDOWN")                   # the probes themselves
-    monkeypatch.setenv("FEM_TWIN_SPARSE", "pardiso")          # the probes' own backend
     for kind in ("micro", "macro"):                # a time, whatever the machine's load
         seconds = speed.probe_seconds(kind, repeats=1)
         assert np.isfinite(seconds) and seconds > 0
+    monkeypatch.setenv("FEM_TWIN_SPARSE", "pardiso")   # the timed probes' backend, as read
     case = load_case(ROOT / "examples" / "pin_on_disk.toml")
     estimates = []
     for factor in (1.0, 2.0):
