@@ -4,11 +4,12 @@ the bundled ball.
 
     FEM_TWIN_BENCH_DIR=DIR python benchmarks/run.py estimate    # about 6 min on 2 cores
 
-The case with its first patch pair, its first viscosity, isothermal, no speed refinement and
-no band.  The reference refines everything at once: the macro grid twice as fine (a ball's
-``[macro] grid`` 2n - 1), the cells on the patches' own pixels (the measurement holds no
-finer surface; twice as fine where that is finer), four times the steps, twice the h0
-candidates (a pin's and a ball's every one of them).  Each part's own change refines that
+The case with its first patch pair (``estimate-pairs``, ``estimate-ball-pairs``: every
+pair, whose average the run reads), its first viscosity, isothermal, no speed refinement
+and no band.  The reference refines everything at once: the macro grid twice as fine (a
+ball's ``[macro] grid`` 2n - 1), the cells on the patches' own pixels (the measurement
+holds no finer surface; twice as fine where that is finer), four times the steps, twice
+the h0 candidates (a pin's and a ball's every one of them).  Each part's own change refines that
 alone.  Rows, per speed: the estimate (``cf_err``), the change to the reference (the truth)
 and their ratio, the effectivity (``ok``: 1 to 3, or both under 0.05 % C_f,b); then each
 part's signed estimate over its own signed change (negative: the wrong sign), and the film
@@ -125,9 +126,10 @@ def _signed_parts(folder, ball) -> dict:
     return out
 
 
-def subset_case(case, viscosity):
-    """The case's first patch pair at ``viscosity``, isothermal, no refinement, no band."""
-    return replace(case, geometry=replace(case.geometry, patches=case.geometry.patches[:1]),
+def subset_case(case, viscosity, pairs=1):
+    """The case's first ``pairs`` patch pairs (None: all) at ``viscosity``, isothermal, no
+    refinement, no band."""
+    return replace(case, geometry=replace(case.geometry, patches=case.geometry.patches[:pairs]),
                    thermal=replace(case.thermal, model="none"),
                    lubricant=replace(case.lubricant, viscosities=(viscosity,),
                                      temperatures=case.lubricant.temperatures[:1]),
@@ -135,22 +137,24 @@ def subset_case(case, viscosity):
                    run=replace(case.run, patch_band=False))
 
 
-def run(case_file="pin_on_disk.toml", viscosity=0.066):
-    """The estimate of ``case_file`` (in examples/) at ``viscosity`` [Pa s] against its
-    reference and each part against its own change (module docstring).  Baseline: the base
-    run."""
+def run(case_file="pin_on_disk.toml", viscosity=0.066, pairs=1):
+    """The estimate of ``case_file`` (in examples/) at ``viscosity`` [Pa s] on its first
+    ``pairs`` patch pairs (None: all) against its reference and each part against its own
+    change (module docstring).  Baseline: the base run."""
     from fem_twin.case import load_case
 
-    case = subset_case(load_case(os.path.join(HERE, "..", "examples", case_file)), viscosity)
+    case = subset_case(load_case(os.path.join(HERE, "..", "examples", case_file)), viscosity,
+                       pairs)
     every_h0 = case_file != "paper.toml"
-    stem = os.path.splitext(case_file)[0]
+    n = len(case.geometry.patches)
+    stem = os.path.splitext(case_file)[0] + ("" if pairs == 1 else f"_{n}_pairs")
     t_base, base, signed = run_kept(case, f"{stem}_base", reuse=False)
     fine = _refined(case, PARTS, every_h0)
     t_ref, ref, _ = run_kept(fine, f"{stem}_reference")
     own = {part: run_kept(_refined(case, (part,), every_h0), f"{stem}_{part}")
            for part in PARTS}
     cb = case.tribometer.boundary_friction
-    rows = [(f"baseline: {stem}, 1 patch, 1 viscosity", t_base, ""),
+    rows = [(f"baseline: {stem}, {n} patch pair{'s' * (n > 1)}, 1 viscosity", t_base, ""),
             (f"reference: all refined ({fine.micro.steps} steps, {fine.micro.h0_count} h0)",
              t_ref, "")]
     rows += [(f"{part} refined alone", t, "") for part, (t, *_) in own.items()]

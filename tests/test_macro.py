@@ -470,9 +470,9 @@ def test_the_micro_parts_of_a_fine_grid_are_solved_on_a_coarser_level(factors, m
     """fem_twin.macro.estimate: on grids of more than twice ``MICRO_PARTS_SIDE`` a side the
     micro parts are solved on the coarsest nested level with at least that many nodes a
     side (lowered here to 32: a 128^2 point's 32^2 level), warm from the point there; the
-    macro part stays on the grid coarsened by two, and a level the nested solve already has
-    is not solved again (here: the 64^2 one, so one solve: the 32^2 point; the variants are
-    its linear responses)."""
+    macro part stays on the grid coarsened by two, at the order observed with the 32^2
+    level, and a level the nested solve already has is not solved again (here: the 64^2
+    one, so one solve: the 32^2 point; the variants are its linear responses)."""
     import fem_twin.macro.estimate as E
     from fem_twin.macro.nested import solve_nested
     from fem_twin.macro.point import OperatingPoint
@@ -489,16 +489,38 @@ def test_the_micro_parts_of_a_fine_grid_are_solved_on_a_coarser_level(factors, m
     monkeypatch.setattr(E, "solve_point", lambda *a, **k: solves.append(1) or counted(*a, **k))
     est = E.friction_error(point, op, levels)
     assert len(solves) == 1
-    assert est["macro"] == pytest.approx(abs(point.friction_coefficient
-                                             - levels[0].friction_coefficient)
-                                         / (2 ** E.MACRO_ORDER - 1), rel=1e-12)
     four = dict(face=face[::4, ::4], speed=0.05, **kw)
     base = solve_mixed(gap[::4, ::4], (4 * dx[0], 4 * dx[1]), factors, initial=levels[0],
                        **four)
+    c = [r.friction_coefficient for r in (point, levels[0], base)]
+    assert est["macro_order"] == pytest.approx(E.observed_order(*c) or E.MACRO_ORDER,
+                                               rel=1e-3)
+    assert est["macro"] == pytest.approx(abs(c[0] - c[1]) / (2 ** est["macro_order"] - 1),
+                                         rel=1e-12)
     time = solve_mixed(gap[::4, ::4], (4 * dx[0], 4 * dx[1]), factors.variants()["time"],
                        initial=base, **four)
     assert est["time"] == pytest.approx(abs(time.friction_coefficient
                                             - base.friction_coefficient), rel=1e-2)
+
+
+def test_the_macro_order_is_observed_on_three_grids():
+    """fem_twin.macro.estimate.observed_order: C_f = C + K h^p on grids h, 2h and 4h gives
+    p, clipped to [MACRO_ORDER, SCHEME_ORDER] (1, 2); changes of opposite signs give none,
+    and a point on a grid whose second coarsening has fewer than ORDER_SIDE nodes a side
+    takes MACRO_ORDER (the estimate of ``test_friction_error_parts``, on 32^2)."""
+    import fem_twin.macro.estimate as E
+
+    def cf(p):
+        return [0.1 + 2e-3 * (k * 0.01) ** p for k in (1, 2, 4)]
+
+    assert E.observed_order(*cf(1.5)) == pytest.approx(1.5, rel=1e-9)
+    assert E.observed_order(*cf(1.0)) == pytest.approx(1.0, rel=1e-9)
+    assert E.observed_order(*cf(3.0)) == E.SCHEME_ORDER == 2.0
+    assert E.observed_order(*cf(0.5)) == E.MACRO_ORDER == 1.0
+    assert E.observed_order(0.1, 0.101, 0.1005) is None
+    assert E.observed_order(0.1, 0.1, 0.1) is None
+    assert E.observed_order(0.1, 0.101, float("nan")) is None
+    assert 4 * E.ORDER_SIDE > 32
 
 
 @pytest.mark.integration

@@ -2,17 +2,18 @@
 
 Each part is a change of C_f [-] (why each is so: docs/accuracy.md, "The error bar on
 every friction coefficient"): ``"macro"``, the point on the macro grid coarsened by two,
-``|C_f(h) - C_f(2h)| / (2^p - 1)``, ``p`` the settings' ``grid_order`` or
-``MACRO_ORDER``; ``"time"``, ``"grid"``, ``"h0"``, the flow factors' own estimates carried
-into C_f (the linear response of the point, on the level :func:`micro_parts_level` gives,
-to each variant of the factors, :meth:`FlowFactors.variants`: :mod:`.coupling.linearised`;
-``"h0"`` over ``H0_SPACING_RATIO``).  ``"total"`` sums their magnitudes, a bound (a root
-sum of squares fell below the truth where they add with one sign); ``"signed"`` keeps
-their signs, whose sum (:func:`signed_total`) the accuracy warning reads.  Beside them,
-``"film"``: the friction of the point's fields with half and twice the boundary film,
-times ``FILM_COUPLING``, a model sensitivity no refinement reduces (not in the total).  A
-part not estimated is NaN, left out of the total and named in ``"missing"`` (the reason
-in ``"failed"``).  Smooth factors have no micro parts (0); a screening model's point
+``|C_f(h) - C_f(2h)| / (2^p - 1)``, ``p`` the settings' ``grid_order`` or else the order
+observed on the grids coarsened once and twice (:func:`observed_order`); ``"time"``,
+``"grid"``, ``"h0"``, the flow factors' own estimates carried into C_f (the linear response
+of the point, on the level :func:`micro_parts_level` gives, to each variant of the factors,
+:meth:`FlowFactors.variants`: :mod:`.coupling.linearised`; ``"h0"`` over
+``H0_SPACING_RATIO``).  ``"total"`` sums their magnitudes, a bound (a root sum of squares
+fell below the truth where they add with one sign); ``"signed"`` keeps their signs, whose
+sum (:func:`signed_total`) the accuracy warning reads.  Beside them, ``"film"``: the
+friction of the point's fields with half and twice the boundary film, times
+``FILM_COUPLING``, a model sensitivity no refinement reduces (not in the total).  A part
+not estimated is NaN, left out of the total and named in ``"missing"`` (the reason in
+``"failed"``).  Smooth factors have no micro parts (0); a screening model's point
 (:attr:`FlowFactors.screening`) has no estimate (NaN, :data:`SCREENING`)."""
 
 from __future__ import annotations
@@ -26,13 +27,17 @@ from .coupling.result import friction_with
 from .mixed import solve_point
 from .point import OperatingPoint
 
-#: the macro grid's order of convergence in C_f, ``p`` of ``|C_f(h) - C_f(2h)| / (2^p - 1)``,
-#: where ``[macro] grid_order`` (``MacroSettings.grid_order``) does not set it: a pin's map,
-#: resampled from the measured pin, converges at first order in the mixed regime, where
-#: the face's edge moves by a fraction of a pixel from grid to grid (observed 0.69-1.10 on
-#: the paper pair's maps at 128^2, 256^2 and 512^2, 0.8-1.15 on the bundled pin's from 64
-#: to 128 px; ``benchmarks/run.py estimate-paper``)
+#: the lowest macro order ``p`` of ``|C_f(h) - C_f(2h)| / (2^p - 1)`` a pin's map takes
+#: where ``[macro] grid_order`` (``MacroSettings.grid_order``) does not set it, and the
+#: order where none is observed: a map resampled from the measured pin converges at first
+#: order in the mixed regime, where the face's edge moves by a fraction of a pixel from
+#: grid to grid (observed 0.69-1.10 on the paper pair's maps at 128^2, 256^2 and 512^2;
+#: ``benchmarks/run.py estimate-paper``)
 MACRO_ORDER = 1.0
+#: the highest observed order taken: the Q1 scheme's on a smooth film
+SCHEME_ORDER = 2.0
+#: the fewest nodes a side of the grid coarsened twice on which the order is observed
+ORDER_SIDE = 16
 #: the order of a ball's sphere, smooth on every grid: observed 1.77-2.15 in the mixed
 #: regime on its meshes graded over 73^2, 145^2 and 289^2 (``benchmarks/run.py
 #: estimate-ball``); a ball's run sets ``grid_order`` to it
@@ -60,7 +65,8 @@ FILM = "film"
 #: how the estimate is made, kept with it as ``"method"``: a checkpointed point whose
 #: estimate was made another way (by an earlier fem_twin: the film's sensitivity in the
 #: total, the micro parts' variants solved to 1e-3) gets it made again when a run resumes
-METHOD = "discretisation parts, micro parts as linear responses, macro order by geometry"
+METHOD = ("discretisation parts, micro parts as linear responses, macro order observed on "
+          "the point's nested grids")
 #: the fewest nodes a side of the grid the micro parts are solved on: there their sum is
 #: within a few per cent of the next finer level's at a seventh of the time
 #: (docs/accuracy.md)
@@ -92,7 +98,7 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
         base = solve(1)
     except MixedNotConverged as err:
         return _not_estimated(f"coarse grid: {err.args[0]}")
-    order = macro_order(point.settings)
+    order, observed = _order(solve, point)
     signed = {"macro": (base.friction_coefficient - result.friction_coefficient)
               / (2 ** order - 1)}
     micro, failed = _micro_parts(solve, factors, micro_parts_level(point.gap.shape))
@@ -110,6 +116,7 @@ def friction_error(result, point: OperatingPoint, levels=()) -> dict:
     out["total"] = float(np.nansum([out[part] for part in PARTS]))
     out["signed"] = {part: float(signed[part]) for part in parts}
     out["method"], out["macro_order"] = METHOD, order
+    out["grid_order"], out["observed_order"] = point.settings.grid_order, observed
     missing = [part for part in parts if np.isnan(out[part])]
     if missing:
         out["missing"] = missing
@@ -141,16 +148,37 @@ def _not_estimated(reason: str) -> dict:
 
 def is_current(meta: dict, settings) -> bool:
     """Whether a point's metadata ``meta`` holds a C_f error estimate made by this
-    :data:`METHOD` at the macro order of ``settings`` (a resumed run makes any other
-    again; a screening model's estimate, which has no macro part, at any order)."""
-    estimate, order = meta.get("error_estimate") or {}, macro_order(settings)
-    return estimate.get("method") == METHOD and estimate.get("macro_order", order) == order
+    :data:`METHOD` for the ``grid_order`` of ``settings`` (a resumed run makes any other
+    again; a screening model's estimate, which has no macro part, for any)."""
+    estimate = meta.get("error_estimate") or {}
+    return (estimate.get("method") == METHOD
+            and estimate.get("grid_order", settings.grid_order) == settings.grid_order)
 
 
-def macro_order(settings) -> float:
-    """The macro part's order ``p`` for the macro ``settings``: their ``grid_order``, or
-    :data:`MACRO_ORDER`."""
-    return settings.grid_order or MACRO_ORDER
+def observed_order(c0: float, c1: float, c2: float) -> float | None:
+    """The macro order observed from C_f on a grid (``c0``) and on its coarsenings by two
+    (``c1``) and four (``c2``), ``log2((c2 - c1) / (c1 - c0))``, clipped to
+    [:data:`MACRO_ORDER`, :data:`SCHEME_ORDER`]; None where the changes differ in sign."""
+    d1, d2 = c2 - c1, c1 - c0
+    if not d1 * d2 > 0:
+        return None
+    return float(np.clip(np.log2(d1 / d2), MACRO_ORDER, SCHEME_ORDER))
+
+
+def _order(solve, point) -> tuple[float, float | None]:
+    """``(p, observed)``: the macro part's order, the settings' ``grid_order`` or else the
+    :func:`observed_order` of the point's ``solve`` levels 0-2 (:data:`MACRO_ORDER` where
+    none is observed: the changes differ in sign, the grid coarsened twice has fewer than
+    :data:`ORDER_SIDE` nodes a side, or its solve fails)."""
+    if point.settings.grid_order:
+        return point.settings.grid_order, None
+    if min(point.gap.shape) < 4 * ORDER_SIDE:
+        return MACRO_ORDER, None
+    try:
+        observed = observed_order(*(solve(k).friction_coefficient for k in range(3)))
+    except MixedNotConverged:
+        return MACRO_ORDER, None
+    return observed or MACRO_ORDER, observed
 
 
 def signed_total(estimate: dict) -> float:
@@ -165,11 +193,12 @@ def signed_total(estimate: dict) -> float:
 
 
 class _Levels:
-    """``solve(level)``: the point on the grid coarsened ``level`` times, warm from the
-    next finer level; a known level is taken, not solved again (nor twice)."""
+    """``solve(level)``: the point on the grid coarsened ``level`` times (0: the point's
+    own ``result``), warm from the next finer level; a known level is taken, not solved
+    again (nor twice)."""
 
     def __init__(self, result, point, levels):
-        self.result, self.points, self.known = result, [point], {}
+        self.result, self.points, self.known = result, [point], {0: result}
         for k, level in enumerate(levels, 1):
             if level.pressure.shape != self.point(k).gap.shape:
                 break                                     # a level the nested solve left out

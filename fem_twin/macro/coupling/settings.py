@@ -81,8 +81,8 @@ class MacroSettings:
     gap_floor: float = setting(1e-9, "smallest h0 passed to the flow factors", "gap_floor")
     grid_order: float | None = setting(
         None, "the macro grid's order of convergence in C_f that the error estimate's macro "
-        "part assumes; none: 1 for a pin's measured map, 2 for a ball's sphere (measured, "
-        "docs/accuracy.md)", "convergence_order")
+        "part assumes; none: a pin's observed on the point's grids coarsened once and twice "
+        "(1 to 2), 2 for a ball's sphere (measured, docs/accuracy.md)", "convergence_order")
 
     def __post_init__(self):
         check_choices(self)
