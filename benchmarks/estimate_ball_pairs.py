@@ -1,5 +1,5 @@
 """Group ``estimate-ball-pairs``: the ``estimate`` group on the bundled ball with every
-patch pair, whose average the run reads (reference as ``estimate-ball``'s: about 30 min on
+patch pair, whose average the run reads (reference as ``estimate-ball``'s: about 25 min on
 2 cores, kept in ``$FEM_TWIN_BENCH_DIR`` and read on later runs).  Checked as
 ``estimate``."""
 

@@ -1,7 +1,7 @@
 """Group ``estimate-pairs``: the ``estimate`` group on the bundled pin with every patch pair
-(the run reads their average, in which each pair's own grid and time errors partly
-cancel; reference as ``estimate``'s: about 35 min on 2 cores, kept in
-``$FEM_TWIN_BENCH_DIR`` and read on later runs).  Checked as ``estimate``."""
+(the run reads their average, in which the pairs' own cell-grid errors largely cancel;
+reference as ``estimate``'s: about 40 min on 2 cores, kept in ``$FEM_TWIN_BENCH_DIR`` and
+read on later runs).  Checked as ``estimate``."""
 
 from __future__ import annotations
 
